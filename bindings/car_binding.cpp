@@ -1,0 +1,592 @@
+#include "bindings/car_binding.hpp"
+
+#include <cctype>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <string_view>
+
+#include "bindings/lua_support.hpp"
+#include "bindings/script_host.hpp"
+#include "engine/protocol/anki/advertisement.hpp"
+#include "engine/core/log.hpp"
+#include "engine/protocol/anki/json.hpp"
+
+namespace pitwall {
+
+using namespace anki;
+using lua::LuaError;
+
+namespace {
+
+constexpr const char* kMetatable = "pitwall.car";
+
+constexpr std::array<const char*, kCarEventCount> kEventNames = {
+    "onPosition", "onTransition", "onIntersection", "onDelocalized", "onOffset",
+    "onBattery",  "onVersion",    "onPing",         "onStatus",      "onCollision",
+    "onSpeed",    "onLaneChange", "onRecovery",     "onConnect",     "onDisconnect",
+    "onMalformed", "onMessage"};
+
+constexpr std::array<const char*, kCarEventCount> kEventHandlerNames = {
+    "onPosition handler", "onTransition handler", "onIntersection handler",
+    "onDelocalized handler", "onOffset handler", "onBattery handler", "onVersion handler",
+    "onPing handler", "onStatus handler", "onCollision handler", "onSpeed handler",
+    "onLaneChange handler", "onRecovery handler", "onConnect handler", "onDisconnect handler",
+    "onMalformed handler", "onMessage handler"};
+
+int eventIndex(std::string_view key) {
+  for (std::size_t i = 0; i < kEventNames.size(); ++i)
+    if (key == kEventNames[i]) return static_cast<int>(i);
+  return -1;
+}
+
+std::string eventList() {
+  std::string s;
+  for (auto* n : kEventNames) s += (s.empty() ? "" : ", ") + std::string(n);
+  return s;
+}
+
+}  // namespace
+
+struct CarBinding::Proxy {
+  AnkiCar* car = nullptr;
+  int selfRef = LUA_NOREF;
+  std::array<int, kCarEventCount> handlers;
+  std::array<int, kCarEventCount> tables;
+  Proxy() {
+    handlers.fill(LUA_NOREF);
+    tables.fill(LUA_NOREF);
+  }
+};
+
+namespace {
+
+CarBinding::Proxy& proxyAt(lua_State* L, int idx) {
+  auto** p = static_cast<CarBinding::Proxy**>(luaL_testudata(L, idx, kMetatable));
+  if (!p) throw LuaError(std::string("expected a car, got ") + luaL_typename(L, idx));
+  return **p;
+}
+
+void raiseIfRefused(const AnkiCar::Sent& sent) {
+  if (!sent) throw LuaError(sent.error());
+}
+
+// ---- methods ----
+int setSpeed(lua_State* L) {
+  AnkiCar& car = CarBinding::check(L, 1);
+  auto speed = lua::checkInteger(L, 2, "speed (mm/s)");
+  auto accel = lua::optInteger(L, 3, "acceleration (mm/s²)", kDefaultAccel);
+  bool limit = lua_toboolean(L, 4);
+  auto clamp = [](long long v) { return static_cast<int>(std::max(-1000000LL, std::min(v, 1000000LL))); };
+  raiseIfRefused(car.setSpeed(clamp(speed), clamp(accel), limit));
+  return 0;
+}
+int stop(lua_State* L) {
+  raiseIfRefused(CarBinding::check(L, 1).stop());
+  return 0;
+}
+int changeLane(lua_State* L) {
+  AnkiCar& car = CarBinding::check(L, 1);
+  double offset = lua::checkNumber(L, 2, "offset (mm)");
+  auto speed = lua::optInteger(L, 3, "lane-change speed (mm/s)", kDefaultLaneSpeed);
+  auto accel = lua::optInteger(L, 4, "lane-change acceleration (mm/s²)", kDefaultLaneAccel);
+  auto clamp = [](long long v) { return static_cast<int>(std::max(-1000000LL, std::min(v, 1000000LL))); };
+  raiseIfRefused(car.changeLane(offset, clamp(speed), clamp(accel)));
+  return 0;
+}
+int setOffset(lua_State* L) {
+  AnkiCar& car = CarBinding::check(L, 1);
+  raiseIfRefused(car.setOffset(lua::checkNumber(L, 2, "offset (mm)")));
+  return 0;
+}
+int cancelLaneChange(lua_State* L) {
+  raiseIfRefused(CarBinding::check(L, 1).cancelLaneChange());
+  return 0;
+}
+int uturn(lua_State* L) {
+  raiseIfRefused(CarBinding::check(L, 1).turn(TurnType::UTurn));
+  return 0;
+}
+int turn(lua_State* L) {
+  AnkiCar& car = CarBinding::check(L, 1);
+  std::string type = lua::checkString(L, 2, "turn type");
+  std::string trigger = lua_isnoneornil(L, 3) ? "immediate" : lua::checkString(L, 3, "trigger");
+  TurnType t;
+  if (type == "left") t = TurnType::Left;
+  else if (type == "right") t = TurnType::Right;
+  else if (type == "uturn") t = TurnType::UTurn;
+  else if (type == "uturn-jump") t = TurnType::UTurnJump;
+  else if (type == "none") t = TurnType::None;
+  else throw LuaError("turn type '" + type + "' is unknown; use left, right, uturn, uturn-jump or none");
+  TurnTrigger g;
+  if (trigger == "immediate") g = TurnTrigger::Immediate;
+  else if (trigger == "intersection") g = TurnTrigger::Intersection;
+  else throw LuaError("turn trigger '" + trigger + "' is unknown; use immediate or intersection");
+  raiseIfRefused(car.turn(t, g));
+  return 0;
+}
+int lights(lua_State* L) {
+  AnkiCar& car = CarBinding::check(L, 1);
+  if (lua_istable(L, 2)) {
+    // {headlights=true, brake=false, front=…, engine=…}: touched lights in the low nibble,
+    // their values in the high nibble (anki-overdrive.md, set lights).
+    static constexpr std::array<const char*, 4> kNames = {"headlights", "brake", "front", "engine"};
+    int mask = 0;
+    for (int bit = 0; bit < 4; ++bit) {
+      int type = lua_getfield(L, 2, kNames[bit]);
+      if (type != LUA_TNIL) {
+        mask |= 1 << bit;
+        if (lua_toboolean(L, -1)) mask |= 1 << (bit + 4);
+      }
+      lua_pop(L, 1);
+    }
+    raiseIfRefused(car.lights(mask));
+    return 0;
+  }
+  auto mask = lua::checkInteger(L, 2, "lights mask");
+  if (mask < 0 || mask > 255)
+    throw LuaError("lights mask " + std::to_string(mask) + " is out of range 0..255");
+  raiseIfRefused(car.lights(static_cast<int>(mask)));
+  return 0;
+}
+int nameOrNumber(lua_State* L, int idx, const char* what, std::initializer_list<const char*> names,
+                 long long max) {
+  if (lua_type(L, idx) == LUA_TSTRING) {
+    std::string s = lua_tostring(L, idx);
+    int i = 0;
+    std::string all;
+    for (const char* n : names) {
+      if (s == n) return i;
+      all += (all.empty() ? "" : ", ") + std::string(n);
+      ++i;
+    }
+    throw LuaError(std::string(what) + " '" + s + "' is unknown; use one of " + all);
+  }
+  auto v = lua::checkInteger(L, idx, what);
+  if (v < 0 || v > max)
+    throw LuaError(std::string(what) + " " + std::to_string(v) + " is out of range 0.." +
+                   std::to_string(max));
+  return static_cast<int>(v);
+}
+int lightsPattern(lua_State* L) {
+  AnkiCar& car = CarBinding::check(L, 1);
+  if (!lua_istable(L, 2))
+    throw LuaError("lightsPattern takes a list of up to 3 channels, e.g. "
+                   "{{channel='red', effect='throb', from=0, to=14, cycles=5}}");
+  LightsPattern p;
+  auto n = luaL_len(L, 2);
+  if (n < 1 || n > 3)
+    throw LuaError("lightsPattern takes 1 to 3 channels, got " + std::to_string(n));
+  p.channel_count = static_cast<uint8_t>(n);
+  for (int i = 1; i <= n; ++i) {
+    lua_geti(L, 2, i);
+    int t = lua_gettop(L);
+    if (!lua_istable(L, t)) throw LuaError("lightsPattern channel " + std::to_string(i) + " must be a table");
+    auto& c = p.channels[i - 1];
+    lua_getfield(L, t, "channel");
+    c.channel = static_cast<uint8_t>(nameOrNumber(
+        L, -1, "channel", {"red", "tail", "blue", "green", "front-left", "front-right"}, 5));
+    lua_getfield(L, t, "effect");
+    c.effect = static_cast<uint8_t>(
+        lua_isnil(L, -1) ? 0
+                         : nameOrNumber(L, -1, "effect", {"steady", "fade", "throb", "flash", "random"}, 4));
+    lua_getfield(L, t, "from");
+    c.start = static_cast<uint8_t>(lua_isnil(L, -1) ? 0 : nameOrNumber(L, -1, "from (intensity)", {}, 14));
+    lua_getfield(L, t, "to");
+    c.end = static_cast<uint8_t>(lua_isnil(L, -1) ? c.start : nameOrNumber(L, -1, "to (intensity)", {}, 14));
+    lua_getfield(L, t, "cycles");
+    c.cycles_per_10s = static_cast<uint8_t>(lua_isnil(L, -1) ? 0 : nameOrNumber(L, -1, "cycles (per 10 s)", {}, 255));
+    lua_settop(L, t - 1);
+  }
+  raiseIfRefused(car.lightsPattern(p));
+  return 0;
+}
+int ping(lua_State* L) {
+  raiseIfRefused(CarBinding::check(L, 1).ping());
+  return 0;
+}
+int battery(lua_State* L) {
+  raiseIfRefused(CarBinding::check(L, 1).requestBattery());
+  return 0;
+}
+int version(lua_State* L) {
+  raiseIfRefused(CarBinding::check(L, 1).requestVersion());
+  return 0;
+}
+int disconnect(lua_State* L) {
+  raiseIfRefused(CarBinding::check(L, 1).disconnect());
+  return 0;
+}
+
+// ---- state fields ----
+bool pushField(lua_State* L, const AnkiCar& car, std::string_view key) {
+  const CarState& s = car.state();
+  const CarIdentity& id = car.identity();
+  auto integer = [&](long long v) { lua_pushinteger(L, v); return true; };
+  auto number = [&](double v) { lua_pushnumber(L, v); return true; };
+  auto boolean = [&](bool v) { lua_pushboolean(L, v); return true; };
+  auto string = [&](const std::string& v) { lua_pushlstring(L, v.data(), v.size()); return true; };
+  auto known = [&](long long v) { if (v < 0) { lua_pushnil(L); return true; } return integer(v); };
+  if (key == "speed") return integer(s.speed_mm_s);
+  if (key == "piece") return known(s.piece);
+  if (key == "location") return known(s.location);
+  if (key == "offset") return number(s.offset_mm);
+  if (key == "name") return string(id.name);
+  if (key == "number") return integer(id.number);
+  if (key == "model") return string(modelName(id.model_id));
+  if (key == "modelId") return integer(id.model_id);
+  if (key == "identifier") return integer(id.identifier);
+  if (key == "address") return string(const_cast<AnkiCar&>(car).link().address());
+  if (key == "connected") return boolean(s.connected);
+  if (key == "onTrack") return boolean(s.on_track);
+  if (key == "onCharger") return boolean(s.on_charger);
+  if (key == "delocalized") return boolean(s.delocalized);
+  if (key == "reverse") return boolean(s.reverse);
+  if (key == "targetSpeed") return integer(s.target_speed_mm_s);
+  if (key == "prevPiece") return known(s.prev_piece);
+  if (key == "laneChanging") return boolean(s.lane_change_target_mm.has_value());
+  if (key == "targetOffset") {
+    if (!s.lane_change_target_mm) { lua_pushnil(L); return true; }
+    return number(*s.lane_change_target_mm);
+  }
+  if (key == "battery") return known(s.battery_mv > 0 ? s.battery_mv : -1);
+  if (key == "batteryLow") return boolean(s.battery_low);
+  if (key == "batteryFull") return boolean(s.battery_full);
+  if (key == "version") return known(s.version > 0 ? s.version : -1);
+  if (key == "lastPing") {
+    if (auto rtt = car.lastPingRtt()) return number(*rtt);
+    lua_pushnil(L);
+    return true;
+  }
+  if (key == "lastPositionTime") {
+    if (s.last_position_time < 0) {
+      lua_pushnil(L);
+      return true;
+    }
+    return number(s.last_position_time);
+  }
+  return false;
+}
+
+constexpr std::array<const char*, 27> kFieldNames = {
+    "speed", "piece", "location", "offset", "name", "number", "model", "modelId", "identifier",
+    "address", "connected", "onTrack", "onCharger", "delocalized", "reverse", "targetSpeed",
+    "prevPiece", "laneChanging", "targetOffset", "battery", "batteryLow", "batteryFull",
+    "version", "lastPing", "lastPositionTime", "frames", "malformed"};
+
+bool isField(std::string_view key) {
+  for (auto* f : kFieldNames)
+    if (key == f) return true;
+  return false;
+}
+
+int index(lua_State* L) {
+  // 1: car, 2: key. Methods first (upvalue 1), then state, then the car's own fields.
+  lua_pushvalue(L, 2);
+  if (lua_rawget(L, lua_upvalueindex(1)) != LUA_TNIL) return 1;
+  lua_pop(L, 1);
+  auto& p = proxyAt(L, 1);
+  if (lua_type(L, 2) == LUA_TSTRING) {
+    std::string_view key = lua_tostring(L, 2);
+    if (key == "frames") {
+      lua_pushinteger(L, static_cast<lua_Integer>(p.car->state().frames_in + p.car->state().frames_out));
+      return 1;
+    }
+    if (key == "malformed") {
+      lua_pushinteger(L, static_cast<lua_Integer>(p.car->state().malformed));
+      return 1;
+    }
+    if (pushField(L, *p.car, key)) return 1;
+  }
+  lua_getiuservalue(L, 1, 1);
+  lua_pushvalue(L, 2);
+  lua_rawget(L, -2);
+  return 1;
+}
+
+int newindex(lua_State* L) {
+  // 1: car, 2: key, 3: value
+  auto& p = proxyAt(L, 1);
+  if (lua_type(L, 2) == LUA_TSTRING) {
+    std::string key = lua_tostring(L, 2);
+    int e = eventIndex(key);
+    if (e >= 0) {
+      if (!lua_isnil(L, 3) && !lua_isfunction(L, 3))
+        throw LuaError("car." + key + " must be a function or nil, got " + luaL_typename(L, 3));
+      luaL_unref(L, LUA_REGISTRYINDEX, p.handlers[e]);
+      p.handlers[e] = LUA_NOREF;
+      if (lua_isfunction(L, 3)) {
+        lua_pushvalue(L, 3);
+        p.handlers[e] = luaL_ref(L, LUA_REGISTRYINDEX);
+      }
+    } else if (key.size() > 2 && key[0] == 'o' && key[1] == 'n' &&
+               std::isupper(static_cast<unsigned char>(key[2]))) {
+      throw LuaError("car." + key + " is not an event; the events are " + eventList());
+    } else if (isField(key)) {
+      throw LuaError("car." + key + " is read-only (it is the car's state)");
+    } else {
+      lua_pushvalue(L, 2);
+      bool isMethod = lua_rawget(L, lua_upvalueindex(1)) != LUA_TNIL;
+      lua_pop(L, 1);
+      if (isMethod) throw LuaError("car:" + key + " is a method and cannot be replaced");
+    }
+  }
+  lua_settop(L, 3);
+  lua_getiuservalue(L, 1, 1);
+  lua_pushvalue(L, 2);
+  lua_pushvalue(L, 3);
+  lua_rawset(L, 4);
+  return 0;
+}
+
+int tostring(lua_State* L) {
+  auto& p = proxyAt(L, 1);
+  std::string s = p.car->label();
+  lua_pushlstring(L, s.data(), s.size());
+  return 1;
+}
+
+}  // namespace
+
+CarBinding::CarBinding(ScriptHost& host) : host_(host), L_(host.state()) {}
+
+CarBinding::~CarBinding() {
+  for (auto& [car, proxy] : proxies_) {
+    car->onMessage = nullptr;
+    car->onConnection = nullptr;
+    car->onMalformed = nullptr;
+  }
+}
+
+void CarBinding::registerType(lua_State* L) {
+  static const luaL_Reg methods[] = {
+      {"setSpeed", lua::guarded<setSpeed>},
+      {"stop", lua::guarded<stop>},
+      {"changeLane", lua::guarded<changeLane>},
+      {"setOffset", lua::guarded<setOffset>},
+      {"cancelLaneChange", lua::guarded<cancelLaneChange>},
+      {"uturn", lua::guarded<uturn>},
+      {"turn", lua::guarded<turn>},
+      {"lights", lua::guarded<lights>},
+      {"lightsPattern", lua::guarded<lightsPattern>},
+      {"ping", lua::guarded<ping>},
+      {"battery", lua::guarded<battery>},
+      {"version", lua::guarded<version>},
+      {"disconnect", lua::guarded<disconnect>},
+      {nullptr, nullptr}};
+  luaL_newmetatable(L, kMetatable);
+  luaL_newlib(L, methods);
+  lua_pushvalue(L, -1);
+  lua_setfield(L, -3, "__methods");  // for completion in the REPL
+  lua_pushvalue(L, -1);
+  lua_pushcclosure(L, lua::guarded<index>, 1);
+  lua_setfield(L, -3, "__index");
+  lua_pushcclosure(L, lua::guarded<newindex>, 1);
+  lua_setfield(L, -2, "__newindex");
+  lua_pushcfunction(L, lua::guarded<tostring>);
+  lua_setfield(L, -2, "__tostring");
+  lua_pushliteral(L, "car");
+  lua_setfield(L, -2, "__name");
+  lua_pop(L, 1);
+}
+
+AnkiCar& CarBinding::check(lua_State* L, int idx) { return *proxyAt(L, idx).car; }
+
+void CarBinding::bind(AnkiCar& car) {
+  if (proxies_.count(&car)) return;
+  auto proxy = std::make_unique<Proxy>();
+  Proxy& p = *proxy;
+  p.car = &car;
+  lua_State* L = L_;
+  auto** ud = static_cast<Proxy**>(lua_newuserdatauv(L, sizeof(Proxy*), 1));
+  *ud = &p;
+  luaL_setmetatable(L, kMetatable);
+  lua_newtable(L);
+  lua_setiuservalue(L, -2, 1);
+  p.selfRef = luaL_ref(L, LUA_REGISTRYINDEX);  // cars live as long as the run
+  for (auto& t : p.tables) {
+    lua_createtable(L, 0, 8);
+    t = luaL_ref(L, LUA_REGISTRYINDEX);
+  }
+  proxies_.emplace(&car, std::move(proxy));
+
+  car.onMessage = [this, &p](const Message& m) { dispatch(p, m); };
+  car.onConnection = [this, &p](bool up, const std::string& reason) {
+    if (up) {
+      if (begin(p, CarEvent::Connect)) finish(p, CarEvent::Connect);
+    } else if (begin(p, CarEvent::Disconnect)) {
+      lua_pushlstring(L_, reason.data(), reason.size());
+      lua_setfield(L_, -2, "reason");
+      finish(p, CarEvent::Disconnect);
+    }
+  };
+  car.onMalformed = [this, &p](const DecodeError& e, std::span<const std::uint8_t> bytes) {
+    std::string what = e.message();
+    log::warn(p.car->label(), "malformed frame ignored: " + what);
+    if (!begin(p, CarEvent::Malformed)) return;
+    lua_pushlstring(L_, what.data(), what.size());
+    lua_setfield(L_, -2, "error");
+    std::string hex;
+    for (auto b : bytes) {
+      char h[4];
+      std::snprintf(h, sizeof h, hex.empty() ? "%02x" : " %02x", b);
+      hex += h;
+    }
+    lua_pushlstring(L_, hex.data(), hex.size());
+    lua_setfield(L_, -2, "hex");
+    finish(p, CarEvent::Malformed);
+  };
+}
+
+void CarBinding::push(lua_State* L, AnkiCar& car) {
+  auto it = proxies_.find(&car);
+  if (it == proxies_.end()) {
+    bind(car);
+    it = proxies_.find(&car);
+  }
+  lua_rawgeti(L, LUA_REGISTRYINDEX, it->second->selfRef);
+}
+
+bool CarBinding::begin(Proxy& p, CarEvent e) {
+  int h = p.handlers[static_cast<std::size_t>(e)];
+  if (h == LUA_NOREF) return false;
+  lua_State* L = L_;
+  lua_rawgeti(L, LUA_REGISTRYINDEX, h);
+  lua_rawgeti(L, LUA_REGISTRYINDEX, p.selfRef);
+  lua_rawgeti(L, LUA_REGISTRYINDEX, p.tables[static_cast<std::size_t>(e)]);
+  lua_pushnumber(L, host_.loop().seconds());
+  lua_setfield(L, -2, "time");
+  return true;
+}
+
+void CarBinding::finish(Proxy& p, CarEvent e, int nargs) {
+  host_.call(nargs, 0, kEventHandlerNames[static_cast<std::size_t>(e)], p.car);
+}
+
+void CarBinding::dispatch(Proxy& p, const Message& m) {
+  lua_State* L = L_;
+  auto setI = [L](const char* k, lua_Integer v) {
+    lua_pushinteger(L, v);
+    lua_setfield(L, -2, k);
+  };
+  auto setN = [L](const char* k, double v) {
+    lua_pushnumber(L, v);
+    lua_setfield(L, -2, k);
+  };
+  auto setB = [L](const char* k, bool v) {
+    lua_pushboolean(L, v);
+    lua_setfield(L, -2, k);
+  };
+  if (auto* pos = std::get_if<PositionUpdate>(&m)) {
+    if (begin(p, CarEvent::Position)) {
+      setI("piece", pos->piece_id);
+      setI("location", pos->location_id);
+      setN("offset", pos->offset_mm);
+      setI("speed", pos->speed_mm_s);
+      setB("reverse", (pos->parsing_flags & 0x20) != 0);
+      finish(p, CarEvent::Position);
+    }
+  } else if (auto* t = std::get_if<TransitionUpdate>(&m)) {
+    if (begin(p, CarEvent::Transition)) {
+      setN("offset", t->offset_mm);
+      setI("leftWheel", t->left_wheel_distance_cm);
+      setI("rightWheel", t->right_wheel_distance_cm);
+      setI("drift", t->average_follow_line_drift_px);
+      setI("uphill", t->uphill_counter);
+      setI("downhill", t->downhill_counter);
+      finish(p, CarEvent::Transition);
+    }
+  } else if (auto* i = std::get_if<IntersectionUpdate>(&m)) {
+    if (begin(p, CarEvent::Intersection)) {
+      setI("piece", i->piece_idx);
+      setN("offset", i->offset_mm);
+      setI("code", i->intersection_code);
+      setB("exiting", i->is_exiting != 0);
+      setI("sinceTransition", i->mm_since_last_transition_bar);
+      if (i->mm_since_last_intersection_code)
+        setI("sinceIntersection", *i->mm_since_last_intersection_code);
+      finish(p, CarEvent::Intersection);
+    }
+  } else if (std::holds_alternative<Delocalized>(m)) {
+    if (begin(p, CarEvent::Delocalized)) finish(p, CarEvent::Delocalized);
+  } else if (auto* o = std::get_if<OffsetUpdate>(&m)) {
+    if (begin(p, CarEvent::Offset)) {
+      setN("offset", o->offset_mm);
+      setI("laneChangeId", o->lane_change_id);
+      finish(p, CarEvent::Offset);
+    }
+  } else if (auto* b = std::get_if<BatteryResponse>(&m)) {
+    if (begin(p, CarEvent::Battery)) {
+      setI("millivolts", b->millivolts);
+      setB("low", p.car->state().battery_low);
+      setB("full", p.car->state().battery_full);
+      setB("charging", p.car->state().on_charger);
+      finish(p, CarEvent::Battery);
+    }
+  } else if (auto* v = std::get_if<VersionResponse>(&m)) {
+    if (begin(p, CarEvent::Version)) {
+      setI("version", v->version);
+      finish(p, CarEvent::Version);
+    }
+  } else if (std::holds_alternative<PingResponse>(m)) {
+    if (begin(p, CarEvent::Ping)) {
+      if (auto rtt = p.car->lastPingRtt()) setN("rtt", *rtt);
+      finish(p, CarEvent::Ping);
+    }
+  } else if (auto* s = std::get_if<CarStatus>(&m)) {
+    if (begin(p, CarEvent::Status)) {
+      setB("onTrack", s->on_track);
+      setB("onCharger", s->on_charger);
+      setB("lowBattery", s->low_battery.value_or(false));
+      setB("fullyCharged", s->fully_charged.value_or(false));
+      finish(p, CarEvent::Status);
+    }
+  } else if (auto* c = std::get_if<Collision>(&m)) {
+    if (begin(p, CarEvent::Collision)) {
+      setI("side", c->side);
+      lua_pushstring(L, c->front_back ? "back" : "front");
+      lua_setfield(L, -2, "where");
+      finish(p, CarEvent::Collision);
+    }
+  } else if (auto* sp = std::get_if<SpeedUpdate>(&m)) {
+    if (begin(p, CarEvent::Speed)) {
+      setI("desired", sp->desired_mm_s);
+      setI("accel", sp->accel_mm_s2);
+      setI("actual", sp->actual_mm_s);
+      finish(p, CarEvent::Speed);
+    }
+  } else if (auto* lc = std::get_if<LaneChangeUpdate>(&m)) {
+    if (begin(p, CarEvent::LaneChange)) {
+      setN("current", lc->current_offset_mm);
+      setN("target", lc->target_offset_mm);
+      setI("hSpeed", lc->h_speed_mm_s);
+      setI("vSpeed", lc->v_speed_mm_s);
+      setI("laneChangeId", lc->lane_change_id);
+      finish(p, CarEvent::LaneChange);
+    }
+  } else if (std::holds_alternative<AutoRecoveryEntered>(m) ||
+             std::holds_alternative<AutoRecoverySucceeded>(m)) {
+    if (begin(p, CarEvent::Recovery)) {
+      setB("succeeded", std::holds_alternative<AutoRecoverySucceeded>(m));
+      finish(p, CarEvent::Recovery);
+    }
+  }
+  // onMessage sees every message as a fresh table built from its JSON form (for debugging).
+  if (p.handlers[static_cast<std::size_t>(CarEvent::Message)] != LUA_NOREF) {
+    lua_rawgeti(L, LUA_REGISTRYINDEX, p.handlers[static_cast<std::size_t>(CarEvent::Message)]);
+    lua_rawgeti(L, LUA_REGISTRYINDEX, p.selfRef);
+    nlohmann::json j = toJson(m);
+    lua_createtable(L, 0, static_cast<int>(j.size()) + 1);
+    for (auto& [k, v] : j.items()) {
+      if (v.is_boolean()) lua_pushboolean(L, v.get<bool>());
+      else if (v.is_number_integer()) lua_pushinteger(L, v.get<lua_Integer>());
+      else if (v.is_number()) lua_pushnumber(L, v.get<double>());
+      else lua_pushstring(L, v.is_string() ? v.get<std::string>().c_str() : v.dump().c_str());
+      lua_setfield(L, -2, k.c_str());
+    }
+    setN("time", host_.loop().seconds());
+    host_.call(2, 0, "onMessage handler", p.car);
+  }
+}
+
+}  // namespace pitwall

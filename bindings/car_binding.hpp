@@ -1,0 +1,47 @@
+#pragma once
+// Cars as Lua objects: one full userdata per car (so `car == car` holds), one metatable, methods
+// for the commands, read-only state fields, `on…` event handlers, and any other field the script
+// wants to keep on the car. Event tables are reused per car and event (docs/lua-api.md).
+#include <lua.hpp>
+
+#include <array>
+#include <memory>
+#include <unordered_map>
+
+#include "engine/vehicles/anki_car.hpp"
+
+namespace pitwall {
+
+class ScriptHost;
+
+enum class CarEvent {
+  Position, Transition, Intersection, Delocalized, Offset, Battery, Version, Ping, Status,
+  Collision, Speed, LaneChange, Recovery, Connect, Disconnect, Malformed, Message,
+  Count_
+};
+inline constexpr std::size_t kCarEventCount = static_cast<std::size_t>(CarEvent::Count_);
+
+class CarBinding {
+ public:
+  explicit CarBinding(ScriptHost& host);
+  ~CarBinding();
+
+  void registerType(lua_State* L);
+  // Makes the Lua object of a car (once) and routes its events into Lua.
+  void bind(AnkiCar& car);
+  void push(lua_State* L, AnkiCar& car);
+  static AnkiCar& check(lua_State* L, int idx);
+
+  struct Proxy;
+
+ private:
+  void dispatch(Proxy& p, const anki::Message& m);
+  bool begin(Proxy& p, CarEvent e);  // pushes handler, car, event table; false if no handler
+  void finish(Proxy& p, CarEvent e, int nargs = 2);
+
+  ScriptHost& host_;
+  lua_State* L_;
+  std::unordered_map<AnkiCar*, std::unique_ptr<Proxy>> proxies_;
+};
+
+}  // namespace pitwall

@@ -1,0 +1,84 @@
+#pragma once
+// Small tools every binding uses. Lua raises errors with longjmp, which must never cross a C++
+// frame holding live objects (LÖVE's rule): binding bodies throw LuaError instead, and guarded()
+// turns the exception into a Lua error only after every C++ object of the body is destroyed.
+#include <lua.hpp>
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+namespace pitwall::lua {
+
+struct LuaError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+template <int (*Body)(lua_State*)>
+int guarded(lua_State* L) {
+  int results = 0;
+  bool failed = false;
+  try {
+    results = Body(L);
+  } catch (const std::exception& e) {
+    lua_pushstring(L, e.what());
+    failed = true;
+  }
+  if (failed) {
+    // Prefix "file:line:" of the Lua code that called us, as luaL_error does.
+    luaL_where(L, 1);
+    lua_insert(L, -2);
+    lua_concat(L, 2);
+    return lua_error(L);
+  }
+  return results;
+}
+
+inline std::string typeName(lua_State* L, int idx) { return luaL_typename(L, idx); }
+
+inline double checkNumber(lua_State* L, int idx, const char* what) {
+  int isnum = 0;
+  double v = lua_tonumberx(L, idx, &isnum);
+  if (!isnum)
+    throw LuaError(std::string(what) + " must be a number, got " + typeName(L, idx));
+  if (!std::isfinite(v)) throw LuaError(std::string(what) + " must be a finite number");
+  return v;
+}
+
+inline double optNumber(lua_State* L, int idx, const char* what, double fallback) {
+  return lua_isnoneornil(L, idx) ? fallback : checkNumber(L, idx, what);
+}
+
+// An integral number (600 or 600.0, not 600.5), range-checked by the caller.
+inline long long checkInteger(lua_State* L, int idx, const char* what) {
+  int isint = 0;
+  lua_Integer v = lua_tointegerx(L, idx, &isint);
+  if (isint) return v;
+  if (lua_type(L, idx) == LUA_TNUMBER)
+    throw LuaError(std::string(what) + " must be a whole number, got " +
+                   std::to_string(lua_tonumber(L, idx)));
+  throw LuaError(std::string(what) + " must be a whole number, got " + typeName(L, idx));
+}
+
+inline long long optInteger(lua_State* L, int idx, const char* what, long long fallback) {
+  return lua_isnoneornil(L, idx) ? fallback : checkInteger(L, idx, what);
+}
+
+inline std::string checkString(lua_State* L, int idx, const char* what) {
+  if (lua_type(L, idx) != LUA_TSTRING)
+    throw LuaError(std::string(what) + " must be a string, got " + typeName(L, idx));
+  size_t n = 0;
+  const char* s = lua_tolstring(L, idx, &n);
+  return std::string(s, n);
+}
+
+inline void checkFunction(lua_State* L, int idx, const char* what) {
+  if (lua_type(L, idx) != LUA_TFUNCTION)
+    throw LuaError(std::string(what) + " must be a function, got " + typeName(L, idx));
+}
+
+// Message handler for lua_pcall: the error text plus a traceback.
+int traceback(lua_State* L);
+
+}  // namespace pitwall::lua

@@ -1,0 +1,211 @@
+#include "bindings/pitwall_module.hpp"
+
+#include <algorithm>
+#include <cctype>
+
+#include "bindings/car_binding.hpp"
+#include "bindings/lua_support.hpp"
+#include "bindings/script_host.hpp"
+#include "engine/core/log.hpp"
+
+namespace pitwall {
+
+using lua::LuaError;
+
+namespace {
+
+constexpr const char* kTimerMetatable = "pitwall.timer";
+
+Duration checkDelay(lua_State* L, int idx, const char* what, bool allowZero) {
+  double s = lua::checkNumber(L, idx, what);
+  if (s < 0 || (!allowZero && s <= 0))
+    throw LuaError(std::string(what) + " must be " + (allowZero ? "≥ 0" : "> 0") +
+                   " seconds, got " + std::to_string(s));
+  if (s > 1e9) throw LuaError(std::string(what) + " is too large: " + std::to_string(s) + " s");
+  return fromSeconds(s);
+}
+
+int cars(lua_State* L) {
+  ScriptHost& host = ScriptHost::from(L);
+  const auto& all = host.fleet().cars();
+  lua_createtable(L, static_cast<int>(all.size()), 0);
+  int i = 0;
+  for (AnkiCar* car : all) {
+    host.cars().push(L, *car);
+    lua_rawseti(L, -2, ++i);
+  }
+  return 1;
+}
+
+int car(lua_State* L) {
+  ScriptHost& host = ScriptHost::from(L);
+  AnkiCar* found = nullptr;
+  if (lua_type(L, 1) == LUA_TNUMBER) {
+    found = host.fleet().find(static_cast<int>(lua::checkInteger(L, 1, "car number")));
+  } else {
+    std::string name = lua::checkString(L, 1, "car name or number");
+    for (AnkiCar* c : host.fleet().cars())
+      if (c->identity().name == name) found = c;
+  }
+  if (!found) {
+    lua_pushnil(L);
+    return 1;
+  }
+  host.cars().push(L, *found);
+  return 1;
+}
+
+int now(lua_State* L) {
+  lua_pushnumber(L, ScriptHost::from(L).loop().seconds());
+  return 1;
+}
+
+int pushTimer(lua_State* L, int handle) {
+  auto* h = static_cast<int*>(lua_newuserdatauv(L, sizeof(int), 0));
+  *h = handle;
+  luaL_setmetatable(L, kTimerMetatable);
+  return 1;
+}
+
+int after(lua_State* L) {
+  Duration d = checkDelay(L, 1, "pitwall.after delay", true);
+  lua::checkFunction(L, 2, "pitwall.after callback");
+  lua_settop(L, 2);
+  return pushTimer(L, ScriptHost::from(L).addTimer(d, std::nullopt));
+}
+
+int every(lua_State* L) {
+  Duration d = checkDelay(L, 1, "pitwall.every period", false);
+  lua::checkFunction(L, 2, "pitwall.every callback");
+  lua_settop(L, 2);
+  return pushTimer(L, ScriptHost::from(L).addTimer(d, d));
+}
+
+int cancelTimer(lua_State* L) {
+  auto* h = static_cast<int*>(luaL_testudata(L, 1, kTimerMetatable));
+  if (!h) throw LuaError(std::string("expected a timer, got ") + luaL_typename(L, 1));
+  lua_pushboolean(L, ScriptHost::from(L).cancelTimer(*h));
+  return 1;
+}
+
+int spawn(lua_State* L) {
+  lua::checkFunction(L, 1, "pitwall.spawn's argument");
+  std::string name = lua_isnoneornil(L, 2) ? "" : lua::checkString(L, 2, "task name");
+  if (name.empty()) {
+    lua_Debug ar;
+    if (lua_getstack(L, 1, &ar) && lua_getinfo(L, "Sl", &ar))
+      name = std::string(ar.short_src) + ":" + std::to_string(ar.currentline);
+    else
+      name = "task";
+  }
+  lua_settop(L, 1);
+  ScriptHost::from(L).spawn(name);
+  return 0;
+}
+
+int sleepBody(lua_State* L) {
+  Duration d = checkDelay(L, 1, "pitwall.sleep time", true);
+  if (!lua_isyieldable(L))
+    throw LuaError(
+        "pitwall.sleep works only inside a task (pitwall.spawn or the script's main chunk); "
+        "callbacks must return quickly — start a task from the callback instead");
+  ScriptHost::from(L).sleepCurrent(L, d);
+  return -1;  // the caller yields
+}
+
+// Not guarded<>: lua_yield must be the last call of the C function itself.
+int sleep(lua_State* L) {
+  int r = lua::guarded<sleepBody>(L);
+  if (r == -1) return lua_yield(L, 0);
+  return r;
+}
+
+int stop(lua_State* L) {
+  ScriptHost::from(L).requestStop();
+  return 0;
+}
+
+int logBody(lua_State* L) {
+  int n = lua_gettop(L);
+  log::Level level = log::Level::Info;
+  int first = 1;
+  if (n >= 2 && lua_type(L, 1) == LUA_TSTRING) {
+    if (auto l = log::parseLevel(lua_tostring(L, 1))) {
+      level = *l;
+      first = 2;
+    }
+  }
+  std::string text;
+  for (int i = first; i <= n; ++i) {
+    if (i > first) text += ' ';
+    text += luaL_tolstring(L, i, nullptr);
+    lua_pop(L, 1);
+  }
+  lua_Debug ar;
+  std::string where = "script";
+  if (lua_getstack(L, 1, &ar) && lua_getinfo(L, "Sl", &ar))
+    where = std::string(ar.short_src) + ":" + std::to_string(ar.currentline);
+  log::write(level, where, text);
+  return 0;
+}
+
+int timerToString(lua_State* L) {
+  auto* h = static_cast<int*>(luaL_checkudata(L, 1, kTimerMetatable));
+  lua_pushfstring(L, "timer %d", *h);
+  return 1;
+}
+
+}  // namespace
+
+void openPitwallModule(ScriptHost& host) {
+  lua_State* L = host.state();
+  luaL_newmetatable(L, kTimerMetatable);
+  lua_newtable(L);
+  lua_pushcfunction(L, lua::guarded<cancelTimer>);
+  lua_setfield(L, -2, "cancel");
+  lua_setfield(L, -2, "__index");
+  lua_pushcfunction(L, timerToString);
+  lua_setfield(L, -2, "__tostring");
+  lua_pop(L, 1);
+
+  static const luaL_Reg functions[] = {
+      {"cars", lua::guarded<cars>},   {"car", lua::guarded<car>},
+      {"now", now},                   {"after", lua::guarded<after>},
+      {"every", lua::guarded<every>}, {"cancel", lua::guarded<cancelTimer>},
+      {"spawn", lua::guarded<spawn>}, {"sleep", sleep},
+      {"stop", stop},                 {"log", lua::guarded<logBody>},
+      {nullptr, nullptr}};
+  luaL_newlib(L, functions);
+  lua_pushboolean(L, host.loop().clockKind() == ClockKind::Virtual);
+  lua_setfield(L, -2, "virtualTime");
+  lua_pushinteger(L, static_cast<lua_Integer>(host.options().seed));
+  lua_setfield(L, -2, "seed");
+  lua_pushvalue(L, -1);
+  lua_setglobal(L, "pitwall");
+  luaL_getsubtable(L, LUA_REGISTRYINDEX, LUA_LOADED_TABLE);
+  lua_pushvalue(L, -2);
+  lua_setfield(L, -2, "pitwall");
+  lua_pop(L, 2);
+
+  if (host.sim()) openSimModule(host);
+
+  // Cars already known get their Lua objects now; later ones when they join, with onCar.
+  for (AnkiCar* c : host.fleet().cars()) host.cars().bind(*c);
+  auto previous = host.fleet().onCar;
+  host.fleet().onCar = [&host, previous](AnkiCar& car) {
+    if (previous) previous(car);
+    host.cars().bind(car);
+    lua_State* L = host.state();
+    int top = lua_gettop(L);
+    lua_getglobal(L, "pitwall");
+    if (lua_istable(L, -1) && lua_getfield(L, -1, "onCar") == LUA_TFUNCTION) {
+      lua_remove(L, -2);
+      host.cars().push(L, car);
+      host.call(1, 0, "pitwall.onCar handler", &car);
+    } else {
+      lua_settop(L, top);
+    }
+  };
+}
+
+}  // namespace pitwall

@@ -1,0 +1,8 @@
+#pragma once
+// The `pitwall` global: cars, clock, timers, tasks, stop, log; and `pitwall.sim` when the
+// simulator is the transport (sim_binding.cpp).
+namespace pitwall {
+class ScriptHost;
+void openPitwallModule(ScriptHost& host);
+void openSimModule(ScriptHost& host);  // leaves nothing on the stack; sets pitwall.sim
+}  // namespace pitwall

@@ -1,0 +1,288 @@
+#include "bindings/script_host.hpp"
+
+#include <filesystem>
+
+#include "bindings/car_binding.hpp"
+#include "bindings/lua_support.hpp"
+#include "bindings/pitwall_module.hpp"
+#include "engine/core/log.hpp"
+
+#ifndef PITWALL_SCRIPTS_DIR
+#define PITWALL_SCRIPTS_DIR "scripts"
+#endif
+
+namespace pitwall {
+
+namespace lua {
+int traceback(lua_State* L) {
+  const char* msg = lua_tostring(L, 1);
+  if (!msg) {
+    if (luaL_callmeta(L, 1, "__tostring") && lua_type(L, -1) == LUA_TSTRING) return 1;
+    msg = lua_pushfstring(L, "(error object is a %s value)", luaL_typename(L, 1));
+  }
+  luaL_traceback(L, L, msg, 1);
+  return 1;
+}
+}  // namespace lua
+
+namespace {
+void closeThread(lua_State* co) {
+#if LUA_VERSION_RELEASE_NUM >= 50406
+  lua_closethread(co, nullptr);
+#else
+  lua_resetthread(co);
+#endif
+}
+
+std::string scriptsDir() {
+  if (const char* env = std::getenv("PITWALL_SCRIPTS")) return env;
+  return PITWALL_SCRIPTS_DIR;
+}
+}  // namespace
+
+ScriptHost::ScriptHost(Loop& loop, Fleet& fleet, SimSession* sim, HostOptions options)
+    : loop_(loop), fleet_(fleet), sim_(sim), options_(std::move(options)) {
+  L_ = luaL_newstate();
+  if (!L_) throw std::runtime_error("cannot create a Lua state (out of memory)");
+  *static_cast<ScriptHost**>(lua_getextraspace(L_)) = this;
+  cars_ = std::make_unique<CarBinding>(*this);
+  openLibraries();
+}
+
+ScriptHost::~ScriptHost() {
+  for (auto& [co, task] : tasks_)
+    if (task.wake) loop_.cancel(*task.wake);
+  for (auto& [handle, timer] : timers_) loop_.cancel(timer.id);
+  cars_.reset();  // unhooks the cars before their Lua objects go
+  lua_close(L_);
+}
+
+ScriptHost& ScriptHost::from(lua_State* L) { return **static_cast<ScriptHost**>(lua_getextraspace(L)); }
+
+void ScriptHost::openLibraries() {
+  lua_State* L = L_;
+  luaL_openlibs(L);
+  // require: the shipped library first, then the extra folders (the script's own joins later).
+  std::string path;
+  for (const auto& dir : options_.library_paths) path += dir + "/?.lua;" + dir + "/?/init.lua;";
+  std::string lib = scriptsDir();
+  path += lib + "/?.lua;" + lib + "/?/init.lua;";
+  lua_getglobal(L, "package");
+  lua_getfield(L, -1, "path");
+  path += lua_tostring(L, -1);
+  lua_pop(L, 1);
+  lua_pushlstring(L, path.data(), path.size());
+  lua_setfield(L, -2, "path");
+  lua_pop(L, 1);
+
+  // Same seed, same random numbers: part of a deterministic run.
+  lua_getglobal(L, "math");
+  lua_getfield(L, -1, "randomseed");
+  lua_pushinteger(L, static_cast<lua_Integer>(options_.seed));
+  lua_call(L, 1, 0);
+  lua_pop(L, 1);
+
+  cars_->registerType(L);
+  openPitwallModule(*this);
+
+  // The Lua half of the module (waitUntil, copy, …) and, in tests, the expectations.
+  const char* prelude = options_.test_mode
+                            ? "require 'pitwall.core'; expect = require 'pitwall.test'"
+                            : "require 'pitwall.core'";
+  if (luaL_dostring(L, prelude) != LUA_OK) {
+    std::string err = lua_tostring(L, -1);
+    lua_pop(L, 1);
+    throw std::runtime_error("cannot load the pitwall Lua library from " + lib + ": " + err +
+                             " (set PITWALL_SCRIPTS to the folder that holds pitwall/core.lua)");
+  }
+}
+
+bool ScriptHost::call(int nargs, int nresults, const char* what, const AnkiCar* car) {
+  lua_State* L = L_;
+  int base = lua_gettop(L) - nargs;  // the function's slot
+  lua_pushcfunction(L, lua::traceback);
+  lua_insert(L, base);
+  int status = lua_pcall(L, nargs, nresults, base);
+  lua_remove(L, base);
+  if (status == LUA_OK) return true;
+  std::string message = lua_tostring(L, -1) ? lua_tostring(L, -1) : "(error without a message)";
+  lua_pop(L, 1);
+  std::string where = what;
+  if (car) where += " of " + car->label();
+  reportError(where, message);
+  return false;
+}
+
+void ScriptHost::reportError(const std::string& where, const std::string& message) {
+  ++errors_;
+  lua_State* L = L_;
+  std::string text = "error in " + where + ": " + message;
+  if (!inOnError_) {
+    // A script may take its own errors (pitwall.onError): then they are handled, not failures.
+    int top = lua_gettop(L);
+    lua_getglobal(L, "pitwall");
+    bool handler = lua_istable(L, -1) && lua_getfield(L, -1, "onError") == LUA_TFUNCTION;
+    if (handler) {
+      lua_remove(L, -2);
+      lua_pushlstring(L, text.data(), text.size());
+      lua_pushlstring(L, where.data(), where.size());
+      inOnError_ = true;
+      bool handled = call(2, 0, "pitwall.onError");
+      inOnError_ = false;
+      if (handled) return;
+    } else {
+      lua_settop(L, top);
+    }
+  }
+  log::error("script", text);
+  if (options_.test_mode && !failure_) {
+    failure_ = text;
+    requestStop();
+  }
+}
+
+void ScriptHost::requestStop() {
+  if (stopRequested_) return;
+  stopRequested_ = true;
+  if (onStopRequested) onStopRequested();
+}
+
+Result<bool, std::string> ScriptHost::startLoaded(int status) {
+  if (status != LUA_OK) {
+    std::string err = lua_tostring(L_, -1) ? lua_tostring(L_, -1) : "cannot load the script";
+    lua_pop(L_, 1);
+    return Unexpected{err};
+  }
+  spawn("main chunk");
+  return true;
+}
+
+Result<bool, std::string> ScriptHost::startFile(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) return Unexpected{"cannot open " + path + ": no such file"};
+  // The script's own folder joins the front of the require path.
+  std::string dir = fs::path(path).parent_path().string();
+  if (dir.empty()) dir = ".";
+  lua_getglobal(L_, "package");
+  lua_getfield(L_, -1, "path");
+  std::string p = dir + "/?.lua;" + dir + "/?/init.lua;" + lua_tostring(L_, -1);
+  lua_pop(L_, 1);
+  lua_pushlstring(L_, p.data(), p.size());
+  lua_setfield(L_, -2, "path");
+  lua_pop(L_, 1);
+  return startLoaded(luaL_loadfilex(L_, path.c_str(), "t"));
+}
+
+Result<bool, std::string> ScriptHost::startString(const std::string& code,
+                                                  const std::string& chunkname) {
+  return startLoaded(
+      luaL_loadbufferx(L_, code.data(), code.size(), ("@" + chunkname).c_str(), "t"));
+}
+
+void ScriptHost::spawn(const std::string& name) {
+  lua_State* L = L_;
+  lua_State* co = lua_newthread(L);
+  int ref = luaL_ref(L, LUA_REGISTRYINDEX);  // pops the thread, keeps it alive
+  lua_xmove(L, co, 1);                        // the function
+  tasks_.emplace(co, Task{ref, name, std::nullopt});
+  if (name == "main chunk") mainTask_ = co;
+  resume(co, 0);
+}
+
+void ScriptHost::sleepCurrent(lua_State* co, Duration delay) {
+  auto it = tasks_.find(co);
+  if (it == tasks_.end()) return;
+  it->second.wake = loop_.after(delay, [this, co] {
+    auto t = tasks_.find(co);
+    if (t == tasks_.end()) return;
+    t->second.wake.reset();
+    resume(co, 0);
+  });
+}
+
+void ScriptHost::resume(lua_State* co, int nargs) {
+  auto it = tasks_.find(co);
+  if (it == tasks_.end()) return;
+  int nres = 0;
+  int status = lua_resume(co, L_, nargs, &nres);
+  it = tasks_.find(co);
+  if (status == LUA_YIELD) {
+    lua_pop(co, nres);
+    if (!it->second.wake) {
+      // A bare coroutine.yield() has nobody to wake it: end the task with a clear error.
+      std::string name = it->second.name;
+      luaL_unref(L_, LUA_REGISTRYINDEX, it->second.threadRef);
+      tasks_.erase(it);
+      reportError(name == "main chunk" ? name : "task " + name,
+                  "the task yielded without pitwall.sleep or pitwall.waitUntil; nothing would "
+                  "ever resume it");
+    }
+    return;
+  }
+  std::string name = it->second.name;
+  std::string error;
+  if (status != LUA_OK) {
+    const char* msg = lua_tostring(co, -1);
+    luaL_traceback(L_, co, msg ? msg : "(error without a message)", 0);
+    error = lua_tostring(L_, -1);
+    lua_pop(L_, 1);
+  }
+  closeThread(co);
+  luaL_unref(L_, LUA_REGISTRYINDEX, it->second.threadRef);
+  tasks_.erase(it);
+  bool wasMain = co == mainTask_;
+  if (wasMain) {
+    mainTask_ = nullptr;
+    mainFinished_ = true;
+  }
+  if (!error.empty()) reportError(wasMain ? name : "task " + name, error);
+  if (wasMain && !error.empty()) {
+    // The script died: the run ends and its cars are stopped (DESIGN.md, "keeps cars safe").
+    mainFailed_ = true;
+    requestStop();
+  }
+  if (wasMain && options_.test_mode) requestStop();  // a scenario ends with its main chunk
+}
+
+int ScriptHost::addTimer(Duration first, std::optional<Duration> period) {
+  int handle = nextTimer_++;
+  Timer t;
+  t.fnRef = luaL_ref(L_, LUA_REGISTRYINDEX);
+  t.period = period;
+  t.due = loop_.now() + first;
+  t.id = loop_.at(t.due, [this, handle] { fireTimer(handle); });
+  timers_.emplace(handle, t);
+  return handle;
+}
+
+bool ScriptHost::cancelTimer(int handle) {
+  auto it = timers_.find(handle);
+  if (it == timers_.end()) return false;
+  loop_.cancel(it->second.id);
+  luaL_unref(L_, LUA_REGISTRYINDEX, it->second.fnRef);
+  timers_.erase(it);
+  return true;
+}
+
+void ScriptHost::fireTimer(int handle) {
+  auto it = timers_.find(handle);
+  if (it == timers_.end()) return;
+  Timer& t = it->second;
+  int fnRef = t.fnRef;
+  bool repeating = t.period.has_value();
+  if (repeating) {
+    // Scheduled before the call, so the callback may cancel it; due times do not drift.
+    t.due += *t.period;
+    t.id = loop_.at(t.due, [this, handle] { fireTimer(handle); });
+    lua_rawgeti(L_, LUA_REGISTRYINDEX, fnRef);
+    call(0, 0, "pitwall.every callback");
+  } else {
+    timers_.erase(it);
+    lua_rawgeti(L_, LUA_REGISTRYINDEX, fnRef);
+    luaL_unref(L_, LUA_REGISTRYINDEX, fnRef);
+    call(0, 0, "pitwall.after callback");
+  }
+}
+
+}  // namespace pitwall

@@ -1,0 +1,121 @@
+#pragma once
+// The Lua world of one run: the state, the `pitwall` module, car objects, timers and tasks on the
+// engine clock, and the one protected-call path every call into Lua goes through.
+//
+// Errors: an error in a callback is reported with a traceback (or handed to pitwall.onError) and
+// the run carries on; in test mode it fails the scenario instead.
+#include <lua.hpp>
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "engine/core/loop.hpp"
+#include "engine/core/result.hpp"
+#include "engine/sim/world.hpp"
+#include "engine/vehicles/fleet.hpp"
+
+namespace pitwall {
+
+class CarBinding;
+
+// The simulator as scripts see it (pitwall.sim): present for simulator runs and scenario tests.
+struct SimSession {
+  std::unique_ptr<sim::World> world;
+  std::uint64_t seed = 1;
+};
+
+struct HostOptions {
+  bool test_mode = false;       // callback errors fail the run; `expect` helpers loaded
+  std::uint64_t seed = 1;       // math.randomseed
+  std::vector<std::string> library_paths;  // extra folders searched by require
+};
+
+class ScriptHost {
+ public:
+  ScriptHost(Loop& loop, Fleet& fleet, SimSession* sim, HostOptions options);
+  ~ScriptHost();
+  ScriptHost(const ScriptHost&) = delete;
+  ScriptHost& operator=(const ScriptHost&) = delete;
+
+  lua_State* state() { return L_; }
+  Loop& loop() { return loop_; }
+  Fleet& fleet() { return fleet_; }
+  SimSession* sim() { return sim_; }
+  CarBinding& cars() { return *cars_; }
+  const HostOptions& options() const { return options_; }
+
+  // Loads SCRIPT and starts its main chunk as a task (so it may pitwall.sleep). A script that
+  // does not load gives "FILE:LINE: message". Its folder joins the require path.
+  Result<bool, std::string> startFile(const std::string& path);
+  // Same for a chunk of text (tests, benchmarks).
+  Result<bool, std::string> startString(const std::string& code, const std::string& chunkname);
+  bool mainFinished() const { return mainFinished_; }
+  bool mainFailed() const { return mainFailed_; }
+
+  // Calls the function under the top `nargs` values with the traceback handler. On error the
+  // failure is reported as happening in `what` (of `car`, when given): "onPosition handler of
+  // car 1 (skull)". Returns true when the call succeeded; results are left on the stack. Builds
+  // no string unless the call fails: this is the hot path of every event.
+  bool call(int nargs, int nresults, const char* what, const AnkiCar* car = nullptr);
+  // Reports a script error: to pitwall.onError if set, else the log; in test mode, a failure.
+  void reportError(const std::string& where, const std::string& message);
+
+  // A task: a coroutine resumed on the loop. The function is on top of the stack.
+  void spawn(const std::string& name);
+  // Called by pitwall.sleep from inside a task: resume it after `delay`.
+  void sleepCurrent(lua_State* co, Duration delay);
+
+  // Timers from Lua (pitwall.after / pitwall.every): the function is on top of the stack.
+  int addTimer(Duration first, std::optional<Duration> period);
+  bool cancelTimer(int handle);
+
+  // pitwall.stop() and failures end the run through this.
+  std::function<void()> onStopRequested;
+  void requestStop();
+  bool stopRequested() const { return stopRequested_; }
+  // In test mode: the first failure (error in a task or callback, failed expectation).
+  const std::optional<std::string>& failure() const { return failure_; }
+  int errorCount() const { return errors_; }
+
+  static ScriptHost& from(lua_State* L);
+
+ private:
+  struct Task {
+    int threadRef = LUA_NOREF;
+    std::string name;
+    std::optional<Loop::TimerId> wake;
+  };
+  struct Timer {
+    int fnRef = LUA_NOREF;
+    Loop::TimerId id = 0;
+    std::optional<Duration> period;
+    TimePoint due{};
+  };
+  void openLibraries();
+  void resume(lua_State* co, int nargs);
+  void fireTimer(int handle);
+  Result<bool, std::string> startLoaded(int status);
+
+  Loop& loop_;
+  Fleet& fleet_;
+  SimSession* sim_;
+  HostOptions options_;
+  lua_State* L_ = nullptr;
+  std::unique_ptr<CarBinding> cars_;
+  std::unordered_map<lua_State*, Task> tasks_;
+  lua_State* mainTask_ = nullptr;
+  bool mainFinished_ = false;
+  bool mainFailed_ = false;
+  std::unordered_map<int, Timer> timers_;
+  int nextTimer_ = 1;
+  bool stopRequested_ = false;
+  bool inOnError_ = false;
+  std::optional<std::string> failure_;
+  int errors_ = 0;
+};
+
+}  // namespace pitwall

@@ -1,0 +1,268 @@
+// pitwall.sim: the simulated world as a script sees it — its track, its cars, ground truth and
+// noise. Scenario tests build their world with it; `require "pitwall.sim"` returns it.
+#include <algorithm>
+#include <cctype>
+
+#include "bindings/car_binding.hpp"
+#include "bindings/lua_support.hpp"
+#include "bindings/pitwall_module.hpp"
+#include "bindings/script_host.hpp"
+#include "engine/protocol/anki/advertisement.hpp"
+#include "engine/sim/grid.hpp"
+#include "engine/transport/sim_link.hpp"
+
+namespace pitwall {
+
+using lua::LuaError;
+
+namespace {
+
+SimSession& session(lua_State* L) { return *ScriptHost::from(L).sim(); }
+
+sim::SimCar& simCarOf(lua_State* L, int idx) {
+  AnkiCar& car = CarBinding::check(L, idx);
+  auto* link = dynamic_cast<SimLink*>(&car.link());
+  if (!link) throw LuaError(car.label() + " is not a simulated car");
+  return link->car();
+}
+
+std::uint8_t modelFromLua(lua_State* L, int idx) {
+  if (lua_type(L, idx) == LUA_TSTRING) {
+    std::string want = lua_tostring(L, idx);
+    std::transform(want.begin(), want.end(), want.begin(), ::tolower);
+    for (int id = 0; id < 256; ++id) {
+      std::string name = anki::modelName(static_cast<std::uint8_t>(id));
+      std::transform(name.begin(), name.end(), name.begin(), ::tolower);
+      std::replace(name.begin(), name.end(), ' ', '-');
+      if (name == want) return static_cast<std::uint8_t>(id);
+    }
+    throw LuaError("model '" + want + "' is unknown (try groundshock, skull, thermo, nuke, …)");
+  }
+  auto id = lua::checkInteger(L, idx, "model");
+  if (id < 0 || id > 255) throw LuaError("model id " + std::to_string(id) + " is out of range 0..255");
+  return static_cast<std::uint8_t>(id);
+}
+
+void pushTrack(lua_State* L, const sim::Track& track) {
+  lua_createtable(L, 0, 4);
+  lua_pushstring(L, track.name().c_str());
+  lua_setfield(L, -2, "name");
+  lua_pushnumber(L, track.lapLength(0));
+  lua_setfield(L, -2, "lapLength");
+  lua_pushinteger(L, static_cast<lua_Integer>(track.finishIndex()) + 1);
+  lua_setfield(L, -2, "finishIndex");
+  lua_createtable(L, static_cast<int>(track.size()), 0);
+  for (std::size_t i = 0; i < track.size(); ++i) {
+    const sim::Piece& p = track.piece(i);
+    lua_createtable(L, 0, 4);
+    lua_pushinteger(L, p.id);
+    lua_setfield(L, -2, "id");
+    lua_pushstring(L, std::string(anki::pieceTypeName(p.type)).c_str());
+    lua_setfield(L, -2, "type");
+    lua_pushinteger(L, p.turn);
+    lua_setfield(L, -2, "turn");
+    lua_pushnumber(L, p.length(0));
+    lua_setfield(L, -2, "length");
+    lua_rawseti(L, -2, static_cast<lua_Integer>(i) + 1);
+  }
+  lua_setfield(L, -2, "pieces");
+}
+
+int track(lua_State* L) {
+  pushTrack(L, session(L).world->track());
+  return 1;
+}
+
+int setTrack(lua_State* L) {
+  std::string what = lua::checkString(L, 1, "track layout (a name, a file or layout text)");
+  SimSession& s = session(L);
+  if (!s.world->cars().empty())
+    throw LuaError("the track cannot change once cars are on it; call sim.setTrack first");
+  // A layout name, a file, or the layout text itself.
+  auto loaded = sim::loadLayout(what);
+  if (!loaded && what.find(' ') != std::string::npos) loaded = sim::parseLayout(what);
+  if (!loaded) throw LuaError(loaded.error());
+  sim::Noise noise = s.world->noise();
+  Loop& loop = s.world->loop();
+  s.world = std::make_unique<sim::World>(loop, std::move(*loaded), s.seed);
+  s.world->setNoise(noise);
+  pushTrack(L, s.world->track());
+  return 1;
+}
+
+int layouts(lua_State* L) {
+  auto names = sim::layoutNames();
+  lua_createtable(L, static_cast<int>(names.size()), 0);
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    lua_pushstring(L, names[i].c_str());
+    lua_rawseti(L, -2, static_cast<lua_Integer>(i) + 1);
+  }
+  return 1;
+}
+
+// sim._addCar{name=, model=, piece=, distance=, lane= | offset=, battery=, version=}
+int addCar(lua_State* L) {
+  ScriptHost& host = ScriptHost::from(L);
+  SimSession& s = *host.sim();
+  if (!lua_isnoneornil(L, 1) && !lua_istable(L, 1))
+    throw LuaError(std::string("sim.addCar takes a table, got ") + luaL_typename(L, 1));
+  if (lua_isnoneornil(L, 1)) {
+    lua_settop(L, 0);
+    lua_newtable(L);
+  }
+  const sim::Track& track = s.world->track();
+  int index = static_cast<int>(s.world->cars().size());
+  sim::CarSpec spec = sim::gridSpec(track, index);
+  if (lua_getfield(L, 1, "model") != LUA_TNIL) spec.model_id = modelFromLua(L, -1);
+  lua_pop(L, 1);
+  if (lua_getfield(L, 1, "piece") != LUA_TNIL) {
+    auto piece = lua::checkInteger(L, -1, "piece (index into the track, from 1)");
+    if (piece < 1 || piece > static_cast<long long>(track.size()))
+      throw LuaError("piece " + std::to_string(piece) + " is out of range 1.." +
+                     std::to_string(track.size()) + " (an index into the track's pieces)");
+    spec.piece_index = static_cast<std::size_t>(piece - 1);
+    spec.distance_mm = 0;
+  }
+  lua_pop(L, 1);
+  if (lua_getfield(L, 1, "distance") != LUA_TNIL) {
+    spec.distance_mm = lua::checkNumber(L, -1, "distance (mm into the piece)");
+    double len = track.piece(spec.piece_index).length(spec.offset_mm);
+    if (spec.distance_mm < 0 || spec.distance_mm >= len)
+      throw LuaError("distance " + std::to_string(spec.distance_mm) + " mm is outside the piece (0.." +
+                     std::to_string(len) + " mm)");
+  }
+  lua_pop(L, 1);
+  if (lua_getfield(L, 1, "lane") != LUA_TNIL) {
+    auto lane = lua::checkInteger(L, -1, "lane");
+    if (lane < 1 || lane > 4) throw LuaError("lane " + std::to_string(lane) + " is out of range 1..4 (1 is leftmost)");
+    spec.offset_mm = sim::kLaneOffsets[lane - 1];
+  }
+  lua_pop(L, 1);
+  if (lua_getfield(L, 1, "offset") != LUA_TNIL) {
+    spec.offset_mm = lua::checkNumber(L, -1, "offset (mm)");
+    if (spec.offset_mm < -100 || spec.offset_mm > 100)
+      throw LuaError("offset " + std::to_string(spec.offset_mm) + " mm is off the road (-100..100 mm)");
+  }
+  lua_pop(L, 1);
+  if (lua_getfield(L, 1, "battery") != LUA_TNIL) {
+    auto mv = lua::checkInteger(L, -1, "battery (mV)");
+    if (mv < 3000 || mv > 4300) throw LuaError("battery " + std::to_string(mv) + " mV is out of range 3000..4300 mV");
+    spec.battery_mv = static_cast<std::uint16_t>(mv);
+  }
+  lua_pop(L, 1);
+  if (lua_getfield(L, 1, "version") != LUA_TNIL) {
+    auto v = lua::checkInteger(L, -1, "version");
+    if (v < 0 || v > 0xffff) throw LuaError("version " + std::to_string(v) + " is out of range 0..0xffff");
+    spec.version = static_cast<std::uint16_t>(v);
+  }
+  lua_pop(L, 1);
+  std::vector<std::string> taken;
+  for (AnkiCar* c : host.fleet().cars()) taken.push_back(c->identity().name);
+  if (lua_getfield(L, 1, "name") != LUA_TNIL)
+    spec.name = lua::checkString(L, -1, "name");
+  else
+    spec.name = sim::uniqueCarName(spec.model_id, taken);
+  lua_pop(L, 1);
+  if (std::find(taken.begin(), taken.end(), spec.name) != taken.end())
+    throw LuaError("a car named '" + spec.name + "' is already in the run");
+
+  AnkiCar& car = host.fleet().addSimulated(*s.world, spec);
+  host.cars().bind(car);
+  host.cars().push(L, car);
+  return 1;
+}
+
+int truth(lua_State* L) {
+  sim::Truth t = simCarOf(L, 1).truth();
+  lua_createtable(L, 0, 16);
+  auto setI = [L](const char* k, lua_Integer v) { lua_pushinteger(L, v); lua_setfield(L, -2, k); };
+  auto setN = [L](const char* k, double v) { lua_pushnumber(L, v); lua_setfield(L, -2, k); };
+  auto setB = [L](const char* k, bool v) { lua_pushboolean(L, v); lua_setfield(L, -2, k); };
+  setI("pieceIndex", static_cast<lua_Integer>(t.piece_index) + 1);
+  setI("piece", t.piece_id);
+  setN("pieceDistance", t.piece_distance_mm);
+  setN("lapDistance", t.lap_distance_mm);
+  setN("offset", t.offset_mm);
+  setN("speed", t.speed_mm_s);
+  setN("targetSpeed", t.target_speed_mm_s);
+  setI("laps", t.laps);
+  setB("onTrack", t.on_track);
+  setB("delocalized", t.delocalized);
+  setB("sdkMode", t.sdk_mode);
+  setB("connected", t.connected);
+  setI("battery", t.battery_mv);
+  setI("collisions", t.collisions);
+  return 1;
+}
+
+int lift(lua_State* L) {
+  simCarOf(L, 1).lift();
+  return 0;
+}
+
+int place(lua_State* L) {
+  sim::SimCar& car = simCarOf(L, 1);
+  const sim::Track& track = session(L).world->track();
+  auto piece = lua::checkInteger(L, 2, "piece (index into the track, from 1)");
+  if (piece < 1 || piece > static_cast<long long>(track.size()))
+    throw LuaError("piece " + std::to_string(piece) + " is out of range 1.." + std::to_string(track.size()));
+  double offset = lua::optNumber(L, 3, "offset (mm)", 0);
+  if (offset < -100 || offset > 100)
+    throw LuaError("offset " + std::to_string(offset) + " mm is off the road (-100..100 mm)");
+  car.place(static_cast<std::size_t>(piece - 1), offset);
+  return 0;
+}
+
+int noise(lua_State* L) {
+  SimSession& s = session(L);
+  sim::Noise n = s.world->noise();
+  if (!lua_isnoneornil(L, 1)) {
+    if (!lua_istable(L, 1)) throw LuaError("sim.noise takes a table {drop=, late=, lateBy=}");
+    auto prob = [L](const char* key, double& out) {
+      if (lua_getfield(L, 1, key) != LUA_TNIL) {
+        double v = lua::checkNumber(L, -1, key);
+        if (v < 0 || v > 1) throw LuaError(std::string("noise ") + key + " " + std::to_string(v) + " is out of range 0..1 (a probability)");
+        out = v;
+      }
+      lua_pop(L, 1);
+    };
+    prob("drop", n.drop);
+    prob("late", n.late);
+    if (lua_getfield(L, 1, "lateBy") != LUA_TNIL) {
+      double v = lua::checkNumber(L, -1, "lateBy (s)");
+      if (v < 0 || v > 10) throw LuaError("noise lateBy " + std::to_string(v) + " s is out of range 0..10 s");
+      n.late_by = fromSeconds(v);
+    }
+    lua_pop(L, 1);
+    s.world->setNoise(n);
+  }
+  lua_createtable(L, 0, 3);
+  lua_pushnumber(L, n.drop);
+  lua_setfield(L, -2, "drop");
+  lua_pushnumber(L, n.late);
+  lua_setfield(L, -2, "late");
+  lua_pushnumber(L, toSeconds(n.late_by));
+  lua_setfield(L, -2, "lateBy");
+  return 1;
+}
+
+}  // namespace
+
+void openSimModule(ScriptHost& host) {
+  lua_State* L = host.state();
+  static const luaL_Reg functions[] = {{"track", lua::guarded<track>},
+                                       {"setTrack", lua::guarded<setTrack>},
+                                       {"layouts", lua::guarded<layouts>},
+                                       {"_addCar", lua::guarded<addCar>},
+                                       {"truth", lua::guarded<truth>},
+                                       {"lift", lua::guarded<lift>},
+                                       {"place", lua::guarded<place>},
+                                       {"noise", lua::guarded<noise>},
+                                       {nullptr, nullptr}};
+  lua_getglobal(L, "pitwall");
+  luaL_newlib(L, functions);
+  lua_setfield(L, -2, "sim");
+  lua_pop(L, 1);
+}
+
+}  // namespace pitwall

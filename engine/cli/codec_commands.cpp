@@ -1,0 +1,77 @@
+// pitwall decode / pitwall encode: the codecs from the shell.
+#include <cctype>
+#include <iostream>
+
+#include "engine/cli/commands.hpp"
+#include "engine/protocol/anki/codec.hpp"
+#include "engine/protocol/anki/command_text.hpp"
+#include "engine/protocol/anki/json.hpp"
+#include "engine/vehicles/recorder.hpp"
+
+namespace pitwall::cli {
+
+namespace {
+
+constexpr const char* kProtocols = "anki";
+
+// "06 24 e8", "06:24:e8", "0624e8" and "0x06 0x24" all give the same bytes.
+Result<std::vector<std::uint8_t>, std::string> parseHex(const std::vector<std::string>& words) {
+  std::string digits;
+  for (const auto& w : words) {
+    for (std::size_t i = 0; i < w.size(); ++i) {
+      char c = w[i];
+      if (c == '0' && i + 1 < w.size() && (w[i + 1] == 'x' || w[i + 1] == 'X') &&
+          (i == 0 || !std::isxdigit(static_cast<unsigned char>(w[i - 1])))) {
+        ++i;
+        continue;
+      }
+      if (std::isxdigit(static_cast<unsigned char>(c)))
+        digits += c;
+      else if (c != ' ' && c != ':' && c != ',' && c != '-')
+        return Unexpected{std::string("'") + c + "' is not a hex digit in \"" + w + "\""};
+    }
+  }
+  if (digits.empty()) return Unexpected{std::string("no bytes given; write them as hex, e.g. \"01 17\"")};
+  if (digits.size() % 2) return Unexpected{"odd number of hex digits (" + std::to_string(digits.size()) + ")"};
+  std::vector<std::uint8_t> bytes;
+  for (std::size_t i = 0; i < digits.size(); i += 2)
+    bytes.push_back(static_cast<std::uint8_t>(std::stoi(digits.substr(i, 2), nullptr, 16)));
+  return bytes;
+}
+
+}  // namespace
+
+int decode(const std::string& protocol, const std::vector<std::string>& hex) {
+  if (protocol != "anki") {
+    std::cerr << "pitwall decode: unknown protocol '" << protocol << "'; known: " << kProtocols << "\n";
+    return 2;
+  }
+  auto bytes = parseHex(hex);
+  if (!bytes) {
+    std::cerr << "pitwall decode: " << bytes.error() << "\n";
+    return 2;
+  }
+  auto message = anki::decode(*bytes);
+  if (!message) {
+    std::cerr << "pitwall decode: " << message.error().message() << "\n";
+    return 2;
+  }
+  std::cout << anki::toJson(*message).dump() << "\n";
+  return 0;
+}
+
+int encode(const std::string& protocol, const std::vector<std::string>& words) {
+  if (protocol != "anki") {
+    std::cerr << "pitwall encode: unknown protocol '" << protocol << "'; known: " << kProtocols << "\n";
+    return 2;
+  }
+  auto message = anki::parseCommand(words);
+  if (!message) {
+    std::cerr << "pitwall encode: " << message.error() << "\n";
+    return 2;
+  }
+  std::cout << toHex(anki::encode(*message).span()) << "\n";
+  return 0;
+}
+
+}  // namespace pitwall::cli

@@ -1,0 +1,76 @@
+// pitwall — the command line (docs/cli.md).
+#include <CLI/CLI.hpp>
+#include <iostream>
+
+#include "engine/cli/commands.hpp"
+#include "engine/core/log.hpp"
+#include "engine/protocol/anki/command_text.hpp"
+
+int main(int argc, char** argv) {
+  using namespace pitwall;
+  CLI::App app{"pitwall — an automation engine for robot race cars, scripted in Lua"};
+  app.require_subcommand(1);
+  std::string logLevel;
+  app.add_option("--log-level", logLevel, "debug, info, warn, error or off (default: info; "
+                                          "warn for `test`)");
+
+  cli::RunOptions run;
+  auto* runCmd = app.add_subcommand("run", "Run a Lua script; by default against the built-in simulator");
+  runCmd->add_option("script", run.script, "The Lua script to run")->required();
+  runCmd->add_flag("--fast", run.fast, "Virtual time: the run goes as fast as the machine can");
+  runCmd->add_option("--duration", run.duration, "End the run after this many seconds of engine time")
+      ->check(CLI::PositiveNumber);
+  runCmd->add_option("--seed", run.seed, "Seed of the simulator's and the script's randomness");
+  runCmd->add_option("--cars", run.cars, "Number of simulated cars on the grid (default 4)")
+      ->check(CLI::Range(0, 64));
+  runCmd->add_option("--track", run.track, "Track layout: a name (oval, …) or a layout file");
+  runCmd->add_option("--record", run.record, "Write every frame in and out as JSON lines to FILE");
+
+  cli::TestOptions test;
+  auto* testCmd = app.add_subcommand("test", "Run scenario test scripts in virtual time");
+  testCmd->add_option("paths", test.paths, "Scenario files, or folders of *_test.lua files");
+  testCmd->add_option("--seed", test.seed, "Seed of the simulator's and the scripts' randomness");
+  testCmd->add_option("--timeout", test.timeout, "Virtual seconds a scenario may run (default 600)")
+      ->check(CLI::PositiveNumber);
+
+  std::string protocol;
+  std::vector<std::string> words;
+  auto* decodeCmd = app.add_subcommand("decode", "Decode one frame: pitwall decode anki \"01 17\"");
+  decodeCmd->add_option("protocol", protocol, "Protocol (anki)")->required();
+  decodeCmd->add_option("hex", words, "The frame's bytes in hex")->required();
+  auto* encodeCmd = app.add_subcommand("encode", "Encode one command: pitwall encode anki set-speed 600 1000");
+  encodeCmd->add_option("protocol", protocol, "Protocol (anki)")->required();
+  encodeCmd->add_option("message", words, "The command and its arguments")->required();
+  std::string forms;
+  for (const auto& f : anki::commandForms()) forms += "\n  " + f;
+  encodeCmd->footer("Commands (anki):" + forms);
+  // Negative numbers (set-offset -23.5) are arguments, not options.
+  for (auto* c : {decodeCmd, encodeCmd}) c->positionals_at_end(false);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+
+  bool testing = testCmd->parsed();
+  if (!logLevel.empty()) {
+    auto level = log::parseLevel(logLevel);
+    if (!level) {
+      std::cerr << "pitwall: --log-level '" << logLevel << "' is unknown; use debug, info, warn, error or off\n";
+      return 2;
+    }
+    log::setLevel(*level);
+  } else if (testing) {
+    log::setLevel(log::Level::Warn);
+  }
+
+  if (runCmd->parsed()) return cli::run(run);
+  if (testing) {
+    if (test.paths.empty()) test.paths.push_back("tests/scenarios");
+    return cli::test(test);
+  }
+  if (decodeCmd->parsed()) return cli::decode(protocol, words);
+  if (encodeCmd->parsed()) return cli::encode(protocol, words);
+  return 2;
+}

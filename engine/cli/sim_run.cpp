@@ -1,0 +1,63 @@
+#include "engine/cli/sim_run.hpp"
+
+#include "engine/core/log.hpp"
+#include "engine/sim/grid.hpp"
+
+namespace pitwall::cli {
+
+// Long enough for a frame to cross the simulator link and be acted on.
+constexpr Duration kFlush = std::chrono::milliseconds(100);
+
+SimRun::SimRun(ClockKind clock, sim::Track track, std::uint64_t seed)
+    : loop_(clock), fleet_(loop_) {
+  sim_.seed = seed;
+  sim_.world = std::make_unique<sim::World>(loop_, std::move(track), seed);
+  log::setTimeSource([this] { return loop_.seconds(); });
+}
+
+SimRun::~SimRun() {
+  host_.reset();
+  log::setTimeSource(nullptr);
+}
+
+void SimRun::record(const std::string& path) {
+  recorder_ = std::make_unique<Recorder>(path);
+  fleet_.onFrame = [this](AnkiCar& car, AnkiCar::Direction d, std::span<const std::uint8_t> f,
+                          const anki::Message& m) {
+    recorder_->write(loop_.seconds(), car.identity().number, d == AnkiCar::Direction::Tx, f, m);
+  };
+}
+
+bool SimRun::addGridCars(int count) {
+  std::vector<std::string> names;
+  for (int i = 0; i < count; ++i) {
+    sim::CarSpec spec = sim::gridSpec(sim_.world->track(), i);
+    spec.name = sim::uniqueCarName(spec.model_id, names);
+    names.push_back(spec.name);
+    fleet_.addSimulated(*sim_.world, spec);
+  }
+  if (count == 0) return true;
+  auto previous = fleet_.onCar;
+  fleet_.onCar = [&](AnkiCar&) {
+    if (fleet_.connectedCount() == static_cast<std::size_t>(count)) loop_.stop();
+  };
+  auto timeout = loop_.after(std::chrono::seconds(5), [this] { loop_.stop(); });
+  loop_.run();
+  loop_.cancel(timeout);
+  fleet_.onCar = previous;
+  return fleet_.connectedCount() == static_cast<std::size_t>(count);
+}
+
+void SimRun::startHost(HostOptions options) {
+  host_ = std::make_unique<ScriptHost>(loop_, fleet_, &sim_, std::move(options));
+  host_->onStopRequested = [this] { finish(); };
+}
+
+void SimRun::finish() {
+  if (finishing_) return;
+  finishing_ = true;
+  fleet_.stopAll();
+  loop_.after(kFlush, [this] { loop_.stop(); });
+}
+
+}  // namespace pitwall::cli

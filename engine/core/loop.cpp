@@ -1,0 +1,101 @@
+#include "engine/core/loop.hpp"
+
+#include <boost/asio/executor_work_guard.hpp>
+#include <boost/asio/post.hpp>
+
+namespace pitwall {
+
+Loop::Loop(ClockKind kind) : kind_(kind), wake_(io_), epoch_(std::chrono::steady_clock::now()) {}
+
+TimePoint Loop::now() const {
+  if (kind_ == ClockKind::Virtual) return virtualNow_;
+  return std::chrono::duration_cast<TimePoint>(std::chrono::steady_clock::now() - epoch_);
+}
+
+Loop::TimerId Loop::at(TimePoint when, Callback fn) {
+  TimerId id = nextId_++;
+  Key key{when, nextSeq_++};
+  timers_.emplace(key, std::make_pair(id, std::move(fn)));
+  keys_.emplace(id, key);
+  if (kind_ == ClockKind::Real && (!armedFor_ || when < *armedFor_)) armRealTimer();
+  return id;
+}
+
+bool Loop::cancel(TimerId id) {
+  auto it = keys_.find(id);
+  if (it == keys_.end()) return false;
+  timers_.erase(it->second);
+  keys_.erase(it);
+  return true;
+}
+
+std::optional<TimePoint> Loop::nextDue() const {
+  if (timers_.empty()) return std::nullopt;
+  return timers_.begin()->first.when;
+}
+
+void Loop::post(Callback fn) { boost::asio::post(io_, std::move(fn)); }
+
+bool Loop::fireDue() {
+  bool fired = false;
+  TimePoint t = now();
+  while (!stopped_ && !timers_.empty() && timers_.begin()->first.when <= t) {
+    auto node = timers_.extract(timers_.begin());
+    keys_.erase(node.mapped().first);
+    fired = true;
+    node.mapped().second();
+  }
+  return fired;
+}
+
+void Loop::stop() {
+  stopped_ = true;
+  io_.stop();
+}
+
+void Loop::run() {
+  stopped_ = false;
+  io_.restart();
+  if (kind_ == ClockKind::Virtual)
+    runVirtual();
+  else
+    runReal();
+}
+
+void Loop::runVirtual() {
+  while (!stopped_) {
+    std::size_t ran = io_.poll();
+    if (stopped_) break;
+    if (io_.stopped()) io_.restart();
+    if (fireDue() || ran > 0) continue;
+    // Nothing is ready: jump to the next timer, or end when no timer is left.
+    if (timers_.empty()) break;
+    virtualNow_ = timers_.begin()->first.when;
+  }
+}
+
+void Loop::armRealTimer() {
+  if (timers_.empty()) {
+    armedFor_.reset();
+    wake_.cancel();
+    return;
+  }
+  TimePoint when = timers_.begin()->first.when;
+  armedFor_ = when;
+  wake_.expires_at(epoch_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(when));
+  wake_.async_wait([this](const boost::system::error_code& ec) {
+    if (ec) return;  // re-armed for an earlier timer, or stopped
+    armedFor_.reset();
+    fireDue();
+    if (!stopped_) armRealTimer();
+  });
+}
+
+void Loop::runReal() {
+  // Keeps run() going while the loop waits for sockets, signals or the next timer.
+  auto guard = boost::asio::make_work_guard(io_);
+  armRealTimer();
+  io_.run();
+}
+
+}  // namespace pitwall

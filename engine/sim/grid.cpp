@@ -1,0 +1,38 @@
+#include "engine/sim/grid.hpp"
+
+#include <algorithm>
+#include <cctype>
+
+#include "engine/protocol/anki/advertisement.hpp"
+
+namespace pitwall::sim {
+
+std::uint8_t gridModel(int index) {
+  static constexpr std::uint8_t kModels[] = {8, 9, 10, 11, 3, 4, 6, 7, 12, 14, 16, 18};
+  return kModels[index % std::size(kModels)];
+}
+
+std::string uniqueCarName(std::uint8_t model_id, const std::vector<std::string>& taken) {
+  std::string base = anki::modelName(model_id);
+  std::transform(base.begin(), base.end(), base.begin(), [](unsigned char c) {
+    return c == ' ' ? '-' : static_cast<char>(std::tolower(c));
+  });
+  std::string name = base;
+  for (int n = 2; std::find(taken.begin(), taken.end(), name) != taken.end(); ++n)
+    name = base + "-" + std::to_string(n);
+  return name;
+}
+
+CarSpec gridSpec(const Track& track, int index) {
+  CarSpec spec;
+  spec.model_id = gridModel(index);
+  // The start piece (34) sits just before the finish line; rows of four go back from there.
+  std::size_t start = (track.finishIndex() + track.size() - 1) % track.size();
+  int row = index / 4;
+  spec.piece_index = (start + track.size() * (row / track.size() + 1) - row) % track.size();
+  spec.offset_mm = kLaneOffsets[index % 4];
+  spec.distance_mm = 60.0 + 20.0 * (index % 4);  // staggered a little, like a real grid
+  return spec;
+}
+
+}  // namespace pitwall::sim

@@ -1,0 +1,97 @@
+#pragma once
+// The simulated world: a track and the cars on it, stepped on the engine loop. Simulated cars
+// implement the *vehicle* side of the Anki protocol: they take controller frames and send
+// vehicle frames, encoded and decoded by the same codec the real cars' controller uses.
+// Rules (docs/simulator.md): physics tick, location codes, delocalization, collisions, battery.
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <random>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "engine/core/loop.hpp"
+#include "engine/sim/track.hpp"
+
+namespace pitwall::sim {
+
+struct CarSpec {
+  std::string name;              // user name in the advertisement
+  std::uint8_t model_id = 8;     // Groundshock
+  std::uint32_t identifier = 0;  // 0: the world assigns one
+  std::size_t piece_index = 0;   // index into track.pieces() where the car starts
+  double distance_mm = 0;        // how far into that piece (along its lane)
+  double offset_mm = 0;          // lateral offset from road centre, mm (+ right)
+  std::uint16_t version = 0x2b70;
+  std::uint16_t battery_mv = 4100;
+};
+
+struct Noise {
+  double drop = 0;          // probability that a vehicle→controller frame is lost
+  double late = 0;          // probability that one is delayed
+  Duration late_by{std::chrono::milliseconds(150)};  // upper bound of that delay
+};
+
+// Ground truth of a simulated car, for tests and the `pitwall.sim` Lua module.
+struct Truth {
+  std::size_t piece_index = 0;
+  std::uint8_t piece_id = 0;
+  double piece_distance_mm = 0;  // along the car's lane within the piece
+  double lap_distance_mm = 0;    // along the centre line from the finish line, 0..lap length
+  double offset_mm = 0;
+  double speed_mm_s = 0;
+  double target_speed_mm_s = 0;
+  int laps = 0;                  // finish lines crossed (34 → 33) while on track
+  bool on_track = true;
+  bool delocalized = false;
+  bool sdk_mode = false;
+  bool connected = false;
+  std::uint16_t battery_mv = 0;
+  int collisions = 0;
+};
+
+class SimCar {
+ public:
+  using FrameSink = std::function<void(std::span<const std::uint8_t>)>;
+  virtual ~SimCar() = default;
+
+  virtual const CarSpec& spec() const = 0;
+  virtual std::uint32_t identifier() const = 0;
+  // Manufacturer data (8 raw bytes) and local name bytes as the car would advertise them.
+  virtual std::vector<std::uint8_t> manufacturerData() const = 0;
+  virtual std::vector<std::uint8_t> localName() const = 0;
+
+  // The radio: a controller connects, frames flow, either side may drop the connection.
+  virtual void connect(FrameSink toController, std::function<void()> onDropped) = 0;
+  virtual void disconnect() = 0;  // controller side went away: the car stops
+  virtual void receive(std::span<const std::uint8_t> frame) = 0;  // controller → vehicle
+
+  virtual Truth truth() const = 0;
+  // Test hooks: lift the car off the track (it delocalizes and stops reporting) and put it back.
+  virtual void lift() = 0;
+  virtual void place(std::size_t piece_index, double offset_mm) = 0;
+};
+
+class World {
+ public:
+  static constexpr Duration kTick = std::chrono::milliseconds(5);
+
+  World(Loop& loop, Track track, std::uint64_t seed);
+  ~World();
+  World(const World&) = delete;
+  World& operator=(const World&) = delete;
+
+  const Track& track() const;
+  Loop& loop();
+  SimCar& addCar(CarSpec spec);
+  std::vector<SimCar*> cars();
+  void setNoise(Noise noise);
+  const Noise& noise() const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace pitwall::sim

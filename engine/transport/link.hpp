@@ -1,0 +1,41 @@
+#pragma once
+// A link moves frames between the controller side (a vehicle model) and one device. Links are
+// driven by the engine's one loop; callbacks run on it.
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <string>
+
+namespace pitwall {
+
+class Link {
+ public:
+  using FrameHandler = std::function<void(std::span<const std::uint8_t>)>;
+  using StateHandler = std::function<void(bool connected, const std::string& reason)>;
+
+  virtual ~Link() = default;
+  // Queues one frame to the device. Returns false (and sends nothing) when not connected.
+  virtual bool send(std::span<const std::uint8_t> frame) = 0;
+  virtual bool connected() const = 0;
+  // Asks the device side to drop the connection; the state handler reports it.
+  virtual void disconnect() = 0;
+  // A short human name of where the device is ("sim:0", "ble:AA:BB:…").
+  virtual std::string address() const = 0;
+
+  void onFrame(FrameHandler h) { frameHandler_ = std::move(h); }
+  void onState(StateHandler h) { stateHandler_ = std::move(h); }
+
+ protected:
+  void deliverFrame(std::span<const std::uint8_t> f) {
+    if (frameHandler_) frameHandler_(f);
+  }
+  void deliverState(bool up, const std::string& reason) {
+    if (stateHandler_) stateHandler_(up, reason);
+  }
+
+ private:
+  FrameHandler frameHandler_;
+  StateHandler stateHandler_;
+};
+
+}  // namespace pitwall

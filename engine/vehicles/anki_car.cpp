@@ -1,0 +1,188 @@
+#include "engine/vehicles/anki_car.hpp"
+
+#include <cmath>
+
+#include "engine/core/log.hpp"
+#include "engine/protocol/anki/advertisement.hpp"
+#include "engine/protocol/anki/limits.hpp"
+
+namespace pitwall {
+
+using namespace anki;
+
+namespace {
+// Does a number fit the field it is narrowed to? Checked before validate() sees the message so
+// that 70000 is reported as 70000, not as what it wraps to.
+std::optional<std::string> outOfField(const char* what, long long v, const char* unit, int lo,
+                                      int hi) {
+  if (v < lo || v > hi)
+    return std::string(what) + " " + std::to_string(v) + " " + unit + " is out of range " +
+           std::to_string(lo) + ".." + std::to_string(hi) + " " + unit;
+  return std::nullopt;
+}
+}  // namespace
+
+AnkiCar::AnkiCar(Loop& loop, Link& link, CarIdentity identity)
+    : loop_(loop), link_(link), identity_(std::move(identity)) {
+  link_.onFrame([this](std::span<const std::uint8_t> f) { receive(f); });
+  link_.onState([this](bool up, const std::string& why) { connectionChanged(up, why); });
+  state_.connected = link_.connected();
+}
+
+std::string AnkiCar::label() const {
+  std::string l = "car " + std::to_string(identity_.number);
+  if (!identity_.name.empty()) l += " (" + identity_.name + ")";
+  return l;
+}
+
+AnkiCar::Sent AnkiCar::send(const Message& message) {
+  if (auto problem = limits::validate(message)) return Unexpected{*problem};
+  if (!link_.connected())
+    return Unexpected{label() + " is not connected; " + std::string(name(message)) +
+                      " was not sent"};
+  Frame frame = encode(message);
+  if (!link_.send(frame.span()))
+    return Unexpected{label() + ": the link refused " + std::string(name(message))};
+  ++state_.frames_out;
+  if (onFrame) onFrame(Direction::Tx, frame.span(), message);
+  return true;
+}
+
+AnkiCar::Sent AnkiCar::setSpeed(int speed, int accel, bool respect_limit) {
+  if (auto e = outOfField("speed", speed, "mm/s", limits::kSpeedMin, limits::kSpeedMax))
+    return Unexpected{*e};
+  if (auto e = outOfField("acceleration", accel, "mm/s²", limits::kAccelMin,
+                                   limits::kAccelMax))
+    return Unexpected{*e};
+  auto sent = send(SetSpeed{static_cast<int16_t>(speed), static_cast<int16_t>(accel),
+                            respect_limit});
+  if (sent) state_.target_speed_mm_s = speed;
+  return sent;
+}
+
+AnkiCar::Sent AnkiCar::stop() { return setSpeed(0, kStopAccel); }
+
+AnkiCar::Sent AnkiCar::changeLane(double offset, int h_speed, int h_accel) {
+  if (auto e = outOfField("lane-change speed", h_speed, "mm/s", limits::kLaneSpeedMin,
+                                    limits::kLaneSpeedMax))
+    return Unexpected{*e};
+  if (auto e = outOfField("lane-change acceleration", h_accel, "mm/s²",
+                                    limits::kLaneAccelMin, limits::kLaneAccelMax))
+    return Unexpected{*e};
+  auto sent = send(ChangeLane{static_cast<uint16_t>(h_speed), static_cast<uint16_t>(h_accel),
+                              static_cast<float>(offset), 0, 0});
+  if (sent) state_.lane_change_target_mm = offset;
+  return sent;
+}
+
+AnkiCar::Sent AnkiCar::setOffset(double offset) {
+  auto sent = send(SetOffset{static_cast<float>(offset)});
+  if (sent) state_.offset_mm = offset;
+  return sent;
+}
+
+AnkiCar::Sent AnkiCar::cancelLaneChange() {
+  auto sent = send(CancelLaneChange{});
+  if (sent) state_.lane_change_target_mm.reset();
+  return sent;
+}
+
+AnkiCar::Sent AnkiCar::turn(TurnType type, TurnTrigger trigger) {
+  return send(Turn{type, trigger});
+}
+
+AnkiCar::Sent AnkiCar::lights(int mask) {
+  if (auto e = outOfField("lights mask", mask, "", 0, 255)) return Unexpected{*e};
+  return send(SetLights{static_cast<uint8_t>(mask)});
+}
+
+AnkiCar::Sent AnkiCar::lightsPattern(const LightsPattern& pattern) { return send(pattern); }
+
+AnkiCar::Sent AnkiCar::ping() {
+  auto sent = send(PingRequest{});
+  if (sent) pingSentAt_ = loop_.seconds();
+  return sent;
+}
+
+AnkiCar::Sent AnkiCar::requestBattery() { return send(BatteryRequest{}); }
+AnkiCar::Sent AnkiCar::requestVersion() { return send(VersionRequest{}); }
+AnkiCar::Sent AnkiCar::sdkMode(bool on, std::uint8_t flags) { return send(SdkMode{on, flags}); }
+
+AnkiCar::Sent AnkiCar::disconnect() {
+  if (!link_.connected()) return Unexpected{label() + " is not connected"};
+  auto sent = send(Disconnect{});
+  link_.disconnect();
+  return sent;
+}
+
+void AnkiCar::receive(std::span<const std::uint8_t> frame) {
+  auto decoded = decode(frame);
+  if (!decoded) {
+    ++state_.malformed;
+    if (onMalformed)
+      onMalformed(decoded.error(), frame);
+    else
+      log::warn(label(), "malformed frame ignored: " + decoded.error().message());
+    return;
+  }
+  ++state_.frames_in;
+  apply(*decoded);
+  if (onFrame) onFrame(Direction::Rx, frame, *decoded);
+  if (onMessage) onMessage(*decoded);
+}
+
+void AnkiCar::apply(const Message& message) {
+  // Only the messages that change what we know of the car; the rest pass through as events.
+  if (auto* p = std::get_if<PositionUpdate>(&message)) {
+    state_.prev_piece = state_.piece;
+    state_.piece = p->piece_id;
+    state_.location = p->location_id;
+    state_.offset_mm = p->offset_mm;
+    state_.speed_mm_s = p->speed_mm_s;
+    state_.reverse = (p->parsing_flags & 0x20) != 0;
+    state_.on_track = true;
+    state_.delocalized = false;
+    state_.last_position_time = loop_.seconds();
+  } else if (auto* t = std::get_if<TransitionUpdate>(&message)) {
+    state_.offset_mm = t->offset_mm;
+  } else if (auto* o = std::get_if<OffsetUpdate>(&message)) {
+    state_.offset_mm = o->offset_mm;
+    state_.lane_change_target_mm.reset();
+  } else if (std::holds_alternative<Delocalized>(message)) {
+    state_.delocalized = true;
+    state_.speed_mm_s = 0;
+  } else if (std::holds_alternative<AutoRecoverySucceeded>(message)) {
+    state_.delocalized = false;
+  } else if (auto* s = std::get_if<SpeedUpdate>(&message)) {
+    state_.speed_mm_s = s->actual_mm_s;
+  } else if (auto* b = std::get_if<BatteryResponse>(&message)) {
+    state_.battery_mv = b->millivolts;
+  } else if (auto* v = std::get_if<VersionResponse>(&message)) {
+    state_.version = v->version;
+  } else if (auto* c = std::get_if<CarStatus>(&message)) {
+    state_.on_track = c->on_track;
+    state_.on_charger = c->on_charger;
+    if (c->low_battery) state_.battery_low = *c->low_battery;
+    if (c->fully_charged) state_.battery_full = *c->fully_charged;
+  } else if (std::holds_alternative<PingResponse>(message)) {
+    if (pingSentAt_) lastPingRtt_ = loop_.seconds() - *pingSentAt_;
+    pingSentAt_.reset();
+  }
+}
+
+void AnkiCar::connectionChanged(bool up, const std::string& reason) {
+  state_.connected = up;
+  if (up) {
+    // Without SDK mode the car ignores speed and lane commands (anki-overdrive.md "GATT").
+    if (auto sent = sdkMode(true); !sent) log::warn(label(), sent.error());
+    requestVersion();
+    requestBattery();
+  } else {
+    state_.speed_mm_s = 0;
+    pingSentAt_.reset();
+  }
+  log::info(label(), up ? "connected" : "disconnected: " + reason);
+  if (onConnection) onConnection(up, reason);
+}
+
+}  // namespace pitwall

@@ -1,0 +1,109 @@
+#pragma once
+// The controller-side model of one Anki Overdrive car: its state as last reported, validated
+// commands that become frames on its link, and typed events from the frames it sends. The same
+// code serves simulated and real cars: only the Link differs.
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <span>
+#include <string>
+
+#include "engine/core/loop.hpp"
+#include "engine/core/result.hpp"
+#include "engine/protocol/anki/codec.hpp"
+#include "engine/transport/link.hpp"
+
+namespace pitwall {
+
+struct CarIdentity {
+  int number = 0;               // 1-based, in the order cars joined the run
+  std::string name;             // user name from the advertisement, or "car<n>"
+  std::uint8_t model_id = 0;
+  std::uint32_t identifier = 0;
+};
+
+struct CarState {
+  bool connected = false;
+  bool on_track = false;
+  bool on_charger = false;
+  bool delocalized = false;
+  bool reverse = false;         // parsing flag 0x20: driving backwards
+  int speed_mm_s = 0;           // as last reported
+  int target_speed_mm_s = 0;    // as last commanded
+  int piece = -1;               // road piece id, −1 before the first position update
+  int prev_piece = -1;          // piece of the position update before the last one
+  int location = -1;
+  double offset_mm = 0;         // from road centre, as the car believes it
+  std::optional<double> lane_change_target_mm;  // set while a lane change is under way
+  int battery_mv = 0;           // 0 until known
+  bool battery_low = false;
+  bool battery_full = false;
+  int version = 0;              // firmware version, 0 until known
+  double last_position_time = -1;
+  std::uint64_t frames_in = 0, frames_out = 0, malformed = 0;
+};
+
+// Command defaults (docs/lua-api.md)
+inline constexpr int kDefaultAccel = 1000;        // mm/s²
+inline constexpr int kStopAccel = 12500;          // mm/s², brisk but not a crash stop
+inline constexpr int kDefaultLaneSpeed = 300;     // mm/s
+inline constexpr int kDefaultLaneAccel = 3000;    // mm/s²
+
+class AnkiCar {
+ public:
+  using Error = std::string;
+  using Sent = Result<bool, Error>;  // true, or a sentence saying why nothing was sent
+  enum class Direction { Rx, Tx };
+
+  AnkiCar(Loop& loop, Link& link, CarIdentity identity);
+  AnkiCar(const AnkiCar&) = delete;
+  AnkiCar& operator=(const AnkiCar&) = delete;
+
+  const CarIdentity& identity() const { return identity_; }
+  const CarState& state() const { return state_; }
+  Link& link() { return link_; }
+  std::string label() const;  // "car 2 (groundshock)"
+
+  // Commands: validated; an invalid or undeliverable one is refused with a sentence.
+  Sent setSpeed(int speed_mm_s, int accel_mm_s2 = kDefaultAccel, bool respect_limit = false);
+  Sent stop();
+  Sent changeLane(double offset_mm, int h_speed_mm_s = kDefaultLaneSpeed,
+                  int h_accel_mm_s2 = kDefaultLaneAccel);
+  Sent setOffset(double offset_mm);
+  Sent cancelLaneChange();
+  Sent turn(anki::TurnType type, anki::TurnTrigger trigger = anki::TurnTrigger::Immediate);
+  Sent lights(int mask);
+  Sent lightsPattern(const anki::LightsPattern& pattern);
+  Sent ping();
+  Sent requestBattery();
+  Sent requestVersion();
+  Sent sdkMode(bool on, std::uint8_t flags = 0x01);
+  Sent disconnect();
+  // Any controller→vehicle message, validated (the CLI and bridges use this).
+  Sent send(const anki::Message& message);
+
+  // Events. Handlers are called on the loop; the message has already updated state().
+  std::function<void(const anki::Message&)> onMessage;
+  std::function<void(bool connected, const std::string& reason)> onConnection;
+  std::function<void(const anki::DecodeError&, std::span<const std::uint8_t>)> onMalformed;
+  // Round-trip time of the last ping, delivered with the ping response (seconds).
+  std::optional<double> lastPingRtt() const { return lastPingRtt_; }
+  // Every frame in and out, for recording.
+  std::function<void(Direction, std::span<const std::uint8_t>, const anki::Message&)> onFrame;
+
+  // Entry point of frames from the link (public for tests and benchmarks).
+  void receive(std::span<const std::uint8_t> frame);
+
+ private:
+  void apply(const anki::Message& message);
+  void connectionChanged(bool up, const std::string& reason);
+
+  Loop& loop_;
+  Link& link_;
+  CarIdentity identity_;
+  CarState state_;
+  std::optional<double> pingSentAt_;
+  std::optional<double> lastPingRtt_;
+};
+
+}  // namespace pitwall

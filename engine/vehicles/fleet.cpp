@@ -1,0 +1,71 @@
+#include "engine/vehicles/fleet.hpp"
+
+#include "engine/core/log.hpp"
+#include "engine/protocol/anki/advertisement.hpp"
+#include "engine/transport/sim_link.hpp"
+
+namespace pitwall {
+
+struct Fleet::Entry {
+  std::unique_ptr<Link> link;
+  std::unique_ptr<AnkiCar> car;
+  bool joined = false;
+};
+
+Fleet::Fleet(Loop& loop) : loop_(loop) {}
+Fleet::~Fleet() = default;
+
+AnkiCar& Fleet::add(std::unique_ptr<Link> link, CarIdentity identity) {
+  auto entry = std::make_unique<Entry>();
+  identity.number = static_cast<int>(entries_.size()) + 1;
+  if (identity.name.empty()) identity.name = "car" + std::to_string(identity.number);
+  entry->link = std::move(link);
+  entry->car = std::make_unique<AnkiCar>(loop_, *entry->link, std::move(identity));
+  Entry* e = entry.get();
+  AnkiCar& car = *e->car;
+  car.onConnection = [this, e](bool up, const std::string&) {
+    if (up && !e->joined) {
+      e->joined = true;
+      if (onCar) onCar(*e->car);
+    }
+  };
+  car.onFrame = [this, e](AnkiCar::Direction d, std::span<const std::uint8_t> f,
+                          const anki::Message& m) {
+    if (onFrame) onFrame(*e->car, d, f, m);
+  };
+  entries_.push_back(std::move(entry));
+  cars_.push_back(&car);
+  return car;
+}
+
+AnkiCar& Fleet::addSimulated(sim::World& world, const sim::CarSpec& spec) {
+  sim::SimCar& simCar = world.addCar(spec);
+  auto link = std::make_unique<SimLink>(loop_, simCar);
+  SimLink* raw = link.get();
+  CarIdentity id;
+  id.name = spec.name;
+  id.model_id = spec.model_id;
+  id.identifier = simCar.identifier();
+  AnkiCar& car = add(std::move(link), std::move(id));
+  raw->connect();
+  return car;
+}
+
+AnkiCar* Fleet::find(int number) const {
+  if (number < 1 || number > static_cast<int>(cars_.size())) return nullptr;
+  return cars_[number - 1];
+}
+
+std::size_t Fleet::connectedCount() const {
+  std::size_t n = 0;
+  for (auto* c : cars_) n += c->state().connected ? 1 : 0;
+  return n;
+}
+
+void Fleet::stopAll() {
+  for (auto* car : cars_)
+    if (car->state().connected)
+      if (auto sent = car->stop(); !sent) log::warn(car->label(), sent.error());
+}
+
+}  // namespace pitwall
