@@ -249,10 +249,10 @@ bool pushField(lua_State* L, const AnkiCar& car, std::string_view key) {
     if (!s.lane_change_target_mm) { lua_pushnil(L); return true; }
     return number(*s.lane_change_target_mm);
   }
-  if (key == "battery") return known(s.battery_mv > 0 ? s.battery_mv : -1);
+  if (key == "batteryLevel") return known(s.battery_mv > 0 ? s.battery_mv : -1);
   if (key == "batteryLow") return boolean(s.battery_low);
   if (key == "batteryFull") return boolean(s.battery_full);
-  if (key == "version") return known(s.version > 0 ? s.version : -1);
+  if (key == "firmware") return known(s.version > 0 ? s.version : -1);
   if (key == "lastPing") {
     if (auto rtt = car.lastPingRtt()) return number(*rtt);
     lua_pushnil(L);
@@ -271,8 +271,8 @@ bool pushField(lua_State* L, const AnkiCar& car, std::string_view key) {
 constexpr std::array<const char*, 27> kFieldNames = {
     "speed", "piece", "location", "offset", "name", "number", "model", "modelId", "identifier",
     "address", "connected", "onTrack", "onCharger", "delocalized", "reverse", "targetSpeed",
-    "prevPiece", "laneChanging", "targetOffset", "battery", "batteryLow", "batteryFull",
-    "version", "lastPing", "lastPositionTime", "frames", "malformed"};
+    "prevPiece", "laneChanging", "targetOffset", "batteryLevel", "batteryLow", "batteryFull",
+    "firmware", "lastPing", "lastPositionTime", "frames", "malformed"};
 
 bool isField(std::string_view key) {
   for (auto* f : kFieldNames)

@@ -71,14 +71,14 @@ int after(lua_State* L) {
   Duration d = checkDelay(L, 1, "pitwall.after delay", true);
   lua::checkFunction(L, 2, "pitwall.after callback");
   lua_settop(L, 2);
-  return pushTimer(L, ScriptHost::from(L).addTimer(d, std::nullopt));
+  return pushTimer(L, ScriptHost::from(L).addTimer(L, d, std::nullopt));
 }
 
 int every(lua_State* L) {
   Duration d = checkDelay(L, 1, "pitwall.every period", false);
   lua::checkFunction(L, 2, "pitwall.every callback");
   lua_settop(L, 2);
-  return pushTimer(L, ScriptHost::from(L).addTimer(d, d));
+  return pushTimer(L, ScriptHost::from(L).addTimer(L, d, d));
 }
 
 int cancelTimer(lua_State* L) {
@@ -99,7 +99,7 @@ int spawn(lua_State* L) {
       name = "task";
   }
   lua_settop(L, 1);
-  ScriptHost::from(L).spawn(name);
+  ScriptHost::from(L).spawn(L, name);
   return 0;
 }
 

@@ -134,11 +134,12 @@ void ScriptHost::reportError(const std::string& where, const std::string& messag
       lua_settop(L, top);
     }
   }
-  log::error("script", text);
   if (options_.test_mode && !failure_) {
-    failure_ = text;
+    failure_ = text;  // the test runner prints it with the scenario's result
     requestStop();
+    return;
   }
+  log::error("script", text);
 }
 
 void ScriptHost::requestStop() {
@@ -153,7 +154,7 @@ Result<bool, std::string> ScriptHost::startLoaded(int status) {
     lua_pop(L_, 1);
     return Unexpected{err};
   }
-  spawn("main chunk");
+  spawn(L_, "main chunk");
   return true;
 }
 
@@ -180,8 +181,7 @@ Result<bool, std::string> ScriptHost::startString(const std::string& code,
       luaL_loadbufferx(L_, code.data(), code.size(), ("@" + chunkname).c_str(), "t"));
 }
 
-void ScriptHost::spawn(const std::string& name) {
-  lua_State* L = L_;
+void ScriptHost::spawn(lua_State* L, const std::string& name) {
   lua_State* co = lua_newthread(L);
   int ref = luaL_ref(L, LUA_REGISTRYINDEX);  // pops the thread, keeps it alive
   lua_xmove(L, co, 1);                        // the function
@@ -245,10 +245,10 @@ void ScriptHost::resume(lua_State* co, int nargs) {
   if (wasMain && options_.test_mode) requestStop();  // a scenario ends with its main chunk
 }
 
-int ScriptHost::addTimer(Duration first, std::optional<Duration> period) {
+int ScriptHost::addTimer(lua_State* L, Duration first, std::optional<Duration> period) {
   int handle = nextTimer_++;
   Timer t;
-  t.fnRef = luaL_ref(L_, LUA_REGISTRYINDEX);
+  t.fnRef = luaL_ref(L, LUA_REGISTRYINDEX);
   t.period = period;
   t.due = loop_.now() + first;
   t.id = loop_.at(t.due, [this, handle] { fireTimer(handle); });

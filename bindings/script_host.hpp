@@ -64,13 +64,14 @@ class ScriptHost {
   // Reports a script error: to pitwall.onError if set, else the log; in test mode, a failure.
   void reportError(const std::string& where, const std::string& message);
 
-  // A task: a coroutine resumed on the loop. The function is on top of the stack.
-  void spawn(const std::string& name);
+  // A task: a coroutine resumed on the loop. The function is on top of L's stack (L: the
+  // calling thread, which may itself be a task).
+  void spawn(lua_State* L, const std::string& name);
   // Called by pitwall.sleep from inside a task: resume it after `delay`.
   void sleepCurrent(lua_State* co, Duration delay);
 
-  // Timers from Lua (pitwall.after / pitwall.every): the function is on top of the stack.
-  int addTimer(Duration first, std::optional<Duration> period);
+  // Timers from Lua (pitwall.after / pitwall.every): the function is on top of L's stack.
+  int addTimer(lua_State* L, Duration first, std::optional<Duration> period);
   bool cancelTimer(int handle);
 
   // pitwall.stop() and failures end the run through this.

@@ -1,0 +1,150 @@
+// The Lua surface of cars, driven through a CaptureLink (no simulator): what scripts see and what
+// reaches the car.
+#include "bindings/car_binding.hpp"
+
+#include <doctest/doctest.h>
+
+#include "bindings/script_host.hpp"
+#include "engine/core/log.hpp"
+#include "tests/unit/capture_link.hpp"
+
+using namespace pitwall;
+using namespace pitwall::anki;
+using pitwall::testing::CaptureLink;
+
+namespace {
+
+struct LuaFixture {
+  Loop loop{ClockKind::Virtual};
+  Fleet fleet{loop};
+  CaptureLink* link = nullptr;
+  AnkiCar* car = nullptr;
+  std::unique_ptr<ScriptHost> host;
+  std::vector<std::string> logged;
+
+  LuaFixture() {
+    auto l = std::make_unique<CaptureLink>();
+    link = l.get();
+    car = &fleet.add(std::move(l), CarIdentity{0, "skull", 9, 1});
+    link->setConnected(true);
+    link->sent.clear();
+    setenv("PITWALL_SCRIPTS", PITWALL_SOURCE_DIR "/scripts", 1);
+    host = std::make_unique<ScriptHost>(loop, fleet, nullptr, HostOptions{});
+    log::setSink([this](log::Level, std::string_view line) { logged.emplace_back(line); });
+  }
+  ~LuaFixture() { log::setSink(nullptr); }
+
+  // Runs code as a task; returns the error text, empty when it ran cleanly.
+  std::string run(const std::string& code) {
+    int before = host->errorCount();
+    auto started = host->startString(code, "test.lua");
+    if (!started) return started.error();
+    loop.run();
+    if (host->errorCount() > before) return logged.empty() ? "error" : logged.back();
+    return "";
+  }
+  double number(const char* global) {
+    lua_getglobal(host->state(), global);
+    double v = lua_tonumber(host->state(), -1);
+    lua_pop(host->state(), 1);
+    return v;
+  }
+};
+
+}  // namespace
+
+TEST_CASE_FIXTURE(LuaFixture, "a car is one Lua value: the same object every time") {
+  CHECK(run("local a = pitwall.cars()[1]; local b = pitwall.car('skull'); "
+            "assert(a == b and rawequal(a, b)); assert(tostring(a) == 'car 1 (skull)')") == "");
+}
+
+TEST_CASE_FIXTURE(LuaFixture, "setSpeed from Lua sends the frame the codec makes") {
+  CHECK(run("pitwall.cars()[1]:setSpeed(1000, 25000)") == "");
+  REQUIRE(link->sent.size() == 1);
+  CHECK(link->sent[0] == std::vector<std::uint8_t>{0x06, 0x24, 0xe8, 0x03, 0xa8, 0x61, 0x00});
+}
+
+TEST_CASE_FIXTURE(LuaFixture, "an out-of-range command raises an error naming the range, sends nothing") {
+  std::string err = run("pitwall.cars()[1]:setSpeed(5000)");
+  CHECK(err.find("test.lua:1:") != std::string::npos);
+  CHECK(err.find("0..1500") != std::string::npos);
+  CHECK(link->sent.empty());
+  CHECK(run("pitwall.cars()[1]:setSpeed('fast')").find("must be a whole number") != std::string::npos);
+  CHECK(run("pitwall.cars()[1]:turn('sideways')").find("left, right, uturn") != std::string::npos);
+}
+
+TEST_CASE_FIXTURE(LuaFixture, "onPosition receives the car and an event with the reported fields") {
+  REQUIRE(run("local car = pitwall.cars()[1]\n"
+               "car.onPosition = function(c, ev) got_piece, got_loc, got_speed, got_off, got_time ="
+               " ev.piece, ev.location, ev.speed, ev.offset, ev.time; same = (c == car) end") == "");
+  loop.after(std::chrono::seconds(2), [&] {
+    PositionUpdate p;
+    p.piece_id = 17;
+    p.location_id = 9;
+    p.speed_mm_s = 640;
+    p.offset_mm = 23.0f;
+    link->carSends(p);
+  });
+  loop.run();
+  CHECK(number("got_piece") == 17);
+  CHECK(number("got_loc") == 9);
+  CHECK(number("got_speed") == 640);
+  CHECK(number("got_off") == 23.0);
+  CHECK(number("got_time") == 2.0);
+  CHECK(run("assert(same == true); assert(pitwall.cars()[1].piece == 17)") == "");
+}
+
+TEST_CASE_FIXTURE(LuaFixture, "state fields are read-only and unknown events are refused by name") {
+  CHECK(run("pitwall.cars()[1].speed = 3").find("read-only") != std::string::npos);
+  CHECK(run("pitwall.cars()[1].onPostion = function() end").find("not an event") != std::string::npos);
+  CHECK(run("pitwall.cars()[1].onPosition = 42").find("must be a function") != std::string::npos);
+  CHECK(run("pitwall.cars()[1].setSpeed = print").find("method") != std::string::npos);
+}
+
+TEST_CASE_FIXTURE(LuaFixture, "scripts may keep their own fields on a car") {
+  CHECK(run("local c = pitwall.cars()[1]; c.laps = 3; c.laps = c.laps + 1; assert(pitwall.car(1).laps == 4)") == "");
+}
+
+TEST_CASE_FIXTURE(LuaFixture, "an error in a handler is reported with a traceback and the handler stays") {
+  REQUIRE(run("calls = 0; pitwall.cars()[1].onBattery = function() calls = calls + 1; error('flat') end") == "");
+  link->carSends(BatteryResponse{3800});
+  link->carSends(BatteryResponse{3700});
+  CHECK(number("calls") == 2);
+  CHECK(host->errorCount() == 2);
+  REQUIRE_FALSE(logged.empty());
+  CHECK(logged.back().find("onBattery handler of car 1 (skull)") != std::string::npos);
+  CHECK(logged.back().find("flat") != std::string::npos);
+  CHECK(logged.back().find("stack traceback") != std::string::npos);
+}
+
+TEST_CASE_FIXTURE(LuaFixture, "sleep works in tasks and is refused in callbacks") {
+  CHECK(run("t0 = pitwall.now(); pitwall.sleep(1.5); t1 = pitwall.now()") == "");
+  CHECK(number("t1") - number("t0") == doctest::Approx(1.5));
+  REQUIRE(run("pitwall.cars()[1].onVersion = function() pitwall.sleep(1) end") == "");
+  link->carSends(VersionResponse{0x2b70});
+  CHECK(logged.back().find("only inside a task") != std::string::npos);
+}
+
+TEST_CASE_FIXTURE(LuaFixture, "timers fire on the engine clock and can be cancelled") {
+  CHECK(run("n = 0; local t = pitwall.every(0.25, function() n = n + 1 end)\n"
+            "once = nil; pitwall.after(1, function() once = pitwall.now() end)\n"
+            "pitwall.after(1.1, function() t:cancel() end)") == "");
+  CHECK(number("n") == 4);
+  CHECK(number("once") == 1.0);
+  CHECK(run("pitwall.every(0, print)").find("> 0") != std::string::npos);
+}
+
+TEST_CASE_FIXTURE(LuaFixture, "a bare coroutine.yield in a task is an error, not a hang") {
+  CHECK(run("coroutine.yield()").find("yielded without pitwall.sleep") != std::string::npos);
+}
+
+TEST_CASE_FIXTURE(LuaFixture, "a script that fails to load names the chunk and the line") {
+  auto started = host->startString("local x = = 1", "broken.lua");
+  REQUIRE_FALSE(started);
+  CHECK(started.error().find("broken.lua:1:") != std::string::npos);
+}
+
+TEST_CASE_FIXTURE(LuaFixture, "require finds the shipped library; pitwall.sim says it needs the simulator") {
+  CHECK(run("local core = require 'pitwall.core'; assert(core == pitwall)") == "");
+  CHECK(run("require 'pitwall.sim'").find("only available") != std::string::npos);
+}

@@ -1,0 +1,118 @@
+#include "engine/vehicles/anki_car.hpp"
+
+#include <doctest/doctest.h>
+
+#include "tests/unit/capture_link.hpp"
+
+using namespace pitwall;
+using namespace pitwall::anki;
+using pitwall::testing::CaptureLink;
+
+namespace {
+struct Fixture {
+  Loop loop{ClockKind::Virtual};
+  CaptureLink link;
+  AnkiCar car{loop, link, CarIdentity{1, "skull", 9, 42}};
+};
+}  // namespace
+
+TEST_CASE_FIXTURE(Fixture, "connecting turns on SDK mode first, then asks for version and battery") {
+  link.setConnected(true);
+  REQUIRE(link.sent.size() == 3);
+  CHECK(link.sent[0] == std::vector<std::uint8_t>{0x03, 0x90, 0x01, 0x01});
+  CHECK(std::holds_alternative<VersionRequest>(*decode(link.sent[1])));
+  CHECK(std::holds_alternative<BatteryRequest>(*decode(link.sent[2])));
+  CHECK(car.state().connected);
+}
+
+TEST_CASE_FIXTURE(Fixture, "a valid setSpeed sends the drive-sdk frame and records the target") {
+  link.setConnected(true);
+  REQUIRE(car.setSpeed(1000, 25000));
+  CHECK(link.sent.back() == std::vector<std::uint8_t>{0x06, 0x24, 0xe8, 0x03, 0xa8, 0x61, 0x00});
+  CHECK(car.state().target_speed_mm_s == 1000);
+}
+
+TEST_CASE_FIXTURE(Fixture, "out-of-range commands are refused with the range and send nothing") {
+  link.setConnected(true);
+  auto before = link.sent.size();
+  auto speed = car.setSpeed(70000);
+  REQUIRE_FALSE(speed);
+  CHECK(speed.error().find("0..1500") != std::string::npos);
+  CHECK(speed.error().find("70000") != std::string::npos);
+  auto lane = car.changeLane(250);
+  REQUIRE_FALSE(lane);
+  CHECK(lane.error().find("-100") != std::string::npos);
+  CHECK_FALSE(car.lights(300));
+  CHECK(link.sent.size() == before);
+}
+
+TEST_CASE_FIXTURE(Fixture, "commands to a disconnected car fail with a sentence saying so") {
+  auto sent = car.setSpeed(500);
+  REQUIRE_FALSE(sent);
+  CHECK(sent.error().find("not connected") != std::string::npos);
+  CHECK(link.sent.empty());
+}
+
+TEST_CASE_FIXTURE(Fixture, "position updates update the state and reach onMessage") {
+  link.setConnected(true);
+  int events = 0;
+  car.onMessage = [&](const Message& m) { events += std::holds_alternative<PositionUpdate>(m); };
+  PositionUpdate p;
+  p.piece_id = 34;
+  p.location_id = 7;
+  p.offset_mm = -23.0f;
+  p.speed_mm_s = 612;
+  p.parsing_flags = 0x20;
+  link.carSends(p);
+  CHECK(events == 1);
+  CHECK(car.state().piece == 34);
+  CHECK(car.state().location == 7);
+  CHECK(car.state().offset_mm == doctest::Approx(-23.0));
+  CHECK(car.state().speed_mm_s == 612);
+  CHECK(car.state().reverse);
+  CHECK(car.state().on_track);
+}
+
+TEST_CASE_FIXTURE(Fixture, "a malformed frame is counted and reported, and the car carries on") {
+  link.setConnected(true);
+  std::string reported;
+  car.onMalformed = [&](const DecodeError& e, std::span<const std::uint8_t>) {
+    reported = e.message();
+  };
+  link.carSendsBytes({0x10, 0x27, 0x01});
+  CHECK(car.state().malformed == 1);
+  CHECK(reported.find("0x27") != std::string::npos);
+  link.carSends(BatteryResponse{3900});
+  CHECK(car.state().battery_mv == 3900);
+}
+
+TEST_CASE_FIXTURE(Fixture, "a ping's round trip is measured on the engine clock") {
+  link.setConnected(true);
+  REQUIRE(car.ping());
+  loop.after(std::chrono::milliseconds(30), [&] { link.carSends(PingResponse{}); });
+  loop.run();
+  REQUIRE(car.lastPingRtt());
+  CHECK(*car.lastPingRtt() == doctest::Approx(0.030));
+}
+
+TEST_CASE_FIXTURE(Fixture, "delocalization and car status are tracked") {
+  link.setConnected(true);
+  link.carSends(SpeedUpdate{600, 1000, 580});
+  CHECK(car.state().speed_mm_s == 580);
+  link.carSends(Delocalized{});
+  CHECK(car.state().delocalized);
+  CHECK(car.state().speed_mm_s == 0);
+  link.carSends(CarStatus{false, true, true, false});
+  CHECK_FALSE(car.state().on_track);
+  CHECK(car.state().on_charger);
+  CHECK(car.state().battery_low);
+}
+
+TEST_CASE_FIXTURE(Fixture, "a lane change is under way until the offset update arrives") {
+  link.setConnected(true);
+  REQUIRE(car.changeLane(68));
+  CHECK(car.state().lane_change_target_mm == doctest::Approx(68.0));
+  link.carSends(OffsetUpdate{68.0f, 0});
+  CHECK_FALSE(car.state().lane_change_target_mm);
+  CHECK(car.state().offset_mm == doctest::Approx(68.0));
+}
