@@ -1,0 +1,109 @@
+// What an Anki car advertises: manufacturer data in both shapes, the local name, model names.
+#include "engine/protocol/anki/advertisement.hpp"
+
+#include <doctest/doctest.h>
+
+#include <string>
+#include <vector>
+
+using namespace pitwall::anki;
+
+namespace {
+std::vector<std::uint8_t> operator""_b(const char* s, std::size_t n) {
+  return {reinterpret_cast<const std::uint8_t*>(s), reinterpret_cast<const std::uint8_t*>(s) + n};
+}
+}  // namespace
+
+TEST_CASE("eight raw manufacturer bytes give model and big-endian identifier") {
+  const std::vector<std::uint8_t> raw{0xBE, 0xEF, 0x00, 0x08, 0x12, 0x34, 0x56, 0x78};
+  const auto r = parseManufacturerData(raw);
+  REQUIRE(r.ok());
+  CHECK(r->product_id == 0xBEEF);
+  CHECK(r->model_id == 8);
+  CHECK(r->identifier == 0x12345678u);
+}
+
+TEST_CASE("BlueZ's key plus six bytes gives the same result, with the key signed or not") {
+  const std::vector<std::uint8_t> value{0x00, 0x08, 0x12, 0x34, 0x56, 0x78};
+  for (int key : {0xEFBE, -4162}) {
+    INFO("key " << key);
+    const auto r = parseManufacturerData(key, value);
+    REQUIRE(r.ok());
+    CHECK(r->product_id == 0xBEEF);
+    CHECK(r->model_id == 8);
+    CHECK(r->identifier == 0x12345678u);
+  }
+}
+
+TEST_CASE("a foreign manufacturer key is refused with the key and Anki's") {
+  const std::vector<std::uint8_t> value{0x00, 0x08, 0x12, 0x34, 0x56, 0x78};
+  const auto r = parseManufacturerData(0x004C, value);
+  REQUIRE_FALSE(r.ok());
+  CHECK(r.error().find("76") != std::string::npos);
+  CHECK(r.error().find("0xEFBE") != std::string::npos);
+}
+
+TEST_CASE("raw manufacturer data not starting with BE EF is refused") {
+  const std::vector<std::uint8_t> raw{0x4C, 0x00, 0x00, 0x08, 0x12, 0x34, 0x56, 0x78};
+  const auto r = parseManufacturerData(raw);
+  REQUIRE_FALSE(r.ok());
+  CHECK(r.error().find("0x4C00") != std::string::npos);
+  CHECK(r.error().find("0xBEEF") != std::string::npos);
+}
+
+TEST_CASE("manufacturer data too short is refused with its length") {
+  const std::vector<std::uint8_t> raw{0xBE, 0xEF, 0x00, 0x08};
+  const auto r = parseManufacturerData(raw);
+  REQUIRE_FALSE(r.ok());
+  CHECK(r.error().find("4 bytes") != std::string::npos);
+  const auto v = parseManufacturerData(0xEFBE, std::span(raw).first(3));
+  REQUIRE_FALSE(v.ok());
+  CHECK(v.error().find("3 bytes") != std::string::npos);
+}
+
+TEST_CASE("the local name gives state bits, version and the NUL-terminated user name") {
+  const auto raw = "\x50\x6e\x2b\x00\x00\x00\x00\x00Skull\x00\x00junk"_b;
+  const auto n = parseLocalName(raw);
+  CHECK(n.full_battery);
+  CHECK_FALSE(n.low_battery);
+  CHECK(n.on_charger);
+  CHECK(n.version == 0x2b6e);
+  CHECK(n.user_name == "Skull");
+}
+
+TEST_CASE("a user name without a NUL runs to the end of the data") {
+  const auto n = parseLocalName(
+      "\x20\x01\x00\x00\x00\x00\x00\x00"
+      "Drive"_b);
+  CHECK(n.low_battery);
+  CHECK_FALSE(n.full_battery);
+  CHECK(n.version == 1);
+  CHECK(n.user_name == "Drive");
+}
+
+TEST_CASE("a local name cut short gives what could be read") {
+  CHECK(parseLocalName({}).user_name.empty());
+  const auto state_only = parseLocalName("\x40"_b);
+  CHECK(state_only.on_charger);
+  CHECK(state_only.version == 0);
+  const auto no_name = parseLocalName("\x10\x6e\x2b\x00"_b);
+  CHECK(no_name.full_battery);
+  CHECK(no_name.version == 0x2b6e);
+  CHECK(no_name.user_name.empty());
+}
+
+TEST_CASE("a user name that is not valid UTF-8 is kept printable") {
+  const auto n = parseLocalName("\x00\x00\x00\x00\x00\x00\x00\x00R\xffx\xc3\xa9"_b);
+  CHECK(n.user_name == "R\xEF\xBF\xBDx\xC3\xA9");
+}
+
+TEST_CASE("model ids name the car, unknown ones print as model-n") {
+  CHECK(modelName(1) == "Kourai");
+  CHECK(modelName(8) == "Groundshock");
+  CHECK(modelName(9) == "Skull");
+  CHECK(modelName(14) == "Big Bang");
+  CHECK(modelName(20) == "Nuke Phantom");
+  CHECK(modelName(13) == "model-13");
+  CHECK(modelName(0) == "model-0");
+  CHECK(modelName(200) == "model-200");
+}
