@@ -42,6 +42,7 @@ class SimLink : public Link {
   void enqueue(std::deque<InFlight>& queue, Loop::TimerId& timer, bool toCar,
                std::span<const std::uint8_t> frame);
   void arm(std::deque<InFlight>& queue, Loop::TimerId& timer, bool toCar);
+  void deliver(std::deque<InFlight>& queue, Loop::TimerId& timer, bool toCar);
   void deliverToCar();
   void deliverToController();
   void lost(const std::string& reason);  // the connection is gone: clear, report

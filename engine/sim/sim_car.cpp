@@ -1,0 +1,440 @@
+#include "engine/sim/sim_car.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "engine/protocol/anki/codec.hpp"
+
+namespace pitwall::sim {
+
+namespace {
+
+// Rules of the simulated car (docs/simulator.md has the reasoning behind each number).
+constexpr double kMaxSpeed = 1500;          // mm/s: the fastest firmware (anki-overdrive.md)
+constexpr double kMaxAccel = 25000;         // mm/s²: taken when a set-speed asks for 0
+constexpr double kDefaultLaneSpeed = 100;   // mm/s: taken when a change-lane asks for 0
+constexpr double kDefaultLaneAccel = 1000;  // mm/s²
+constexpr double kStopDecel = 5000;         // mm/s²: a dropped connection stops the car
+constexpr double kCoastDecel = 6000;        // mm/s²: a delocalized car coasts ≈190 mm from 1500
+constexpr double kMaxLateralAccel = 9000;   // mm/s²: v²/r above this throws the car off a curve
+constexpr double kOffRoadMm = 100;          // |offset| beyond this is off the road
+constexpr double kRowWidthMm = 12;          // 16 code rows across a 192 mm road
+constexpr int kRows = 16;
+constexpr double kHalfTrackMm = 20;  // wheel distance from the car's centre line
+constexpr double kDrainMvPerMm = 500.0 / (20 * 60 * kMaxSpeed);  // 500 mV per 20 min flat out
+constexpr double kLowBatteryMv = 3600;
+constexpr double kFullBatteryMv = 4200;
+constexpr std::uint8_t kBitsRead = 0x07;  // parsing flags low nibble: 7-bit codes (§4.5.1)
+constexpr std::uint8_t kReverseDriving = 0x20;
+
+template <class... F>
+struct Overloaded : F... {
+  using F::operator()...;
+};
+template <class... F>
+Overloaded(F...) -> Overloaded<F...>;
+
+std::uint16_t clampU16(double v) {
+  return static_cast<std::uint16_t>(std::clamp(std::lround(v), 0L, 65535L));
+}
+std::uint8_t clampCm(double mm) {
+  return static_cast<std::uint8_t>(std::clamp(std::lround(mm / 10), 0L, 255L));
+}
+
+}  // namespace
+
+Car::Car(Environment& env, CarSpec spec, std::uint32_t identifier)
+    : env_(env), spec_(std::move(spec)), identifier_(identifier) {
+  piece_ = spec_.piece_index % env_.pieces.size();
+  offset_ = spec_.offset_mm;
+  double len = here().piece.length(offset_);
+  u_ = std::clamp(spec_.distance_mm / len, 0.0, std::nextafter(1.0, 0.0));
+  battery_mv_ = spec_.battery_mv;
+  low_battery_ = battery_mv_ < kLowBatteryMv;
+}
+
+Car::~Car() {
+  // The radio goes with the car: a connected controller learns that the car is gone.
+  if (sink_) drop(true);
+  if (outbox_timer_) env_.loop.cancel(outbox_timer_);
+}
+
+std::vector<std::uint8_t> Car::manufacturerData() const {
+  // [BE EF][reserved][model][identifier, big-endian] (anki-overdrive.md "Advertisement")
+  std::uint32_t id = identifier_;
+  return {0xBE,
+          0xEF,
+          0x00,
+          spec_.model_id,
+          static_cast<std::uint8_t>(id >> 24),
+          static_cast<std::uint8_t>(id >> 16),
+          static_cast<std::uint8_t>(id >> 8),
+          static_cast<std::uint8_t>(id)};
+}
+
+std::vector<std::uint8_t> Car::localName() const {
+  // [state bits][version LE][5 reserved][user name, NUL-terminated], at most 20 bytes.
+  std::vector<std::uint8_t> out(8, 0);
+  if (battery_mv_ >= kFullBatteryMv) out[0] |= 0x10;
+  if (low_battery_) out[0] |= 0x20;
+  out[1] = static_cast<std::uint8_t>(spec_.version & 0xff);
+  out[2] = static_cast<std::uint8_t>(spec_.version >> 8);
+  for (char c : spec_.name) {
+    if (out.size() >= 19) break;
+    out.push_back(static_cast<std::uint8_t>(c));
+  }
+  out.push_back(0);
+  return out;
+}
+
+// ---- the radio ----
+
+void Car::connect(FrameSink toController, std::function<void()> onDropped) {
+  if (sink_) drop(true);  // one controller at a time, as on a real car
+  sink_ = std::move(toController);
+  on_dropped_ = std::move(onDropped);
+  sdk_ = false;
+  sendStatus();
+}
+
+void Car::disconnect() {
+  drop(false);
+}
+
+void Car::drop(bool notify) {
+  if (!sink_) return;
+  stop();
+  sdk_ = false;
+  sink_ = nullptr;
+  outbox_.clear();
+  if (outbox_timer_) env_.loop.cancel(outbox_timer_);
+  outbox_timer_ = 0;
+  auto dropped = std::move(on_dropped_);
+  on_dropped_ = nullptr;
+  if (notify && dropped) dropped();
+}
+
+void Car::stop() {
+  target_ = 0;
+  accel_ = kStopDecel;
+}
+
+void Car::receive(std::span<const std::uint8_t> frame) {
+  if (!sink_) return;  // frames only arrive over a connection
+  auto decoded = anki::decode(frame);
+  if (!decoded) return;  // a real car ignores what it cannot parse
+  // Driving commands need SDK mode (anki-overdrive.md "GATT"); answers are always given.
+  const bool sdk = sdk_;
+  std::visit(
+      Overloaded{
+          [&](const anki::PingRequest&) { emit(anki::PingResponse{}); },
+          [&](const anki::VersionRequest&) { emit(anki::VersionResponse{spec_.version}); },
+          [&](const anki::BatteryRequest&) { emit(anki::BatteryResponse{clampU16(battery_mv_)}); },
+          [&](const anki::SdkMode& m) {
+            sdk_ = m.on;
+            if (sdk_) sendStatus();
+          },
+          [&](const anki::Disconnect&) { drop(true); },
+          [&](const anki::SetSpeed& m) {
+            if (!sdk) return;
+            target_ = std::clamp<double>(m.speed_mm_s, 0, kMaxSpeed);
+            accel_ = m.accel_mm_s2 > 0 ? m.accel_mm_s2 : kMaxAccel;
+            emit(anki::SpeedUpdate{static_cast<std::int16_t>(target_), m.accel_mm_s2,
+                                   static_cast<std::int16_t>(std::lround(speed_))});
+            if (target_ > 0) env_.wake();
+          },
+          [&](const anki::ChangeLane& m) {
+            if (!sdk || !std::isfinite(m.offset_mm)) return;
+            ++lane_recv_id_;
+            lane_speed_asked_ = m.h_speed_mm_s;
+            lane_speed_ = m.h_speed_mm_s > 0 ? m.h_speed_mm_s : kDefaultLaneSpeed;
+            lane_accel_ = m.h_accel_mm_s2 > 0 ? m.h_accel_mm_s2 : kDefaultLaneAccel;
+            // The target is relative to what the car believes (set-offset re-bases that belief).
+            lane_target_ = (m.offset_mm - bias_) * dir_;
+            lane_active_ = true;
+            lane_vel_ = 0;
+            env_.wake();
+          },
+          [&](const anki::CancelLaneChange&) {
+            if (!sdk) return;
+            lane_active_ = false;
+            lane_vel_ = 0;
+          },
+          [&](const anki::SetOffset& m) {
+            if (!sdk || !std::isfinite(m.offset_mm)) return;
+            bias_ = m.offset_mm - offset_ * dir_;
+          },
+          [&](const anki::Turn& m) {
+            if (!sdk || m.trigger != anki::TurnTrigger::Immediate) return;
+            if (m.type != anki::TurnType::UTurn && m.type != anki::TurnType::UTurnJump) return;
+            // Left/right turns need an intersection piece, which no simulated layout has.
+            dir_ = -dir_;
+            bias_ = -bias_;  // what was believed right of the car is now left of it
+            lane_active_ = false;
+            lane_vel_ = 0;
+          },
+          [&](const auto&) {},  // lights, config, and vehicle→controller ids: nothing to do
+      },
+      *decoded);
+}
+
+// ---- physics ----
+
+void Car::plan(double dt) {
+  if (delocalized_) {
+    speed_ = std::max(0.0, speed_ - kCoastDecel * dt);
+  } else if (speed_ < target_) {
+    speed_ = std::min(target_, speed_ + accel_ * dt);
+  } else if (speed_ > target_) {
+    speed_ = std::max(target_, speed_ - accel_ * dt);
+  }
+
+  // Lateral move toward the target lane: accelerate to the asked lateral speed, and slow down
+  // in time to arrive without overshoot. A car steers only while it rolls.
+  if (lane_active_ && !delocalized_ && speed_ > 0) {
+    double remaining = lane_target_ - offset_;
+    double dist = std::abs(remaining);
+    double v =
+        std::min({lane_speed_, lane_vel_ + lane_accel_ * dt, std::sqrt(2 * lane_accel_ * dist)});
+    double step = v * dt;
+    if (step >= dist) {
+      offset_ = lane_target_;
+      lane_active_ = false;
+      lane_vel_ = 0;
+      lane_exec_id_ = lane_recv_id_;
+      if (on_track_) emit(anki::OffsetUpdate{static_cast<float>(believedOffset()), lane_exec_id_});
+    } else {
+      offset_ += remaining > 0 ? step : -step;
+      lane_vel_ = v;
+    }
+  }
+
+  planned_lane_ = speed_ * dt;
+  planned_centre_ = planned_lane_ * here().centre_mm / here().piece.length(offset_);
+}
+
+void Car::holdAt(double centre_mm, double speed) {
+  planned_lane_ = centre_mm * here().piece.length(offset_) / here().centre_mm;
+  planned_centre_ = centre_mm;
+  speed_ = speed;
+}
+
+void Car::collided(bool rear) {
+  ++collisions_;
+  emit(anki::Collision{0, static_cast<std::uint8_t>(rear ? 1 : 0)});
+}
+
+void Car::commit() {
+  if (planned_lane_ <= 0) return;
+  move(planned_lane_);
+  if (!delocalized_) {
+    battery_mv_ -= kDrainMvPerMm * planned_lane_;
+    if (!low_battery_ && battery_mv_ < kLowBatteryMv) {
+      low_battery_ = true;
+      sendStatus();
+    }
+  }
+  checkDelocalization();
+}
+
+void Car::move(double lane_mm) {
+  const bool reporting = on_track_ && !delocalized_;
+  for (;;) {
+    const PieceInfo& p = here();
+    double len = p.piece.length(offset_);
+    double left = dir_ > 0 ? (1 - u_) * len : u_ * len;
+    double step = std::min(lane_mm, left);
+    bool crosses = step >= left;
+    double nu = crosses ? (dir_ > 0 ? 1.0 : 0.0) : u_ + dir_ * step / len;
+    if (reporting) {
+      // At most one code per tick in practice; loop in driving order to be safe.
+      for (int k = 0; k < p.codes; ++k) {
+        int idx = dir_ > 0 ? k : p.codes - 1 - k;
+        double f = p.code_at[idx];
+        if (dir_ > 0 ? (f > u_ && f <= nu) : (f < u_ && f >= nu)) sendPosition(idx);
+      }
+    }
+    // Wheels run on lanes of their own: in a curve the outer wheel travels further.
+    wheel_left_mm_ += step * p.piece.length(offset_ - kHalfTrackMm * dir_) / len;
+    wheel_right_mm_ += step * p.piece.length(offset_ + kHalfTrackMm * dir_) / len;
+    u_ = nu;
+    lane_mm -= step;
+    if (!crosses) return;
+    crossBoundary();
+    if (lane_mm <= 0) return;
+  }
+}
+
+void Car::crossBoundary() {
+  const bool reporting = on_track_ && !delocalized_;
+  if (reporting) sendTransition();
+  std::size_t n = env_.pieces.size();
+  std::size_t from = piece_;
+  piece_ = dir_ > 0 ? (piece_ + 1) % n : (piece_ + n - 1) % n;
+  u_ = dir_ > 0 ? 0.0 : 1.0;
+  wheel_left_mm_ = wheel_right_mm_ = 0;
+  // The finish line lies between 34 and 33 (anki-overdrive.md "Track").
+  if (reporting && dir_ > 0 && env_.pieces[from].piece.type == anki::PieceType::StartLong &&
+      here().piece.type == anki::PieceType::StartShort)
+    ++laps_;
+}
+
+void Car::checkDelocalization() {
+  if (!on_track_ || delocalized_) return;
+  bool off = std::abs(offset_) > kOffRoadMm;
+  bool thrown = false;
+  const Piece& p = here().piece;
+  if (p.type == anki::PieceType::Curve && speed_ > 0) {
+    double r = anki::kCurveRadiusMm + p.turn * offset_;
+    thrown = r <= 0 || speed_ * speed_ / r > kMaxLateralAccel;
+  }
+  if (off || thrown) delocalize();
+}
+
+void Car::delocalize() {
+  delocalized_ = true;
+  on_track_ = false;
+  lane_active_ = false;
+  lane_vel_ = 0;
+  emit(anki::Delocalized{});
+  sendStatus();
+}
+
+bool Car::active() const {
+  return speed_ > 0 || (target_ > 0 && on_track_ && !delocalized_);
+}
+
+double Car::lapPosition() const {
+  return here().lap_start_mm + u_ * here().centre_mm;
+}
+
+// ---- test hooks ----
+
+void Car::lift() {
+  speed_ = 0;
+  if (!on_track_) {
+    delocalized_ = true;
+    return;
+  }
+  delocalize();
+}
+
+void Car::place(std::size_t piece_index, double offset_mm) {
+  piece_ = piece_index % env_.pieces.size();
+  u_ = 0;
+  dir_ = 1;
+  offset_ = offset_mm;
+  bias_ = 0;
+  speed_ = target_ = 0;
+  lane_active_ = false;
+  lane_vel_ = 0;
+  wheel_left_mm_ = wheel_right_mm_ = 0;
+  delocalized_ = false;
+  on_track_ = true;
+  sendStatus();
+}
+
+Truth Car::truth() const {
+  Truth t;
+  t.piece_index = piece_;
+  t.piece_id = here().piece.id;
+  t.piece_distance_mm = u_ * here().piece.length(offset_);
+  t.lap_distance_mm = lapPosition();
+  t.offset_mm = offset_;
+  t.speed_mm_s = speed_;
+  t.target_speed_mm_s = target_;
+  t.laps = laps_;
+  t.on_track = on_track_;
+  t.delocalized = delocalized_;
+  t.sdk_mode = sdk_;
+  t.connected = static_cast<bool>(sink_);
+  t.battery_mv = clampU16(battery_mv_);
+  t.collisions = collisions_;
+  return t;
+}
+
+// ---- frames out ----
+
+void Car::sendStatus() {
+  emit(anki::CarStatus{on_track_, false, low_battery_, battery_mv_ >= kFullBatteryMv});
+}
+
+void Car::sendPosition(int code_index) {
+  const PieceInfo& p = here();
+  // Rows and codes are read in the car's own frame: driving backwards reverses both.
+  double drive_offset = offset_ * dir_;
+  int row = std::clamp(
+      static_cast<int>(std::floor((drive_offset + kRows / 2 * kRowWidthMm) / kRowWidthMm)), 0,
+      kRows - 1);
+  int along = dir_ > 0 ? code_index : p.codes - 1 - code_index;
+  anki::PositionUpdate m;
+  m.location_id = static_cast<std::uint8_t>(row * p.codes + along);
+  m.piece_id = p.piece.id;
+  m.offset_mm = static_cast<float>(believedOffset());
+  m.speed_mm_s = clampU16(speed_);
+  m.parsing_flags = kBitsRead | (dir_ < 0 ? kReverseDriving : 0);
+  m.last_recv_lane_change_id = lane_recv_id_;
+  m.last_exec_lane_change_id = lane_exec_id_;
+  m.last_desired_lane_change_speed_mm_s = lane_speed_asked_;
+  m.last_desired_speed_mm_s = clampU16(target_);
+  emit(m);
+}
+
+void Car::sendTransition() {
+  anki::TransitionUpdate m;
+  m.piece_idx = 0;  // always 0 on real cars (anki-overdrive.md, firmware variants)
+  m.prev_piece_idx = 0;
+  m.offset_mm = static_cast<float>(believedOffset());
+  m.last_recv_lane_change_id = lane_recv_id_;
+  m.last_exec_lane_change_id = lane_exec_id_;
+  m.last_desired_lane_change_speed_mm_s = lane_speed_asked_;
+  m.had_lane_change_activity = lane_recv_id_ != 0 ? 1 : 0;
+  m.left_wheel_distance_cm = clampCm(wheel_left_mm_);
+  m.right_wheel_distance_cm = clampCm(wheel_right_mm_);
+  emit(m);
+}
+
+double Car::uniform() {
+  // 53 random bits → [0, 1): fixed arithmetic, so every platform draws the same numbers.
+  return static_cast<double>(env_.rng() >> 11) * 0x1.0p-53;
+}
+
+void Car::emit(const anki::Message& message) {
+  if (!sink_) return;
+  const Noise& noise = env_.noise;
+  if (noise.drop > 0 && uniform() < noise.drop) return;
+  TimePoint now = env_.loop.now();
+  TimePoint due = now;
+  if (noise.late > 0 && uniform() < noise.late)
+    due += Duration(
+        static_cast<Duration::rep>(uniform() * static_cast<double>(noise.late_by.count())));
+  // BLE keeps order: a frame never overtakes one held back before it.
+  if (!outbox_.empty()) due = std::max(due, outbox_.back().due);
+  if (due == now && outbox_.empty()) {
+    anki::Frame frame = anki::encode(message);
+    sink_(frame.span());
+    return;
+  }
+  outbox_.push_back({due, anki::encode(message)});
+  if (!outbox_timer_)
+    outbox_timer_ = env_.loop.at(outbox_.front().due, [this] {
+      outbox_timer_ = 0;
+      flushOutbox();
+    });
+}
+
+void Car::flushOutbox() {
+  TimePoint now = env_.loop.now();
+  while (!outbox_.empty() && outbox_.front().due <= now) {
+    anki::Frame frame = outbox_.front().frame;
+    outbox_.pop_front();
+    if (sink_) sink_(frame.span());
+  }
+  if (!outbox_.empty() && !outbox_timer_)
+    outbox_timer_ = env_.loop.at(outbox_.front().due, [this] {
+      outbox_timer_ = 0;
+      flushOutbox();
+    });
+}
+
+}  // namespace pitwall::sim

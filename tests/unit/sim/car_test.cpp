@@ -1,0 +1,349 @@
+// The vehicle side of the protocol as a simulated car speaks it (docs/simulator.md).
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "engine/protocol/anki/codec.hpp"
+#include "engine/sim/world.hpp"
+
+using namespace pitwall;
+using namespace pitwall::sim;
+using namespace std::chrono_literals;
+
+namespace {
+
+struct Heard {
+  double t;
+  anki::Message m;
+};
+
+// One car on a track, its frames decoded and logged with their time.
+struct Rig {
+  Loop loop{ClockKind::Virtual};
+  World world;
+  SimCar& car;
+  std::vector<Heard> heard;
+  bool dropped = false;
+
+  explicit Rig(CarSpec spec = {}, std::string_view layout = "oval")
+      : world(loop, namedLayout(layout).value(), 7), car(world.addCar(std::move(spec))) {
+    car.connect(
+        [this](std::span<const std::uint8_t> f) {
+          auto m = anki::decode(f);
+          REQUIRE(m.ok());
+          heard.push_back({loop.seconds(), *m});
+        },
+        [this] { dropped = true; });
+  }
+  void send(const anki::Message& m) { car.receive(anki::encode(m).span()); }
+  void sdk() { send(anki::SdkMode{true, 1}); }
+  void runUntil(double seconds) {
+    loop.at(fromSeconds(seconds), [this] { loop.stop(); });
+    loop.run();
+  }
+  template <class T>
+  std::vector<std::pair<double, T>> all() const {
+    std::vector<std::pair<double, T>> out;
+    for (const auto& h : heard)
+      if (auto* m = std::get_if<T>(&h.m)) out.emplace_back(h.t, *m);
+    return out;
+  }
+};
+
+}  // namespace
+
+TEST_CASE("a car answers ping, version and battery requests without SDK mode") {
+  Rig rig(CarSpec{.name = "car", .version = 0x2b70, .battery_mv = 3950});
+  rig.heard.clear();
+  rig.send(anki::PingRequest{});
+  rig.send(anki::VersionRequest{});
+  rig.send(anki::BatteryRequest{});
+  REQUIRE(rig.heard.size() == 3);
+  CHECK(std::holds_alternative<anki::PingResponse>(rig.heard[0].m));
+  CHECK(std::get<anki::VersionResponse>(rig.heard[1].m).version == 0x2b70);
+  CHECK(std::get<anki::BatteryResponse>(rig.heard[2].m).millivolts == 3950);
+}
+
+TEST_CASE("a car reports its status when connected and when SDK mode goes on") {
+  Rig rig;
+  auto status = rig.all<anki::CarStatus>();
+  REQUIRE(status.size() == 1);
+  CHECK(status[0].second.on_track);
+  CHECK(status[0].second.low_battery == false);  // the long form
+  rig.sdk();
+  CHECK(rig.all<anki::CarStatus>().size() == 2);
+  CHECK(rig.car.truth().sdk_mode);
+  CHECK(rig.car.truth().connected);
+}
+
+TEST_CASE("a car ignores driving commands until SDK mode is on") {
+  Rig rig;
+  rig.send(anki::SetSpeed{600, 1000});
+  rig.send(anki::ChangeLane{100, 1000, 40.0f});
+  rig.send(anki::SetOffset{30.0f});
+  rig.send(anki::Turn{anki::TurnType::UTurn, anki::TurnTrigger::Immediate});
+  rig.runUntil(2);
+  Truth t = rig.car.truth();
+  CHECK(t.speed_mm_s == 0);
+  CHECK(t.target_speed_mm_s == 0);
+  CHECK(t.offset_mm == 0);
+  CHECK(rig.all<anki::SpeedUpdate>().empty());
+  CHECK(rig.all<anki::PositionUpdate>().empty());
+
+  rig.sdk();
+  rig.send(anki::SetSpeed{600, 1000});
+  rig.runUntil(4);
+  CHECK(rig.car.truth().speed_mm_s == 600);
+  CHECK_FALSE(rig.all<anki::PositionUpdate>().empty());
+}
+
+TEST_CASE("a stopped car sends nothing but answers") {
+  Rig rig;
+  rig.sdk();
+  rig.heard.clear();
+  rig.runUntil(30);
+  CHECK(rig.heard.empty());
+  CHECK(rig.loop.pendingTimers() == 0);  // an idle world does not tick
+}
+
+TEST_CASE("a set-speed is acknowledged with a speed update") {
+  Rig rig;
+  rig.sdk();
+  rig.send(anki::SetSpeed{800, 2000});
+  auto updates = rig.all<anki::SpeedUpdate>();
+  REQUIRE(updates.size() == 1);
+  CHECK(updates[0].second.desired_mm_s == 800);
+  CHECK(updates[0].second.accel_mm_s2 == 2000);
+  CHECK(updates[0].second.actual_mm_s == 0);
+}
+
+TEST_CASE("a car accelerates and decelerates toward the set speed at the set acceleration") {
+  Rig rig;
+  rig.sdk();
+  rig.send(anki::SetSpeed{800, 1000});
+  rig.runUntil(0.5);
+  CHECK(rig.car.truth().speed_mm_s == doctest::Approx(500).epsilon(0.011));
+  rig.runUntil(1.0);
+  CHECK(rig.car.truth().speed_mm_s == 800);
+  rig.runUntil(3.0);
+  CHECK(rig.car.truth().speed_mm_s == 800);
+  rig.send(anki::SetSpeed{200, 2000});
+  rig.runUntil(3.15);
+  CHECK(rig.car.truth().speed_mm_s == doctest::Approx(500).epsilon(0.021));
+  rig.runUntil(4.0);
+  CHECK(rig.car.truth().speed_mm_s == 200);
+}
+
+TEST_CASE("speed is capped at 1500 mm/s") {
+  Rig rig(CarSpec{.name = "car", .offset_mm = 68});  // outer lane: 1500 mm/s stays on in the curves
+  rig.sdk();
+  rig.send(anki::SetSpeed{3000, 25000});
+  rig.runUntil(1);
+  CHECK(rig.car.truth().speed_mm_s == 1500);
+  CHECK(rig.all<anki::SpeedUpdate>()[0].second.desired_mm_s == 1500);
+}
+
+TEST_CASE("a car at 600 mm/s laps the oval in lap length over speed") {
+  Rig rig;
+  rig.sdk();
+  rig.send(anki::SetSpeed{600, 25000});
+  std::vector<double> lapTimes;
+  int laps = 0;
+  // Sample truth every tick to find when each lap is counted.
+  for (double t = 0.005; t < 30; t += 0.005) {
+    rig.runUntil(t);
+    if (rig.car.truth().laps != laps) {
+      laps = rig.car.truth().laps;
+      lapTimes.push_back(rig.loop.seconds());
+    }
+  }
+  REQUIRE(lapTimes.size() >= 4);
+  double expected = rig.world.track().lapLength(0) / 600;  // ≈ 6.67 s
+  for (std::size_t i = 1; i < lapTimes.size(); ++i)
+    CHECK(lapTimes[i] - lapTimes[i - 1] == doctest::Approx(expected).epsilon(0.002));
+}
+
+TEST_CASE("position updates come every 140 to 190 mm with the location ids of the lane row") {
+  Rig rig;  // centre lane: row 8
+  rig.sdk();
+  rig.send(anki::SetSpeed{600, 25000});
+  rig.runUntil(14);
+  auto pos = rig.all<anki::PositionUpdate>();
+  REQUIRE(pos.size() > 40);
+  for (std::size_t i = 1; i < pos.size(); ++i) {
+    double mm = (pos[i].first - pos[i - 1].first) * 600;
+    CAPTURE(i);
+    CHECK(mm >= 140 - 3);  // emitted at tick time: ±3 mm at 600 mm/s
+    CHECK(mm <= 190 + 3);
+  }
+  // The location ids along one lap, piece by piece (34: 2 codes, 33: 1, others 3 per row).
+  std::vector<std::pair<int, int>> seen;
+  for (auto& [t, m] : pos) seen.emplace_back(m.piece_id, m.location_id);
+  std::vector<std::pair<int, int>> lap = {
+      {34, 16}, {34, 17}, {33, 8},  {36, 24}, {36, 25}, {36, 26}, {17, 24}, {17, 25}, {17, 26},
+      {18, 24}, {18, 25}, {18, 26}, {39, 24}, {39, 25}, {39, 26}, {40, 24}, {40, 25}, {40, 26},
+      {20, 24}, {20, 25}, {20, 26}, {23, 24}, {23, 25}, {23, 26}, {34, 16}};
+  REQUIRE(seen.size() >= lap.size());
+  CHECK(std::vector(seen.begin(), seen.begin() + lap.size()) == lap);
+  for (auto& [t, m] : pos) {
+    CHECK(m.speed_mm_s == 600);
+    CHECK(m.offset_mm == 0);
+    CHECK(m.parsing_flags == 0x07);
+    CHECK(m.last_desired_speed_mm_s == 600);
+  }
+}
+
+TEST_CASE("location ids count rows from the car's left") {
+  Rig rig(CarSpec{.name = "car", .piece_index = 2, .offset_mm = -68});
+  rig.sdk();
+  rig.send(anki::SetSpeed{400, 25000});
+  rig.runUntil(1.5);
+  auto pos = rig.all<anki::PositionUpdate>();
+  REQUIRE(pos.size() >= 3);
+  CHECK(pos[0].second.piece_id == 36);
+  CHECK(pos[0].second.location_id == 6);  // row 2 × 3 codes + first code
+  CHECK(pos[1].second.location_id == 7);
+  CHECK(pos[2].second.location_id == 8);
+}
+
+TEST_CASE("a transition update is sent at each piece boundary with the wheel distances") {
+  Rig rig;
+  rig.sdk();
+  rig.send(anki::SetSpeed{600, 25000});
+  rig.runUntil(0.2);
+  rig.heard.clear();
+  double lap = rig.world.track().lapLength(0) / 600;
+  rig.runUntil(0.2 + lap);
+  auto tr = rig.all<anki::TransitionUpdate>();
+  CHECK(tr.size() == rig.world.track().size());
+  // The car starts on 34: the boundaries are 34→33, 33→36, 36→17, 17→18, 18→39, …
+  std::vector<std::pair<int, int>> wheels;
+  for (auto& [t, m] : tr) wheels.emplace_back(m.left_wheel_distance_cm, m.right_wheel_distance_cm);
+  CHECK(wheels[1] == std::pair{22, 22});  // 33
+  CHECK(wheels[2] == std::pair{56, 56});  // the straight 36
+  // A left curve: the left wheel runs at 260 mm radius (408 mm), the right at 300 (471 mm).
+  CHECK(wheels[3] == std::pair{41, 47});
+  CHECK(wheels[4] == std::pair{41, 47});
+  CHECK(tr[0].second.offset_mm == 0);
+}
+
+TEST_CASE("a lane change moves to the target offset and reports an offset update") {
+  Rig rig;
+  rig.sdk();
+  rig.send(anki::SetSpeed{500, 25000});
+  rig.send(anki::ChangeLane{150, 1500, 68.0f});
+  rig.runUntil(0.2);
+  double mid = rig.car.truth().offset_mm;
+  CHECK(mid > 0);
+  CHECK(mid < 68);
+  CHECK(rig.all<anki::OffsetUpdate>().empty());
+  rig.runUntil(2);
+  CHECK(rig.car.truth().offset_mm == 68);
+  auto done = rig.all<anki::OffsetUpdate>();
+  REQUIRE(done.size() == 1);
+  CHECK(done[0].second.offset_mm == 68);
+  CHECK(done[0].second.lane_change_id == 1);
+  // 68 mm at ≤150 mm/s takes at least 0.45 s.
+  CHECK(done[0].first >= 0.45);
+  auto pos = rig.all<anki::PositionUpdate>();
+  CHECK(pos.back().second.offset_mm == 68);
+  CHECK(pos.back().second.last_desired_lane_change_speed_mm_s == 150);
+}
+
+TEST_CASE("set-offset re-bases what the car believes; lane changes are relative to it") {
+  Rig rig;
+  rig.sdk();
+  rig.send(anki::SetOffset{23.0f});
+  rig.send(anki::SetSpeed{500, 25000});
+  rig.send(anki::ChangeLane{200, 2000, 68.0f});
+  rig.runUntil(2);
+  CHECK(rig.car.truth().offset_mm == doctest::Approx(45));  // moved by 68 − 23
+  auto done = rig.all<anki::OffsetUpdate>();
+  REQUIRE(done.size() == 1);
+  CHECK(done[0].second.offset_mm == 68);  // as the car believes it
+}
+
+TEST_CASE("cancel lane change stops the lateral move where it is") {
+  Rig rig;
+  rig.sdk();
+  rig.send(anki::SetSpeed{500, 25000});
+  rig.send(anki::ChangeLane{100, 1000, -60.0f});
+  rig.runUntil(0.3);
+  rig.send(anki::CancelLaneChange{});
+  double there = rig.car.truth().offset_mm;
+  CHECK(there < 0);
+  rig.runUntil(2);
+  CHECK(rig.car.truth().offset_mm == there);
+  CHECK(rig.all<anki::OffsetUpdate>().empty());
+}
+
+TEST_CASE("a U-turn reverses the car: pieces run backwards and positions carry flag 0x20") {
+  Rig rig(CarSpec{.name = "car", .piece_index = 2, .distance_mm = 200, .offset_mm = -68});
+  rig.sdk();
+  rig.send(anki::SetSpeed{400, 25000});
+  rig.runUntil(0.1);
+  rig.send(anki::Turn{anki::TurnType::UTurn, anki::TurnTrigger::Immediate});
+  rig.heard.clear();
+  rig.runUntil(2.5);
+  auto pos = rig.all<anki::PositionUpdate>();
+  REQUIRE(pos.size() >= 5);
+  for (auto& [t, m] : pos) CHECK((m.parsing_flags & 0x20) == 0x20);
+  // Backwards on 36, then 33 and 34: the car is now at +68 in its own frame (row 13).
+  CHECK(pos[0].second.piece_id == 36);
+  CHECK(pos[0].second.location_id == 13 * 3 + 2);  // the first code it passed lies last
+  CHECK(pos[0].second.offset_mm == doctest::Approx(68));
+  std::vector<int> pieces;
+  for (auto& [t, m] : pos)
+    if (pieces.empty() || pieces.back() != m.piece_id) pieces.push_back(m.piece_id);
+  CHECK(pieces == std::vector<int>{36, 33, 34, 23});
+  CHECK(rig.car.truth().laps == 0);  // crossing the finish backwards is not a lap
+}
+
+TEST_CASE("battery drains while driving and low battery is reported below 3600 mV") {
+  Rig rig(CarSpec{.name = "car", .offset_mm = 68, .battery_mv = 3604});
+  rig.sdk();
+  rig.send(anki::SetSpeed{1500, 25000});
+  // 500 mV per 20 min at 1500 mm/s: 4 mV take 9.6 s.
+  rig.runUntil(9.0);
+  CHECK(rig.car.truth().battery_mv == 3600);
+  CHECK(rig.all<anki::CarStatus>().back().second.low_battery == false);
+  rig.runUntil(11.0);
+  auto status = rig.all<anki::CarStatus>();
+  CHECK(status.back().second.low_battery == true);
+  CHECK(status.back().second.on_track == true);
+  rig.send(anki::BatteryRequest{});
+  CHECK(std::get<anki::BatteryResponse>(rig.heard.back().m).millivolts == 3599);
+}
+
+TEST_CASE("a disconnect frame drops the connection and the car stops") {
+  Rig rig;
+  rig.sdk();
+  rig.send(anki::SetSpeed{800, 25000});
+  rig.runUntil(1);
+  rig.send(anki::Disconnect{});
+  CHECK(rig.dropped);
+  CHECK_FALSE(rig.car.truth().connected);
+  CHECK_FALSE(rig.car.truth().sdk_mode);
+  auto before = rig.heard.size();
+  rig.runUntil(3);
+  CHECK(rig.car.truth().speed_mm_s == 0);
+  CHECK(rig.heard.size() == before);
+}
+
+TEST_CASE("a car advertises its model, identifier, version and name") {
+  Loop loop(ClockKind::Virtual);
+  World world(loop, namedLayout("oval").value(), 1);
+  SimCar& a = world.addCar({.name = "Blue", .model_id = 9, .identifier = 0x01020304});
+  SimCar& b = world.addCar({});
+  CHECK(a.manufacturerData() ==
+        std::vector<std::uint8_t>{0xBE, 0xEF, 0x00, 9, 0x01, 0x02, 0x03, 0x04});
+  CHECK(b.identifier() != 0);
+  CHECK(b.identifier() != a.identifier());
+  auto name = a.localName();
+  REQUIRE(name.size() == 13);
+  CHECK(name[1] == 0x70);
+  CHECK(name[2] == 0x2b);
+  CHECK(std::string(name.begin() + 8, name.end() - 1) == "Blue");
+  CHECK(name.back() == 0);
+}
