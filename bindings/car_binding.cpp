@@ -3,13 +3,14 @@
 #include <cctype>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <string>
 #include <string_view>
 
 #include "bindings/lua_support.hpp"
 #include "bindings/script_host.hpp"
-#include "engine/protocol/anki/advertisement.hpp"
 #include "engine/core/log.hpp"
+#include "engine/protocol/anki/advertisement.hpp"
 #include "engine/protocol/anki/json.hpp"
 
 namespace pitwall {
@@ -22,17 +23,16 @@ namespace {
 constexpr const char* kMetatable = "pitwall.car";
 
 constexpr std::array<const char*, kCarEventCount> kEventNames = {
-    "onPosition", "onTransition", "onIntersection", "onDelocalized", "onOffset",
-    "onBattery",  "onVersion",    "onPing",         "onStatus",      "onCollision",
-    "onSpeed",    "onLaneChange", "onRecovery",     "onConnect",     "onDisconnect",
-    "onMalformed", "onMessage"};
+    "onPosition", "onTransition", "onIntersection", "onDelocalized", "onOffset", "onBattery",
+    "onVersion",  "onPing",       "onStatus",       "onCollision",   "onSpeed",  "onLaneChange",
+    "onRecovery", "onConnect",    "onDisconnect",   "onMalformed",   "onMessage"};
 
 constexpr std::array<const char*, kCarEventCount> kEventHandlerNames = {
-    "onPosition handler", "onTransition handler", "onIntersection handler",
-    "onDelocalized handler", "onOffset handler", "onBattery handler", "onVersion handler",
-    "onPing handler", "onStatus handler", "onCollision handler", "onSpeed handler",
-    "onLaneChange handler", "onRecovery handler", "onConnect handler", "onDisconnect handler",
-    "onMalformed handler", "onMessage handler"};
+    "onPosition handler", "onTransition handler", "onIntersection handler", "onDelocalized handler",
+    "onOffset handler",   "onBattery handler",    "onVersion handler",      "onPing handler",
+    "onStatus handler",   "onCollision handler",  "onSpeed handler",        "onLaneChange handler",
+    "onRecovery handler", "onConnect handler",    "onDisconnect handler",   "onMalformed handler",
+    "onMessage handler"};
 
 int eventIndex(std::string_view key) {
   for (std::size_t i = 0; i < kEventNames.size(); ++i)
@@ -53,6 +53,14 @@ struct CarBinding::Proxy {
   int selfRef = LUA_NOREF;
   std::array<int, kCarEventCount> handlers;
   std::array<int, kCarEventCount> tables;
+  // What the reused onPosition / onTransition tables hold now: a field is written only when its
+  // value changed (at a steady speed a position event rewrites just time and location). This is
+  // why event tables are read-only for scripts (docs/lua-api.md).
+  struct Written {
+    std::array<double, 6> value;
+    Written() { value.fill(std::numeric_limits<double>::quiet_NaN()); }
+  };
+  Written position, transition;
   Proxy() {
     handlers.fill(LUA_NOREF);
     tables.fill(LUA_NOREF);
@@ -77,7 +85,9 @@ int setSpeed(lua_State* L) {
   auto speed = lua::checkInteger(L, 2, "speed (mm/s)");
   auto accel = lua::optInteger(L, 3, "acceleration (mm/s²)", kDefaultAccel);
   bool limit = lua_toboolean(L, 4);
-  auto clamp = [](long long v) { return static_cast<int>(std::max(-1000000LL, std::min(v, 1000000LL))); };
+  auto clamp = [](long long v) {
+    return static_cast<int>(std::max(-1000000LL, std::min(v, 1000000LL)));
+  };
   raiseIfRefused(car.setSpeed(clamp(speed), clamp(accel), limit));
   return 0;
 }
@@ -90,7 +100,9 @@ int changeLane(lua_State* L) {
   double offset = lua::checkNumber(L, 2, "offset (mm)");
   auto speed = lua::optInteger(L, 3, "lane-change speed (mm/s)", kDefaultLaneSpeed);
   auto accel = lua::optInteger(L, 4, "lane-change acceleration (mm/s²)", kDefaultLaneAccel);
-  auto clamp = [](long long v) { return static_cast<int>(std::max(-1000000LL, std::min(v, 1000000LL))); };
+  auto clamp = [](long long v) {
+    return static_cast<int>(std::max(-1000000LL, std::min(v, 1000000LL)));
+  };
   raiseIfRefused(car.changeLane(offset, clamp(speed), clamp(accel)));
   return 0;
 }
@@ -112,16 +124,26 @@ int turn(lua_State* L) {
   std::string type = lua::checkString(L, 2, "turn type");
   std::string trigger = lua_isnoneornil(L, 3) ? "immediate" : lua::checkString(L, 3, "trigger");
   TurnType t;
-  if (type == "left") t = TurnType::Left;
-  else if (type == "right") t = TurnType::Right;
-  else if (type == "uturn") t = TurnType::UTurn;
-  else if (type == "uturn-jump") t = TurnType::UTurnJump;
-  else if (type == "none") t = TurnType::None;
-  else throw LuaError("turn type '" + type + "' is unknown; use left, right, uturn, uturn-jump or none");
+  if (type == "left")
+    t = TurnType::Left;
+  else if (type == "right")
+    t = TurnType::Right;
+  else if (type == "uturn")
+    t = TurnType::UTurn;
+  else if (type == "uturn-jump")
+    t = TurnType::UTurnJump;
+  else if (type == "none")
+    t = TurnType::None;
+  else
+    throw LuaError("turn type '" + type +
+                   "' is unknown; use left, right, uturn, uturn-jump or none");
   TurnTrigger g;
-  if (trigger == "immediate") g = TurnTrigger::Immediate;
-  else if (trigger == "intersection") g = TurnTrigger::Intersection;
-  else throw LuaError("turn trigger '" + trigger + "' is unknown; use immediate or intersection");
+  if (trigger == "immediate")
+    g = TurnTrigger::Immediate;
+  else if (trigger == "intersection")
+    g = TurnTrigger::Intersection;
+  else
+    throw LuaError("turn trigger '" + trigger + "' is unknown; use immediate or intersection");
   raiseIfRefused(car.turn(t, g));
   return 0;
 }
@@ -171,8 +193,9 @@ int nameOrNumber(lua_State* L, int idx, const char* what, std::initializer_list<
 int lightsPattern(lua_State* L) {
   AnkiCar& car = CarBinding::check(L, 1);
   if (!lua_istable(L, 2))
-    throw LuaError("lightsPattern takes a list of up to 3 channels, e.g. "
-                   "{{channel='red', effect='throb', from=0, to=14, cycles=5}}");
+    throw LuaError(
+        "lightsPattern takes a list of up to 3 channels, e.g. "
+        "{{channel='red', effect='throb', from=0, to=14, cycles=5}}");
   LightsPattern p;
   auto n = luaL_len(L, 2);
   if (n < 1 || n > 3)
@@ -181,21 +204,26 @@ int lightsPattern(lua_State* L) {
   for (int i = 1; i <= n; ++i) {
     lua_geti(L, 2, i);
     int t = lua_gettop(L);
-    if (!lua_istable(L, t)) throw LuaError("lightsPattern channel " + std::to_string(i) + " must be a table");
+    if (!lua_istable(L, t))
+      throw LuaError("lightsPattern channel " + std::to_string(i) + " must be a table");
     auto& c = p.channels[i - 1];
     lua_getfield(L, t, "channel");
     c.channel = static_cast<uint8_t>(nameOrNumber(
         L, -1, "channel", {"red", "tail", "blue", "green", "front-left", "front-right"}, 5));
     lua_getfield(L, t, "effect");
     c.effect = static_cast<uint8_t>(
-        lua_isnil(L, -1) ? 0
-                         : nameOrNumber(L, -1, "effect", {"steady", "fade", "throb", "flash", "random"}, 4));
+        lua_isnil(L, -1)
+            ? 0
+            : nameOrNumber(L, -1, "effect", {"steady", "fade", "throb", "flash", "random"}, 4));
     lua_getfield(L, t, "from");
-    c.start = static_cast<uint8_t>(lua_isnil(L, -1) ? 0 : nameOrNumber(L, -1, "from (intensity)", {}, 14));
+    c.start = static_cast<uint8_t>(
+        lua_isnil(L, -1) ? 0 : nameOrNumber(L, -1, "from (intensity)", {}, 14));
     lua_getfield(L, t, "to");
-    c.end = static_cast<uint8_t>(lua_isnil(L, -1) ? c.start : nameOrNumber(L, -1, "to (intensity)", {}, 14));
+    c.end = static_cast<uint8_t>(lua_isnil(L, -1) ? c.start
+                                                  : nameOrNumber(L, -1, "to (intensity)", {}, 14));
     lua_getfield(L, t, "cycles");
-    c.cycles_per_10s = static_cast<uint8_t>(lua_isnil(L, -1) ? 0 : nameOrNumber(L, -1, "cycles (per 10 s)", {}, 255));
+    c.cycles_per_10s = static_cast<uint8_t>(
+        lua_isnil(L, -1) ? 0 : nameOrNumber(L, -1, "cycles (per 10 s)", {}, 255));
     lua_settop(L, t - 1);
   }
   raiseIfRefused(car.lightsPattern(p));
@@ -222,11 +250,29 @@ int disconnect(lua_State* L) {
 bool pushField(lua_State* L, const AnkiCar& car, std::string_view key) {
   const CarState& s = car.state();
   const CarIdentity& id = car.identity();
-  auto integer = [&](long long v) { lua_pushinteger(L, v); return true; };
-  auto number = [&](double v) { lua_pushnumber(L, v); return true; };
-  auto boolean = [&](bool v) { lua_pushboolean(L, v); return true; };
-  auto string = [&](const std::string& v) { lua_pushlstring(L, v.data(), v.size()); return true; };
-  auto known = [&](long long v) { if (v < 0) { lua_pushnil(L); return true; } return integer(v); };
+  auto integer = [&](long long v) {
+    lua_pushinteger(L, v);
+    return true;
+  };
+  auto number = [&](double v) {
+    lua_pushnumber(L, v);
+    return true;
+  };
+  auto boolean = [&](bool v) {
+    lua_pushboolean(L, v);
+    return true;
+  };
+  auto string = [&](const std::string& v) {
+    lua_pushlstring(L, v.data(), v.size());
+    return true;
+  };
+  auto known = [&](long long v) {
+    if (v < 0) {
+      lua_pushnil(L);
+      return true;
+    }
+    return integer(v);
+  };
   if (key == "speed") return integer(s.speed_mm_s);
   if (key == "piece") return known(s.piece);
   if (key == "location") return known(s.location);
@@ -246,7 +292,10 @@ bool pushField(lua_State* L, const AnkiCar& car, std::string_view key) {
   if (key == "prevPiece") return known(s.prev_piece);
   if (key == "laneChanging") return boolean(s.lane_change_target_mm.has_value());
   if (key == "targetOffset") {
-    if (!s.lane_change_target_mm) { lua_pushnil(L); return true; }
+    if (!s.lane_change_target_mm) {
+      lua_pushnil(L);
+      return true;
+    }
     return number(*s.lane_change_target_mm);
   }
   if (key == "batteryLevel") return known(s.battery_mv > 0 ? s.battery_mv : -1);
@@ -269,10 +318,12 @@ bool pushField(lua_State* L, const AnkiCar& car, std::string_view key) {
 }
 
 constexpr std::array<const char*, 27> kFieldNames = {
-    "speed", "piece", "location", "offset", "name", "number", "model", "modelId", "identifier",
-    "address", "connected", "onTrack", "onCharger", "delocalized", "reverse", "targetSpeed",
-    "prevPiece", "laneChanging", "targetOffset", "batteryLevel", "batteryLow", "batteryFull",
-    "firmware", "lastPing", "lastPositionTime", "frames", "malformed"};
+    "speed",       "piece",       "location",     "offset",       "name",
+    "number",      "model",       "modelId",      "identifier",   "address",
+    "connected",   "onTrack",     "onCharger",    "delocalized",  "reverse",
+    "targetSpeed", "prevPiece",   "laneChanging", "targetOffset", "batteryLevel",
+    "batteryLow",  "batteryFull", "firmware",     "lastPing",     "lastPositionTime",
+    "frames",      "malformed"};
 
 bool isField(std::string_view key) {
   for (auto* f : kFieldNames)
@@ -289,7 +340,8 @@ int index(lua_State* L) {
   if (lua_type(L, 2) == LUA_TSTRING) {
     std::string_view key = lua_tostring(L, 2);
     if (key == "frames") {
-      lua_pushinteger(L, static_cast<lua_Integer>(p.car->state().frames_in + p.car->state().frames_out));
+      lua_pushinteger(
+          L, static_cast<lua_Integer>(p.car->state().frames_in + p.car->state().frames_out));
       return 1;
     }
     if (key == "malformed") {
@@ -359,21 +411,20 @@ CarBinding::~CarBinding() {
 }
 
 void CarBinding::registerType(lua_State* L) {
-  static const luaL_Reg methods[] = {
-      {"setSpeed", lua::guarded<setSpeed>},
-      {"stop", lua::guarded<stop>},
-      {"changeLane", lua::guarded<changeLane>},
-      {"setOffset", lua::guarded<setOffset>},
-      {"cancelLaneChange", lua::guarded<cancelLaneChange>},
-      {"uturn", lua::guarded<uturn>},
-      {"turn", lua::guarded<turn>},
-      {"lights", lua::guarded<lights>},
-      {"lightsPattern", lua::guarded<lightsPattern>},
-      {"ping", lua::guarded<ping>},
-      {"battery", lua::guarded<battery>},
-      {"version", lua::guarded<version>},
-      {"disconnect", lua::guarded<disconnect>},
-      {nullptr, nullptr}};
+  static const luaL_Reg methods[] = {{"setSpeed", lua::guarded<setSpeed>},
+                                     {"stop", lua::guarded<stop>},
+                                     {"changeLane", lua::guarded<changeLane>},
+                                     {"setOffset", lua::guarded<setOffset>},
+                                     {"cancelLaneChange", lua::guarded<cancelLaneChange>},
+                                     {"uturn", lua::guarded<uturn>},
+                                     {"turn", lua::guarded<turn>},
+                                     {"lights", lua::guarded<lights>},
+                                     {"lightsPattern", lua::guarded<lightsPattern>},
+                                     {"ping", lua::guarded<ping>},
+                                     {"battery", lua::guarded<battery>},
+                                     {"version", lua::guarded<version>},
+                                     {"disconnect", lua::guarded<disconnect>},
+                                     {nullptr, nullptr}};
   luaL_newmetatable(L, kMetatable);
   luaL_newlib(L, methods);
   lua_pushvalue(L, -1);
@@ -390,7 +441,9 @@ void CarBinding::registerType(lua_State* L) {
   lua_pop(L, 1);
 }
 
-AnkiCar& CarBinding::check(lua_State* L, int idx) { return *proxyAt(L, idx).car; }
+AnkiCar& CarBinding::check(lua_State* L, int idx) {
+  return *proxyAt(L, idx).car;
+}
 
 void CarBinding::bind(AnkiCar& car) {
   if (proxies_.count(&car)) return;
@@ -477,23 +530,42 @@ void CarBinding::dispatch(Proxy& p, const Message& m) {
     lua_pushboolean(L, v);
     lua_setfield(L, -2, k);
   };
+  // Writes field `k` (slot `i` of `w`) only when it differs from what the table holds.
+  auto changedI = [L](Proxy::Written& w, int i, const char* k, lua_Integer v) {
+    if (w.value[i] == static_cast<double>(v)) return;
+    w.value[i] = static_cast<double>(v);
+    lua_pushinteger(L, v);
+    lua_setfield(L, -2, k);
+  };
+  auto changedN = [L](Proxy::Written& w, int i, const char* k, double v) {
+    if (w.value[i] == v) return;
+    w.value[i] = v;
+    lua_pushnumber(L, v);
+    lua_setfield(L, -2, k);
+  };
   if (auto* pos = std::get_if<PositionUpdate>(&m)) {
     if (begin(p, CarEvent::Position)) {
-      setI("piece", pos->piece_id);
-      setI("location", pos->location_id);
-      setN("offset", pos->offset_mm);
-      setI("speed", pos->speed_mm_s);
-      setB("reverse", (pos->parsing_flags & 0x20) != 0);
+      Proxy::Written& w = p.position;
+      changedI(w, 0, "location", pos->location_id);
+      changedI(w, 1, "piece", pos->piece_id);
+      changedI(w, 2, "speed", pos->speed_mm_s);
+      changedN(w, 3, "offset", pos->offset_mm);
+      bool reverse = (pos->parsing_flags & 0x20) != 0;
+      if (w.value[4] != (reverse ? 1.0 : 0.0)) {
+        w.value[4] = reverse ? 1.0 : 0.0;
+        setB("reverse", reverse);
+      }
       finish(p, CarEvent::Position);
     }
   } else if (auto* t = std::get_if<TransitionUpdate>(&m)) {
     if (begin(p, CarEvent::Transition)) {
-      setN("offset", t->offset_mm);
-      setI("leftWheel", t->left_wheel_distance_cm);
-      setI("rightWheel", t->right_wheel_distance_cm);
-      setI("drift", t->average_follow_line_drift_px);
-      setI("uphill", t->uphill_counter);
-      setI("downhill", t->downhill_counter);
+      Proxy::Written& w = p.transition;
+      changedN(w, 0, "offset", t->offset_mm);
+      changedI(w, 1, "leftWheel", t->left_wheel_distance_cm);
+      changedI(w, 2, "rightWheel", t->right_wheel_distance_cm);
+      changedI(w, 3, "drift", t->average_follow_line_drift_px);
+      changedI(w, 4, "uphill", t->uphill_counter);
+      changedI(w, 5, "downhill", t->downhill_counter);
       finish(p, CarEvent::Transition);
     }
   } else if (auto* i = std::get_if<IntersectionUpdate>(&m)) {
@@ -578,10 +650,14 @@ void CarBinding::dispatch(Proxy& p, const Message& m) {
     nlohmann::json j = toJson(m);
     lua_createtable(L, 0, static_cast<int>(j.size()) + 1);
     for (auto& [k, v] : j.items()) {
-      if (v.is_boolean()) lua_pushboolean(L, v.get<bool>());
-      else if (v.is_number_integer()) lua_pushinteger(L, v.get<lua_Integer>());
-      else if (v.is_number()) lua_pushnumber(L, v.get<double>());
-      else lua_pushstring(L, v.is_string() ? v.get<std::string>().c_str() : v.dump().c_str());
+      if (v.is_boolean())
+        lua_pushboolean(L, v.get<bool>());
+      else if (v.is_number_integer())
+        lua_pushinteger(L, v.get<lua_Integer>());
+      else if (v.is_number())
+        lua_pushnumber(L, v.get<double>());
+      else
+        lua_pushstring(L, v.is_string() ? v.get<std::string>().c_str() : v.dump().c_str());
       lua_setfield(L, -2, k.c_str());
     }
     setN("time", host_.loop().seconds());

@@ -15,8 +15,23 @@ namespace pitwall {
 class ScriptHost;
 
 enum class CarEvent {
-  Position, Transition, Intersection, Delocalized, Offset, Battery, Version, Ping, Status,
-  Collision, Speed, LaneChange, Recovery, Connect, Disconnect, Malformed, Message,
+  Position,
+  Transition,
+  Intersection,
+  Delocalized,
+  Offset,
+  Battery,
+  Version,
+  Ping,
+  Status,
+  Collision,
+  Speed,
+  LaneChange,
+  Recovery,
+  Connect,
+  Disconnect,
+  Malformed,
+  Message,
   Count_
 };
 inline constexpr std::size_t kCarEventCount = static_cast<std::size_t>(CarEvent::Count_);

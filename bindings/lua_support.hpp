@@ -35,13 +35,14 @@ int guarded(lua_State* L) {
   return results;
 }
 
-inline std::string typeName(lua_State* L, int idx) { return luaL_typename(L, idx); }
+inline std::string typeName(lua_State* L, int idx) {
+  return luaL_typename(L, idx);
+}
 
 inline double checkNumber(lua_State* L, int idx, const char* what) {
   int isnum = 0;
   double v = lua_tonumberx(L, idx, &isnum);
-  if (!isnum)
-    throw LuaError(std::string(what) + " must be a number, got " + typeName(L, idx));
+  if (!isnum) throw LuaError(std::string(what) + " must be a number, got " + typeName(L, idx));
   if (!std::isfinite(v)) throw LuaError(std::string(what) + " must be a finite number");
   return v;
 }

@@ -168,13 +168,17 @@ void openPitwallModule(ScriptHost& host) {
   lua_setfield(L, -2, "__tostring");
   lua_pop(L, 1);
 
-  static const luaL_Reg functions[] = {
-      {"cars", lua::guarded<cars>},   {"car", lua::guarded<car>},
-      {"now", now},                   {"after", lua::guarded<after>},
-      {"every", lua::guarded<every>}, {"cancel", lua::guarded<cancelTimer>},
-      {"spawn", lua::guarded<spawn>}, {"sleep", sleep},
-      {"stop", stop},                 {"log", lua::guarded<logBody>},
-      {nullptr, nullptr}};
+  static const luaL_Reg functions[] = {{"cars", lua::guarded<cars>},
+                                       {"car", lua::guarded<car>},
+                                       {"now", now},
+                                       {"after", lua::guarded<after>},
+                                       {"every", lua::guarded<every>},
+                                       {"cancel", lua::guarded<cancelTimer>},
+                                       {"spawn", lua::guarded<spawn>},
+                                       {"sleep", sleep},
+                                       {"stop", stop},
+                                       {"log", lua::guarded<logBody>},
+                                       {nullptr, nullptr}};
   luaL_newlib(L, functions);
   lua_pushboolean(L, host.loop().clockKind() == ClockKind::Virtual);
   lua_setfield(L, -2, "virtualTime");

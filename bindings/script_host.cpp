@@ -57,7 +57,9 @@ ScriptHost::~ScriptHost() {
   lua_close(L_);
 }
 
-ScriptHost& ScriptHost::from(lua_State* L) { return **static_cast<ScriptHost**>(lua_getextraspace(L)); }
+ScriptHost& ScriptHost::from(lua_State* L) {
+  return **static_cast<ScriptHost**>(lua_getextraspace(L));
+}
 
 void ScriptHost::openLibraries() {
   lua_State* L = L_;
@@ -184,7 +186,7 @@ Result<bool, std::string> ScriptHost::startString(const std::string& code,
 void ScriptHost::spawn(lua_State* L, const std::string& name) {
   lua_State* co = lua_newthread(L);
   int ref = luaL_ref(L, LUA_REGISTRYINDEX);  // pops the thread, keeps it alive
-  lua_xmove(L, co, 1);                        // the function
+  lua_xmove(L, co, 1);                       // the function
   tasks_.emplace(co, Task{ref, name, std::nullopt});
   if (name == "main chunk") mainTask_ = co;
   resume(co, 0);

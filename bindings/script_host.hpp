@@ -29,8 +29,8 @@ struct SimSession {
 };
 
 struct HostOptions {
-  bool test_mode = false;       // callback errors fail the run; `expect` helpers loaded
-  std::uint64_t seed = 1;       // math.randomseed
+  bool test_mode = false;                  // callback errors fail the run; `expect` helpers loaded
+  std::uint64_t seed = 1;                  // math.randomseed
   std::vector<std::string> library_paths;  // extra folders searched by require
 };
 

@@ -17,7 +17,9 @@ using lua::LuaError;
 
 namespace {
 
-SimSession& session(lua_State* L) { return *ScriptHost::from(L).sim(); }
+SimSession& session(lua_State* L) {
+  return *ScriptHost::from(L).sim();
+}
 
 sim::SimCar& simCarOf(lua_State* L, int idx) {
   AnkiCar& car = CarBinding::check(L, idx);
@@ -39,7 +41,8 @@ std::uint8_t modelFromLua(lua_State* L, int idx) {
     throw LuaError("model '" + want + "' is unknown (try groundshock, skull, thermo, nuke, …)");
   }
   auto id = lua::checkInteger(L, idx, "model");
-  if (id < 0 || id > 255) throw LuaError("model id " + std::to_string(id) + " is out of range 0..255");
+  if (id < 0 || id > 255)
+    throw LuaError("model id " + std::to_string(id) + " is out of range 0..255");
   return static_cast<std::uint8_t>(id);
 }
 
@@ -128,31 +131,35 @@ int addCar(lua_State* L) {
     spec.distance_mm = lua::checkNumber(L, -1, "distance (mm into the piece)");
     double len = track.piece(spec.piece_index).length(spec.offset_mm);
     if (spec.distance_mm < 0 || spec.distance_mm >= len)
-      throw LuaError("distance " + std::to_string(spec.distance_mm) + " mm is outside the piece (0.." +
-                     std::to_string(len) + " mm)");
+      throw LuaError("distance " + std::to_string(spec.distance_mm) +
+                     " mm is outside the piece (0.." + std::to_string(len) + " mm)");
   }
   lua_pop(L, 1);
   if (lua_getfield(L, 1, "lane") != LUA_TNIL) {
     auto lane = lua::checkInteger(L, -1, "lane");
-    if (lane < 1 || lane > 4) throw LuaError("lane " + std::to_string(lane) + " is out of range 1..4 (1 is leftmost)");
+    if (lane < 1 || lane > 4)
+      throw LuaError("lane " + std::to_string(lane) + " is out of range 1..4 (1 is leftmost)");
     spec.offset_mm = sim::kLaneOffsets[lane - 1];
   }
   lua_pop(L, 1);
   if (lua_getfield(L, 1, "offset") != LUA_TNIL) {
     spec.offset_mm = lua::checkNumber(L, -1, "offset (mm)");
     if (spec.offset_mm < -100 || spec.offset_mm > 100)
-      throw LuaError("offset " + std::to_string(spec.offset_mm) + " mm is off the road (-100..100 mm)");
+      throw LuaError("offset " + std::to_string(spec.offset_mm) +
+                     " mm is off the road (-100..100 mm)");
   }
   lua_pop(L, 1);
   if (lua_getfield(L, 1, "battery") != LUA_TNIL) {
     auto mv = lua::checkInteger(L, -1, "battery (mV)");
-    if (mv < 3000 || mv > 4300) throw LuaError("battery " + std::to_string(mv) + " mV is out of range 3000..4300 mV");
+    if (mv < 3000 || mv > 4300)
+      throw LuaError("battery " + std::to_string(mv) + " mV is out of range 3000..4300 mV");
     spec.battery_mv = static_cast<std::uint16_t>(mv);
   }
   lua_pop(L, 1);
   if (lua_getfield(L, 1, "version") != LUA_TNIL) {
     auto v = lua::checkInteger(L, -1, "version");
-    if (v < 0 || v > 0xffff) throw LuaError("version " + std::to_string(v) + " is out of range 0..0xffff");
+    if (v < 0 || v > 0xffff)
+      throw LuaError("version " + std::to_string(v) + " is out of range 0..0xffff");
     spec.version = static_cast<std::uint16_t>(v);
   }
   lua_pop(L, 1);
@@ -175,9 +182,18 @@ int addCar(lua_State* L) {
 int truth(lua_State* L) {
   sim::Truth t = simCarOf(L, 1).truth();
   lua_createtable(L, 0, 16);
-  auto setI = [L](const char* k, lua_Integer v) { lua_pushinteger(L, v); lua_setfield(L, -2, k); };
-  auto setN = [L](const char* k, double v) { lua_pushnumber(L, v); lua_setfield(L, -2, k); };
-  auto setB = [L](const char* k, bool v) { lua_pushboolean(L, v); lua_setfield(L, -2, k); };
+  auto setI = [L](const char* k, lua_Integer v) {
+    lua_pushinteger(L, v);
+    lua_setfield(L, -2, k);
+  };
+  auto setN = [L](const char* k, double v) {
+    lua_pushnumber(L, v);
+    lua_setfield(L, -2, k);
+  };
+  auto setB = [L](const char* k, bool v) {
+    lua_pushboolean(L, v);
+    lua_setfield(L, -2, k);
+  };
   setI("pieceIndex", static_cast<lua_Integer>(t.piece_index) + 1);
   setI("piece", t.piece_id);
   setN("pieceDistance", t.piece_distance_mm);
@@ -205,7 +221,8 @@ int place(lua_State* L) {
   const sim::Track& track = session(L).world->track();
   auto piece = lua::checkInteger(L, 2, "piece (index into the track, from 1)");
   if (piece < 1 || piece > static_cast<long long>(track.size()))
-    throw LuaError("piece " + std::to_string(piece) + " is out of range 1.." + std::to_string(track.size()));
+    throw LuaError("piece " + std::to_string(piece) + " is out of range 1.." +
+                   std::to_string(track.size()));
   double offset = lua::optNumber(L, 3, "offset (mm)", 0);
   if (offset < -100 || offset > 100)
     throw LuaError("offset " + std::to_string(offset) + " mm is off the road (-100..100 mm)");
@@ -221,7 +238,9 @@ int noise(lua_State* L) {
     auto prob = [L](const char* key, double& out) {
       if (lua_getfield(L, 1, key) != LUA_TNIL) {
         double v = lua::checkNumber(L, -1, key);
-        if (v < 0 || v > 1) throw LuaError(std::string("noise ") + key + " " + std::to_string(v) + " is out of range 0..1 (a probability)");
+        if (v < 0 || v > 1)
+          throw LuaError(std::string("noise ") + key + " " + std::to_string(v) +
+                         " is out of range 0..1 (a probability)");
         out = v;
       }
       lua_pop(L, 1);
@@ -230,7 +249,8 @@ int noise(lua_State* L) {
     prob("late", n.late);
     if (lua_getfield(L, 1, "lateBy") != LUA_TNIL) {
       double v = lua::checkNumber(L, -1, "lateBy (s)");
-      if (v < 0 || v > 10) throw LuaError("noise lateBy " + std::to_string(v) + " s is out of range 0..10 s");
+      if (v < 0 || v > 10)
+        throw LuaError("noise lateBy " + std::to_string(v) + " s is out of range 0..10 s");
       n.late_by = fromSeconds(v);
     }
     lua_pop(L, 1);

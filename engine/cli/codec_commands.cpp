@@ -31,8 +31,10 @@ Result<std::vector<std::uint8_t>, std::string> parseHex(const std::vector<std::s
         return Unexpected{std::string("'") + c + "' is not a hex digit in \"" + w + "\""};
     }
   }
-  if (digits.empty()) return Unexpected{std::string("no bytes given; write them as hex, e.g. \"01 17\"")};
-  if (digits.size() % 2) return Unexpected{"odd number of hex digits (" + std::to_string(digits.size()) + ")"};
+  if (digits.empty())
+    return Unexpected{std::string("no bytes given; write them as hex, e.g. \"01 17\"")};
+  if (digits.size() % 2)
+    return Unexpected{"odd number of hex digits (" + std::to_string(digits.size()) + ")"};
   std::vector<std::uint8_t> bytes;
   for (std::size_t i = 0; i < digits.size(); i += 2)
     bytes.push_back(static_cast<std::uint8_t>(std::stoi(digits.substr(i, 2), nullptr, 16)));
@@ -43,7 +45,8 @@ Result<std::vector<std::uint8_t>, std::string> parseHex(const std::vector<std::s
 
 int decode(const std::string& protocol, const std::vector<std::string>& hex) {
   if (protocol != "anki") {
-    std::cerr << "pitwall decode: unknown protocol '" << protocol << "'; known: " << kProtocols << "\n";
+    std::cerr << "pitwall decode: unknown protocol '" << protocol << "'; known: " << kProtocols
+              << "\n";
     return 2;
   }
   auto bytes = parseHex(hex);
@@ -62,7 +65,8 @@ int decode(const std::string& protocol, const std::vector<std::string>& hex) {
 
 int encode(const std::string& protocol, const std::vector<std::string>& words) {
   if (protocol != "anki") {
-    std::cerr << "pitwall encode: unknown protocol '" << protocol << "'; known: " << kProtocols << "\n";
+    std::cerr << "pitwall encode: unknown protocol '" << protocol << "'; known: " << kProtocols
+              << "\n";
     return 2;
   }
   auto message = anki::parseCommand(words);

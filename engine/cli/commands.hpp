@@ -14,7 +14,7 @@ struct RunOptions {
   std::uint64_t seed = 1;
   int cars = 4;
   std::string track = "oval";
-  std::string record;              // --record FILE, empty: none
+  std::string record;  // --record FILE, empty: none
 };
 int run(const RunOptions& options);
 

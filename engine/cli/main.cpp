@@ -11,14 +11,17 @@ int main(int argc, char** argv) {
   CLI::App app{"pitwall — an automation engine for robot race cars, scripted in Lua"};
   app.require_subcommand(1);
   std::string logLevel;
-  app.add_option("--log-level", logLevel, "debug, info, warn, error or off (default: info; "
-                                          "warn for `test`)");
+  app.add_option("--log-level", logLevel,
+                 "debug, info, warn, error or off (default: info; "
+                 "warn for `test`)");
 
   cli::RunOptions run;
-  auto* runCmd = app.add_subcommand("run", "Run a Lua script; by default against the built-in simulator");
+  auto* runCmd =
+      app.add_subcommand("run", "Run a Lua script; by default against the built-in simulator");
   runCmd->add_option("script", run.script, "The Lua script to run")->required();
   runCmd->add_flag("--fast", run.fast, "Virtual time: the run goes as fast as the machine can");
-  runCmd->add_option("--duration", run.duration, "End the run after this many seconds of engine time")
+  runCmd
+      ->add_option("--duration", run.duration, "End the run after this many seconds of engine time")
       ->check(CLI::PositiveNumber);
   runCmd->add_option("--seed", run.seed, "Seed of the simulator's and the script's randomness");
   runCmd->add_option("--cars", run.cars, "Number of simulated cars on the grid (default 4)")
@@ -38,7 +41,8 @@ int main(int argc, char** argv) {
   auto* decodeCmd = app.add_subcommand("decode", "Decode one frame: pitwall decode anki \"01 17\"");
   decodeCmd->add_option("protocol", protocol, "Protocol (anki)")->required();
   decodeCmd->add_option("hex", words, "The frame's bytes in hex")->required();
-  auto* encodeCmd = app.add_subcommand("encode", "Encode one command: pitwall encode anki set-speed 600 1000");
+  auto* encodeCmd =
+      app.add_subcommand("encode", "Encode one command: pitwall encode anki set-speed 600 1000");
   encodeCmd->add_option("protocol", protocol, "Protocol (anki)")->required();
   encodeCmd->add_option("message", words, "The command and its arguments")->required();
   std::string forms;
@@ -57,7 +61,8 @@ int main(int argc, char** argv) {
   if (!logLevel.empty()) {
     auto level = log::parseLevel(logLevel);
     if (!level) {
-      std::cerr << "pitwall: --log-level '" << logLevel << "' is unknown; use debug, info, warn, error or off\n";
+      std::cerr << "pitwall: --log-level '" << logLevel
+                << "' is unknown; use debug, info, warn, error or off\n";
       return 2;
     }
     log::setLevel(*level);

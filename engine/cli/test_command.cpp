@@ -95,8 +95,7 @@ int test(const TestOptions& options) {
     Outcome o = runScenario(file, options);
     double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
     char timing[96];
-    std::snprintf(timing, sizeof timing, "(%.1f s simulated in %.0f ms)", o.simulated,
-                  wall * 1000);
+    std::snprintf(timing, sizeof timing, "(%.1f s simulated in %.0f ms)", o.simulated, wall * 1000);
     if (o.passed) {
       ++passed;
       std::cout << "ok    " << file << " " << timing << "\n";

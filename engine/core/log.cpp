@@ -10,18 +10,27 @@ std::function<void(Level, std::string_view)> g_sink;
 
 const char* levelName(Level l) {
   switch (l) {
-    case Level::Debug: return "debug";
-    case Level::Info: return "info";
-    case Level::Warn: return "warn";
-    case Level::Error: return "error";
-    case Level::Off: return "off";
+    case Level::Debug:
+      return "debug";
+    case Level::Info:
+      return "info";
+    case Level::Warn:
+      return "warn";
+    case Level::Error:
+      return "error";
+    case Level::Off:
+      return "off";
   }
   return "?";
 }
 }  // namespace
 
-void setLevel(Level level) { g_level = level; }
-Level level() { return g_level; }
+void setLevel(Level level) {
+  g_level = level;
+}
+Level level() {
+  return g_level;
+}
 
 std::optional<Level> parseLevel(std::string_view text) {
   for (Level l : {Level::Debug, Level::Info, Level::Warn, Level::Error, Level::Off})
@@ -29,8 +38,12 @@ std::optional<Level> parseLevel(std::string_view text) {
   return std::nullopt;
 }
 
-void setTimeSource(std::function<double()> seconds) { g_time = std::move(seconds); }
-void setSink(std::function<void(Level, std::string_view)> sink) { g_sink = std::move(sink); }
+void setTimeSource(std::function<double()> seconds) {
+  g_time = std::move(seconds);
+}
+void setSink(std::function<void(Level, std::string_view)> sink) {
+  g_sink = std::move(sink);
+}
 
 void write(Level level, std::string_view component, std::string_view message) {
   if (level < g_level || g_level == Level::Off) return;

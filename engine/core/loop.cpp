@@ -34,7 +34,9 @@ std::optional<TimePoint> Loop::nextDue() const {
   return timers_.begin()->first.when;
 }
 
-void Loop::post(Callback fn) { boost::asio::post(io_, std::move(fn)); }
+void Loop::post(Callback fn) {
+  boost::asio::post(io_, std::move(fn));
+}
 
 bool Loop::fireDue() {
   bool fired = false;

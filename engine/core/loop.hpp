@@ -20,7 +20,9 @@ using Duration = std::chrono::nanoseconds;
 using TimePoint = std::chrono::nanoseconds;  // since the loop's epoch
 enum class ClockKind { Real, Virtual };
 
-inline double toSeconds(Duration d) { return std::chrono::duration<double>(d).count(); }
+inline double toSeconds(Duration d) {
+  return std::chrono::duration<double>(d).count();
+}
 inline Duration fromSeconds(double s) {
   return std::chrono::duration_cast<Duration>(std::chrono::duration<double>(s));
 }

@@ -51,23 +51,24 @@ AnkiCar::Sent AnkiCar::send(const Message& message) {
 AnkiCar::Sent AnkiCar::setSpeed(int speed, int accel, bool respect_limit) {
   if (auto e = outOfField("speed", speed, "mm/s", limits::kSpeedMin, limits::kSpeedMax))
     return Unexpected{*e};
-  if (auto e = outOfField("acceleration", accel, "mm/s²", limits::kAccelMin,
-                                   limits::kAccelMax))
+  if (auto e = outOfField("acceleration", accel, "mm/s²", limits::kAccelMin, limits::kAccelMax))
     return Unexpected{*e};
-  auto sent = send(SetSpeed{static_cast<int16_t>(speed), static_cast<int16_t>(accel),
-                            respect_limit});
+  auto sent =
+      send(SetSpeed{static_cast<int16_t>(speed), static_cast<int16_t>(accel), respect_limit});
   if (sent) state_.target_speed_mm_s = speed;
   return sent;
 }
 
-AnkiCar::Sent AnkiCar::stop() { return setSpeed(0, kStopAccel); }
+AnkiCar::Sent AnkiCar::stop() {
+  return setSpeed(0, kStopAccel);
+}
 
 AnkiCar::Sent AnkiCar::changeLane(double offset, int h_speed, int h_accel) {
   if (auto e = outOfField("lane-change speed", h_speed, "mm/s", limits::kLaneSpeedMin,
-                                    limits::kLaneSpeedMax))
+                          limits::kLaneSpeedMax))
     return Unexpected{*e};
-  if (auto e = outOfField("lane-change acceleration", h_accel, "mm/s²",
-                                    limits::kLaneAccelMin, limits::kLaneAccelMax))
+  if (auto e = outOfField("lane-change acceleration", h_accel, "mm/s²", limits::kLaneAccelMin,
+                          limits::kLaneAccelMax))
     return Unexpected{*e};
   auto sent = send(ChangeLane{static_cast<uint16_t>(h_speed), static_cast<uint16_t>(h_accel),
                               static_cast<float>(offset), 0, 0});
@@ -96,7 +97,9 @@ AnkiCar::Sent AnkiCar::lights(int mask) {
   return send(SetLights{static_cast<uint8_t>(mask)});
 }
 
-AnkiCar::Sent AnkiCar::lightsPattern(const LightsPattern& pattern) { return send(pattern); }
+AnkiCar::Sent AnkiCar::lightsPattern(const LightsPattern& pattern) {
+  return send(pattern);
+}
 
 AnkiCar::Sent AnkiCar::ping() {
   auto sent = send(PingRequest{});
@@ -104,9 +107,15 @@ AnkiCar::Sent AnkiCar::ping() {
   return sent;
 }
 
-AnkiCar::Sent AnkiCar::requestBattery() { return send(BatteryRequest{}); }
-AnkiCar::Sent AnkiCar::requestVersion() { return send(VersionRequest{}); }
-AnkiCar::Sent AnkiCar::sdkMode(bool on, std::uint8_t flags) { return send(SdkMode{on, flags}); }
+AnkiCar::Sent AnkiCar::requestBattery() {
+  return send(BatteryRequest{});
+}
+AnkiCar::Sent AnkiCar::requestVersion() {
+  return send(VersionRequest{});
+}
+AnkiCar::Sent AnkiCar::sdkMode(bool on, std::uint8_t flags) {
+  return send(SdkMode{on, flags});
+}
 
 AnkiCar::Sent AnkiCar::disconnect() {
   if (!link_.connected()) return Unexpected{label() + " is not connected"};

@@ -16,8 +16,8 @@
 namespace pitwall {
 
 struct CarIdentity {
-  int number = 0;               // 1-based, in the order cars joined the run
-  std::string name;             // user name from the advertisement, or "car<n>"
+  int number = 0;    // 1-based, in the order cars joined the run
+  std::string name;  // user name from the advertisement, or "car<n>"
   std::uint8_t model_id = 0;
   std::uint32_t identifier = 0;
 };
@@ -27,27 +27,27 @@ struct CarState {
   bool on_track = false;
   bool on_charger = false;
   bool delocalized = false;
-  bool reverse = false;         // parsing flag 0x20: driving backwards
-  int speed_mm_s = 0;           // as last reported
-  int target_speed_mm_s = 0;    // as last commanded
-  int piece = -1;               // road piece id, −1 before the first position update
-  int prev_piece = -1;          // piece of the position update before the last one
+  bool reverse = false;       // parsing flag 0x20: driving backwards
+  int speed_mm_s = 0;         // as last reported
+  int target_speed_mm_s = 0;  // as last commanded
+  int piece = -1;             // road piece id, −1 before the first position update
+  int prev_piece = -1;        // piece of the position update before the last one
   int location = -1;
-  double offset_mm = 0;         // from road centre, as the car believes it
+  double offset_mm = 0;                         // from road centre, as the car believes it
   std::optional<double> lane_change_target_mm;  // set while a lane change is under way
-  int battery_mv = 0;           // 0 until known
+  int battery_mv = 0;                           // 0 until known
   bool battery_low = false;
   bool battery_full = false;
-  int version = 0;              // firmware version, 0 until known
+  int version = 0;  // firmware version, 0 until known
   double last_position_time = -1;
   std::uint64_t frames_in = 0, frames_out = 0, malformed = 0;
 };
 
 // Command defaults (docs/lua-api.md)
-inline constexpr int kDefaultAccel = 1000;        // mm/s²
-inline constexpr int kStopAccel = 12500;          // mm/s², brisk but not a crash stop
-inline constexpr int kDefaultLaneSpeed = 300;     // mm/s
-inline constexpr int kDefaultLaneAccel = 3000;    // mm/s²
+inline constexpr int kDefaultAccel = 1000;      // mm/s²
+inline constexpr int kStopAccel = 12500;        // mm/s², brisk but not a crash stop
+inline constexpr int kDefaultLaneSpeed = 300;   // mm/s
+inline constexpr int kDefaultLaneAccel = 3000;  // mm/s²
 
 class AnkiCar {
  public:

@@ -31,8 +31,7 @@ void Recorder::write(double t, int car, bool tx, std::span<const std::uint8_t> f
   char stamp[32];
   std::snprintf(stamp, sizeof stamp, "%.6f", t);
   out_ << "{\"t\":" << stamp << ",\"car\":" << car << ",\"dir\":\"" << (tx ? "tx" : "rx")
-       << "\",\"hex\":\"" << toHex(frame) << "\",\"msg\":" << anki::toJson(message).dump()
-       << "}\n";
+       << "\",\"hex\":\"" << toHex(frame) << "\",\"msg\":" << anki::toJson(message).dump() << "}\n";
   ++lines_;
 }
 

@@ -64,19 +64,21 @@ TEST_CASE_FIXTURE(LuaFixture, "setSpeed from Lua sends the frame the codec makes
   CHECK(link->sent[0] == std::vector<std::uint8_t>{0x06, 0x24, 0xe8, 0x03, 0xa8, 0x61, 0x00});
 }
 
-TEST_CASE_FIXTURE(LuaFixture, "an out-of-range command raises an error naming the range, sends nothing") {
+TEST_CASE_FIXTURE(LuaFixture,
+                  "an out-of-range command raises an error naming the range, sends nothing") {
   std::string err = run("pitwall.cars()[1]:setSpeed(5000)");
   CHECK(err.find("test.lua:1:") != std::string::npos);
   CHECK(err.find("0..1500") != std::string::npos);
   CHECK(link->sent.empty());
-  CHECK(run("pitwall.cars()[1]:setSpeed('fast')").find("must be a whole number") != std::string::npos);
+  CHECK(run("pitwall.cars()[1]:setSpeed('fast')").find("must be a whole number") !=
+        std::string::npos);
   CHECK(run("pitwall.cars()[1]:turn('sideways')").find("left, right, uturn") != std::string::npos);
 }
 
 TEST_CASE_FIXTURE(LuaFixture, "onPosition receives the car and an event with the reported fields") {
   REQUIRE(run("local car = pitwall.cars()[1]\n"
-               "car.onPosition = function(c, ev) got_piece, got_loc, got_speed, got_off, got_time ="
-               " ev.piece, ev.location, ev.speed, ev.offset, ev.time; same = (c == car) end") == "");
+              "car.onPosition = function(c, ev) got_piece, got_loc, got_speed, got_off, got_time ="
+              " ev.piece, ev.location, ev.speed, ev.offset, ev.time; same = (c == car) end") == "");
   loop.after(std::chrono::seconds(2), [&] {
     PositionUpdate p;
     p.piece_id = 17;
@@ -96,17 +98,21 @@ TEST_CASE_FIXTURE(LuaFixture, "onPosition receives the car and an event with the
 
 TEST_CASE_FIXTURE(LuaFixture, "state fields are read-only and unknown events are refused by name") {
   CHECK(run("pitwall.cars()[1].speed = 3").find("read-only") != std::string::npos);
-  CHECK(run("pitwall.cars()[1].onPostion = function() end").find("not an event") != std::string::npos);
+  CHECK(run("pitwall.cars()[1].onPostion = function() end").find("not an event") !=
+        std::string::npos);
   CHECK(run("pitwall.cars()[1].onPosition = 42").find("must be a function") != std::string::npos);
   CHECK(run("pitwall.cars()[1].setSpeed = print").find("method") != std::string::npos);
 }
 
 TEST_CASE_FIXTURE(LuaFixture, "scripts may keep their own fields on a car") {
-  CHECK(run("local c = pitwall.cars()[1]; c.laps = 3; c.laps = c.laps + 1; assert(pitwall.car(1).laps == 4)") == "");
+  CHECK(run("local c = pitwall.cars()[1]; c.laps = 3; c.laps = c.laps + 1; "
+            "assert(pitwall.car(1).laps == 4)") == "");
 }
 
-TEST_CASE_FIXTURE(LuaFixture, "an error in a handler is reported with a traceback and the handler stays") {
-  REQUIRE(run("calls = 0; pitwall.cars()[1].onBattery = function() calls = calls + 1; error('flat') end") == "");
+TEST_CASE_FIXTURE(LuaFixture,
+                  "an error in a handler is reported with a traceback and the handler stays") {
+  REQUIRE(run("calls = 0; pitwall.cars()[1].onBattery = function() calls = calls + 1; "
+              "error('flat') end") == "");
   link->carSends(BatteryResponse{3800});
   link->carSends(BatteryResponse{3700});
   CHECK(number("calls") == 2);
@@ -144,7 +150,27 @@ TEST_CASE_FIXTURE(LuaFixture, "a script that fails to load names the chunk and t
   CHECK(started.error().find("broken.lua:1:") != std::string::npos);
 }
 
-TEST_CASE_FIXTURE(LuaFixture, "require finds the shipped library; pitwall.sim says it needs the simulator") {
+TEST_CASE_FIXTURE(LuaFixture,
+                  "require finds the shipped library; pitwall.sim says it needs the simulator") {
   CHECK(run("local core = require 'pitwall.core'; assert(core == pitwall)") == "");
   CHECK(run("require 'pitwall.sim'").find("only available") != std::string::npos);
+}
+
+TEST_CASE_FIXTURE(LuaFixture, "a reused event table shows each event's values, changed or not") {
+  REQUIRE(run("seen = {}\n"
+              "pitwall.cars()[1].onPosition = function(c, ev)\n"
+              "  seen[#seen + 1] = string.format('%d/%d/%d/%s', ev.piece, ev.location, ev.speed, "
+              "tostring(ev.reverse))\n"
+              "end") == "");
+  PositionUpdate p;
+  p.piece_id = 17, p.location_id = 1, p.speed_mm_s = 500;
+  link->carSends(p);
+  p.location_id = 2;  // only the location changes
+  link->carSends(p);
+  p.piece_id = 18, p.parsing_flags = 0x20;
+  link->carSends(p);
+  p.parsing_flags = 0;  // back to what an earlier event had
+  link->carSends(p);
+  CHECK(run("assert(table.concat(seen, ' ') == '17/1/500/false 17/2/500/false 18/2/500/true "
+            "18/2/500/false', table.concat(seen, ' '))") == "");
 }

@@ -16,7 +16,8 @@ struct Fixture {
 };
 }  // namespace
 
-TEST_CASE_FIXTURE(Fixture, "connecting turns on SDK mode first, then asks for version and battery") {
+TEST_CASE_FIXTURE(Fixture,
+                  "connecting turns on SDK mode first, then asks for version and battery") {
   link.setConnected(true);
   REQUIRE(link.sent.size() == 3);
   CHECK(link.sent[0] == std::vector<std::uint8_t>{0x03, 0x90, 0x01, 0x01});
