@@ -1,0 +1,369 @@
+// From a received frame to a Lua onPosition callback, against the floor of doing the same work
+// by hand with the Lua C API. Target: the path within 1.5× of the floor (docs/performance.md).
+//
+// Path:  AnkiCar::receive(frame) with a real ScriptHost and a handler set from Lua
+//        (decode → car state → onMessage → car binding → protected call with traceback).
+// Floor: decode of the same frame, a table kept in the registry filled with the same three
+//        fields, lua_pcall of a Lua function that reads them, with the same traceback handler.
+// Each iteration changes the location id, so nothing is constant.
+#include <benchmark/benchmark.h>
+#include <lua.hpp>
+
+#include <array>
+#include <chrono>
+#include <ctime>
+#include <memory>
+#include <string>
+#include <variant>
+
+#include "bindings/lua_support.hpp"
+#include "bindings/script_host.hpp"
+#include "engine/protocol/anki/codec.hpp"
+#include "engine/vehicles/fleet.hpp"
+
+namespace {
+
+using namespace pitwall;
+
+// A link that accepts everything and delivers nothing: frames enter through AnkiCar::receive.
+class BenchLink final : public Link {
+ public:
+  bool send(std::span<const std::uint8_t>) override { return true; }
+  bool connected() const override { return true; }
+  void disconnect() override {}
+  std::string address() const override { return "bench"; }
+};
+
+// Byte 2 of a position update is its location id ([size][id][location][piece]…).
+constexpr std::size_t kLocationByte = 2;
+
+anki::Frame positionFrame() {
+  anki::PositionUpdate m;
+  m.location_id = 0;
+  m.piece_id = 39;
+  m.offset_mm = 23.0f;
+  m.speed_mm_s = 640;
+  m.parsing_flags = 0x07;
+  m.last_desired_speed_mm_s = 650;
+  return anki::encode(m);
+}
+
+// The handler of the path and the function of the floor do the same work.
+constexpr const char* kPathHandler =
+    "pitwall.cars()[1].onPosition = function(car, ev)\n"
+    "  local p, l, s = ev.piece, ev.location, ev.speed\n"
+    "end\n";
+constexpr const char* kFloorFunction =
+    "return function(ev)\n"
+    "  local p, l, s = ev.piece, ev.location, ev.speed\n"
+    "end\n";
+constexpr const char* kFloorCarFunction =
+    "return function(car, ev)\n"
+    "  local p, l, s = ev.piece, ev.location, ev.speed\n"
+    "end\n";
+
+// One car on a BenchLink, known to a ScriptHost (cars added before the host are bound).
+struct PathRig {
+  Loop loop{ClockKind::Virtual};
+  Fleet fleet{loop};
+  AnkiCar& car;
+  std::unique_ptr<ScriptHost> host;
+  std::string error;
+
+  explicit PathRig(const char* handler)
+      : car(fleet.add(std::make_unique<BenchLink>(), CarIdentity{})),
+        host(std::make_unique<ScriptHost>(loop, fleet, nullptr, HostOptions{})) {
+    // First prove that frames reach Lua: a handler that keeps the location it saw.
+    if (!run("pitwall.cars()[1].onPosition = function(car, ev) seen = ev.location end")) return;
+    anki::Frame frame = positionFrame();
+    frame.bytes[kLocationByte] = 77;
+    car.receive(frame.span());
+    lua_State* L = host->state();
+    lua_getglobal(L, "seen");
+    bool reached = lua_tointeger(L, -1) == 77;
+    lua_pop(L, 1);
+    if (!reached) {
+      error = "a position update did not reach the Lua onPosition handler";
+      return;
+    }
+    if (handler) run(handler);
+  }
+  bool run(const char* code) {
+    auto started = host->startString(code, "bench");
+    if (!started) error = started.error();
+    return static_cast<bool>(started);
+  }
+  bool healthy() {
+    if (error.empty() && host->errorCount() > 0) error = "a Lua handler raised an error";
+    return error.empty();
+  }
+};
+
+// The floor: a bare Lua state, the function and the reused table held in the registry.
+// Full: what the car binding hands a position handler, by hand: the car (a userdata) and the
+// table as arguments, and the six fields of ev (time, piece, location, offset, speed, reverse).
+struct Floor {
+  enum class Fields { Three, Full };
+  lua_State* L = luaL_newstate();
+  Fields fields;
+  int fn = LUA_NOREF;
+  int table = LUA_NOREF;
+  int car = LUA_NOREF;
+  double time = 0;
+  std::string error;
+
+  explicit Floor(Fields f = Fields::Three) : fields(f) {
+    luaL_openlibs(L);
+    if (luaL_dostring(L, f == Fields::Three ? kFloorFunction : kFloorCarFunction) != LUA_OK) {
+      error = lua_tostring(L, -1);
+      return;
+    }
+    fn = luaL_ref(L, LUA_REGISTRYINDEX);
+    lua_createtable(L, 0, 8);
+    table = luaL_ref(L, LUA_REGISTRYINDEX);
+    lua_newuserdatauv(L, sizeof(void*), 1);
+    car = luaL_ref(L, LUA_REGISTRYINDEX);
+  }
+  ~Floor() { lua_close(L); }
+  Floor(const Floor&) = delete;
+  Floor& operator=(const Floor&) = delete;
+
+  // One event: decode, fill, call. False when the frame is not a position update or Lua fails.
+  bool event(std::span<const std::uint8_t> frame) {
+    auto decoded = anki::decode(frame);
+    const auto* pos = decoded ? std::get_if<anki::PositionUpdate>(&*decoded) : nullptr;
+    if (!pos) return false;
+    lua_pushcfunction(L, lua::traceback);
+    lua_rawgeti(L, LUA_REGISTRYINDEX, fn);
+    if (fields == Fields::Full) lua_rawgeti(L, LUA_REGISTRYINDEX, car);
+    lua_rawgeti(L, LUA_REGISTRYINDEX, table);
+    if (fields == Fields::Full) {
+      lua_pushnumber(L, time += 0.001);
+      lua_setfield(L, -2, "time");
+    }
+    lua_pushinteger(L, pos->piece_id);
+    lua_setfield(L, -2, "piece");
+    lua_pushinteger(L, pos->location_id);
+    lua_setfield(L, -2, "location");
+    if (fields == Fields::Full) {
+      lua_pushnumber(L, pos->offset_mm);
+      lua_setfield(L, -2, "offset");
+    }
+    lua_pushinteger(L, pos->speed_mm_s);
+    lua_setfield(L, -2, "speed");
+    if (fields == Fields::Full) {
+      lua_pushboolean(L, (pos->parsing_flags & 0x20) != 0);
+      lua_setfield(L, -2, "reverse");
+    }
+    int nargs = fields == Fields::Full ? 2 : 1;
+    int status = lua_pcall(L, nargs, 0, -(nargs + 2));
+    lua_pop(L, status == LUA_OK ? 1 : 2);
+    return status == LUA_OK;
+  }
+
+  // The protected call alone, on the table as the last event left it: no decode, no fill.
+  bool callOnly() {
+    lua_pushcfunction(L, lua::traceback);
+    lua_rawgeti(L, LUA_REGISTRYINDEX, fn);
+    lua_rawgeti(L, LUA_REGISTRYINDEX, table);
+    int status = lua_pcall(L, 1, 0, -3);
+    lua_pop(L, status == LUA_OK ? 1 : 2);
+    return status == LUA_OK;
+  }
+};
+
+void BM_FrameToLuaCallback(benchmark::State& state) {
+  PathRig rig(kPathHandler);
+  if (!rig.healthy()) {
+    state.SkipWithError(rig.error.c_str());
+    return;
+  }
+  anki::Frame frame = positionFrame();
+  std::uint8_t location = 0;
+  for (auto _ : state) {
+    frame.bytes[kLocationByte] = location++;
+    rig.car.receive(frame.span());
+  }
+  if (!rig.healthy()) state.SkipWithError(rig.error.c_str());
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_FrameToLuaCallback);
+
+// The path when piece, offset and speed change with every event too (the binding rewrites only
+// the fields of the reused event table that changed, so the steady-speed case above is its best
+// case and this one its worst while driving forward).
+void BM_FrameToLuaCallbackEveryFieldChanging(benchmark::State& state) {
+  PathRig rig(kPathHandler);
+  if (!rig.healthy()) {
+    state.SkipWithError(rig.error.c_str());
+    return;
+  }
+  std::array<anki::Frame, 256> frames;
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    anki::PositionUpdate m;
+    m.location_id = static_cast<std::uint8_t>(i);
+    m.piece_id = static_cast<std::uint8_t>(17 + i % 7);
+    m.offset_mm = -68.0f + static_cast<float>(i % 5) * 0.5f;
+    m.speed_mm_s = static_cast<std::uint16_t>(600 + i % 11);
+    m.parsing_flags = 0x07;
+    frames[i] = anki::encode(m);
+  }
+  std::size_t i = 0;
+  for (auto _ : state) rig.car.receive(frames[i++ & 0xff].span());
+  if (!rig.healthy()) state.SkipWithError(rig.error.c_str());
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_FrameToLuaCallbackEveryFieldChanging);
+
+void floorBenchmark(benchmark::State& state, Floor::Fields fields) {
+  Floor floor(fields);
+  if (!floor.error.empty()) {
+    state.SkipWithError(floor.error.c_str());
+    return;
+  }
+  anki::Frame frame = positionFrame();
+  std::uint8_t location = 0;
+  for (auto _ : state) {
+    frame.bytes[kLocationByte] = location++;
+    if (!floor.event(frame.span())) {
+      state.SkipWithError("the floor's Lua call failed");
+      break;
+    }
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+void BM_FrameToLuaFloor(benchmark::State& state) {
+  floorBenchmark(state, Floor::Fields::Three);
+}
+BENCHMARK(BM_FrameToLuaFloor);
+
+// This thread's CPU time: blocks timed with it do not count time the thread spent preempted
+// (the benchmark machines are shared; see docs/performance.md).
+struct ThreadCpuClock {
+  using duration = std::chrono::nanoseconds;
+  using time_point = std::chrono::time_point<ThreadCpuClock>;
+  static time_point now() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return time_point(std::chrono::seconds(ts.tv_sec) + std::chrono::nanoseconds(ts.tv_nsec));
+  }
+};
+
+// Path and floor interleaved in blocks within one benchmark, so that both see the same machine
+// state (frequency, caches, noisy neighbours), each block timed in thread CPU time. Reports
+// path_ns, floor_ns and ratio = path/floor, and full_floor_ns: the floor doing all the Lua work
+// of the binding (see BM_FrameToLuaFloorFullEvent below).
+void BM_FrameToLuaRatio(benchmark::State& state) {
+  using Clock = ThreadCpuClock;
+  constexpr int kBlock = 512;
+  PathRig rig(kPathHandler);
+  Floor floor(Floor::Fields::Three);
+  Floor full(Floor::Fields::Full);
+  if (!rig.healthy() || !floor.error.empty() || !full.error.empty()) {
+    state.SkipWithError(!rig.error.empty() ? rig.error.c_str() : "the floor's Lua did not load");
+    return;
+  }
+  anki::Frame frame = positionFrame();
+  std::uint8_t location = 0;
+  Clock::duration pathTime{}, floorTime{}, fullTime{};
+  bool ok = true;
+  for (auto _ : state) {
+    auto t0 = Clock::now();
+    for (int i = 0; i < kBlock; ++i) {
+      frame.bytes[kLocationByte] = location++;
+      rig.car.receive(frame.span());
+    }
+    auto t1 = Clock::now();
+    for (int i = 0; i < kBlock; ++i) {
+      frame.bytes[kLocationByte] = location++;
+      ok &= floor.event(frame.span());
+    }
+    auto t2 = Clock::now();
+    for (int i = 0; i < kBlock; ++i) {
+      frame.bytes[kLocationByte] = location++;
+      ok &= full.event(frame.span());
+    }
+    auto t3 = Clock::now();
+    pathTime += t1 - t0;
+    floorTime += t2 - t1;
+    fullTime += t3 - t2;
+  }
+  if (!ok || !rig.healthy()) {
+    state.SkipWithError(ok ? rig.error.c_str() : "the floor's Lua call failed");
+    return;
+  }
+  double events = static_cast<double>(state.iterations()) * kBlock;
+  auto perEvent = [events](Clock::duration d) {
+    return std::chrono::duration<double, std::nano>(d).count() / events;
+  };
+  state.counters["path_ns"] = perEvent(pathTime);
+  state.counters["floor_ns"] = perEvent(floorTime);
+  state.counters["full_floor_ns"] = perEvent(fullTime);
+  state.counters["ratio"] = perEvent(pathTime) / perEvent(floorTime);
+}
+BENCHMARK(BM_FrameToLuaRatio);
+
+// ---- steps of the path, to see where its time goes ----
+
+// The engine's part only: decode, car state, the fleet's frame hook; no Lua at all.
+void BM_FrameToCarState(benchmark::State& state) {
+  Loop loop(ClockKind::Virtual);
+  Fleet fleet(loop);
+  AnkiCar& car = fleet.add(std::make_unique<BenchLink>(), CarIdentity{});
+  anki::Frame frame = positionFrame();
+  std::uint8_t location = 0;
+  for (auto _ : state) {
+    frame.bytes[kLocationByte] = location++;
+    car.receive(frame.span());
+  }
+  if (car.state().frames_in != static_cast<std::uint64_t>(state.iterations()))
+    state.SkipWithError("not every frame was taken");
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_FrameToCarState);
+
+// The car bound to Lua but no onPosition handler: the binding's dispatch without a call.
+void BM_FrameToLuaNoHandler(benchmark::State& state) {
+  PathRig rig("pitwall.cars()[1].onPosition = nil");
+  if (!rig.healthy()) {
+    state.SkipWithError(rig.error.c_str());
+    return;
+  }
+  anki::Frame frame = positionFrame();
+  std::uint8_t location = 0;
+  for (auto _ : state) {
+    frame.bytes[kLocationByte] = location++;
+    rig.car.receive(frame.span());
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_FrameToLuaNoHandler);
+
+// The floor doing by hand all the Lua work the binding does for a position event (two arguments,
+// six fields): the difference to the path is the binding's own machinery, the difference to
+// the three-field floor is what the richer event costs.
+void BM_FrameToLuaFloorFullEvent(benchmark::State& state) {
+  floorBenchmark(state, Floor::Fields::Full);
+}
+BENCHMARK(BM_FrameToLuaFloorFullEvent);
+
+// The floor's protected call alone (traceback handler, function and table from the registry,
+// lua_pcall): the part of every event that no binding can avoid.
+void BM_LuaPcallOnly(benchmark::State& state) {
+  Floor floor(Floor::Fields::Three);
+  anki::Frame frame = positionFrame();
+  if (!floor.error.empty() || !floor.event(frame.span())) {
+    state.SkipWithError("the floor's Lua call failed");
+    return;
+  }
+  for (auto _ : state) {
+    if (!floor.callOnly()) {
+      state.SkipWithError("the floor's Lua call failed");
+      break;
+    }
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_LuaPcallOnly);
+
+}  // namespace
