@@ -5,7 +5,7 @@
 #include "engine/cli/commands.hpp"
 #include "engine/protocol/anki/codec.hpp"
 #include "engine/protocol/anki/command_text.hpp"
-#include "engine/protocol/anki/json.hpp"
+#include "engine/protocol/anki/message_json.hpp"
 #include "engine/vehicles/recorder.hpp"
 
 namespace pitwall::cli {

@@ -5,7 +5,7 @@
 #include <cstring>
 #include <stdexcept>
 
-#include "engine/protocol/anki/json.hpp"
+#include "engine/protocol/anki/message_json.hpp"
 
 namespace pitwall {
 

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/protocol/anki/json.hpp"
+#include "engine/protocol/anki/message_json.hpp"
 
 using namespace pitwall::anki;
 

@@ -1,6 +1,6 @@
 // Messages as JSON objects for `pitwall decode` and `--record` files. Field names are the struct
 // field names (they carry the unit); optional fields are left out when absent.
-#include "engine/protocol/anki/json.hpp"
+#include "engine/protocol/anki/message_json.hpp"
 
 #include <charconv>
 #include <cmath>

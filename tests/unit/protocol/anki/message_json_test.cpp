@@ -1,5 +1,5 @@
 // Messages as JSON: names, hex ids, every field under its struct name, optional fields left out.
-#include "engine/protocol/anki/json.hpp"
+#include "engine/protocol/anki/message_json.hpp"
 
 #include <doctest/doctest.h>
 
