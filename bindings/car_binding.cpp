@@ -11,7 +11,7 @@
 #include "bindings/script_host.hpp"
 #include "engine/core/log.hpp"
 #include "engine/protocol/anki/advertisement.hpp"
-#include "engine/protocol/anki/json.hpp"
+#include "engine/protocol/anki/message_json.hpp"
 
 namespace pitwall {
 
