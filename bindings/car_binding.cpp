@@ -1,5 +1,7 @@
 #include "bindings/car_binding.hpp"
 
+#include "bindings/car_proxy.hpp"
+
 #include <cctype>
 #include <cstdio>
 #include <cstring>
@@ -27,13 +29,6 @@ constexpr std::array<const char*, kCarEventCount> kEventNames = {
     "onVersion",  "onPing",       "onStatus",       "onCollision",   "onSpeed",  "onLaneChange",
     "onRecovery", "onConnect",    "onDisconnect",   "onMalformed",   "onMessage"};
 
-constexpr std::array<const char*, kCarEventCount> kEventHandlerNames = {
-    "onPosition handler", "onTransition handler", "onIntersection handler", "onDelocalized handler",
-    "onOffset handler",   "onBattery handler",    "onVersion handler",      "onPing handler",
-    "onStatus handler",   "onCollision handler",  "onSpeed handler",        "onLaneChange handler",
-    "onRecovery handler", "onConnect handler",    "onDisconnect handler",   "onMalformed handler",
-    "onMessage handler"};
-
 int eventIndex(std::string_view key) {
   for (std::size_t i = 0; i < kEventNames.size(); ++i)
     if (key == kEventNames[i]) return static_cast<int>(i);
@@ -47,25 +42,6 @@ std::string eventList() {
 }
 
 }  // namespace
-
-struct CarBinding::Proxy {
-  AnkiCar* car = nullptr;
-  int selfRef = LUA_NOREF;
-  std::array<int, kCarEventCount> handlers;
-  std::array<int, kCarEventCount> tables;
-  // What the reused onPosition / onTransition tables hold now: a field is written only when its
-  // value changed (at a steady speed a position event rewrites just time and location). This is
-  // why event tables are read-only for scripts (docs/lua-api.md).
-  struct Written {
-    std::array<double, 6> value;
-    Written() { value.fill(std::numeric_limits<double>::quiet_NaN()); }
-  };
-  Written position, transition;
-  Proxy() {
-    handlers.fill(LUA_NOREF);
-    tables.fill(LUA_NOREF);
-  }
-};
 
 namespace {
 
@@ -463,32 +439,7 @@ void CarBinding::bind(AnkiCar& car) {
   }
   proxies_.emplace(&car, std::move(proxy));
 
-  car.onMessage = [this, &p](const Message& m) { dispatch(p, m); };
-  car.onConnection = [this, &p](bool up, const std::string& reason) {
-    if (up) {
-      if (begin(p, CarEvent::Connect)) finish(p, CarEvent::Connect);
-    } else if (begin(p, CarEvent::Disconnect)) {
-      lua_pushlstring(L_, reason.data(), reason.size());
-      lua_setfield(L_, -2, "reason");
-      finish(p, CarEvent::Disconnect);
-    }
-  };
-  car.onMalformed = [this, &p](const DecodeError& e, std::span<const std::uint8_t> bytes) {
-    std::string what = e.message();
-    log::warn(p.car->label(), "malformed frame ignored: " + what);
-    if (!begin(p, CarEvent::Malformed)) return;
-    lua_pushlstring(L_, what.data(), what.size());
-    lua_setfield(L_, -2, "error");
-    std::string hex;
-    for (auto b : bytes) {
-      char h[4];
-      std::snprintf(h, sizeof h, hex.empty() ? "%02x" : " %02x", b);
-      hex += h;
-    }
-    lua_pushlstring(L_, hex.data(), hex.size());
-    lua_setfield(L_, -2, "hex");
-    finish(p, CarEvent::Malformed);
-  };
+  hookEvents(p);
 }
 
 void CarBinding::push(lua_State* L, AnkiCar& car) {
@@ -498,171 +449,6 @@ void CarBinding::push(lua_State* L, AnkiCar& car) {
     it = proxies_.find(&car);
   }
   lua_rawgeti(L, LUA_REGISTRYINDEX, it->second->selfRef);
-}
-
-bool CarBinding::begin(Proxy& p, CarEvent e) {
-  int h = p.handlers[static_cast<std::size_t>(e)];
-  if (h == LUA_NOREF) return false;
-  lua_State* L = L_;
-  lua_rawgeti(L, LUA_REGISTRYINDEX, h);
-  lua_rawgeti(L, LUA_REGISTRYINDEX, p.selfRef);
-  lua_rawgeti(L, LUA_REGISTRYINDEX, p.tables[static_cast<std::size_t>(e)]);
-  lua_pushnumber(L, host_.loop().seconds());
-  lua_setfield(L, -2, "time");
-  return true;
-}
-
-void CarBinding::finish(Proxy& p, CarEvent e, int nargs) {
-  host_.call(nargs, 0, kEventHandlerNames[static_cast<std::size_t>(e)], p.car);
-}
-
-void CarBinding::dispatch(Proxy& p, const Message& m) {
-  lua_State* L = L_;
-  auto setI = [L](const char* k, lua_Integer v) {
-    lua_pushinteger(L, v);
-    lua_setfield(L, -2, k);
-  };
-  auto setN = [L](const char* k, double v) {
-    lua_pushnumber(L, v);
-    lua_setfield(L, -2, k);
-  };
-  auto setB = [L](const char* k, bool v) {
-    lua_pushboolean(L, v);
-    lua_setfield(L, -2, k);
-  };
-  // Writes field `k` (slot `i` of `w`) only when it differs from what the table holds.
-  auto changedI = [L](Proxy::Written& w, int i, const char* k, lua_Integer v) {
-    if (w.value[i] == static_cast<double>(v)) return;
-    w.value[i] = static_cast<double>(v);
-    lua_pushinteger(L, v);
-    lua_setfield(L, -2, k);
-  };
-  auto changedN = [L](Proxy::Written& w, int i, const char* k, double v) {
-    if (w.value[i] == v) return;
-    w.value[i] = v;
-    lua_pushnumber(L, v);
-    lua_setfield(L, -2, k);
-  };
-  if (auto* pos = std::get_if<PositionUpdate>(&m)) {
-    if (begin(p, CarEvent::Position)) {
-      Proxy::Written& w = p.position;
-      changedI(w, 0, "location", pos->location_id);
-      changedI(w, 1, "piece", pos->piece_id);
-      changedI(w, 2, "speed", pos->speed_mm_s);
-      changedN(w, 3, "offset", pos->offset_mm);
-      bool reverse = (pos->parsing_flags & 0x20) != 0;
-      if (w.value[4] != (reverse ? 1.0 : 0.0)) {
-        w.value[4] = reverse ? 1.0 : 0.0;
-        setB("reverse", reverse);
-      }
-      finish(p, CarEvent::Position);
-    }
-  } else if (auto* t = std::get_if<TransitionUpdate>(&m)) {
-    if (begin(p, CarEvent::Transition)) {
-      Proxy::Written& w = p.transition;
-      changedN(w, 0, "offset", t->offset_mm);
-      changedI(w, 1, "leftWheel", t->left_wheel_distance_cm);
-      changedI(w, 2, "rightWheel", t->right_wheel_distance_cm);
-      changedI(w, 3, "drift", t->average_follow_line_drift_px);
-      changedI(w, 4, "uphill", t->uphill_counter);
-      changedI(w, 5, "downhill", t->downhill_counter);
-      finish(p, CarEvent::Transition);
-    }
-  } else if (auto* i = std::get_if<IntersectionUpdate>(&m)) {
-    if (begin(p, CarEvent::Intersection)) {
-      setI("piece", i->piece_idx);
-      setN("offset", i->offset_mm);
-      setI("code", i->intersection_code);
-      setB("exiting", i->is_exiting != 0);
-      setI("sinceTransition", i->mm_since_last_transition_bar);
-      if (i->mm_since_last_intersection_code)
-        setI("sinceIntersection", *i->mm_since_last_intersection_code);
-      finish(p, CarEvent::Intersection);
-    }
-  } else if (std::holds_alternative<Delocalized>(m)) {
-    if (begin(p, CarEvent::Delocalized)) finish(p, CarEvent::Delocalized);
-  } else if (auto* o = std::get_if<OffsetUpdate>(&m)) {
-    if (begin(p, CarEvent::Offset)) {
-      setN("offset", o->offset_mm);
-      setI("laneChangeId", o->lane_change_id);
-      finish(p, CarEvent::Offset);
-    }
-  } else if (auto* b = std::get_if<BatteryResponse>(&m)) {
-    if (begin(p, CarEvent::Battery)) {
-      setI("millivolts", b->millivolts);
-      setB("low", p.car->state().battery_low);
-      setB("full", p.car->state().battery_full);
-      setB("charging", p.car->state().on_charger);
-      finish(p, CarEvent::Battery);
-    }
-  } else if (auto* v = std::get_if<VersionResponse>(&m)) {
-    if (begin(p, CarEvent::Version)) {
-      setI("version", v->version);
-      finish(p, CarEvent::Version);
-    }
-  } else if (std::holds_alternative<PingResponse>(m)) {
-    if (begin(p, CarEvent::Ping)) {
-      if (auto rtt = p.car->lastPingRtt()) setN("rtt", *rtt);
-      finish(p, CarEvent::Ping);
-    }
-  } else if (auto* s = std::get_if<CarStatus>(&m)) {
-    if (begin(p, CarEvent::Status)) {
-      setB("onTrack", s->on_track);
-      setB("onCharger", s->on_charger);
-      setB("lowBattery", s->low_battery.value_or(false));
-      setB("fullyCharged", s->fully_charged.value_or(false));
-      finish(p, CarEvent::Status);
-    }
-  } else if (auto* c = std::get_if<Collision>(&m)) {
-    if (begin(p, CarEvent::Collision)) {
-      setI("side", c->side);
-      lua_pushstring(L, c->front_back ? "back" : "front");
-      lua_setfield(L, -2, "where");
-      finish(p, CarEvent::Collision);
-    }
-  } else if (auto* sp = std::get_if<SpeedUpdate>(&m)) {
-    if (begin(p, CarEvent::Speed)) {
-      setI("desired", sp->desired_mm_s);
-      setI("accel", sp->accel_mm_s2);
-      setI("actual", sp->actual_mm_s);
-      finish(p, CarEvent::Speed);
-    }
-  } else if (auto* lc = std::get_if<LaneChangeUpdate>(&m)) {
-    if (begin(p, CarEvent::LaneChange)) {
-      setN("current", lc->current_offset_mm);
-      setN("target", lc->target_offset_mm);
-      setI("hSpeed", lc->h_speed_mm_s);
-      setI("vSpeed", lc->v_speed_mm_s);
-      setI("laneChangeId", lc->lane_change_id);
-      finish(p, CarEvent::LaneChange);
-    }
-  } else if (std::holds_alternative<AutoRecoveryEntered>(m) ||
-             std::holds_alternative<AutoRecoverySucceeded>(m)) {
-    if (begin(p, CarEvent::Recovery)) {
-      setB("succeeded", std::holds_alternative<AutoRecoverySucceeded>(m));
-      finish(p, CarEvent::Recovery);
-    }
-  }
-  // onMessage sees every message as a fresh table built from its JSON form (for debugging).
-  if (p.handlers[static_cast<std::size_t>(CarEvent::Message)] != LUA_NOREF) {
-    lua_rawgeti(L, LUA_REGISTRYINDEX, p.handlers[static_cast<std::size_t>(CarEvent::Message)]);
-    lua_rawgeti(L, LUA_REGISTRYINDEX, p.selfRef);
-    nlohmann::json j = toJson(m);
-    lua_createtable(L, 0, static_cast<int>(j.size()) + 1);
-    for (auto& [k, v] : j.items()) {
-      if (v.is_boolean())
-        lua_pushboolean(L, v.get<bool>());
-      else if (v.is_number_integer())
-        lua_pushinteger(L, v.get<lua_Integer>());
-      else if (v.is_number())
-        lua_pushnumber(L, v.get<double>());
-      else
-        lua_pushstring(L, v.is_string() ? v.get<std::string>().c_str() : v.dump().c_str());
-      lua_setfield(L, -2, k.c_str());
-    }
-    setN("time", host_.loop().seconds());
-    host_.call(2, 0, "onMessage handler", p.car);
-  }
 }
 
 }  // namespace pitwall

@@ -50,9 +50,14 @@ class CarBinding {
   struct Proxy;
 
  private:
+  // Event delivery (car_events.cpp).
+  class EventTable;
+  void hookEvents(Proxy& p);
   void dispatch(Proxy& p, const anki::Message& m);
-  bool begin(Proxy& p, CarEvent e);  // pushes handler, car, event table; false if no handler
-  void finish(Proxy& p, CarEvent e, int nargs = 2);
+  // Pushes traceback handler, handler, car and the reused event table (time set); false, and
+  // nothing pushed, when the car has no handler for `e`.
+  bool begin(Proxy& p, CarEvent e);
+  void finish(Proxy& p, CarEvent e);
 
   ScriptHost& host_;
   lua_State* L_;

@@ -82,4 +82,22 @@ inline void checkFunction(lua_State* L, int idx, const char* what) {
 // Message handler for lua_pcall: the error text plus a traceback.
 int traceback(lua_State* L);
 
+// t[key] = value for the table on top of the stack.
+inline void setInteger(lua_State* L, const char* key, lua_Integer v) {
+  lua_pushinteger(L, v);
+  lua_setfield(L, -2, key);
+}
+inline void setNumber(lua_State* L, const char* key, double v) {
+  lua_pushnumber(L, v);
+  lua_setfield(L, -2, key);
+}
+inline void setBoolean(lua_State* L, const char* key, bool v) {
+  lua_pushboolean(L, v);
+  lua_setfield(L, -2, key);
+}
+inline void setString(lua_State* L, const char* key, std::string_view v) {
+  lua_pushlstring(L, v.data(), v.size());
+  lua_setfield(L, -2, key);
+}
+
 }  // namespace pitwall::lua

@@ -106,9 +106,23 @@ bool ScriptHost::call(int nargs, int nresults, const char* what, const AnkiCar* 
   lua_insert(L, base);
   int status = lua_pcall(L, nargs, nresults, base);
   lua_remove(L, base);
+  return finishCall(status, what, car);
+}
+
+bool ScriptHost::callAboveHandler(int nargs, const char* what, const AnkiCar* car) {
+  int status = lua_pcall(L_, nargs, 0, -(nargs + 2));
+  if (status == LUA_OK) {
+    lua_pop(L_, 1);  // the handler
+    return true;
+  }
+  lua_remove(L_, -2);  // the handler, under the error
+  return finishCall(status, what, car);
+}
+
+bool ScriptHost::finishCall(int status, const char* what, const AnkiCar* car) {
   if (status == LUA_OK) return true;
-  std::string message = lua_tostring(L, -1) ? lua_tostring(L, -1) : "(error without a message)";
-  lua_pop(L, 1);
+  std::string message = lua_tostring(L_, -1) ? lua_tostring(L_, -1) : "(error without a message)";
+  lua_pop(L_, 1);
   std::string where = what;
   if (car) where += " of " + car->label();
   reportError(where, message);
@@ -165,8 +179,8 @@ Result<bool, std::string> ScriptHost::startFile(const std::string& path) {
   std::error_code ec;
   if (!fs::is_regular_file(path, ec)) return Unexpected{"cannot open " + path + ": no such file"};
   // The script's own folder joins the front of the require path.
-  std::string dir = fs::path(path).parent_path().string();
-  if (dir.empty()) dir = ".";
+  fs::path folder = fs::path(path).parent_path();
+  const std::string dir = folder.empty() ? std::string(".") : folder.string();
   lua_getglobal(L_, "package");
   lua_getfield(L_, -1, "path");
   std::string p = dir + "/?.lua;" + dir + "/?/init.lua;" + lua_tostring(L_, -1);

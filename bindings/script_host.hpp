@@ -61,6 +61,9 @@ class ScriptHost {
   // car 1 (skull)". Returns true when the call succeeded; results are left on the stack. Builds
   // no string unless the call fails: this is the hot path of every event.
   bool call(int nargs, int nresults, const char* what, const AnkiCar* car = nullptr);
+  // The same with no results, for a caller that pushed lua::traceback itself right under the
+  // function (the event hot path: no stack rotation). Pops the handler too.
+  bool callAboveHandler(int nargs, const char* what, const AnkiCar* car = nullptr);
   // Reports a script error: to pitwall.onError if set, else the log; in test mode, a failure.
   void reportError(const std::string& where, const std::string& message);
 
@@ -97,6 +100,7 @@ class ScriptHost {
     TimePoint due{};
   };
   void openLibraries();
+  bool finishCall(int status, const char* what, const AnkiCar* car);
   void resume(lua_State* co, int nargs);
   void fireTimer(int handle);
   Result<bool, std::string> startLoaded(int status);

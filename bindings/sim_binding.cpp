@@ -48,24 +48,17 @@ std::uint8_t modelFromLua(lua_State* L, int idx) {
 
 void pushTrack(lua_State* L, const sim::Track& track) {
   lua_createtable(L, 0, 4);
-  lua_pushstring(L, track.name().c_str());
-  lua_setfield(L, -2, "name");
-  lua_pushnumber(L, track.lapLength(0));
-  lua_setfield(L, -2, "lapLength");
-  lua_pushinteger(L, static_cast<lua_Integer>(track.finishIndex()) + 1);
-  lua_setfield(L, -2, "finishIndex");
+  lua::setString(L, "name", track.name());
+  lua::setNumber(L, "lapLength", track.lapLength(0));
+  lua::setInteger(L, "finishIndex", static_cast<lua_Integer>(track.finishIndex()) + 1);
   lua_createtable(L, static_cast<int>(track.size()), 0);
   for (std::size_t i = 0; i < track.size(); ++i) {
     const sim::Piece& p = track.piece(i);
     lua_createtable(L, 0, 4);
-    lua_pushinteger(L, p.id);
-    lua_setfield(L, -2, "id");
-    lua_pushstring(L, std::string(anki::pieceTypeName(p.type)).c_str());
-    lua_setfield(L, -2, "type");
-    lua_pushinteger(L, p.turn);
-    lua_setfield(L, -2, "turn");
-    lua_pushnumber(L, p.length(0));
-    lua_setfield(L, -2, "length");
+    lua::setInteger(L, "id", p.id);
+    lua::setString(L, "type", anki::pieceTypeName(p.type));
+    lua::setInteger(L, "turn", p.turn);
+    lua::setNumber(L, "length", p.length(0));
     lua_rawseti(L, -2, static_cast<lua_Integer>(i) + 1);
   }
   lua_setfield(L, -2, "pieces");
@@ -182,32 +175,20 @@ int addCar(lua_State* L) {
 int truth(lua_State* L) {
   sim::Truth t = simCarOf(L, 1).truth();
   lua_createtable(L, 0, 16);
-  auto setI = [L](const char* k, lua_Integer v) {
-    lua_pushinteger(L, v);
-    lua_setfield(L, -2, k);
-  };
-  auto setN = [L](const char* k, double v) {
-    lua_pushnumber(L, v);
-    lua_setfield(L, -2, k);
-  };
-  auto setB = [L](const char* k, bool v) {
-    lua_pushboolean(L, v);
-    lua_setfield(L, -2, k);
-  };
-  setI("pieceIndex", static_cast<lua_Integer>(t.piece_index) + 1);
-  setI("piece", t.piece_id);
-  setN("pieceDistance", t.piece_distance_mm);
-  setN("lapDistance", t.lap_distance_mm);
-  setN("offset", t.offset_mm);
-  setN("speed", t.speed_mm_s);
-  setN("targetSpeed", t.target_speed_mm_s);
-  setI("laps", t.laps);
-  setB("onTrack", t.on_track);
-  setB("delocalized", t.delocalized);
-  setB("sdkMode", t.sdk_mode);
-  setB("connected", t.connected);
-  setI("battery", t.battery_mv);
-  setI("collisions", t.collisions);
+  lua::setInteger(L, "pieceIndex", static_cast<lua_Integer>(t.piece_index) + 1);
+  lua::setInteger(L, "piece", t.piece_id);
+  lua::setNumber(L, "pieceDistance", t.piece_distance_mm);
+  lua::setNumber(L, "lapDistance", t.lap_distance_mm);
+  lua::setNumber(L, "offset", t.offset_mm);
+  lua::setNumber(L, "speed", t.speed_mm_s);
+  lua::setNumber(L, "targetSpeed", t.target_speed_mm_s);
+  lua::setInteger(L, "laps", t.laps);
+  lua::setBoolean(L, "onTrack", t.on_track);
+  lua::setBoolean(L, "delocalized", t.delocalized);
+  lua::setBoolean(L, "sdkMode", t.sdk_mode);
+  lua::setBoolean(L, "connected", t.connected);
+  lua::setInteger(L, "battery", t.battery_mv);
+  lua::setInteger(L, "collisions", t.collisions);
   return 1;
 }
 
@@ -257,12 +238,9 @@ int noise(lua_State* L) {
     s.world->setNoise(n);
   }
   lua_createtable(L, 0, 3);
-  lua_pushnumber(L, n.drop);
-  lua_setfield(L, -2, "drop");
-  lua_pushnumber(L, n.late);
-  lua_setfield(L, -2, "late");
-  lua_pushnumber(L, toSeconds(n.late_by));
-  lua_setfield(L, -2, "lateBy");
+  lua::setNumber(L, "drop", n.drop);
+  lua::setNumber(L, "late", n.late);
+  lua::setNumber(L, "lateBy", toSeconds(n.late_by));
   return 1;
 }
 

@@ -174,3 +174,35 @@ TEST_CASE_FIXTURE(LuaFixture, "a reused event table shows each event's values, c
   CHECK(run("assert(table.concat(seen, ' ') == '17/1/500/false 17/2/500/false 18/2/500/true "
             "18/2/500/false', table.concat(seen, ' '))") == "");
 }
+
+namespace {
+CaptureLink* g_injectInto = nullptr;
+}
+
+TEST_CASE_FIXTURE(LuaFixture,
+                  "an event delivered while a handler runs is complete and does not leak into the next") {
+  // inject(piece) makes the car send a position update at once, from inside a handler.
+  g_injectInto = link;
+  lua_pushcfunction(host->state(), [](lua_State* L) {
+    PositionUpdate p;
+    p.piece_id = static_cast<std::uint8_t>(lua_tointeger(L, 1));
+    p.location_id = 4;
+    p.speed_mm_s = 321;
+    g_injectInto->carSends(p);
+    return 0;
+  });
+  lua_setglobal(host->state(), "inject");
+  REQUIRE(run("seen = {}\n"
+              "local car = pitwall.cars()[1]\n"
+              "car.onPosition = function(c, ev) seen[#seen + 1] = ev.piece .. '/' .. ev.speed end\n"
+              "car.onBattery = function(c, ev) inject(40); seen[#seen + 1] = 'mv ' .. "
+              "ev.millivolts end") == "");
+  PositionUpdate first;
+  first.piece_id = 17, first.speed_mm_s = 500;
+  link->carSends(first);                  // top level: interned keys
+  link->carSends(BatteryResponse{3777});  // its handler injects a nested position update
+  link->carSends(first);                  // top level again: must not keep the nested values
+  CHECK(run("assert(table.concat(seen, ' ') == '17/500 40/321 mv 3777 17/500', "
+            "table.concat(seen, ' '))") == "");
+  g_injectInto = nullptr;
+}

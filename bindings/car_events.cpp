@@ -1,0 +1,288 @@
+// Events from cars into Lua: the hot path of every run (docs/performance.md).
+//
+// Each car has one reused table per event kind. Filling it is most of the cost of an event, so
+// the position and transition tables get only the fields whose value changed, and the traceback
+// handler is pushed in place under the function instead of rotated in and out. (Keeping the field
+// names as ready-made Lua strings and using lua_rawset was measured slower than lua_setfield,
+// whose key lookup Lua caches: docs/performance.md.)
+#include <cstdio>
+
+#include "bindings/car_binding.hpp"
+#include "bindings/car_proxy.hpp"
+#include "bindings/lua_support.hpp"
+#include "bindings/script_host.hpp"
+#include "engine/core/log.hpp"
+#include "engine/protocol/anki/message_json.hpp"
+
+namespace pitwall {
+
+using namespace anki;
+
+namespace {
+
+enum Key {
+  kTime,
+  kPiece,
+  kLocation,
+  kOffset,
+  kSpeed,
+  kReverse,
+  kLeftWheel,
+  kRightWheel,
+  kDrift,
+  kUphill,
+  kDownhill,
+  kCode,
+  kExiting,
+  kSinceTransition,
+  kSinceIntersection,
+  kLaneChangeId,
+  kMillivolts,
+  kLow,
+  kFull,
+  kCharging,
+  kVersion,
+  kRtt,
+  kOnTrack,
+  kOnCharger,
+  kLowBattery,
+  kFullyCharged,
+  kSide,
+  kWhere,
+  kDesired,
+  kAccel,
+  kActual,
+  kCurrent,
+  kTarget,
+  kHSpeed,
+  kVSpeed,
+  kSucceeded,
+  kReason,
+  kError,
+  kHex,
+  kKeyCount
+};
+
+constexpr std::array<const char*, kKeyCount> kKeyNames = {
+    "time",         "piece",           "location",
+    "offset",       "speed",           "reverse",
+    "leftWheel",    "rightWheel",      "drift",
+    "uphill",       "downhill",        "code",
+    "exiting",      "sinceTransition", "sinceIntersection",
+    "laneChangeId", "millivolts",      "low",
+    "full",         "charging",        "version",
+    "rtt",          "onTrack",         "onCharger",
+    "lowBattery",   "fullyCharged",    "side",
+    "where",        "desired",         "accel",
+    "actual",       "current",         "target",
+    "hSpeed",       "vSpeed",          "succeeded",
+    "reason",       "error",           "hex"};
+
+constexpr std::array<const char*, kCarEventCount> kHandlerNames = {
+    "onPosition handler", "onTransition handler", "onIntersection handler", "onDelocalized handler",
+    "onOffset handler",   "onBattery handler",    "onVersion handler",      "onPing handler",
+    "onStatus handler",   "onCollision handler",  "onSpeed handler",        "onLaneChange handler",
+    "onRecovery handler", "onConnect handler",    "onDisconnect handler",   "onMalformed handler",
+    "onMessage handler"};
+
+}  // namespace
+
+// Sets fields of the event table on top of the stack.
+class CarBinding::EventTable {
+ public:
+  explicit EventTable(lua_State* L) : L_(L) {}
+
+  void integer(Key k, lua_Integer v) {
+    lua_pushinteger(L_, v);
+    lua_setfield(L_, -2, kKeyNames[k]);
+  }
+  void number(Key k, double v) {
+    lua_pushnumber(L_, v);
+    lua_setfield(L_, -2, kKeyNames[k]);
+  }
+  void boolean(Key k, bool v) {
+    lua_pushboolean(L_, v);
+    lua_setfield(L_, -2, kKeyNames[k]);
+  }
+  void string(Key k, std::string_view v) {
+    lua_pushlstring(L_, v.data(), v.size());
+    lua_setfield(L_, -2, kKeyNames[k]);
+  }
+  // Only when `v` differs from what slot `i` of `w` says the table holds.
+  void changed(Proxy::Written& w, int i, Key k, double v) {
+    if (w.value[i] == v) return;
+    w.value[i] = v;
+    number(k, v);
+  }
+  void changedInteger(Proxy::Written& w, int i, Key k, lua_Integer v) {
+    if (w.value[i] == static_cast<double>(v)) return;
+    w.value[i] = static_cast<double>(v);
+    integer(k, v);
+  }
+  void changedBoolean(Proxy::Written& w, int i, Key k, bool v) {
+    if (w.value[i] == (v ? 1.0 : 0.0)) return;
+    w.value[i] = v ? 1.0 : 0.0;
+    boolean(k, v);
+  }
+
+ private:
+  lua_State* L_;
+};
+
+bool CarBinding::begin(Proxy& p, CarEvent e) {
+  int h = p.handlers[static_cast<std::size_t>(e)];
+  if (h == LUA_NOREF) return false;
+  lua_State* L = L_;
+  lua_pushcfunction(L, lua::traceback);
+  lua_rawgeti(L, LUA_REGISTRYINDEX, h);
+  lua_rawgeti(L, LUA_REGISTRYINDEX, p.selfRef);
+  lua_rawgeti(L, LUA_REGISTRYINDEX, p.tables[static_cast<std::size_t>(e)]);
+  EventTable(L).number(kTime, host_.loop().seconds());
+  return true;
+}
+
+void CarBinding::finish(Proxy& p, CarEvent e) {
+  host_.callAboveHandler(2, kHandlerNames[static_cast<std::size_t>(e)], p.car);
+}
+
+void CarBinding::hookEvents(Proxy& p) {
+  AnkiCar& car = *p.car;
+  car.onMessage = [this, &p](const Message& m) { dispatch(p, m); };
+  car.onConnection = [this, &p](bool up, const std::string& reason) {
+    if (up) {
+      if (begin(p, CarEvent::Connect)) finish(p, CarEvent::Connect);
+    } else if (begin(p, CarEvent::Disconnect)) {
+      EventTable(L_).string(kReason, reason);
+      finish(p, CarEvent::Disconnect);
+    }
+  };
+  car.onMalformed = [this, &p](const DecodeError& e, std::span<const std::uint8_t> bytes) {
+    std::string what = e.message();
+    log::warn(p.car->label(), "malformed frame ignored: " + what);
+    if (!begin(p, CarEvent::Malformed)) return;
+    std::string hex;
+    for (auto b : bytes) {
+      char h[4];
+      std::snprintf(h, sizeof h, hex.empty() ? "%02x" : " %02x", b);
+      hex += h;
+    }
+    EventTable t(L_);
+    t.string(kError, what);
+    t.string(kHex, hex);
+    finish(p, CarEvent::Malformed);
+  };
+}
+
+void CarBinding::dispatch(Proxy& p, const Message& m) {
+  auto deliver = [&](CarEvent e, auto&& fill) {
+    if (!begin(p, e)) return;
+    EventTable t(L_);
+    fill(t);
+    finish(p, e);
+  };
+  if (auto* pos = std::get_if<PositionUpdate>(&m)) {
+    deliver(CarEvent::Position, [&](EventTable& t) {
+      Proxy::Written& w = p.position;
+      t.changedInteger(w, 0, kLocation, pos->location_id);
+      t.changedInteger(w, 1, kPiece, pos->piece_id);
+      t.changedInteger(w, 2, kSpeed, pos->speed_mm_s);
+      t.changed(w, 3, kOffset, pos->offset_mm);
+      t.changedBoolean(w, 4, kReverse, (pos->parsing_flags & 0x20) != 0);
+    });
+  } else if (auto* tr = std::get_if<TransitionUpdate>(&m)) {
+    deliver(CarEvent::Transition, [&](EventTable& t) {
+      Proxy::Written& w = p.transition;
+      t.changed(w, 0, kOffset, tr->offset_mm);
+      t.changedInteger(w, 1, kLeftWheel, tr->left_wheel_distance_cm);
+      t.changedInteger(w, 2, kRightWheel, tr->right_wheel_distance_cm);
+      t.changedInteger(w, 3, kDrift, tr->average_follow_line_drift_px);
+      t.changedInteger(w, 4, kUphill, tr->uphill_counter);
+      t.changedInteger(w, 5, kDownhill, tr->downhill_counter);
+    });
+  } else if (auto* i = std::get_if<IntersectionUpdate>(&m)) {
+    deliver(CarEvent::Intersection, [&](EventTable& t) {
+      t.integer(kPiece, i->piece_idx);
+      t.number(kOffset, i->offset_mm);
+      t.integer(kCode, i->intersection_code);
+      t.boolean(kExiting, i->is_exiting != 0);
+      t.integer(kSinceTransition, i->mm_since_last_transition_bar);
+      if (i->mm_since_last_intersection_code)
+        t.integer(kSinceIntersection, *i->mm_since_last_intersection_code);
+    });
+  } else if (std::holds_alternative<Delocalized>(m)) {
+    deliver(CarEvent::Delocalized, [](EventTable&) {});
+  } else if (auto* o = std::get_if<OffsetUpdate>(&m)) {
+    deliver(CarEvent::Offset, [&](EventTable& t) {
+      t.number(kOffset, o->offset_mm);
+      t.integer(kLaneChangeId, o->lane_change_id);
+    });
+  } else if (auto* b = std::get_if<BatteryResponse>(&m)) {
+    deliver(CarEvent::Battery, [&](EventTable& t) {
+      const CarState& s = p.car->state();
+      t.integer(kMillivolts, b->millivolts);
+      t.boolean(kLow, s.battery_low);
+      t.boolean(kFull, s.battery_full);
+      t.boolean(kCharging, s.on_charger);
+    });
+  } else if (auto* v = std::get_if<VersionResponse>(&m)) {
+    deliver(CarEvent::Version, [&](EventTable& t) { t.integer(kVersion, v->version); });
+  } else if (std::holds_alternative<PingResponse>(m)) {
+    deliver(CarEvent::Ping, [&](EventTable& t) {
+      if (auto rtt = p.car->lastPingRtt()) t.number(kRtt, *rtt);
+    });
+  } else if (auto* s = std::get_if<CarStatus>(&m)) {
+    deliver(CarEvent::Status, [&](EventTable& t) {
+      t.boolean(kOnTrack, s->on_track);
+      t.boolean(kOnCharger, s->on_charger);
+      t.boolean(kLowBattery, s->low_battery.value_or(false));
+      t.boolean(kFullyCharged, s->fully_charged.value_or(false));
+    });
+  } else if (auto* c = std::get_if<Collision>(&m)) {
+    deliver(CarEvent::Collision, [&](EventTable& t) {
+      t.integer(kSide, c->side);
+      t.string(kWhere, c->front_back ? "back" : "front");
+    });
+  } else if (auto* sp = std::get_if<SpeedUpdate>(&m)) {
+    deliver(CarEvent::Speed, [&](EventTable& t) {
+      t.integer(kDesired, sp->desired_mm_s);
+      t.integer(kAccel, sp->accel_mm_s2);
+      t.integer(kActual, sp->actual_mm_s);
+    });
+  } else if (auto* lc = std::get_if<LaneChangeUpdate>(&m)) {
+    deliver(CarEvent::LaneChange, [&](EventTable& t) {
+      t.number(kCurrent, lc->current_offset_mm);
+      t.number(kTarget, lc->target_offset_mm);
+      t.integer(kHSpeed, lc->h_speed_mm_s);
+      t.integer(kVSpeed, lc->v_speed_mm_s);
+      t.integer(kLaneChangeId, lc->lane_change_id);
+    });
+  } else if (std::holds_alternative<AutoRecoveryEntered>(m) ||
+             std::holds_alternative<AutoRecoverySucceeded>(m)) {
+    deliver(CarEvent::Recovery, [&](EventTable& t) {
+      t.boolean(kSucceeded, std::holds_alternative<AutoRecoverySucceeded>(m));
+    });
+  }
+  // onMessage sees every message as a fresh table built from its JSON form (for debugging).
+  if (p.handlers[static_cast<std::size_t>(CarEvent::Message)] != LUA_NOREF) {
+    lua_State* L = L_;
+    lua_rawgeti(L, LUA_REGISTRYINDEX, p.handlers[static_cast<std::size_t>(CarEvent::Message)]);
+    lua_rawgeti(L, LUA_REGISTRYINDEX, p.selfRef);
+    nlohmann::json j = toJson(m);
+    lua_createtable(L, 0, static_cast<int>(j.size()) + 1);
+    for (auto& [k, v] : j.items()) {
+      if (v.is_boolean())
+        lua_pushboolean(L, v.get<bool>());
+      else if (v.is_number_integer())
+        lua_pushinteger(L, v.get<lua_Integer>());
+      else if (v.is_number())
+        lua_pushnumber(L, v.get<double>());
+      else
+        lua_pushstring(L, v.is_string() ? v.get<std::string>().c_str() : v.dump().c_str());
+      lua_setfield(L, -2, k.c_str());
+    }
+    lua::setNumber(L, "time", host_.loop().seconds());
+    host_.call(2, 0, "onMessage handler", p.car);
+  }
+}
+
+}  // namespace pitwall

@@ -1,0 +1,29 @@
+#pragma once
+// What CarBinding keeps per car (private to bindings/car_binding.cpp and car_events.cpp).
+#include <array>
+#include <limits>
+
+#include "bindings/car_binding.hpp"
+
+namespace pitwall {
+
+struct CarBinding::Proxy {
+  AnkiCar* car = nullptr;
+  int selfRef = LUA_NOREF;
+  std::array<int, kCarEventCount> handlers;
+  std::array<int, kCarEventCount> tables;
+  // What the reused onPosition / onTransition tables hold now: a field is written only when its
+  // value changed (at a steady speed a position event rewrites just time and location). This is
+  // why event tables are read-only for scripts (docs/lua-api.md).
+  struct Written {
+    std::array<double, 6> value;
+    Written() { value.fill(std::numeric_limits<double>::quiet_NaN()); }
+  };
+  Written position, transition;
+  Proxy() {
+    handlers.fill(LUA_NOREF);
+    tables.fill(LUA_NOREF);
+  }
+};
+
+}  // namespace pitwall
