@@ -5,6 +5,7 @@
 #include <lua.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -14,6 +15,13 @@ namespace pitwall::lua {
 struct LuaError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+
+// A number as a script wrote it: 600, -23.5, 0.25 (not 600.000000).
+inline std::string show(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
 
 template <int (*Body)(lua_State*)>
 int guarded(lua_State* L) {
@@ -58,7 +66,7 @@ inline long long checkInteger(lua_State* L, int idx, const char* what) {
   if (isint) return v;
   if (lua_type(L, idx) == LUA_TNUMBER)
     throw LuaError(std::string(what) + " must be a whole number, got " +
-                   std::to_string(lua_tonumber(L, idx)));
+                   show(lua_tonumber(L, idx)));
   throw LuaError(std::string(what) + " must be a whole number, got " + typeName(L, idx));
 }
 

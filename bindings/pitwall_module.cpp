@@ -20,8 +20,8 @@ Duration checkDelay(lua_State* L, int idx, const char* what, bool allowZero) {
   double s = lua::checkNumber(L, idx, what);
   if (s < 0 || (!allowZero && s <= 0))
     throw LuaError(std::string(what) + " must be " + (allowZero ? "≥ 0" : "> 0") +
-                   " seconds, got " + std::to_string(s));
-  if (s > 1e9) throw LuaError(std::string(what) + " is too large: " + std::to_string(s) + " s");
+                   " seconds, got " + lua::show(s));
+  if (s > 1e9) throw LuaError(std::string(what) + " is too large: " + lua::show(s) + " s");
   return fromSeconds(s);
 }
 

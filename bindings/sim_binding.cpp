@@ -124,8 +124,8 @@ int addCar(lua_State* L) {
     spec.distance_mm = lua::checkNumber(L, -1, "distance (mm into the piece)");
     double len = track.piece(spec.piece_index).length(spec.offset_mm);
     if (spec.distance_mm < 0 || spec.distance_mm >= len)
-      throw LuaError("distance " + std::to_string(spec.distance_mm) +
-                     " mm is outside the piece (0.." + std::to_string(len) + " mm)");
+      throw LuaError("distance " + lua::show(spec.distance_mm) + " mm is outside the piece (0.." +
+                     lua::show(len) + " mm)");
   }
   lua_pop(L, 1);
   if (lua_getfield(L, 1, "lane") != LUA_TNIL) {
@@ -138,8 +138,7 @@ int addCar(lua_State* L) {
   if (lua_getfield(L, 1, "offset") != LUA_TNIL) {
     spec.offset_mm = lua::checkNumber(L, -1, "offset (mm)");
     if (spec.offset_mm < -100 || spec.offset_mm > 100)
-      throw LuaError("offset " + std::to_string(spec.offset_mm) +
-                     " mm is off the road (-100..100 mm)");
+      throw LuaError("offset " + lua::show(spec.offset_mm) + " mm is off the road (-100..100 mm)");
   }
   lua_pop(L, 1);
   if (lua_getfield(L, 1, "battery") != LUA_TNIL) {
@@ -206,7 +205,7 @@ int place(lua_State* L) {
                    std::to_string(track.size()));
   double offset = lua::optNumber(L, 3, "offset (mm)", 0);
   if (offset < -100 || offset > 100)
-    throw LuaError("offset " + std::to_string(offset) + " mm is off the road (-100..100 mm)");
+    throw LuaError("offset " + lua::show(offset) + " mm is off the road (-100..100 mm)");
   car.place(static_cast<std::size_t>(piece - 1), offset);
   return 0;
 }
@@ -220,7 +219,7 @@ int noise(lua_State* L) {
       if (lua_getfield(L, 1, key) != LUA_TNIL) {
         double v = lua::checkNumber(L, -1, key);
         if (v < 0 || v > 1)
-          throw LuaError(std::string("noise ") + key + " " + std::to_string(v) +
+          throw LuaError(std::string("noise ") + key + " " + lua::show(v) +
                          " is out of range 0..1 (a probability)");
         out = v;
       }
@@ -231,7 +230,7 @@ int noise(lua_State* L) {
     if (lua_getfield(L, 1, "lateBy") != LUA_TNIL) {
       double v = lua::checkNumber(L, -1, "lateBy (s)");
       if (v < 0 || v > 10)
-        throw LuaError("noise lateBy " + std::to_string(v) + " s is out of range 0..10 s");
+        throw LuaError("noise lateBy " + lua::show(v) + " s is out of range 0..10 s");
       n.late_by = fromSeconds(v);
     }
     lua_pop(L, 1);
