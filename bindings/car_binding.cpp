@@ -2,6 +2,7 @@
 
 #include "bindings/car_proxy.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cstdio>
 #include <cstring>
@@ -51,6 +52,12 @@ CarBinding::Proxy& proxyAt(lua_State* L, int idx) {
   return **p;
 }
 
+// Narrows a Lua integer for AnkiCar, whose range check then names the value: anything beyond
+// ±1e6 is out of every command's range and is reported as ±1e6 rather than wrapped.
+int toInt(long long v) {
+  return static_cast<int>(std::clamp(v, -1000000LL, 1000000LL));
+}
+
 void raiseIfRefused(const AnkiCar::Sent& sent) {
   if (!sent) throw LuaError(sent.error());
 }
@@ -61,10 +68,7 @@ int setSpeed(lua_State* L) {
   auto speed = lua::checkInteger(L, 2, "speed (mm/s)");
   auto accel = lua::optInteger(L, 3, "acceleration (mm/s²)", kDefaultAccel);
   bool limit = lua_toboolean(L, 4);
-  auto clamp = [](long long v) {
-    return static_cast<int>(std::max(-1000000LL, std::min(v, 1000000LL)));
-  };
-  raiseIfRefused(car.setSpeed(clamp(speed), clamp(accel), limit));
+  raiseIfRefused(car.setSpeed(toInt(speed), toInt(accel), limit));
   return 0;
 }
 int stop(lua_State* L) {
@@ -76,10 +80,7 @@ int changeLane(lua_State* L) {
   double offset = lua::checkNumber(L, 2, "offset (mm)");
   auto speed = lua::optInteger(L, 3, "lane-change speed (mm/s)", kDefaultLaneSpeed);
   auto accel = lua::optInteger(L, 4, "lane-change acceleration (mm/s²)", kDefaultLaneAccel);
-  auto clamp = [](long long v) {
-    return static_cast<int>(std::max(-1000000LL, std::min(v, 1000000LL)));
-  };
-  raiseIfRefused(car.changeLane(offset, clamp(speed), clamp(accel)));
+  raiseIfRefused(car.changeLane(offset, toInt(speed), toInt(accel)));
   return 0;
 }
 int setOffset(lua_State* L) {

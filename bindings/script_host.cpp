@@ -170,7 +170,7 @@ Result<bool, std::string> ScriptHost::startLoaded(int status) {
     lua_pop(L_, 1);
     return Unexpected{err};
   }
-  spawn(L_, "main chunk");
+  spawn(L_, "main chunk", true);
   return true;
 }
 
@@ -197,12 +197,12 @@ Result<bool, std::string> ScriptHost::startString(const std::string& code,
       luaL_loadbufferx(L_, code.data(), code.size(), ("@" + chunkname).c_str(), "t"));
 }
 
-void ScriptHost::spawn(lua_State* L, const std::string& name) {
+void ScriptHost::spawn(lua_State* L, const std::string& name, bool main) {
   lua_State* co = lua_newthread(L);
   int ref = luaL_ref(L, LUA_REGISTRYINDEX);  // pops the thread, keeps it alive
   lua_xmove(L, co, 1);                       // the function
-  tasks_.emplace(co, Task{ref, name, std::nullopt});
-  if (name == "main chunk") mainTask_ = co;
+  tasks_.emplace(co, Task{ref, main ? name : "task " + name, std::nullopt});
+  if (main) mainTask_ = co;
   resume(co, 0);
 }
 
@@ -218,32 +218,29 @@ void ScriptHost::sleepCurrent(lua_State* co, Duration delay) {
 }
 
 void ScriptHost::resume(lua_State* co, int nargs) {
-  auto it = tasks_.find(co);
-  if (it == tasks_.end()) return;
+  if (!tasks_.count(co)) return;
   int nres = 0;
   int status = lua_resume(co, L_, nargs, &nres);
-  it = tasks_.find(co);
+  std::string error;
   if (status == LUA_YIELD) {
     lua_pop(co, nres);
-    if (!it->second.wake) {
-      // A bare coroutine.yield() has nobody to wake it: end the task with a clear error.
-      std::string name = it->second.name;
-      luaL_unref(L_, LUA_REGISTRYINDEX, it->second.threadRef);
-      tasks_.erase(it);
-      reportError(name == "main chunk" ? name : "task " + name,
-                  "the task yielded without pitwall.sleep or pitwall.waitUntil; nothing would "
-                  "ever resume it");
-    }
-    return;
-  }
-  std::string name = it->second.name;
-  std::string error;
-  if (status != LUA_OK) {
+    if (tasks_.at(co).wake) return;  // asleep: its timer resumes it
+    // A bare coroutine.yield() has nobody to wake it: end the task with a clear error.
+    error =
+        "the task yielded without pitwall.sleep or pitwall.waitUntil; nothing would ever "
+        "resume it";
+  } else if (status != LUA_OK) {
     const char* msg = lua_tostring(co, -1);
     luaL_traceback(L_, co, msg ? msg : "(error without a message)", 0);
     error = lua_tostring(L_, -1);
     lua_pop(L_, 1);
   }
+  endTask(co, error);
+}
+
+void ScriptHost::endTask(lua_State* co, const std::string& error) {
+  auto it = tasks_.find(co);
+  std::string where = it->second.name;
   closeThread(co);
   luaL_unref(L_, LUA_REGISTRYINDEX, it->second.threadRef);
   tasks_.erase(it);
@@ -252,7 +249,7 @@ void ScriptHost::resume(lua_State* co, int nargs) {
     mainTask_ = nullptr;
     mainFinished_ = true;
   }
-  if (!error.empty()) reportError(wasMain ? name : "task " + name, error);
+  if (!error.empty()) reportError(where, error);
   if (wasMain && !error.empty()) {
     // The script died: the run ends and its cars are stopped (DESIGN.md, "keeps cars safe").
     mainFailed_ = true;

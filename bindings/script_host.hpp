@@ -69,7 +69,7 @@ class ScriptHost {
 
   // A task: a coroutine resumed on the loop. The function is on top of L's stack (L: the
   // calling thread, which may itself be a task).
-  void spawn(lua_State* L, const std::string& name);
+  void spawn(lua_State* L, const std::string& name, bool main = false);
   // Called by pitwall.sleep from inside a task: resume it after `delay`.
   void sleepCurrent(lua_State* co, Duration delay);
 
@@ -90,7 +90,7 @@ class ScriptHost {
  private:
   struct Task {
     int threadRef = LUA_NOREF;
-    std::string name;
+    std::string name;  // as errors name it: "main chunk", "task lap.lua:12"
     std::optional<Loop::TimerId> wake;
   };
   struct Timer {
@@ -102,6 +102,7 @@ class ScriptHost {
   void openLibraries();
   bool finishCall(int status, const char* what, const AnkiCar* car);
   void resume(lua_State* co, int nargs);
+  void endTask(lua_State* co, const std::string& error);  // error empty: it returned
   void fireTimer(int handle);
   Result<bool, std::string> startLoaded(int status);
 

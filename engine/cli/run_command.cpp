@@ -78,7 +78,7 @@ int run(const RunOptions& options) {
     loop.run();
     return 1;
   }
-  if (!session.host().stopRequested() || loop.pendingTimers() > 0) loop.run();
+  loop.run();  // ends through SimRun::finish, which every way out of a run calls
   signals.cancel();
   if (session.host().mainFailed()) return 1;
   return status;

@@ -26,11 +26,16 @@ LUA
 cat > "$TMP/suite/endless_test.lua" <<'LUA'
 while true do pitwall.sleep(1) end
 LUA
+cat > "$TMP/suite/yields_test.lua" <<'LUA'
+coroutine.yield()
+LUA
 echo "not a test" > "$TMP/suite/helper.lua"
 
 out=$($PITWALL test "$TMP/suite" --timeout 30 2>&1); rc=$?
 check "exit status with failures" 1 "$rc"
-check "closing line" "1 passed, 3 failed" "$(echo "$out" | tail -1)"
+check "closing line" "1 passed, 4 failed" "$(echo "$out" | tail -1)"
+contains "a bare yield in the main chunk fails at once" "yielded without pitwall.sleep" "$out"
+case "$out" in *"yields_test.lua (0.1 s simulated"*) echo "ok: it fails without waiting for the timeout" ;; *) fail "the bare yield was not reported at once: $out" ;; esac
 contains "passing scenario listed" "ok    $TMP/suite/good_test.lua" "$out"
 contains "failed expectation names file, line and values" "bad_test.lua:4: speed: expected 123, got 0" "$out"
 contains "an assert in a callback fails the scenario" "asserted in a callback" "$out"
