@@ -24,7 +24,7 @@ class Words {
   const std::optional<std::string>& error() const { return error_; }
   bool more() const { return !error_ && next_ < words_.size(); }
   bool nextIs(string_view word) const { return more() && words_[next_] == word; }
-  void skip() { ++next_; }
+  void consume() { ++next_; }  // the word nextIs() just matched
 
   // A required word. `what` names it in the error.
   std::optional<string_view> take(string_view what) {
@@ -160,7 +160,7 @@ Message setSpeed(Words& w) {
   }
   if (w.nextIs("respect-limit")) {
     m.respect_limit = true;
-    w.skip();
+    w.consume();
   }
   return m;
 }

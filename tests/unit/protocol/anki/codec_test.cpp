@@ -286,6 +286,26 @@ TEST_CASE("an unknown id decodes to its raw bytes and encodes back to them") {
   CHECK(hex(encode(Unknown{.id = 0x3c, .raw = {}}).span()) == "01 3c");
 }
 
+// decode() reads a position update before any other check (docs/performance.md "Decode"): a
+// frame of its length is one only when both its size byte and its id say so.
+TEST_CASE("a frame of a position update's length is read as one only with its size byte and id") {
+  const auto position = decode(bytes("10 27 0e 24 00 00 88 c2 58 02 47 02 02 2c 01 58 02"));
+  REQUIRE(position.ok());
+  CHECK(std::get<PositionUpdate>(*position).speed_mm_s == 600);
+
+  const auto says_more = errorOf("11 27 0e 24 00 00 88 c2 58 02 47 02 02 2c 01 58 02");
+  CHECK(says_more.kind == DecodeError::Kind::SizeMismatch);
+  CHECK(says_more.expected == 18);
+
+  const auto transition = errorOf("10 29 0e 24 00 00 88 c2 58 02 47 02 02 2c 01 58 02");
+  CHECK(transition.kind == DecodeError::Kind::TooShort);  // 0x29 has 18 or 19 bytes
+  CHECK(transition.id == 0x29);
+
+  const auto unknown = decode(bytes("10 ee 0e 24 00 00 88 c2 58 02 47 02 02 2c 01 58 02"));
+  REQUIRE(unknown.ok());
+  CHECK(std::get<Unknown>(*unknown).raw.length == 17);
+}
+
 TEST_CASE("no bytes at all is an empty-frame error") {
   const auto r = decode({});
   REQUIRE_FALSE(r.ok());

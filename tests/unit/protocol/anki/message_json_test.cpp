@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <limits>
+#include <string_view>
 
 using namespace pitwall::anki;
 using nlohmann::json;
@@ -89,4 +90,82 @@ TEST_CASE("message names and ids of both directions come through") {
       "accel_mm_s2": 1000, "respect_limit": false})"));
   CHECK(toJson(Disconnect{}) == json::parse(R"({"name": "disconnect", "id": "0x0d"})"));
   CHECK(toJson(CycleOvertime{.count = 2, .average_us = 10, .max_us = 40})["max_us"] == 40);
+}
+
+// The kinds the cases above do not show, each with every field set: the exact text `pitwall
+// decode` prints and `--record` files hold (keys sorted, floats shortest, signed stays signed).
+TEST_CASE("every other message kind prints every field under its struct name") {
+  struct Case {
+    Message message;
+    std::string_view dump;
+  };
+  const Case cases[] = {
+      {BatteryRequest{}, R"({"id":"0x1a","name":"battery-request"})"},
+      {SetLights{.mask = 0x44}, R"({"id":"0x1d","mask":68,"name":"set-lights"})"},
+      {ChangeLane{.h_speed_mm_s = 250,
+                  .h_accel_mm_s2 = 1000,
+                  .offset_mm = -68.0f,
+                  .hop_intent = 1,
+                  .tag = 7},
+       R"({"h_accel_mm_s2":1000,"h_speed_mm_s":250,"hop_intent":1,"id":"0x25",)"
+       R"("name":"change-lane","offset_mm":-68.0,"tag":7})"},
+      {SetConfig{.super_code_parse_mask = 1, .track_material = 1},
+       R"({"id":"0x45","name":"set-config","super_code_parse_mask":1,"track_material":1})"},
+      {VersionResponse{.version = 0x2b6e},
+       R"({"id":"0x19","name":"version-response","version":11118})"},
+      {BatteryResponse{.millivolts = 3920},
+       R"({"id":"0x1b","millivolts":3920,"name":"battery-response"})"},
+      {TransitionUpdate{.piece_idx = -1,
+                        .prev_piece_idx = 2,
+                        .offset_mm = 23.5f,
+                        .driving_direction = 1,
+                        .last_recv_lane_change_id = 4,
+                        .last_exec_lane_change_id = 5,
+                        .last_desired_lane_change_speed_mm_s = 300,
+                        .average_follow_line_drift_px = -3,
+                        .had_lane_change_activity = 1,
+                        .uphill_counter = 6,
+                        .downhill_counter = 7,
+                        .left_wheel_distance_cm = 8,
+                        .right_wheel_distance_cm = 9},
+       R"({"average_follow_line_drift_px":-3,"downhill_counter":7,"driving_direction":1,)"
+       R"("had_lane_change_activity":1,"id":"0x29","last_desired_lane_change_speed_mm_s":300,)"
+       R"("last_exec_lane_change_id":5,"last_recv_lane_change_id":4,"left_wheel_distance_cm":8,)"
+       R"("name":"transition-update","offset_mm":23.5,"piece_idx":-1,"prev_piece_idx":2,)"
+       R"("right_wheel_distance_cm":9,"uphill_counter":6})"},
+      {IntersectionUpdate{.piece_idx = 10,
+                          .offset_mm = 0.1f,
+                          .intersection_code = 3,
+                          .is_exiting = 1,
+                          .mm_since_last_transition_bar = 120,
+                          .mm_since_last_intersection_code = 45},
+       R"({"id":"0x2a","intersection_code":3,"is_exiting":1,"mm_since_last_intersection_code":45,)"
+       R"("mm_since_last_transition_bar":120,"name":"intersection-update","offset_mm":0.1,)"
+       R"("piece_idx":10})"},
+      {OffsetUpdate{.offset_mm = -23.0f, .lane_change_id = 2},
+       R"({"id":"0x2d","lane_change_id":2,"name":"offset-update","offset_mm":-23.0})"},
+      {SpeedUpdate{.desired_mm_s = 600, .accel_mm_s2 = -1000, .actual_mm_s = 580},
+       R"({"accel_mm_s2":-1000,"actual_mm_s":580,"desired_mm_s":600,"id":"0x36",)"
+       R"("name":"speed-update"})"},
+      {CarStatus{
+           .on_track = true, .on_charger = false, .low_battery = true, .fully_charged = false},
+       R"({"fully_charged":false,"id":"0x3f","low_battery":true,"name":"car-status",)"
+       R"("on_charger":false,"on_track":true})"},
+      {LaneChangeUpdate{.current_offset_mm = -23.5f,
+                        .target_offset_mm = 23.5f,
+                        .h_speed_mm_s = 250,
+                        .v_speed_mm_s = -2,
+                        .lane_change_id = 3},
+       R"({"current_offset_mm":-23.5,"h_speed_mm_s":250,"id":"0x41","lane_change_id":3,)"
+       R"("name":"lane-change-update","target_offset_mm":23.5,"v_speed_mm_s":-2})"},
+      {AutoRecoverySucceeded{}, R"({"id":"0x44","name":"auto-recovery-succeeded"})"},
+      {Collision{.side = 1, .front_back = 2},
+       R"({"front_back":2,"id":"0x4d","name":"collision","side":1})"},
+      {CycleOvertime{.count = 2, .average_us = 70000, .max_us = 123456},
+       R"({"average_us":70000,"count":2,"id":"0x86","max_us":123456,"name":"cycle-overtime"})"},
+  };
+  for (const auto& c : cases) {
+    CAPTURE(c.dump);
+    CHECK(toJson(c.message).dump() == c.dump);
+  }
 }
