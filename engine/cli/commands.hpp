@@ -15,6 +15,11 @@ struct RunOptions {
   int cars = 4;
   std::string track = "oval";
   std::string record;  // --record FILE, empty: none
+  // Real cars over Bluetooth LE through BlueZ instead of the simulator (docs/bluetooth.md).
+  bool ble = false;
+  std::vector<std::string> carAddresses;  // --car ADDR (repeatable): only these; empty: all found
+  std::vector<std::string> adapters;      // --adapter hciN (repeatable); empty: every adapter
+  double scanTimeout = 5;                 // seconds to look for cars before the script starts
 };
 int run(const RunOptions& options);
 
@@ -24,6 +29,25 @@ struct TestOptions {
   double timeout = 600;  // seconds of virtual time per scenario
 };
 int test(const TestOptions& options);
+
+struct ScanOptions {
+  double timeout = 5;  // seconds
+  bool json = false;   // JSON lines instead of a table
+  std::vector<std::string> adapters;
+};
+int scan(const ScanOptions& options);
+
+// A BLE peripheral that looks like an Anki car to a central, driven by the simulator
+// (tests/qemu: the real bluetoothd end to end).
+struct EmulateOptions {
+  std::string adapter = "hci0";
+  std::string name = "pitwall";
+  std::uint8_t model = 8;  // Groundshock
+  std::string track = "oval";
+  std::uint64_t seed = 1;
+  std::optional<double> duration;  // seconds; none: until SIGINT/SIGTERM
+};
+int emulateCar(const EmulateOptions& options);
 
 int decode(const std::string& protocol, const std::vector<std::string>& hex);
 int encode(const std::string& protocol, const std::vector<std::string>& words);

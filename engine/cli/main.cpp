@@ -28,6 +28,38 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 64));
   runCmd->add_option("--track", run.track, "Track layout: a name (oval, …) or a layout file");
   runCmd->add_option("--record", run.record, "Write every frame in and out as JSON lines to FILE");
+  auto* bleFlag = runCmd->add_flag(
+      "--ble", run.ble, "Drive real cars over Bluetooth LE (BlueZ) instead of the simulator");
+  runCmd->add_option("--car", run.carAddresses, "With --ble: only this car (repeatable)")
+      ->needs(bleFlag);
+  runCmd
+      ->add_option("--adapter", run.adapters,
+                   "With --ble: use this controller, hci0, … (repeatable; default: all)")
+      ->needs(bleFlag);
+  runCmd
+      ->add_option("--scan-timeout", run.scanTimeout,
+                   "With --ble: seconds to look for cars before the script starts (default 5)")
+      ->check(CLI::PositiveNumber)
+      ->needs(bleFlag);
+
+  cli::ScanOptions scan;
+  auto* scanCmd = app.add_subcommand("scan", "List the Anki cars in Bluetooth range");
+  scanCmd->add_option("--timeout", scan.timeout, "Seconds to listen (default 5)")
+      ->check(CLI::PositiveNumber);
+  scanCmd->add_flag("--json", scan.json, "JSON lines instead of a table");
+  scanCmd->add_option("--adapter", scan.adapters, "Use this controller, hci0, … (repeatable)");
+
+  cli::EmulateOptions emulate;
+  auto* emulateCmd = app.add_subcommand(
+      "emulate-car", "Be an Anki car: a BLE peripheral driven by the simulator (needs BlueZ)");
+  emulateCmd->add_option("--adapter", emulate.adapter, "The controller to advertise on (hci0)");
+  emulateCmd->add_option("--name", emulate.name, "The car's user name (pitwall)");
+  emulateCmd->add_option("--model", emulate.model, "Model id (8: Groundshock)")
+      ->check(CLI::Range(1, 255));
+  emulateCmd->add_option("--track", emulate.track, "Track layout the car drives on (oval)");
+  emulateCmd->add_option("--seed", emulate.seed, "Seed of the simulator");
+  emulateCmd->add_option("--duration", emulate.duration, "Stop after this many seconds")
+      ->check(CLI::PositiveNumber);
 
   cli::TestOptions test;
   auto* testCmd = app.add_subcommand("test", "Run scenario test scripts in virtual time");
@@ -71,6 +103,8 @@ int main(int argc, char** argv) {
   }
 
   if (runCmd->parsed()) return cli::run(run);
+  if (scanCmd->parsed()) return cli::scan(scan);
+  if (emulateCmd->parsed()) return cli::emulateCar(emulate);
   if (testing) {
     if (test.paths.empty()) test.paths.push_back("tests/scenarios");
     return cli::test(test);
