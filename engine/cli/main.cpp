@@ -19,17 +19,22 @@ int main(int argc, char** argv) {
   auto* runCmd =
       app.add_subcommand("run", "Run a Lua script; by default against the built-in simulator");
   runCmd->add_option("script", run.script, "The Lua script to run")->required();
-  runCmd->add_flag("--fast", run.fast, "Virtual time: the run goes as fast as the machine can");
+  auto* fastFlag =
+      runCmd->add_flag("--fast", run.fast, "Virtual time: the run goes as fast as the machine can");
   runCmd
       ->add_option("--duration", run.duration, "End the run after this many seconds of engine time")
       ->check(CLI::PositiveNumber);
   runCmd->add_option("--seed", run.seed, "Seed of the simulator's and the script's randomness");
-  runCmd->add_option("--cars", run.cars, "Number of simulated cars on the grid (default 4)")
-      ->check(CLI::Range(0, 64));
-  runCmd->add_option("--track", run.track, "Track layout: a name (oval, …) or a layout file");
+  auto* carsOpt =
+      runCmd->add_option("--cars", run.cars, "Number of simulated cars on the grid (default 4)")
+          ->check(CLI::Range(0, 64));
+  auto* trackOpt =
+      runCmd->add_option("--track", run.track, "Track layout: a name (oval, …) or a layout file");
   runCmd->add_option("--record", run.record, "Write every frame in and out as JSON lines to FILE");
   auto* bleFlag = runCmd->add_flag(
       "--ble", run.ble, "Drive real cars over Bluetooth LE (BlueZ) instead of the simulator");
+  // Real cars run in real time, on a real track.
+  bleFlag->excludes(fastFlag)->excludes(carsOpt)->excludes(trackOpt);
   runCmd->add_option("--car", run.carAddresses, "With --ble: only this car (repeatable)")
       ->needs(bleFlag);
   runCmd

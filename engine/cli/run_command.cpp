@@ -1,10 +1,11 @@
-// pitwall run SCRIPT: a script driving simulated cars, in real or virtual time.
+// pitwall run SCRIPT: a script driving simulated cars (real or virtual time), or real cars over
+// Bluetooth LE with --ble.
 #include <boost/asio/signal_set.hpp>
 #include <csignal>
 #include <iostream>
 
 #include "engine/cli/commands.hpp"
-#include "engine/cli/sim_run.hpp"
+#include "engine/cli/session.hpp"
 #include "engine/core/log.hpp"
 
 namespace pitwall::cli {
@@ -13,14 +14,40 @@ namespace pitwall::cli {
 // forever at full speed; it ends after this much simulated time instead.
 constexpr double kFastDefaultDuration = 3600;
 
-int run(const RunOptions& options) {
-  auto track = sim::loadLayout(options.track);
-  if (!track) {
-    std::cerr << "pitwall run: " << track.error() << "\n";
-    return 2;
+namespace {
+
+// The session for the options, with its cars connected; nullptr after printing why not.
+std::unique_ptr<Session> makeSession(const RunOptions& options, int& status) {
+  status = 2;
+  if (!options.ble) {
+    auto track = sim::loadLayout(options.track);
+    if (!track) {
+      std::cerr << "pitwall run: " << track.error() << "\n";
+      return nullptr;
+    }
+    return std::make_unique<Session>(options.fast ? ClockKind::Virtual : ClockKind::Real,
+                                     std::move(*track), options.seed);
   }
-  SimRun session(options.fast ? ClockKind::Virtual : ClockKind::Real, std::move(*track),
-                 options.seed);
+  ble::CentralOptions central;
+  central.adapters = options.adapters;
+  central.cars = options.carAddresses;
+  central.scan = fromSeconds(options.scanTimeout);
+  try {
+    return std::make_unique<Session>(std::move(central));
+  } catch (const ble::BleError& e) {
+    std::cerr << "pitwall run: " << e.what() << "\n";
+    return nullptr;
+  }
+}
+
+}  // namespace
+
+int run(const RunOptions& options) {
+  int status = 0;
+  auto made = makeSession(options, status);
+  if (!made) return status;
+  Session& session = *made;
+  status = 0;
   if (!options.record.empty()) {
     try {
       session.record(options.record);
@@ -29,21 +56,8 @@ int run(const RunOptions& options) {
       return 2;
     }
   }
-  if (!session.addGridCars(options.cars)) {
-    std::cerr << "pitwall run: not every simulated car connected\n";
-    return 1;
-  }
-  HostOptions host;
-  host.seed = options.seed;
-  try {
-    session.startHost(host);
-  } catch (const std::exception& e) {
-    std::cerr << "pitwall run: " << e.what() << "\n";
-    return 1;
-  }
 
   Loop& loop = session.loop();
-  int status = 0;
   boost::asio::signal_set signals(loop.io(), SIGINT, SIGTERM);
   std::function<void(const boost::system::error_code&, int)> onSignal =
       [&](const boost::system::error_code& ec, int sig) {
@@ -59,6 +73,29 @@ int run(const RunOptions& options) {
         signals.async_wait(onSignal);
       };
   signals.async_wait(onSignal);
+
+  if (options.ble) {
+    auto error = session.connectRealCars();
+    if (status == 130) return status;
+    if (error) {
+      std::cerr << "pitwall run: " << *error << "\n";
+      session.finish();
+      loop.run();
+      return 2;
+    }
+  } else if (!session.addGridCars(options.cars)) {
+    std::cerr << "pitwall run: not every simulated car connected\n";
+    return 1;
+  }
+
+  HostOptions host;
+  host.seed = options.seed;
+  try {
+    session.startHost(host);
+  } catch (const std::exception& e) {
+    std::cerr << "pitwall run: " << e.what() << "\n";
+    return 1;
+  }
 
   std::optional<double> duration = options.duration;
   if (!duration && options.fast) {
@@ -78,7 +115,7 @@ int run(const RunOptions& options) {
     loop.run();
     return 1;
   }
-  loop.run();  // ends through SimRun::finish, which every way out of a run calls
+  loop.run();  // ends through Session::finish, which every way out of a run calls
   signals.cancel();
   if (session.host().mainFailed()) return 1;
   return status;

@@ -5,7 +5,7 @@
 #include <iostream>
 
 #include "engine/cli/commands.hpp"
-#include "engine/cli/sim_run.hpp"
+#include "engine/cli/session.hpp"
 #include "engine/core/log.hpp"
 
 namespace pitwall::cli {
@@ -47,7 +47,7 @@ struct Outcome {
 Outcome runScenario(const std::string& file, const TestOptions& options) {
   Outcome out;
   auto track = sim::namedLayout("oval");
-  SimRun session(ClockKind::Virtual, std::move(*track), options.seed);
+  Session session(ClockKind::Virtual, std::move(*track), options.seed);
   HostOptions host;
   host.test_mode = true;
   host.seed = options.seed;
@@ -68,7 +68,7 @@ Outcome runScenario(const std::string& file, const TestOptions& options) {
     out.message = started.error();
     return out;
   }
-  loop.run();  // ends through SimRun::finish, which every way out of a run calls
+  loop.run();  // ends through Session::finish, which every way out of a run calls
   out.simulated = loop.seconds();
   if (auto& failure = session.host().failure()) {
     out.message = *failure;

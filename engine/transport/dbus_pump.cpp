@@ -2,8 +2,8 @@
 
 #include <poll.h>
 
-#include <sdbus-c++/IConnection.h>
 #include <sdbus-c++/Error.h>
+#include <sdbus-c++/IConnection.h>
 
 #include "engine/core/log.hpp"
 

@@ -2,8 +2,8 @@
 // A private dbus-daemon for one test: started on a socket in /tmp with tests/support/bus.conf,
 // exported as DBUS_SYSTEM_BUS_ADDRESS (and the session address) so that production code that
 // opens "the system bus" talks to it, and killed when the object goes away.
-#include <string>
 #include <sys/types.h>
+#include <string>
 
 namespace pitwall::testing {
 

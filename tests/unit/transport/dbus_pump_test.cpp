@@ -19,13 +19,16 @@ TEST_CASE("dbus pump: async calls, replies, signals and timeouts run on the loop
 
   auto object = sdbus::createObject(*serverConn, "/echo");
   int served = 0;
-  object->registerMethod("Echo").onInterface("org.pitwall.Echo").implementedAs(
-      [&](const std::string& s) {
+  object->registerMethod("Echo")
+      .onInterface("org.pitwall.Echo")
+      .implementedAs([&](const std::string& s) {
         ++served;
         return s + "!";
       });
-  object->registerMethod("Never").onInterface("org.pitwall.Echo").implementedAs(
-      [](sdbus::Result<>&& /*result*/) {});  // never answers: the caller's timeout fires
+  object->registerMethod("Never")
+      .onInterface("org.pitwall.Echo")
+      .implementedAs(
+          [](sdbus::Result<>&& /*result*/) {});  // never answers: the caller's timeout fires
   object->registerSignal("Tick").onInterface("org.pitwall.Echo").withParameters<int>();
   object->finishRegistration();
 
@@ -63,7 +66,8 @@ TEST_CASE("dbus pump: async calls, replies, signals and timeouts run on the loop
   }
 
   SUBCASE("signals arrive in order") {
-    for (int i = 0; i < 5; ++i) object->emitSignal("Tick").onInterface("org.pitwall.Echo").withArguments(i);
+    for (int i = 0; i < 5; ++i)
+      object->emitSignal("Tick").onInterface("org.pitwall.Echo").withArguments(i);
     serverPump.kick();
     std::function<void()> poll = [&] {
       if (ticks.size() == 5) return loop.stop();

@@ -1,4 +1,4 @@
-#include "engine/cli/sim_run.hpp"
+#include "engine/cli/session.hpp"
 
 #include "engine/core/log.hpp"
 #include "engine/sim/grid.hpp"
@@ -8,19 +8,25 @@ namespace pitwall::cli {
 // Long enough for a frame to cross the simulator link and be acted on.
 constexpr Duration kFlush = std::chrono::milliseconds(100);
 
-SimRun::SimRun(ClockKind clock, sim::Track track, std::uint64_t seed)
+Session::Session(ClockKind clock, sim::Track track, std::uint64_t seed)
     : loop_(clock), fleet_(loop_) {
   sim_.seed = seed;
   sim_.world = std::make_unique<sim::World>(loop_, std::move(track), seed);
   log::setTimeSource([this] { return loop_.seconds(); });
 }
 
-SimRun::~SimRun() {
+Session::Session(ble::CentralOptions options) : loop_(ClockKind::Real), fleet_(loop_) {
+  log::setTimeSource([this] { return loop_.seconds(); });
+  central_ = std::make_unique<ble::Central>(loop_, fleet_, std::move(options));
+}
+
+Session::~Session() {
   host_.reset();
+  central_.reset();
   log::setTimeSource(nullptr);
 }
 
-void SimRun::record(const std::string& path) {
+void Session::record(const std::string& path) {
   recorder_ = std::make_unique<Recorder>(path);
   fleet_.onFrame = [this](AnkiCar& car, AnkiCar::Direction d, std::span<const std::uint8_t> f,
                           const anki::Message& m) {
@@ -28,7 +34,7 @@ void SimRun::record(const std::string& path) {
   };
 }
 
-bool SimRun::addGridCars(int count) {
+bool Session::addGridCars(int count) {
   std::vector<std::string> names;
   for (int i = 0; i < count; ++i) {
     sim::CarSpec spec = sim::gridSpec(sim_.world->track(), i);
@@ -48,16 +54,30 @@ bool SimRun::addGridCars(int count) {
   return fleet_.connectedCount() == static_cast<std::size_t>(count);
 }
 
-void SimRun::startHost(HostOptions options) {
-  host_ = std::make_unique<ScriptHost>(loop_, fleet_, &sim_, std::move(options));
+std::optional<std::string> Session::connectRealCars() {
+  std::optional<std::string> result = "interrupted";
+  central_->start([&](std::optional<std::string> error) {
+    result = std::move(error);
+    loop_.stop();
+  });
+  loop_.run();
+  return result;
+}
+
+void Session::startHost(HostOptions options) {
+  host_ =
+      std::make_unique<ScriptHost>(loop_, fleet_, sim_.world ? &sim_ : nullptr, std::move(options));
   host_->onStopRequested = [this] { finish(); };
 }
 
-void SimRun::finish() {
+void Session::finish() {
   if (finishing_) return;
   finishing_ = true;
   fleet_.stopAll();
-  loop_.after(kFlush, [this] { loop_.stop(); });
+  loop_.after(kFlush, [this] {
+    if (!central_) return loop_.stop();
+    central_->shutdown([this] { loop_.stop(); });
+  });
 }
 
 }  // namespace pitwall::cli

@@ -1,20 +1,24 @@
 #pragma once
-// One run on the built-in simulator, as `pitwall run` and `pitwall test` set it up: the loop,
-// the world, the fleet of simulated cars and the Lua host, destroyed in the right order.
+// One run, as `pitwall run` and `pitwall test` set it up: the loop, the cars (simulated in a
+// world, or real ones over Bluetooth LE) and the Lua host, destroyed in the right order.
 #include <memory>
 #include <string>
 
 #include "bindings/script_host.hpp"
 #include "engine/core/loop.hpp"
+#include "engine/vehicles/ble_central.hpp"
 #include "engine/vehicles/fleet.hpp"
 #include "engine/vehicles/recorder.hpp"
 
 namespace pitwall::cli {
 
-class SimRun {
+class Session {
  public:
-  SimRun(ClockKind clock, sim::Track track, std::uint64_t seed);
-  ~SimRun();
+  // On the built-in simulator.
+  Session(ClockKind clock, sim::Track track, std::uint64_t seed);
+  // Real cars through BlueZ, on the real clock. Throws ble::BleError when there is no bus.
+  explicit Session(ble::CentralOptions options);
+  ~Session();
 
   Loop& loop() { return loop_; }
   Fleet& fleet() { return fleet_; }
@@ -24,8 +28,11 @@ class SimRun {
   void record(const std::string& path);  // throws std::runtime_error naming the file
   // Puts `count` cars on the starting grid and runs the loop until all are connected.
   bool addGridCars(int count);
+  // Finds and connects the real cars (runs the loop until every car had a first attempt).
+  std::optional<std::string> connectRealCars();
   void startHost(HostOptions options);
-  // Stops every car, lets the stop frames reach them, then ends loop().run().
+  // Stops every car, lets the stop frames reach them, disconnects real cars, then ends
+  // loop().run().
   void finish();
 
  private:
@@ -33,6 +40,7 @@ class SimRun {
   SimSession sim_;
   Fleet fleet_;
   std::unique_ptr<Recorder> recorder_;
+  std::unique_ptr<ble::Central> central_;  // real cars; after the fleet: its links live there
   std::unique_ptr<ScriptHost> host_;
   bool finishing_ = false;
 };
