@@ -36,8 +36,8 @@ Row rowOf(const ble::Sighting& s) {
     r.model = anki::modelName(d.manufacturer->model_id);
     r.identifier = d.manufacturer->identifier;
   }
-  if (d.localNameIsRaw()) {
-    r.firmware = local.version;
+  if (d.stateKnown()) {
+    if (local.version) r.firmware = local.version;
     r.battery = local.on_charger     ? "charging"
                 : local.low_battery  ? "low"
                 : local.full_battery ? "full"

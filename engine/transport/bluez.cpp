@@ -47,13 +47,31 @@ bool Device::isAnki() const {
                      [](const std::string& u) { return lower(u) == anki::kServiceUuid; });
 }
 
+namespace {
+// Name starts with an Anki state byte: only the bits 0x10, 0x20, 0x40, at least one of them.
+bool startsWithState(const std::string& name) {
+  if (name.empty()) return false;
+  auto b = static_cast<unsigned char>(name[0]);
+  return b != 0 && (b & ~0x70u) == 0;
+}
+}  // namespace
+
 anki::LocalName Device::localName() const {
   if (rawName) return anki::parseLocalName(*rawName);
-  // BlueZ cut the name at its first NUL: the state byte and the version are in what is left only
-  // when they had no zero byte; the user name (from byte 8 on) is lost. Keep what is readable.
+  if (startsWithState(name)) {
+    std::vector<std::uint8_t> bytes(name.begin(), name.end());
+    auto n = anki::parseLocalName(bytes);
+    n.user_name.clear();  // what BlueZ kept ends before the user name
+    if (name.size() < 3) n.version = 0;
+    return n;
+  }
   anki::LocalName n;
   n.user_name = name;
   return n;
+}
+
+bool Device::stateKnown() const {
+  return rawName.has_value() || startsWithState(name);
 }
 
 std::string describe(const sdbus::Error& error, const std::string& step) {
@@ -163,10 +181,13 @@ Bluez::Bluez(Loop& loop) : loop_(loop), alive_(std::make_shared<bool>(true)) {
                    "): is dbus running? (docs/bluetooth.md)");
   }
   // Follow the tree from before it is read: a change between the read and the first signal
-  // would be lost otherwise. Both matches are added synchronously, before the loop runs.
+  // would be lost otherwise. The matches are added synchronously, before the loop runs. They
+  // select by path, not by sender='org.bluez': sd-bus also filters signals locally, against the
+  // sender's unique name, so a well-known sender name never matches there.
   signals_ = std::make_unique<Signals>();
   signals_->objects = connection_->addMatch(
-      "type='signal',sender='org.bluez',interface='org.freedesktop.DBus.ObjectManager'",
+      "type='signal',interface='org.freedesktop.DBus.ObjectManager',path='/',"
+      "arg0path='/org/bluez/'",
       [this](sdbus::Message& msg) {
         sdbus::ObjectPath path;
         msg >> path;
@@ -185,8 +206,8 @@ Bluez::Bluez(Loop& loop) : loop_(loop), alive_(std::make_shared<bool>(true)) {
         }
       });
   signals_->properties = connection_->addMatch(
-      "type='signal',sender='org.bluez',interface='org.freedesktop.DBus.Properties',"
-      "member='PropertiesChanged'",
+      "type='signal',interface='org.freedesktop.DBus.Properties',member='PropertiesChanged',"
+      "path_namespace='/org/bluez'",
       [this](sdbus::Message& msg) {
         std::string iface;
         Properties changed;

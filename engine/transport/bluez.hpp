@@ -55,10 +55,13 @@ struct Device {
   bool servicesResolved = false;
 
   bool isAnki() const;  // advertises the Anki service, or Anki manufacturer data
-  // The Anki local name: from the raw advertising data where present, else from Name (then the
-  // state bits and version are unknown and the user name is what BlueZ kept).
+  // The Anki local name: from the raw advertising data where BlueZ has it (only experimentally,
+  // and not in 5.66), else from what BlueZ made of it in Name: the bytes up to the first NUL —
+  // the state byte and the version when they contain no zero, never the user name (which comes
+  // after reserved NUL bytes). A Name that does not start with a state byte is taken as the
+  // user name (a car emulator that advertises a plain name).
   anki::LocalName localName() const;
-  bool localNameIsRaw() const { return rawName.has_value(); }
+  bool stateKnown() const;  // the state byte and version were readable
 };
 
 struct Characteristic {

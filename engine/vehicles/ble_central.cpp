@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "engine/core/log.hpp"
+#include "engine/sim/grid.hpp"
 
 namespace pitwall::ble {
 
@@ -182,6 +183,8 @@ void Central::start(std::function<void(std::optional<std::string> error)> done) 
 
 void Central::addCars(const std::vector<Sighting>& sightings) {
   std::map<std::string, int> load;
+  std::vector<std::string> taken;
+  for (const auto* c : fleet_.cars()) taken.push_back(c->identity().name);
   for (const auto& s : sightings) {
     // The least loaded adapter that saw the car
     std::string adapter, path;
@@ -196,12 +199,16 @@ void Central::addCars(const std::vector<Sighting>& sightings) {
     Car* raw = car.get();
     link->onDropped = [this, raw](const std::string& why) { retryLater(*raw, why); };
     CarIdentity identity;
-    auto local = s.device.localName();
-    identity.name = local.user_name;
     if (s.device.manufacturer) {
       identity.model_id = s.device.manufacturer->model_id;
       identity.identifier = s.device.manufacturer->identifier;
     }
+    // The user name where BlueZ let us read it, else the model's name, made unique as the
+    // simulator does (groundshock, groundshock2, …).
+    identity.name = s.device.localName().user_name;
+    if (identity.name.empty() && s.device.manufacturer)
+      identity.name = sim::uniqueCarName(identity.model_id, taken);
+    taken.push_back(identity.name);
     car->car = &fleet_.add(std::move(link), std::move(identity));
     log::info("ble", "found " + car->car->label() + " at " + s.address + " on " +
                          adapter.substr(adapter.rfind('/') + 1));

@@ -1,0 +1,108 @@
+// fake_bluez — a fake org.bluez with simulated Anki cars, on the bus named by
+// DBUS_SYSTEM_BUS_ADDRESS. Prints `ready` once it owns org.bluez; runs until SIGTERM or SIGINT.
+#include <CLI/CLI.hpp>
+#include <boost/asio/signal_set.hpp>
+#include <csignal>
+#include <iostream>
+
+#include <sdbus-c++/sdbus-c++.h>
+
+#include "engine/core/log.hpp"
+#include "tests/fake_bluez/fake_bluez.hpp"
+
+namespace {
+
+using pitwall::testing::FakeBluez;
+
+struct Timed {
+  std::string address;
+  double seconds = 0;
+};
+
+// "E0:00:00:00:00:01@2.5" → {address, 2.5}
+Timed parseTimed(const std::string& flag, const std::string& text) {
+  auto at = text.rfind('@');
+  Timed t;
+  try {
+    if (at == std::string::npos) throw std::invalid_argument("no @");
+    std::size_t used = 0;
+    t.address = text.substr(0, at);
+    t.seconds = std::stod(text.substr(at + 1), &used);
+    if (used != text.size() - at - 1 || t.seconds < 0) throw std::invalid_argument("seconds");
+  } catch (const std::exception&) {
+    throw std::invalid_argument(flag + " '" + text +
+                                "': write ADDRESS@SECONDS, e.g. E0:00:00:00:00:01@2.5 (seconds "
+                                "after that car's first connection)");
+  }
+  return t;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace pitwall;
+  CLI::App app{"fake_bluez — a fake org.bluez (BlueZ 5.66 D-Bus API) with simulated Anki cars"};
+  testing::FakeBluezOptions options;
+  std::vector<std::string> refuse, drop, vanish, garbage;
+  std::string logLevel = "info";
+  app.add_option("--adapters", options.adapters, "Number of controllers, hci0… (default 1)")
+      ->check(CLI::Range(1, 16));
+  app.add_option("--cars", options.cars, "Number of cars, spread over the adapters (default 1)")
+      ->check(CLI::Range(0, 64));
+  app.add_option("--track", options.track, "Track layout: a name (oval, …) or a layout file");
+  app.add_option("--seed", options.seed, "Seed of the simulator and the RSSI jitter (default 1)");
+  app.add_option("--address", options.addresses,
+                 "Address of car 1, 2, … in order (repeatable; default E0:00:00:00:00:01, …)");
+  app.add_option("--name", options.names, "User name of car 1, 2, … in order (repeatable)");
+  app.add_option("--refuse", refuse, "Connect to this car fails (repeatable)");
+  app.add_option("--drop", drop, "ADDR@SECONDS: the link drops, the car stays known (repeatable)");
+  app.add_option("--vanish", vanish, "ADDR@SECONDS: the car disconnects and is gone for good");
+  app.add_option("--garbage", garbage, "ADDR@SECONDS: the car sends malformed frames");
+  app.add_flag("--no-acquire", options.noAcquire,
+               "AcquireNotify/AcquireWrite answer org.bluez.Error.NotSupported");
+  app.add_option("--log-level", logLevel, "debug, info, warn, error or off (default info)");
+  CLI11_PARSE(app, argc, argv);
+
+  if (auto level = log::parseLevel(logLevel)) {
+    log::setLevel(*level);
+  } else {
+    std::cerr << "fake_bluez: --log-level '" << logLevel
+              << "' is not one of debug, info, warn, error, off\n";
+    return 2;
+  }
+
+  try {
+    Loop loop(ClockKind::Real);
+    auto connection = sdbus::createSystemBusConnection();
+    FakeBluez fake(loop, *connection, options);
+    for (const auto& a : refuse) fake.refuse(a);
+    auto schedule = [&](const std::vector<std::string>& list, const std::string& flag,
+                        FakeBluez::Fault fault) {
+      for (const auto& text : list) {
+        Timed t = parseTimed(flag, text);
+        fake.schedule(fault, t.address, fromSeconds(t.seconds));
+      }
+    };
+    schedule(drop, "--drop", FakeBluez::Fault::Drop);
+    schedule(vanish, "--vanish", FakeBluez::Fault::Vanish);
+    schedule(garbage, "--garbage", FakeBluez::Fault::Garbage);
+
+    boost::asio::signal_set signals(loop.io(), SIGINT, SIGTERM);
+    signals.async_wait([&](const boost::system::error_code& ec, int) {
+      if (!ec) loop.stop();
+    });
+    std::string list;
+    for (const auto& a : fake.addresses()) list += " " + a;
+    log::info("fake-bluez", std::to_string(options.adapters) + " adapter(s), cars:" +
+                                (list.empty() ? std::string(" none") : list));
+    std::cout << "ready" << std::endl;
+    loop.run();
+    return 0;
+  } catch (const sdbus::Error& e) {
+    std::cerr << "fake_bluez: D-Bus: " << e.getName() << ": " << e.getMessage()
+              << " (is DBUS_SYSTEM_BUS_ADDRESS set to a running bus?)\n";
+  } catch (const std::exception& e) {
+    std::cerr << "fake_bluez: " << e.what() << "\n";
+  }
+  return 1;
+}

@@ -1,0 +1,284 @@
+// The BlueZ client (Bluez, BleLink, Central) against the fake org.bluez on a private bus: the
+// same code that drives real cars, with the cars simulated behind D-Bus. Real clock; every wait
+// is for a condition on the loop, with a deadline.
+#include "engine/vehicles/ble_central.hpp"
+
+#include <doctest/doctest.h>
+
+#include <sdbus-c++/sdbus-c++.h>
+
+#include "tests/fake_bluez/fake_bluez.hpp"
+#include "tests/support/private_bus.hpp"
+
+using namespace pitwall;
+using namespace std::chrono_literals;
+using testing::FakeBluez;
+
+namespace {
+
+constexpr const char* kCar1 = "E0:00:00:00:00:01";
+constexpr const char* kCar2 = "E0:00:00:00:00:02";
+
+struct Rig {
+  testing::PrivateBus bus;
+  Loop loop{ClockKind::Real};
+  std::unique_ptr<sdbus::IConnection> fakeConnection = sdbus::createSystemBusConnection();
+  FakeBluez fake;
+  Fleet fleet{loop};
+  std::unique_ptr<ble::Central> central;
+
+  Rig(FakeBluez::Options o, ble::CentralOptions c = quick())
+      : fake(loop, *fakeConnection, std::move(o)) {
+    central = std::make_unique<ble::Central>(loop, fleet, std::move(c));
+  }
+
+  static ble::CentralOptions quick() {
+    ble::CentralOptions c;
+    c.scan = 300ms;
+    c.backoffMin = 20ms;
+    c.backoffMax = 80ms;
+    return c;
+  }
+
+  // Runs the loop until cond() holds or the deadline passes; returns cond().
+  bool waitFor(const std::function<bool()>& cond, Duration deadline = 5s) {
+    if (cond()) return true;
+    bool expired = false;
+    auto limit = loop.after(deadline, [&] {
+      expired = true;
+      loop.stop();
+    });
+    std::function<void()> poll = [&] {
+      if (cond()) return loop.stop();
+      loop.after(2ms, poll);
+    };
+    loop.post(poll);
+    loop.run();
+    loop.cancel(limit);
+    return cond() && !expired ? true : cond();
+  }
+
+  std::optional<std::string> start() {
+    std::optional<std::string> result = "never finished";
+    bool finished = false;
+    central->start([&](std::optional<std::string> e) {
+      result = e;
+      finished = true;
+    });
+    waitFor([&] { return finished; }, 10s);
+    return result;
+  }
+
+  AnkiCar* car(const std::string& address) {
+    for (auto* c : fleet.cars())
+      if (c->link().address() == "ble:" + address) return c;
+    return nullptr;
+  }
+};
+
+FakeBluez::Options cars(int adapters, int n) {
+  FakeBluez::Options o;
+  o.adapters = adapters;
+  o.cars = n;
+  return o;
+}
+
+}  // namespace
+
+TEST_CASE("ble: cars on two adapters are found, connected one per adapter, and driven") {
+  Rig rig(cars(2, 3));
+  REQUIRE(rig.start() == std::nullopt);
+  REQUIRE(rig.fleet.cars().size() == 3);
+  CHECK(rig.waitFor([&] { return rig.fleet.connectedCount() == 3; }));
+  for (const auto& address : rig.fake.addresses()) {
+    AnkiCar* car = rig.car(address);
+    REQUIRE(car);
+    CHECK(rig.fake.connected(address));
+    CHECK(rig.fake.counters(address).connectCalls == 1);
+    // identity from the advertisement: the model from the manufacturer data, the user name from
+    // the raw local name the fake offers
+    CHECK(car->identity().model_id == rig.fake.car(address).spec().model_id);
+    CHECK(car->identity().name == rig.fake.car(address).spec().name);
+    auto& link = static_cast<ble::BleLink&>(car->link());
+    CHECK(link.notifyAcquired());
+    CHECK(link.writeAcquired());
+  }
+  // SDK mode went out on connect; commands reach the simulated car; notifications come back
+  CHECK(rig.waitFor([&] {
+    for (const auto& a : rig.fake.addresses())
+      if (!rig.fake.car(a).truth().sdk_mode) return false;
+    return true;
+  }));
+  AnkiCar* first = rig.car(kCar1);
+  REQUIRE(first->setSpeed(800, 5000));
+  CHECK(rig.waitFor([&] { return first->state().piece >= 0 && first->state().speed_mm_s > 0; }));
+  CHECK(rig.fake.car(kCar1).truth().speed_mm_s > 0);
+  CHECK(rig.fake.car(kCar2).truth().speed_mm_s == 0);
+}
+
+TEST_CASE("ble: without AcquireNotify/AcquireWrite, StartNotify and WriteValue carry the frames") {
+  auto o = cars(1, 1);
+  o.noAcquire = true;
+  Rig rig(o);
+  REQUIRE(rig.start() == std::nullopt);
+  AnkiCar* car = rig.car(kCar1);
+  REQUIRE(car);
+  REQUIRE(rig.waitFor([&] { return car->state().connected; }));
+  auto& link = static_cast<ble::BleLink&>(car->link());
+  CHECK_FALSE(link.notifyAcquired());
+  CHECK_FALSE(link.writeAcquired());
+  REQUIRE(car->setSpeed(800, 5000));
+  CHECK(rig.waitFor([&] { return car->state().speed_mm_s > 0; }));
+}
+
+TEST_CASE("ble: a refused car is retried with backoff and joins when it stops refusing") {
+  Rig rig(cars(1, 2));
+  rig.fake.refuse(kCar2);
+  REQUIRE(rig.start() == std::nullopt);  // the first round is over: car 1 up, car 2 failed
+  CHECK(rig.car(kCar1)->state().connected);
+  CHECK_FALSE(rig.car(kCar2)->state().connected);
+  CHECK(rig.waitFor([&] { return rig.central->attempts()[kCar2] >= 3; }));
+  CHECK(rig.fake.counters(kCar2).connects == 0);
+  auto refused = rig.car(kCar2)->setSpeed(500);
+  REQUIRE_FALSE(refused);
+  CHECK(refused.error().find("not connected") != std::string::npos);
+  rig.fake.refuse(kCar2, false);
+  CHECK(rig.waitFor([&] { return rig.car(kCar2)->state().connected; }));
+}
+
+TEST_CASE("ble: a dropped car is reported, reconnected, and gets SDK mode again") {
+  Rig rig(cars(1, 1));
+  REQUIRE(rig.start() == std::nullopt);
+  AnkiCar* car = rig.car(kCar1);
+  std::vector<std::pair<bool, std::string>> states;
+  car->onConnection = [&](bool up, const std::string& why) { states.emplace_back(up, why); };
+  REQUIRE(car->setSpeed(800, 5000));
+  REQUIRE(rig.waitFor([&] { return rig.fake.car(kCar1).truth().speed_mm_s > 0; }));
+
+  rig.fake.drop(kCar1);
+  REQUIRE(rig.waitFor([&] { return !states.empty(); }));
+  CHECK_FALSE(states[0].first);
+  CHECK(states[0].second.find(kCar1) != std::string::npos);
+  auto whileDown = car->setSpeed(600);
+  CHECK_FALSE(whileDown);                                     // refused, not silently lost
+  CHECK(rig.fake.car(kCar1).truth().target_speed_mm_s == 0);  // a car that loses its link stops
+
+  REQUIRE(rig.waitFor([&] { return car->state().connected; }));
+  CHECK(states.back().first);
+  CHECK(rig.fake.counters(kCar1).connects == 2);
+  CHECK(rig.waitFor([&] { return rig.fake.car(kCar1).truth().sdk_mode; }));
+  REQUIRE(car->setSpeed(700, 5000));
+  CHECK(rig.waitFor([&] { return rig.fake.car(kCar1).truth().speed_mm_s > 0; }));
+}
+
+TEST_CASE("ble: a vanished car is reported and looked for, without connection attempts") {
+  Rig rig(cars(1, 2));
+  REQUIRE(rig.start() == std::nullopt);
+  AnkiCar* car = rig.car(kCar2);
+  REQUIRE(rig.waitFor([&] { return car->state().connected; }));
+  std::string reason;
+  car->onConnection = [&](bool up, const std::string& why) {
+    if (!up) reason = why;
+  };
+  rig.fake.vanish(kCar2);
+  REQUIRE(rig.waitFor([&] { return !reason.empty(); }));
+  CHECK(reason.find(kCar2) != std::string::npos);
+  // discovery runs again on its adapter to find it, and nobody calls Connect on a device that
+  // is not there
+  CHECK(rig.waitFor([&] {
+    auto& a = rig.central->bluez().adapters();
+    auto it = a.find("/org/bluez/hci0");
+    return it != a.end() && it->second.discovering;
+  }));
+  int attempts = rig.central->attempts()[kCar2];
+  rig.waitFor([] { return false; }, 200ms);
+  CHECK(rig.central->attempts()[kCar2] == attempts);
+  CHECK_FALSE(car->state().connected);
+  CHECK(rig.car(kCar1)->state().connected);  // the other car is untouched
+}
+
+TEST_CASE("ble: malformed notifications are counted and reported; the link carries on") {
+  Rig rig(cars(1, 1));
+  REQUIRE(rig.start() == std::nullopt);
+  AnkiCar* car = rig.car(kCar1);
+  REQUIRE(rig.waitFor([&] { return car->state().connected; }));
+  std::vector<std::string> errors;
+  car->onMalformed = [&](const anki::DecodeError& e, std::span<const std::uint8_t>) {
+    errors.push_back(e.message());
+  };
+  for (const auto& frame : FakeBluez::garbageFrames()) rig.fake.inject(kCar1, frame);
+  CHECK(rig.waitFor([&] { return car->state().malformed >= 2; }));
+  CHECK(errors.size() == car->state().malformed);
+  CHECK(car->state().connected);
+  REQUIRE(car->ping());
+  auto frames = car->state().frames_in;
+  CHECK(rig.waitFor([&] { return car->state().frames_in > frames; }));
+}
+
+TEST_CASE("ble: each step of a connection has a timeout that names it") {
+  auto c = Rig::quick();
+  c.cars = {"E0:00:00:00:00:09"};  // not there: the Central scans, finds nothing, connects nothing
+  Rig rig(cars(1, 1), c);
+  REQUIRE(rig.start());
+  ble::LinkTimeouts timeouts;
+  timeouts.connect = 1ms;  // the fake answers Connect after 30 ms
+  ble::BleLink link(rig.central->bluez(), rig.fake.devicePath(kCar1), kCar1, timeouts);
+  std::string reason;
+  bool done = false;
+  link.connect([&](std::optional<std::string> e) {
+    reason = e.value_or("");
+    done = true;
+  });
+  REQUIRE(rig.waitFor([&] { return done; }));
+  CHECK(reason == std::string("connecting to ") + kCar1 + " timed out");
+  CHECK_FALSE(link.connected());
+}
+
+TEST_CASE("ble: only the cars asked for, and only on the adapters asked for") {
+  SUBCASE("--car") {
+    auto c = Rig::quick();
+    c.cars = {"e0:00:00:00:00:02"};  // any case
+    Rig rig(cars(1, 3), c);
+    REQUIRE(rig.start() == std::nullopt);
+    REQUIRE(rig.fleet.cars().size() == 1);
+    CHECK(rig.fleet.cars()[0]->link().address() == std::string("ble:") + kCar2);
+  }
+  SUBCASE("--adapter") {
+    auto c = Rig::quick();
+    c.adapters = {"hci1"};
+    Rig rig(cars(2, 4), c);
+    REQUIRE(rig.start() == std::nullopt);
+    CHECK(rig.fleet.cars().size() == 2);  // cars 2 and 4 sit on hci1
+    CHECK(rig.car(kCar2));
+  }
+  SUBCASE("an adapter that is not there") {
+    auto c = Rig::quick();
+    c.adapters = {"hci5"};
+    Rig rig(cars(2, 1), c);
+    auto error = rig.start();
+    REQUIRE(error);
+    CHECK(*error == "there is no Bluetooth adapter hci5 (found: hci0, hci1)");
+  }
+  SUBCASE("no car in range") {
+    Rig rig(cars(1, 0));
+    auto error = rig.start();
+    REQUIRE(error);
+    CHECK(error->find("no Anki car found on hci0") == 0);
+  }
+}
+
+TEST_CASE("ble: shutdown disconnects every car") {
+  Rig rig(cars(2, 2));
+  REQUIRE(rig.start() == std::nullopt);
+  REQUIRE(rig.waitFor([&] { return rig.fleet.connectedCount() == 2; }));
+  bool down = false;
+  rig.central->shutdown([&] { down = true; });
+  REQUIRE(rig.waitFor([&] { return down; }));
+  CHECK_FALSE(rig.fake.connected(kCar1));
+  CHECK_FALSE(rig.fake.connected(kCar2));
+  CHECK(rig.fleet.connectedCount() == 0);
+  // and nothing reconnects afterwards
+  int attempts = rig.central->attempts()[kCar1];
+  rig.waitFor([] { return false; }, 200ms);
+  CHECK(rig.central->attempts()[kCar1] == attempts);
+}
