@@ -1,11 +1,147 @@
-// pitwall emulate-car: being written (issue 3).
+// pitwall emulate-car: one simulated car behind a BLE peripheral, so that a central (pitwall run
+// --ble, or any Anki app) can find it, connect and drive it through the real BlueZ stack.
+#include <boost/asio/signal_set.hpp>
+#include <csignal>
+#include <cstdio>
 #include <iostream>
 
+#include <sdbus-c++/sdbus-c++.h>
+
 #include "engine/cli/commands.hpp"
+#include "engine/core/log.hpp"
+#include "engine/protocol/anki/advertisement.hpp"
+#include "engine/sim/grid.hpp"
+#include "engine/sim/world.hpp"
+#include "engine/transport/ble_peripheral.hpp"
+#include "engine/transport/dbus_pump.hpp"
 
 namespace pitwall::cli {
-int emulateCar(const EmulateOptions&) {
-  std::cerr << "pitwall emulate-car: not built yet\n";
-  return 2;
+namespace {
+
+constexpr const char* kComponent = "emulate-car";
+// How long a stop waits for BlueZ to confirm the unregistrations before leaving anyway (the
+// registrations also die with our bus connection).
+constexpr Duration kStopGrace = std::chrono::seconds(1);
+
+std::string hex32(std::uint32_t v) {
+  char text[16];
+  std::snprintf(text, sizeof text, "0x%08x", v);
+  return text;
 }
+
+}  // namespace
+
+int emulateCar(const EmulateOptions& options) {
+  auto track = sim::loadLayout(options.track);
+  if (!track) {
+    std::cerr << "pitwall emulate-car: " << track.error() << "\n";
+    return 2;
+  }
+
+  std::unique_ptr<sdbus::IConnection> bus;
+  try {
+    bus = sdbus::createSystemBusConnection();
+  } catch (const sdbus::Error& e) {
+    std::cerr << "pitwall emulate-car: cannot connect to the system bus (" << e.getMessage()
+              << "): is D-Bus running? (DBUS_SYSTEM_BUS_ADDRESS chooses another bus)\n";
+    return 2;
+  }
+
+  Loop loop(ClockKind::Real);
+  log::setTimeSource([&loop] { return loop.seconds(); });
+  sim::World world(loop, std::move(*track), options.seed);
+  sim::CarSpec spec = sim::gridSpec(world.track(), 0);
+  spec.name = options.name;
+  spec.model_id = options.model;
+  sim::SimCar& car = world.addCar(spec);
+
+  PeripheralSpec peripheralSpec;
+  peripheralSpec.adapter = options.adapter;
+  peripheralSpec.serviceUuid = anki::kServiceUuid;
+  peripheralSpec.notifyCharUuid = anki::kReadCharUuid;
+  peripheralSpec.writeCharUuid = anki::kWriteCharUuid;
+  // 8 bytes [BE EF][reserved][model][id]: BlueZ takes the first two as the company id.
+  auto manufacturer = car.manufacturerData();
+  peripheralSpec.manufacturerKey = anki::kManufacturerKey;
+  peripheralSpec.manufacturerData.assign(manufacturer.begin() + 2, manufacturer.end());
+  peripheralSpec.localName = car.localName();
+  peripheralSpec.fallbackName = options.name;
+
+  DbusPump pump(loop, *bus);
+  BlePeripheral peripheral(pump, peripheralSpec);
+  const std::string who = "'" + options.name + "' (" + anki::modelName(options.model) + ", id " +
+                          hex32(car.identifier()) + ")";
+
+  int status = 0;
+  bool stopping = false;
+  auto finish = [&](int code) {
+    if (stopping) return;
+    stopping = true;
+    status = code;
+    car.disconnect();
+    peripheral.stop([&] { loop.stop(); });
+    loop.after(kStopGrace, [&] { loop.stop(); });
+  };
+
+  int lapsAtConnect = 0;
+  peripheral.onConnected = [&](const std::string& device) {
+    log::info(kComponent, "a central connected (" + device + ")");
+    lapsAtConnect = car.truth().laps;
+    car.connect([&](std::span<const std::uint8_t> frame) { peripheral.notify(frame); },
+                [&] {
+                  log::info(kComponent, "the car dropped the connection");
+                  peripheral.disconnectCentral();
+                });
+  };
+  peripheral.onWrite = [&](std::span<const std::uint8_t> frame) { car.receive(frame); };
+  peripheral.onDisconnected = [&] {
+    log::info(kComponent, "the central went away after " +
+                              std::to_string(car.truth().laps - lapsAtConnect) +
+                              " lap(s); advertising again");
+    car.disconnect();
+  };
+
+  peripheral.start([&](const std::string& error) {
+    if (!error.empty()) {
+      std::cerr << "pitwall emulate-car: " << error << "\n";
+      status = 2;
+      stopping = true;
+      loop.stop();
+      return;
+    }
+    log::info(kComponent, "advertising " + who + " on " + options.adapter +
+                              "; local name: " + peripheral.advertisedName());
+  });
+
+  // Progress while a central drives: one line per lap.
+  int reported = 0;
+  std::function<void()> watchLaps = [&] {
+    int now = car.truth().laps;
+    if (now != reported) {
+      reported = now;
+      log::info(kComponent, "lap " + std::to_string(now));
+    }
+    loop.after(std::chrono::milliseconds(250), watchLaps);
+  };
+  watchLaps();
+
+  boost::asio::signal_set signals(loop.io(), SIGINT, SIGTERM);
+  signals.async_wait([&](const boost::system::error_code& ec, int sig) {
+    if (ec) return;
+    log::info(kComponent, std::string(sig == SIGINT ? "interrupted" : "terminated") +
+                              ": unregistering from BlueZ");
+    finish(0);
+  });
+  if (options.duration)
+    loop.after(fromSeconds(*options.duration), [&] {
+      log::info(kComponent, "the duration is over: unregistering from BlueZ");
+      finish(0);
+    });
+
+  loop.run();
+  car.disconnect();  // no callback into the peripheral from here on
+  log::setTimeSource(nullptr);
+  return status;
+}
+
 }  // namespace pitwall::cli

@@ -91,7 +91,8 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help prints and exits 0; every usage error is status 2 (docs/cli.md), not CLI11's own.
+    return app.exit(e) == 0 ? 0 : 2;
   }
 
   bool testing = testCmd->parsed();

@@ -63,6 +63,7 @@ void BleLink::connect(Done done) {
           return fail(describe(*error, "connecting to " + address_));
         step_ = Step::Resolving;
         const Device* d = bluez_.device(devicePath_);
+        sawConnected_ = d && d->connected;
         if (d && d->servicesResolved) return resolved();
         armStepTimer(timeouts_.resolve, "service discovery on " + address_);
       });
@@ -70,8 +71,12 @@ void BleLink::connect(Done done) {
 }
 
 void BleLink::deviceChanged(const Device& d) {
+  // A loss is Connected going from true to false. BlueZ may answer Connect before its
+  // Connected=true signal arrives: a false seen before any true is not a loss.
+  bool wasConnected = sawConnected_;
+  sawConnected_ = d.connected;
   if (step_ == Step::Idle) return;
-  if (!d.connected && step_ != Step::Connecting) {
+  if (!d.connected && wasConnected && step_ != Step::Connecting) {
     if (step_ == Step::Up)
       lost(address_ + " disconnected");
     else

@@ -83,6 +83,7 @@ class BleLink : public Link {
   Loop::TimerId stepTimer_ = 0;
   std::string readChar_, writeChar_;
   bool disconnectRequested_ = false;
+  bool sawConnected_ = false;  // BlueZ's Connected as last seen
   boost::asio::posix::stream_descriptor notifyFd_, writeFd_;
   std::shared_ptr<bool> alive_;
 };

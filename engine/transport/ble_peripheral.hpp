@@ -22,8 +22,8 @@ namespace pitwall {
 struct PeripheralSpec {
   std::string adapter = "hci0";  // BlueZ adapter name: /org/bluez/<adapter>
   std::string serviceUuid;
-  std::string notifyCharUuid;  // flags read, notify
-  std::string writeCharUuid;   // flags write, write-without-response
+  std::string notifyCharUuid;                  // flags read, notify
+  std::string writeCharUuid;                   // flags write, write-without-response
   std::uint16_t manufacturerKey = 0;           // company id: the first 2 bytes, little-endian
   std::vector<std::uint8_t> manufacturerData;  // the bytes after the company id
   std::vector<std::uint8_t> localName;         // raw bytes (may hold NULs), tried first

@@ -48,20 +48,35 @@ bool Device::isAnki() const {
 }
 
 namespace {
-// Name starts with an Anki state byte: only the bits 0x10, 0x20, 0x40, at least one of them.
-bool startsWithState(const std::string& name) {
-  if (name.empty()) return false;
-  auto b = static_cast<unsigned char>(name[0]);
-  return b != 0 && (b & ~0x70u) == 0;
+bool stateByte(unsigned char b) {
+  return (b & ~0x70u) == 0;
+}  // bits 0x10, 0x20, 0x40 only
+
+// The raw local name is Anki's: a state byte, the version, five reserved zero bytes (a plain
+// name, such as a car emulator's, has letters there).
+bool ankiLocalName(const std::vector<std::uint8_t>& raw) {
+  if (raw.size() < 8 || !stateByte(raw[0])) return false;
+  return std::all_of(raw.begin() + 3, raw.begin() + 8, [](std::uint8_t b) { return b == 0; });
+}
+
+// What BlueZ's Name keeps of an Anki local name: the bytes before the first reserved zero — a
+// non-zero state byte and at most the two version bytes.
+bool cutAnkiName(const std::string& name) {
+  return !name.empty() && name.size() <= 3 && name[0] != 0 &&
+         stateByte(static_cast<unsigned char>(name[0]));
 }
 }  // namespace
 
 anki::LocalName Device::localName() const {
-  if (rawName) return anki::parseLocalName(*rawName);
-  if (startsWithState(name)) {
-    std::vector<std::uint8_t> bytes(name.begin(), name.end());
-    auto n = anki::parseLocalName(bytes);
-    n.user_name.clear();  // what BlueZ kept ends before the user name
+  if (rawName) {
+    if (ankiLocalName(*rawName)) return anki::parseLocalName(*rawName);
+    anki::LocalName n;  // a plain name
+    n.user_name = std::string(rawName->begin(), std::find(rawName->begin(), rawName->end(), 0));
+    return n;
+  }
+  if (cutAnkiName(name)) {
+    auto n = anki::parseLocalName(std::vector<std::uint8_t>(name.begin(), name.end()));
+    n.user_name.clear();
     if (name.size() < 3) n.version = 0;
     return n;
   }
@@ -71,7 +86,7 @@ anki::LocalName Device::localName() const {
 }
 
 bool Device::stateKnown() const {
-  return rawName.has_value() || startsWithState(name);
+  return rawName ? ankiLocalName(*rawName) : cutAnkiName(name);
 }
 
 std::string describe(const sdbus::Error& error, const std::string& step) {

@@ -12,7 +12,8 @@
 //   cache is off, Cache=no / Cache=yes for unpaired devices; the stock Cache=always keeps them,
 //   and method calls on them then fail with Failed "Not connected"); there is no CCCD descriptor
 //   object under the notify characteristic; Value exists before the first notification (empty);
-//   RSSI and TxPower keep their last values after discovery stops (BlueZ invalidates them);
+//   RSSI and TxPower keep their last values after discovery stops (BlueZ invalidates them; the
+//   fake then reports RSSI at the next discovery's first sighting, as BlueZ does);
 //   devices stay known after discovery stops (BlueZ drops temporary ones after 30 s);
 //   AdvertisingData carries the local name (0x09), which stock BlueZ does not export; method
 //   replies come before the PropertiesChanged they cause in BlueZ (gdbus defers signals), here
@@ -237,6 +238,9 @@ struct Device {
   Adapter* adapter = nullptr;
   sim::SimCar* car = nullptr;
   std::int16_t baseRssi = -60;
+  // BlueZ invalidates RSSI when discovery stops (device_set_rssi(dev, 0)), so the first sighting
+  // of the next discovery always reports it. sdbus-c++ cannot invalidate a property: we mark it.
+  bool rssiStale = false;
 
   // What BlueZ knows: the last advertisement, and what the client set.
   std::unique_ptr<sdbus::IObject> object;  // null while BlueZ does not know the device
@@ -387,9 +391,10 @@ FakeBluez::State::State(Loop& loop_, sdbus::IConnection& connection, Options opt
       options(std::move(options_)),
       pump(loop_, connection),
       rng(options.seed * 0x9e3779b97f4a7c15ull + 1) {
-  if (options.adapters < 1)
-    throw std::invalid_argument("a fake BlueZ needs at least one adapter, not " +
-                                std::to_string(options.adapters));
+  // No adapter is a machine without Bluetooth hardware, where bluetoothd still runs.
+  if (options.adapters < 0 || (options.adapters == 0 && options.cars > 0))
+    throw std::invalid_argument("cars need an adapter: " + std::to_string(options.adapters) +
+                                " adapters for " + std::to_string(options.cars) + " cars");
   if (options.cars < 0)
     throw std::invalid_argument("the number of cars cannot be negative (" +
                                 std::to_string(options.cars) + ")");
@@ -703,6 +708,8 @@ void FakeBluez::State::stopScan(Adapter& a) {
   for (auto& id : a.sightings) cancel(id);
   a.sightings.clear();
   cancel(a.advertTimer);
+  for (auto& d : devices)
+    if (d->adapter == &a) d->rssiStale = true;
   emit(a.object.get(), kAdapterIface, {"Discovering"});
 }
 
@@ -747,7 +754,8 @@ void FakeBluez::State::advertise(Device& d) {
     return;
   }
   std::vector<std::string> changed;
-  if (std::abs(rssi - d.rssi) >= kRssiThreshold) {
+  if (d.rssiStale || std::abs(rssi - d.rssi) >= kRssiThreshold) {
+    d.rssiStale = false;
     d.rssi = rssi;
     changed.push_back("RSSI");
   }

@@ -1,5 +1,6 @@
 // fake_bluez — a fake org.bluez with simulated Anki cars, on the bus named by
-// DBUS_SYSTEM_BUS_ADDRESS. Prints `ready` once it owns org.bluez; runs until SIGTERM or SIGINT.
+// DBUS_SYSTEM_BUS_ADDRESS. Prints `ready` once it owns org.bluez; runs until SIGTERM or SIGINT,
+// then prints one line per car: `ADDR connected=… target=… connects=… disconnects=… …`.
 #include <CLI/CLI.hpp>
 #include <boost/asio/signal_set.hpp>
 #include <csignal>
@@ -46,7 +47,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> refuse, drop, vanish, garbage;
   std::string logLevel = "info";
   app.add_option("--adapters", options.adapters, "Number of controllers, hci0… (default 1)")
-      ->check(CLI::Range(1, 16));
+      ->check(CLI::Range(0, 16));
   app.add_option("--cars", options.cars, "Number of cars, spread over the adapters (default 1)")
       ->check(CLI::Range(0, 64));
   app.add_option("--track", options.track, "Track layout: a name (oval, …) or a layout file");
@@ -97,6 +98,16 @@ int main(int argc, char** argv) {
                                 (list.empty() ? std::string(" none") : list));
     std::cout << "ready" << std::endl;
     loop.run();
+    // What each car went through, for the tests to check: one line per car.
+    for (const auto& a : fake.addresses()) {
+      const auto& c = fake.counters(a);
+      auto truth = fake.car(a).truth();
+      std::cout << a << " connected=" << (fake.connected(a) ? "true" : "false")
+                << " target=" << truth.target_speed_mm_s << " connects=" << c.connects
+                << " disconnects=" << c.disconnects << " framesToCar=" << c.framesToCar
+                << " framesToClient=" << c.framesToClient << " laps=" << truth.laps << "\n";
+    }
+    std::cout.flush();
     return 0;
   } catch (const sdbus::Error& e) {
     std::cerr << "fake_bluez: D-Bus: " << e.getName() << ": " << e.getMessage()

@@ -1,0 +1,47 @@
+# For the BLE integration tests: a private dbus-daemon and the fake BlueZ (tests/fake_bluez) on
+# it, started and stopped by the test. $3 is the fake_bluez binary.
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
+FAKE_BLUEZ=$3
+BUS_PID=""
+FAKE_PID=""
+
+stop_fake() {
+  if [ -n "$FAKE_PID" ]; then
+    kill -TERM "$FAKE_PID" 2>/dev/null
+    wait "$FAKE_PID" 2>/dev/null
+    FAKE_PID=""
+  fi
+}
+
+cleanup_ble() {
+  stop_fake
+  [ -n "$BUS_PID" ] && kill "$BUS_PID" 2>/dev/null
+  rm -rf "$TMP"
+}
+trap cleanup_ble EXIT
+
+# start_bus: a private bus, exported as the system bus for everything started after it.
+start_bus() {
+  local out
+  out=$(dbus-daemon --config-file="$SRC/tests/support/bus.conf" --fork --nosyslog \
+    --print-address=1 --print-pid=1) || { echo "cannot start dbus-daemon"; exit 1; }
+  export DBUS_SYSTEM_BUS_ADDRESS=$(echo "$out" | sed -n 1p)
+  BUS_PID=$(echo "$out" | sed -n 2p)
+}
+
+# start_fake ARGS…: the fake BlueZ; returns once it printed "ready". Its stdout is in
+# $TMP/fake.out, its stderr in $TMP/fake.err.
+start_fake() {
+  rm -f "$TMP/fake.fifo"
+  mkfifo "$TMP/fake.fifo"
+  "$FAKE_BLUEZ" "$@" >"$TMP/fake.fifo" 2>"$TMP/fake.err" &
+  FAKE_PID=$!
+  exec 3<"$TMP/fake.fifo"
+  local line=""
+  read -r -t 10 -u 3 line
+  if [ "$line" != "ready" ]; then
+    echo "the fake BlueZ did not start: $(cat "$TMP/fake.err")"
+    exit 1
+  fi
+  cat <&3 >"$TMP/fake.out" &  # the rest of its output, for the test to read after stop_fake
+}
