@@ -5,7 +5,12 @@
 local crossings = tonumber(os.getenv("CROSSINGS") or "2")
 local speed = tonumber(os.getenv("SPEED") or "1000")
 local timeout = tonumber(os.getenv("TIMEOUT") or "30")
-local expected = tonumber(os.getenv("EXPECT_CARS") or "0")  -- 0: every car of the run
+-- MUST: the addresses (comma-separated) of the cars that must lap; default: every car
+local must = nil
+if os.getenv("MUST") then
+  must = {}
+  for a in os.getenv("MUST"):gmatch("[^,]+") do must["ble:" .. a] = true end
+end
 
 local stats = {}
 
@@ -49,13 +54,13 @@ pitwall.onCar = function(car)
 end
 
 local function done()
-  local n = 0
-  for car, s in pairs(stats) do
-    if s.laps < crossings then return false end
-    n = n + 1
+  for _, car in ipairs(pitwall.cars()) do
+    if must == nil or must[car.address] then
+      local s = stats[car]
+      if not s or s.laps < crossings then return false end
+    end
   end
-  local want = expected > 0 and expected or #pitwall.cars()
-  return n >= want
+  return true
 end
 
 local ok = pitwall.waitUntil(done, timeout)
