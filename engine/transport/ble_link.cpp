@@ -50,6 +50,7 @@ void BleLink::connect(Done done) {
   auto attempt = ++attempt_;
   done_ = std::move(done);
   disconnectRequested_ = false;
+  abandonedConnect_ = false;
   step_ = Step::Connecting;
   std::weak_ptr<bool> alive = alive_;
   log::debug(address(), "connecting");
@@ -58,7 +59,11 @@ void BleLink::connect(Done done) {
       .onInterface(kDeviceIface)
       .withTimeout(timeouts_.connect)
       .uponReplyInvoke([this, alive, attempt](const sdbus::Error* error) {
-        if (alive.expired() || !current(attempt)) return;
+        if (alive.expired()) return;
+        if (!current(attempt)) {
+          if (!error && step_ == Step::Idle) disconnectQuietly();  // given up, yet connected
+          return;
+        }
         if (error && error->getName() != "org.bluez.Error.AlreadyConnected")
           return fail(describe(*error, "connecting to " + address_));
         step_ = Step::Resolving;
@@ -75,7 +80,15 @@ void BleLink::deviceChanged(const Device& d) {
   // Connected=true signal arrives: a false seen before any true is not a loss.
   bool wasConnected = sawConnected_;
   sawConnected_ = d.connected;
-  if (step_ == Step::Idle) return;
+  if (step_ == Step::Idle) {
+    // A Connect given up on (sd-bus drops a reply that comes after the call's timeout) may
+    // still succeed: hang up, or the car stays taken and invisible to the next scan.
+    if (abandonedConnect_ && d.connected) {
+      abandonedConnect_ = false;
+      disconnectQuietly();
+    }
+    return;
+  }
   if (!d.connected && wasConnected && step_ != Step::Connecting) {
     if (step_ == Step::Up)
       lost(address_ + " disconnected");
@@ -181,6 +194,7 @@ void BleLink::closeChannels() {
 
 void BleLink::fail(const std::string& reason) {
   bool reachedDevice = step_ != Step::Connecting;
+  abandonedConnect_ = !reachedDevice;
   ++attempt_;  // replies still on their way belong to a finished attempt
   bluez_.loop().cancel(stepTimer_);
   closeChannels();
@@ -188,18 +202,20 @@ void BleLink::fail(const std::string& reason) {
   // Half-connected: leave BlueZ clean for the next attempt.
   if (reachedDevice) {
     const Device* d = bluez_.device(devicePath_);
-    if (d && d->connected) {
-      bluez_.proxy(devicePath_)
-          .callMethodAsync("Disconnect")
-          .onInterface(kDeviceIface)
-          .withTimeout(timeouts_.disconnect)
-          .uponReplyInvoke([](const sdbus::Error*) {});
-      bluez_.pump().kick();
-    }
+    if (d && d->connected) disconnectQuietly();
   }
   auto done = std::move(done_);
   done_ = nullptr;
   if (done) done(reason);
+}
+
+void BleLink::disconnectQuietly() {
+  bluez_.proxy(devicePath_)
+      .callMethodAsync("Disconnect")
+      .onInterface(kDeviceIface)
+      .withTimeout(timeouts_.disconnect)
+      .uponReplyInvoke([](const sdbus::Error*) {});
+  bluez_.pump().kick();
 }
 
 void BleLink::lost(const std::string& reason) {

@@ -69,6 +69,7 @@ class BleLink : public Link {
   void fail(const std::string& reason);  // an attempt failed before the link came up
   void lost(const std::string& reason);  // the link was up and went down
   void closeChannels();
+  void disconnectQuietly();  // Device1.Disconnect, nobody waiting for the answer
   void waitNotify();
   void writeValue(std::span<const std::uint8_t> frame);
   bool current(std::uint64_t attempt) const { return attempt == attempt_; }
@@ -83,7 +84,8 @@ class BleLink : public Link {
   Loop::TimerId stepTimer_ = 0;
   std::string readChar_, writeChar_;
   bool disconnectRequested_ = false;
-  bool sawConnected_ = false;  // BlueZ's Connected as last seen
+  bool sawConnected_ = false;      // BlueZ's Connected as last seen
+  bool abandonedConnect_ = false;  // the last attempt gave up while Connect was under way
   boost::asio::posix::stream_descriptor notifyFd_, writeFd_;
   std::shared_ptr<bool> alive_;
 };

@@ -223,6 +223,12 @@ TEST_CASE("ble: each step of a connection has a timeout that names it") {
   ble::LinkTimeouts timeouts;
   timeouts.connect = 1ms;  // the fake answers Connect after 30 ms
   ble::BleLink link(rig.central->bluez(), rig.fake.devicePath(kCar1), kCar1, timeouts);
+  // The Central routes BlueZ's changes to its own links; this one is ours
+  auto& bluez = rig.central->bluez();
+  bluez.onDevice = [&, previous = bluez.onDevice](const ble::Device& d) {
+    if (previous) previous(d);
+    if (d.path == link.devicePath()) link.deviceChanged(d);
+  };
   std::string reason;
   bool done = false;
   link.connect([&](std::optional<std::string> e) {
@@ -232,6 +238,9 @@ TEST_CASE("ble: each step of a connection has a timeout that names it") {
   REQUIRE(rig.waitFor([&] { return done; }));
   CHECK(reason == std::string("connecting to ") + kCar1 + " timed out");
   CHECK_FALSE(link.connected());
+  // BlueZ connected after the attempt was given up: the link hangs up again
+  CHECK(rig.waitFor([&] { return rig.fake.counters(kCar1).connects == 1; }));
+  CHECK(rig.waitFor([&] { return !rig.fake.connected(kCar1); }));
 }
 
 TEST_CASE("ble: only the cars asked for, and only on the adapters asked for") {
