@@ -223,7 +223,7 @@ void BleLink::lost(const std::string& reason) {
   closeChannels();
   step_ = Step::Idle;
   bool requested = disconnectRequested_;
-  deliverState(false, reason);
+  deliverState(false, requested ? "disconnected by the controller" : reason);
   if (!requested && onDropped) onDropped(reason);
 }
 
