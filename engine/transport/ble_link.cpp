@@ -122,56 +122,52 @@ void BleLink::resolved() {
   subscribe();
 }
 
-void BleLink::subscribe() {
+void BleLink::acquire(const std::string& path, const char* method,
+                      std::function<void(const sdbus::Error*, int fd)> then) {
   auto attempt = attempt_;
   std::weak_ptr<bool> alive = alive_;
-  armStepTimer(timeouts_.subscribe, "enabling notifications on " + address_);
-  bluez_.proxy(readChar_)
-      .callMethodAsync("AcquireNotify")
+  bluez_.proxy(path)
+      .callMethodAsync(method)
       .onInterface(kCharIface)
       .withTimeout(timeouts_.subscribe)
       .withArguments(std::map<std::string, sdbus::Variant>{})
-      .uponReplyInvoke([this, alive, attempt](const sdbus::Error* error, sdbus::UnixFd fd,
-                                              std::uint16_t /*mtu*/) {
+      .uponReplyInvoke([this, alive, attempt, method, then](
+                           const sdbus::Error* error, sdbus::UnixFd fd, std::uint16_t /*mtu*/) {
         if (alive.expired() || !current(attempt)) return;
-        if (!error) {
-          notifyFd_.assign(fd.release());
-          waitNotify();
-          return acquireWrite();
-        }
-        log::debug(address(), "AcquireNotify refused (" + error->getName() +
-                                  "): notifications through StartNotify");
-        bluez_.proxy(readChar_)
-            .callMethodAsync("StartNotify")
-            .onInterface(kCharIface)
-            .withTimeout(timeouts_.subscribe)
-            .uponReplyInvoke([this, alive, attempt](const sdbus::Error* error) {
-              if (alive.expired() || !current(attempt)) return;
-              if (error) return fail(describe(*error, "enabling notifications on " + address_));
-              acquireWrite();
-            });
+        if (error)
+          log::debug(address(), std::string(method) + " refused (" + error->getName() + ")");
+        then(error, error ? -1 : fd.release());
       });
   bluez_.pump().kick();
 }
 
+void BleLink::subscribe() {
+  armStepTimer(timeouts_.subscribe, "enabling notifications on " + address_);
+  acquire(readChar_, "AcquireNotify", [this](const sdbus::Error* error, int fd) {
+    if (!error) {
+      notifyFd_.assign(fd);
+      waitNotify();
+      return acquireWrite();
+    }
+    auto attempt = attempt_;
+    std::weak_ptr<bool> alive = alive_;
+    bluez_.proxy(readChar_)
+        .callMethodAsync("StartNotify")
+        .onInterface(kCharIface)
+        .withTimeout(timeouts_.subscribe)
+        .uponReplyInvoke([this, alive, attempt](const sdbus::Error* error) {
+          if (alive.expired() || !current(attempt)) return;
+          if (error) return fail(describe(*error, "enabling notifications on " + address_));
+          acquireWrite();
+        });
+  });
+}
+
 void BleLink::acquireWrite() {
-  auto attempt = attempt_;
-  std::weak_ptr<bool> alive = alive_;
-  bluez_.proxy(writeChar_)
-      .callMethodAsync("AcquireWrite")
-      .onInterface(kCharIface)
-      .withTimeout(timeouts_.subscribe)
-      .withArguments(std::map<std::string, sdbus::Variant>{})
-      .uponReplyInvoke([this, alive, attempt](const sdbus::Error* error, sdbus::UnixFd fd,
-                                              std::uint16_t /*mtu*/) {
-        if (alive.expired() || !current(attempt)) return;
-        if (!error)
-          writeFd_.assign(fd.release());
-        else
-          log::debug(address(),
-                     "AcquireWrite refused (" + error->getName() + "): writes through WriteValue");
-        up();
-      });
+  acquire(writeChar_, "AcquireWrite", [this](const sdbus::Error* error, int fd) {
+    if (!error) writeFd_.assign(fd);
+    up();
+  });
 }
 
 void BleLink::up() {

@@ -65,6 +65,9 @@ class BleLink : public Link {
   void resolved();
   void subscribe();
   void acquireWrite();
+  // AcquireNotify/AcquireWrite on `path`; then(error or nullptr, the socket) for this attempt.
+  void acquire(const std::string& path, const char* method,
+               std::function<void(const sdbus::Error*, int fd)> then);
   void up();
   void fail(const std::string& reason);  // an attempt failed before the link came up
   void lost(const std::string& reason);  // the link was up and went down

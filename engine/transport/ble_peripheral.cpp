@@ -6,19 +6,20 @@
 #include <sdbus-c++/sdbus-c++.h>
 
 #include "engine/core/log.hpp"
+#include "engine/transport/bluez_api.hpp"
 
 namespace pitwall {
 namespace {
 
-constexpr const char* kBluez = "org.bluez";
-constexpr const char* kAdapterIface = "org.bluez.Adapter1";
-constexpr const char* kDeviceIface = "org.bluez.Device1";
-constexpr const char* kGattManager = "org.bluez.GattManager1";
-constexpr const char* kGattService = "org.bluez.GattService1";
-constexpr const char* kGattChar = "org.bluez.GattCharacteristic1";
-constexpr const char* kAdvManager = "org.bluez.LEAdvertisingManager1";
-constexpr const char* kAdvertisement = "org.bluez.LEAdvertisement1";
-constexpr const char* kProperties = "org.freedesktop.DBus.Properties";
+constexpr const char* kBluez = ble::api::kService;
+constexpr const char* kAdapterIface = ble::api::kAdapter;
+constexpr const char* kDeviceIface = ble::api::kDevice;
+constexpr const char* kGattManager = ble::api::kGattManager;
+constexpr const char* kGattService = ble::api::kGattService;
+constexpr const char* kGattChar = ble::api::kGattCharacteristic;
+constexpr const char* kAdvManager = ble::api::kAdvertisingManager;
+constexpr const char* kAdvertisement = ble::api::kAdvertisement;
+constexpr const char* kProperties = ble::api::kProperties;
 constexpr const char* kComponent = "ble";
 // BlueZ answers in milliseconds; a call still pending after this means bluetoothd is stuck.
 constexpr std::chrono::seconds kCallTimeout{10};

@@ -14,8 +14,7 @@ using ManagedObjects = std::map<sdbus::ObjectPath, Interfaces>;
 
 namespace {
 
-constexpr const char* kObjectManager = "org.freedesktop.DBus.ObjectManager";
-constexpr const char* kProperties = "org.freedesktop.DBus.Properties";
+using api::kObjectManager;
 
 // BlueZ's types are fixed by its API, but a broken or foreign peer must not crash us: a property
 // of an unexpected type is treated as absent.

@@ -16,6 +16,7 @@
 
 #include "engine/core/loop.hpp"
 #include "engine/protocol/anki/advertisement.hpp"
+#include "engine/transport/bluez_api.hpp"
 #include "engine/transport/dbus_pump.hpp"
 
 namespace sdbus {
@@ -26,10 +27,10 @@ class Error;
 
 namespace pitwall::ble {
 
-inline constexpr const char* kService = "org.bluez";
-inline constexpr const char* kAdapterIface = "org.bluez.Adapter1";
-inline constexpr const char* kDeviceIface = "org.bluez.Device1";
-inline constexpr const char* kCharIface = "org.bluez.GattCharacteristic1";
+inline constexpr const char* kService = api::kService;
+inline constexpr const char* kAdapterIface = api::kAdapter;
+inline constexpr const char* kDeviceIface = api::kDevice;
+inline constexpr const char* kCharIface = api::kGattCharacteristic;
 
 // A failure a user can act on, said in one sentence (no adapter, BlueZ not running, …).
 struct BleError : std::runtime_error {

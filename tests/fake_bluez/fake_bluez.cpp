@@ -39,6 +39,7 @@
 #include "engine/protocol/anki/advertisement.hpp"
 #include "engine/sim/grid.hpp"
 #include "engine/sim/track.hpp"
+#include "engine/transport/bluez_api.hpp"
 
 namespace pitwall::testing {
 
@@ -48,10 +49,10 @@ using namespace std::chrono_literals;
 using Dict = std::map<std::string, sdbus::Variant>;
 
 constexpr const char* kComponent = "fake-bluez";
-constexpr const char* kAdapterIface = "org.bluez.Adapter1";
-constexpr const char* kDeviceIface = "org.bluez.Device1";
-constexpr const char* kServiceIface = "org.bluez.GattService1";
-constexpr const char* kCharIface = "org.bluez.GattCharacteristic1";
+constexpr const char* kAdapterIface = ble::api::kAdapter;
+constexpr const char* kDeviceIface = ble::api::kDevice;
+constexpr const char* kServiceIface = ble::api::kGattService;
+constexpr const char* kCharIface = ble::api::kGattCharacteristic;
 
 // Timings: a few BLE connection intervals; short, so that tests stay fast.
 constexpr Duration kFirstSeen = 20ms;      // StartDiscovery → first advertisement of a car

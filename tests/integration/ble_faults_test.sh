@@ -7,10 +7,6 @@ start_bus
 A1=E0:00:00:00:00:01
 A2=E0:00:00:00:00:02
 
-field() {  # field NAME LINE
-  echo "$2" | sed -n "s/.* $1=\([^ ]*\).*/\1/p"
-}
-
 # A dropped link mid-race
 start_fake --cars 2 --drop $A1@1.5
 out=$(CROSSINGS=3 SPEED=1200 TIMEOUT=40 $PITWALL run "$SRC/tests/ble/laps.lua" --ble \

@@ -45,3 +45,8 @@ start_fake() {
   fi
   cat <&3 >"$TMP/fake.out" &  # the rest of its output, for the test to read after stop_fake
 }
+
+# field NAME LINE: the value of NAME=… in one of laps.lua's summary lines
+field() {
+  echo "$2" | sed -n "s/.* $1=\([^ ]*\).*/\1/p"
+}

@@ -14,6 +14,7 @@
 #include <sdbus-c++/sdbus-c++.h>
 
 #include "engine/protocol/anki/advertisement.hpp"
+#include "engine/transport/bluez_api.hpp"
 #include "tests/support/private_bus.hpp"
 
 using namespace pitwall;
@@ -27,12 +28,12 @@ using Dict = std::map<std::string, sdbus::Variant>;
 using Interfaces = std::map<std::string, Dict>;
 using Objects = std::map<sdbus::ObjectPath, Interfaces>;
 
-constexpr const char* kAdapterIface = "org.bluez.Adapter1";
-constexpr const char* kDeviceIface = "org.bluez.Device1";
-constexpr const char* kServiceIface = "org.bluez.GattService1";
-constexpr const char* kCharIface = "org.bluez.GattCharacteristic1";
-constexpr const char* kPropsIface = "org.freedesktop.DBus.Properties";
-constexpr const char* kManagerIface = "org.freedesktop.DBus.ObjectManager";
+constexpr const char* kAdapterIface = ble::api::kAdapter;
+constexpr const char* kDeviceIface = ble::api::kDevice;
+constexpr const char* kServiceIface = ble::api::kGattService;
+constexpr const char* kCharIface = ble::api::kGattCharacteristic;
+constexpr const char* kPropsIface = ble::api::kProperties;
+constexpr const char* kManagerIface = ble::api::kObjectManager;
 
 constexpr const char* kCar = "E0:00:00:00:00:01";
 const std::string kHci0 = "/org/bluez/hci0";
