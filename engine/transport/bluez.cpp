@@ -235,10 +235,18 @@ Bluez::Bluez(Loop& loop) : loop_(loop), alive_(std::make_shared<bool>(true)) {
       [this](sdbus::Message& msg) {
         std::string name, oldOwner, newOwner;
         msg >> name >> oldOwner >> newOwner;
-        if (!newOwner.empty()) return;
-        log::warn("ble", "BlueZ left the bus: every car is disconnected");
-        reset();
-        if (onBluezGone) onBluezGone();
+        if (!oldOwner.empty()) {
+          log::warn("ble", "BlueZ left the bus: every car is disconnected");
+          reset();
+          if (onBluezGone) onBluezGone();
+        }
+        if (newOwner.empty()) return;
+        // bluetoothd (re)started: read its tree again, then let the subscriber go on
+        log::info("ble", "BlueZ is on the bus again");
+        start([this](std::optional<std::string> error) {
+          if (error) return log::warn("ble", *error);
+          if (onBluezBack) onBluezBack();
+        });
       });
   pump_ = std::make_unique<DbusPump>(loop_, *connection_);
 }

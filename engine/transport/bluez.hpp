@@ -107,6 +107,7 @@ class Bluez {
   std::function<void(const std::string& path)> onDeviceRemoved;
   std::function<void(const std::string& charPath, const std::vector<std::uint8_t>&)> onValue;
   std::function<void()> onBluezGone;  // org.bluez left the bus (bluetoothd stopped)
+  std::function<void()> onBluezBack;  // org.bluez is back and its tree has been read again
 
  private:
   struct Signals;      // the signal subscriptions (sdbus slots and the proxy of "/")

@@ -130,6 +130,15 @@ Central::Central(Loop& loop, Fleet& fleet, CentralOptions options)
         vanished(*c);
       }
   };
+  // bluetoothd restarted: its devices went away with it (each car is looking for its own);
+  // look again on the adapters that have cars to find.
+  bluez_->onBluezBack = [this] {
+    for (auto& [path, q] : queues_)
+      if (q.discoverers > 0 && !shuttingDown_)
+        bluez_->startDiscovery(path, [](std::optional<std::string> error) {
+          if (error) log::warn("ble", *error);
+        });
+  };
   bluez_->onValue = [this](const std::string& charPath, const std::vector<std::uint8_t>& v) {
     for (auto& c : cars_)
       if (c->link->notifyPath() == charPath) return c->link->value(v);

@@ -11,7 +11,7 @@
 set -uo pipefail
 
 # Who plays the central on hci1 (PITWALL_QEMU_CENTRAL):
-#   pitwall  `pitwall run tests/qemu/laps_ble.lua --ble --adapter hci1 --duration 30`: the car
+#   pitwall  `pitwall run tests/qemu/laps_ble.lua --ble --adapter hci1 --car ADDR --duration 30`: the car
 #            is found, connected and driven 2 laps.
 #   tools    BlueZ's own bluetoothctl, no pitwall code on the central side: sees the
 #            advertisement (service UUID, manufacturer data, name), connects, subscribes, writes

@@ -82,7 +82,7 @@ say "pitwall emulate-car started (pid $CAR_PID)"
 
 # ---- the central on hci1 ----
 central_pitwall() {
-  "$PITWALL" run "$SRC/tests/qemu/laps_ble.lua" --ble --adapter hci1 --duration 30 \
+  "$PITWALL" run "$SRC/tests/qemu/laps_ble.lua" --ble --adapter hci1 --car "$ADDR0" --duration 30 \
     > >(tee "$LOGS/central.out" | sed -u 's/^/[central] /') 2>&1 || return
   # --duration ending the run is status 0 too: only the script's last line says it drove.
   sleep 0.1  # let tee finish

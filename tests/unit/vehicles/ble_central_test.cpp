@@ -291,3 +291,40 @@ TEST_CASE("ble: shutdown disconnects every car") {
   rig.waitFor([] { return false; }, 200ms);
   CHECK(rig.central->attempts()[kCar1] == attempts);
 }
+
+TEST_CASE("ble: bluetoothd restarting: the cars go down, then are found and connected again") {
+  testing::PrivateBus bus;
+  Loop loop(ClockKind::Real);
+  auto first = sdbus::createSystemBusConnection();
+  auto fake = std::make_unique<FakeBluez>(loop, *first, cars(1, 1));
+  Fleet fleet(loop);
+  ble::Central central(loop, fleet, Rig::quick());
+  auto waitFor = [&](const std::function<bool()>& cond) {
+    auto limit = loop.after(10s, [&] { loop.stop(); });
+    std::function<void()> poll = [&] {
+      if (cond()) return loop.stop();
+      loop.after(2ms, poll);
+    };
+    loop.post(poll);
+    loop.run();
+    loop.cancel(limit);
+    return cond();
+  };
+  bool started = false;
+  central.start([&](std::optional<std::string> e) {
+    CHECK(e == std::nullopt);
+    started = true;
+  });
+  REQUIRE(waitFor([&] { return started && fleet.connectedCount() == 1; }));
+  AnkiCar* car = fleet.cars()[0];
+
+  fake.reset();  // bluetoothd stops: org.bluez leaves the bus
+  first.reset();
+  REQUIRE(waitFor([&] { return !car->state().connected; }));
+
+  auto second = sdbus::createSystemBusConnection();
+  fake = std::make_unique<FakeBluez>(loop, *second, cars(1, 1));
+  CHECK(waitFor([&] { return car->state().connected; }));
+  CHECK(waitFor([&] { return fake->car(kCar1).truth().sdk_mode; }));
+  fake.reset();
+}
