@@ -17,9 +17,9 @@
 // BM_BleNotifyToLuaAcquired (AcquireNotify: one SOCK_SEQPACKET datagram per notification):
 //   sock: a socketpair of our own: send → asio async_wait on the loop → recv until EAGAIN, as
 //         BleLink reads its notification socket: the bare fd path.
-//   fake: the same socket sent to as inject() sends: the fake's address lookup, the send, the
-//         fake's pump kicked. The fake's own cost, which the engine path pays but which is not
-//         the engine (real BlueZ is another process): eng − fake is the engine's receive side.
+//   fake: the same socket sent to as inject() sends: the fake's address lookup, then the send.
+//         The fake's own cost, which the engine path pays but which is not the engine (real
+//         BlueZ is another process): eng − fake is the engine's receive side.
 //   eng:  fake.inject() → datagram → BleLink → AnkiCar → Lua onPosition → mark().
 // Counters in µs: <path>50, <path>99 (median, 99th percentile), <path>Avg, <path>Min, <path>Max;
 // add50/add99 = (eng − bare)/bare in %, for the bare path (bus; sock) and, on the socket path,
@@ -399,8 +399,7 @@ void BM_BleNotifyToLuaAcquired(benchmark::State& state) {
       if (!rig.fake.connected(kAddress)) return;  // the lookup inject() makes
       anki::Frame f = rig.frame;
       f.bytes[kLocationByte] = location;
-      sock.send(f.span());
-      rig.fake.pump().kick();
+      sock.send(f.span());  // inject() kicks the fake's pump only for a D-Bus signal
     });
     rig.sampler.add("eng", [&](std::uint8_t location) { rig.inject(location); });
     rig.sampler.run(static_cast<int>(state.range(0)));
