@@ -11,15 +11,8 @@
 namespace pitwall {
 namespace {
 
-constexpr const char* kBluez = ble::api::kService;
-constexpr const char* kAdapterIface = ble::api::kAdapter;
-constexpr const char* kDeviceIface = ble::api::kDevice;
-constexpr const char* kGattManager = ble::api::kGattManager;
-constexpr const char* kGattService = ble::api::kGattService;
-constexpr const char* kGattChar = ble::api::kGattCharacteristic;
-constexpr const char* kAdvManager = ble::api::kAdvertisingManager;
-constexpr const char* kAdvertisement = ble::api::kAdvertisement;
-constexpr const char* kProperties = ble::api::kProperties;
+namespace api = ble::api;
+
 constexpr const char* kComponent = "ble";
 // BlueZ answers in milliseconds; a call still pending after this means bluetoothd is stuck.
 constexpr std::chrono::seconds kCallTimeout{10};
@@ -125,27 +118,32 @@ struct BlePeripheral::State {
     app->finishRegistration();
 
     service = sdbus::createObject(conn, servicePath);
-    service->registerProperty("UUID").onInterface(kGattService).withGetter([this] {
+    service->registerProperty("UUID").onInterface(api::kGattService).withGetter([this] {
       return spec.serviceUuid;
     });
-    service->registerProperty("Primary").onInterface(kGattService).withGetter([] { return true; });
+    service->registerProperty("Primary").onInterface(api::kGattService).withGetter([] {
+      return true;
+    });
     service->finishRegistration();
 
     notifyChar = sdbus::createObject(conn, notifyPath);
-    notifyChar->registerProperty("UUID").onInterface(kGattChar).withGetter(
-        [this] { return spec.notifyCharUuid; });
-    notifyChar->registerProperty("Service").onInterface(kGattChar).withGetter(
-        [this] { return sdbus::ObjectPath(servicePath); });
-    notifyChar->registerProperty("Flags").onInterface(kGattChar).withGetter([] {
+    notifyChar->registerProperty("UUID").onInterface(api::kGattCharacteristic).withGetter([this] {
+      return spec.notifyCharUuid;
+    });
+    notifyChar->registerProperty("Service")
+        .onInterface(api::kGattCharacteristic)
+        .withGetter([this] { return sdbus::ObjectPath(servicePath); });
+    notifyChar->registerProperty("Flags").onInterface(api::kGattCharacteristic).withGetter([] {
       return std::vector<std::string>{"read", "notify"};
     });
-    notifyChar->registerProperty("Value").onInterface(kGattChar).withGetter(
-        [this] { return value; });
-    notifyChar->registerProperty("Notifying").onInterface(kGattChar).withGetter([this] {
-      return notifying;
+    notifyChar->registerProperty("Value").onInterface(api::kGattCharacteristic).withGetter([this] {
+      return value;
     });
+    notifyChar->registerProperty("Notifying")
+        .onInterface(api::kGattCharacteristic)
+        .withGetter([this] { return notifying; });
     notifyChar->registerMethod("ReadValue")
-        .onInterface(kGattChar)
+        .onInterface(api::kGattCharacteristic)
         .implementedAs([this](const Options& options) {
           std::size_t offset = 0;
           if (auto it = options.find("offset"); it != options.end())
@@ -154,26 +152,32 @@ struct BlePeripheral::State {
             throw sdbus::Error("org.bluez.Error.InvalidOffset", "offset past the value");
           return std::vector<std::uint8_t>(value.begin() + static_cast<long>(offset), value.end());
         });
-    notifyChar->registerMethod("StartNotify").onInterface(kGattChar).implementedAs([this] {
-      setNotifying(true);
-      up(peer);
-    });
-    notifyChar->registerMethod("StopNotify").onInterface(kGattChar).implementedAs([this] {
-      setNotifying(false);
-      down("the central unsubscribed");
-    });
+    notifyChar->registerMethod("StartNotify")
+        .onInterface(api::kGattCharacteristic)
+        .implementedAs([this] {
+          setNotifying(true);
+          up(peer);
+        });
+    notifyChar->registerMethod("StopNotify")
+        .onInterface(api::kGattCharacteristic)
+        .implementedAs([this] {
+          setNotifying(false);
+          down("the central unsubscribed");
+        });
     notifyChar->finishRegistration();
 
     writeChar = sdbus::createObject(conn, writePath);
-    writeChar->registerProperty("UUID").onInterface(kGattChar).withGetter(
-        [this] { return spec.writeCharUuid; });
-    writeChar->registerProperty("Service").onInterface(kGattChar).withGetter(
-        [this] { return sdbus::ObjectPath(servicePath); });
-    writeChar->registerProperty("Flags").onInterface(kGattChar).withGetter([] {
+    writeChar->registerProperty("UUID").onInterface(api::kGattCharacteristic).withGetter([this] {
+      return spec.writeCharUuid;
+    });
+    writeChar->registerProperty("Service").onInterface(api::kGattCharacteristic).withGetter([this] {
+      return sdbus::ObjectPath(servicePath);
+    });
+    writeChar->registerProperty("Flags").onInterface(api::kGattCharacteristic).withGetter([] {
       return std::vector<std::string>{"write", "write-without-response"};
     });
     writeChar->registerMethod("WriteValue")
-        .onInterface(kGattChar)
+        .onInterface(api::kGattCharacteristic)
         .implementedAs([this](const std::vector<std::uint8_t>& bytes, const Options& options) {
           // options: device (o), link (s), mtu (q), offset (q), type (s) — gatt-api.
           std::string device;
@@ -187,30 +191,32 @@ struct BlePeripheral::State {
     writeChar->finishRegistration();
 
     advert = sdbus::createObject(conn, advPath);
-    advert->registerProperty("Type").onInterface(kAdvertisement).withGetter([] {
+    advert->registerProperty("Type").onInterface(api::kAdvertisement).withGetter([] {
       return std::string("peripheral");
     });
-    advert->registerProperty("ServiceUUIDs").onInterface(kAdvertisement).withGetter([this] {
+    advert->registerProperty("ServiceUUIDs").onInterface(api::kAdvertisement).withGetter([this] {
       return std::vector<std::string>{spec.serviceUuid};
     });
-    advert->registerProperty("ManufacturerData").onInterface(kAdvertisement).withGetter([this] {
-      return std::map<std::uint16_t, sdbus::Variant>{
-          {spec.manufacturerKey, sdbus::Variant(spec.manufacturerData)}};
-    });
-    advert->registerProperty("Discoverable").onInterface(kAdvertisement).withGetter([] {
+    advert->registerProperty("ManufacturerData")
+        .onInterface(api::kAdvertisement)
+        .withGetter([this] {
+          return std::map<std::uint16_t, sdbus::Variant>{
+              {spec.manufacturerKey, sdbus::Variant(spec.manufacturerData)}};
+        });
+    advert->registerProperty("Discoverable").onInterface(api::kAdvertisement).withGetter([] {
       return true;
     });
     // Both name properties always exist; the form picks which one carries the name (an empty
     // LocalName is "no name" to BlueZ, an empty Data dictionary adds nothing).
-    advert->registerProperty("Data").onInterface(kAdvertisement).withGetter([this] {
+    advert->registerProperty("Data").onInterface(api::kAdvertisement).withGetter([this] {
       std::map<std::uint8_t, sdbus::Variant> data;
       if (form == NameForm::RawData) data.emplace(0x09, sdbus::Variant(spec.localName));
       return data;
     });
-    advert->registerProperty("LocalName").onInterface(kAdvertisement).withGetter([this] {
+    advert->registerProperty("LocalName").onInterface(api::kAdvertisement).withGetter([this] {
       return form == NameForm::LocalName ? spec.fallbackName : std::string();
     });
-    advert->registerMethod("Release").onInterface(kAdvertisement).implementedAs([this] {
+    advert->registerMethod("Release").onInterface(api::kAdvertisement).implementedAs([this] {
       log::info(kComponent, "BlueZ released the advertisement on " + spec.adapter);
       advertising = false;
     });
@@ -228,7 +234,7 @@ struct BlePeripheral::State {
           std::string iface;
           std::map<std::string, sdbus::Variant> changed;
           m >> iface >> changed;
-          if (iface != kDeviceIface || !isDeviceOf(m.getPath(), adapterPath)) return;
+          if (iface != api::kDevice || !isDeviceOf(m.getPath(), adapterPath)) return;
           auto it = changed.find("Connected");
           if (it == changed.end()) return;
           if (it->second.get<bool>())
@@ -243,7 +249,7 @@ struct BlePeripheral::State {
           sdbus::ObjectPath path;
           std::map<std::string, std::map<std::string, sdbus::Variant>> ifaces;
           m >> path >> ifaces;
-          auto device = ifaces.find(kDeviceIface);
+          auto device = ifaces.find(api::kDevice);
           if (device == ifaces.end() || !isDeviceOf(path, adapterPath)) return;
           auto connected = device->second.find("Connected");
           if (connected != device->second.end() && connected->second.get<bool>())
@@ -257,7 +263,7 @@ struct BlePeripheral::State {
           std::vector<std::string> ifaces;
           m >> path >> ifaces;
           for (const auto& i : ifaces)
-            if (i == kDeviceIface && isDeviceOf(path, adapterPath)) deviceGone(path);
+            if (i == api::kDevice && isDeviceOf(path, adapterPath)) deviceGone(path);
         }));
   }
 
@@ -292,17 +298,17 @@ struct BlePeripheral::State {
 
   void setNotifying(bool on) {
     notifying = on;
-    notifyChar->emitPropertiesChangedSignal(kGattChar, {"Notifying"});
+    notifyChar->emitPropertiesChangedSignal(api::kGattCharacteristic, {"Notifying"});
   }
 
   // ---- registration ----
 
   void checkAdapter(std::function<void(const std::string&)> done) {
-    adapter = sdbus::createProxy(conn, kBluez, adapterPath);
+    adapter = sdbus::createProxy(conn, api::kService, adapterPath);
     adapter->callMethodAsync("Get")
-        .onInterface(kProperties)
+        .onInterface(api::kProperties)
         .withTimeout(kCallTimeout)
-        .withArguments(std::string(kAdapterIface), std::string("Powered"))
+        .withArguments(std::string(api::kAdapter), std::string("Powered"))
         .uponReplyInvoke([this, done](const sdbus::Error* e, sdbus::Variant powered) {
           if (e && isNoBluez(*e))
             return done(
@@ -323,7 +329,7 @@ struct BlePeripheral::State {
 
   void registerApplication(std::function<void(const std::string&)> done) {
     adapter->callMethodAsync("RegisterApplication")
-        .onInterface(kGattManager)
+        .onInterface(api::kGattManager)
         .withTimeout(kCallTimeout)
         .withArguments(sdbus::ObjectPath(appPath), Options{})
         .uponReplyInvoke([this, done](const sdbus::Error* e) {
@@ -343,7 +349,7 @@ struct BlePeripheral::State {
   // refuses it; `done` gets "" once one was accepted.
   void registerAdvertisement(std::function<void(const std::string&)> done) {
     adapter->callMethodAsync("RegisterAdvertisement")
-        .onInterface(kAdvManager)
+        .onInterface(api::kAdvertisingManager)
         .withTimeout(kCallTimeout)
         .withArguments(sdbus::ObjectPath(advPath), Options{})
         .uponReplyInvoke([this, done](const sdbus::Error* e) {
@@ -372,7 +378,7 @@ struct BlePeripheral::State {
     if (readvertising || !adapter) return;
     readvertising = true;
     adapter->callMethodAsync("UnregisterAdvertisement")
-        .onInterface(kAdvManager)
+        .onInterface(api::kAdvertisingManager)
         .withTimeout(kCallTimeout)
         .withArguments(sdbus::ObjectPath(advPath))
         .uponReplyInvoke([this](const sdbus::Error*) {
@@ -422,7 +428,7 @@ void BlePeripheral::stop(std::function<void()> done) {
   if (s.advertising) {
     ++*pending;
     s.adapter->callMethodAsync("UnregisterAdvertisement")
-        .onInterface(kAdvManager)
+        .onInterface(api::kAdvertisingManager)
         .withTimeout(kCallTimeout)
         .withArguments(sdbus::ObjectPath(s.advPath))
         .uponReplyInvoke(answered);
@@ -431,7 +437,7 @@ void BlePeripheral::stop(std::function<void()> done) {
   if (s.appRegistered) {
     ++*pending;
     s.adapter->callMethodAsync("UnregisterApplication")
-        .onInterface(kGattManager)
+        .onInterface(api::kGattManager)
         .withTimeout(kCallTimeout)
         .withArguments(sdbus::ObjectPath(s.appPath))
         .uponReplyInvoke(answered);
@@ -451,7 +457,7 @@ bool BlePeripheral::notify(std::span<const std::uint8_t> value) {
   s.value.assign(value.begin(), value.end());
   // BlueZ turns a PropertiesChanged on Value into a notification to every subscribed central
   // (gatt-api "StartNotify"); the signal carries the value, so back-to-back frames all go out.
-  s.notifyChar->emitPropertiesChangedSignal(kGattChar, {"Value"});
+  s.notifyChar->emitPropertiesChangedSignal(api::kGattCharacteristic, {"Value"});
   s.pump.kick();
   return true;
 }
@@ -459,9 +465,9 @@ bool BlePeripheral::notify(std::span<const std::uint8_t> value) {
 void BlePeripheral::disconnectCentral() {
   State& s = *state_;
   if (s.peer.empty()) return;
-  s.device = sdbus::createProxy(s.conn, kBluez, s.peer);
+  s.device = sdbus::createProxy(s.conn, api::kService, s.peer);
   s.device->callMethodAsync("Disconnect")
-      .onInterface(kDeviceIface)
+      .onInterface(api::kDevice)
       .withTimeout(kCallTimeout)
       .uponReplyInvoke([&s](const sdbus::Error* e) {
         if (e) log::warn(kComponent, "cannot drop the central: " + errorText(*e));

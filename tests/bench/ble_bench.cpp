@@ -48,29 +48,21 @@
 #include "engine/transport/ble_link.hpp"
 #include "engine/vehicles/ble_central.hpp"
 #include "engine/vehicles/fleet.hpp"
+#include "tests/bench/frames.hpp"
 #include "tests/fake_bluez/fake_bluez.hpp"
 #include "tests/support/private_bus.hpp"
+#include "tests/support/run_until.hpp"
 
 namespace {
 
 using namespace pitwall;
+using bench::positionFrame;
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 
 constexpr const char* kAddress = "E0:00:00:00:00:01";
 constexpr std::size_t kLocationByte = 2;  // [size][id][location][piece]…
 constexpr int kWarmup = 300;              // samples per path, not recorded
-
-anki::Frame positionFrame() {
-  anki::PositionUpdate m;
-  m.location_id = 0;
-  m.piece_id = 39;
-  m.offset_mm = 23.0f;
-  m.speed_mm_s = 640;
-  m.parsing_flags = 0x07;
-  m.last_desired_speed_mm_s = 650;
-  return anki::encode(m);
-}
 
 struct Stats {
   double p50 = 0, p99 = 0, mean = 0, min = 0, max = 0;
@@ -203,7 +195,7 @@ struct Rig {
       error = acquire ? "AcquireNotify was not used" : "AcquireNotify was used";
       return;
     }
-    settle(200ms);  // SDK mode and the car's answers
+    testing::runFor(loop, 200ms);  // SDK mode and the car's answers
 
     host = std::make_unique<ScriptHost>(loop, fleet, nullptr, HostOptions{});
     lua_State* L = host->state();
@@ -213,7 +205,7 @@ struct Rig {
     auto started = host->startString(
         "pitwall.cars()[1].onPosition = function(car, ev) mark(ev.location) end", "ble_bench");
     if (!started) error = started.error();
-    settle(10ms);  // the main chunk runs as a task
+    testing::runFor(loop, 10ms);  // the main chunk runs as a task
   }
 
   static testing::FakeBluez::Options fakeOptions(bool acquire) {
@@ -223,20 +215,7 @@ struct Rig {
   }
 
   bool waitFor(const std::function<bool()>& cond, Duration deadline = 5s) {
-    if (cond()) return true;
-    auto limit = loop.after(deadline, [&] { loop.stop(); });
-    std::function<void()> poll = [&] {
-      if (cond()) return loop.stop();
-      loop.after(2ms, poll);
-    };
-    loop.post(poll);
-    loop.run();
-    loop.cancel(limit);
-    return cond();
-  }
-  void settle(Duration d) {
-    loop.after(d, [&] { loop.stop(); });
-    loop.run();
+    return testing::runUntil(loop, cond, deadline);
   }
 
   void inject(std::uint8_t location) {

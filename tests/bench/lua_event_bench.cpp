@@ -20,10 +20,12 @@
 #include "bindings/script_host.hpp"
 #include "engine/protocol/anki/codec.hpp"
 #include "engine/vehicles/fleet.hpp"
+#include "tests/bench/frames.hpp"
 
 namespace {
 
 using namespace pitwall;
+using bench::positionFrame;
 
 // A link that accepts everything and delivers nothing: frames enter through AnkiCar::receive.
 class BenchLink final : public Link {
@@ -36,17 +38,6 @@ class BenchLink final : public Link {
 
 // Byte 2 of a position update is its location id ([size][id][location][piece]…).
 constexpr std::size_t kLocationByte = 2;
-
-anki::Frame positionFrame() {
-  anki::PositionUpdate m;
-  m.location_id = 0;
-  m.piece_id = 39;
-  m.offset_mm = 23.0f;
-  m.speed_mm_s = 640;
-  m.parsing_flags = 0x07;
-  m.last_desired_speed_mm_s = 650;
-  return anki::encode(m);
-}
 
 // The handler of the path and the function of the floor do the same work.
 constexpr const char* kPathHandler =

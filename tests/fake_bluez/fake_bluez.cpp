@@ -45,14 +45,12 @@ namespace pitwall::testing {
 
 namespace {
 
+namespace api = ble::api;
+
 using namespace std::chrono_literals;
 using Dict = std::map<std::string, sdbus::Variant>;
 
 constexpr const char* kComponent = "fake-bluez";
-constexpr const char* kAdapterIface = ble::api::kAdapter;
-constexpr const char* kDeviceIface = ble::api::kDevice;
-constexpr const char* kServiceIface = ble::api::kGattService;
-constexpr const char* kCharIface = ble::api::kGattCharacteristic;
 
 // Timings: a few BLE connection intervals; short, so that tests stay fast.
 constexpr Duration kFirstSeen = 20ms;      // StartDiscovery → first advertisement of a car
@@ -549,13 +547,13 @@ void FakeBluez::State::exportAdapter(Adapter& a) {
   auto sender = [obj] { return obj->getCurrentlyProcessedMessage()->getSender(); };
 
   obj->registerMethod("StartDiscovery")
-      .onInterface(kAdapterIface)
+      .onInterface(api::kAdapter)
       .implementedAs([this, ap, sender] { startDiscovery(*ap, sender()); });
-  obj->registerMethod("StopDiscovery").onInterface(kAdapterIface).implementedAs([this, ap, sender] {
+  obj->registerMethod("StopDiscovery").onInterface(api::kAdapter).implementedAs([this, ap, sender] {
     stopDiscovery(*ap, sender());
   });
   obj->registerMethod("SetDiscoveryFilter")
-      .onInterface(kAdapterIface)
+      .onInterface(api::kAdapter)
       .withInputParamNames("properties")
       .implementedAs([ap, sender](const Dict& dict) {
         if (!ap->powered) throw notReady();
@@ -570,14 +568,14 @@ void FakeBluez::State::exportAdapter(Adapter& a) {
         }
       });
   obj->registerMethod("GetDiscoveryFilters")
-      .onInterface(kAdapterIface)
+      .onInterface(api::kAdapter)
       .withOutputParamNames("filters")
       .implementedAs([] {
         return std::vector<std::string>{"UUIDs",         "RSSI",         "Pathloss", "Transport",
                                         "DuplicateData", "Discoverable", "Pattern"};
       });
   obj->registerMethod("RemoveDevice")
-      .onInterface(kAdapterIface)
+      .onInterface(api::kAdapter)
       .withInputParamNames("device")
       .implementedAs([this, ap](const sdbus::ObjectPath& path) {
         for (auto& d : devices) {
@@ -589,25 +587,25 @@ void FakeBluez::State::exportAdapter(Adapter& a) {
         throw doesNotExist();
       });
 
-  obj->registerProperty("Address").onInterface(kAdapterIface).withGetter([ap] {
+  obj->registerProperty("Address").onInterface(api::kAdapter).withGetter([ap] {
     return ap->address;
   });
-  obj->registerProperty("AddressType").onInterface(kAdapterIface).withGetter([] {
+  obj->registerProperty("AddressType").onInterface(api::kAdapter).withGetter([] {
     return std::string("public");
   });
-  obj->registerProperty("Name").onInterface(kAdapterIface).withGetter([ap] { return ap->name; });
+  obj->registerProperty("Name").onInterface(api::kAdapter).withGetter([ap] { return ap->name; });
   obj->registerProperty("Alias")
-      .onInterface(kAdapterIface)
+      .onInterface(api::kAdapter)
       .withGetter([ap] { return ap->alias.empty() ? ap->name : ap->alias; })
       .withSetter([this, ap](const std::string& v) {
         ap->alias = v;  // "" restores the system name
-        emit(ap->object.get(), kAdapterIface, {"Alias"});
+        emit(ap->object.get(), api::kAdapter, {"Alias"});
       });
-  obj->registerProperty("Class").onInterface(kAdapterIface).withGetter([] {
+  obj->registerProperty("Class").onInterface(api::kAdapter).withGetter([] {
     return std::uint32_t{0};
   });
   obj->registerProperty("Powered")
-      .onInterface(kAdapterIface)
+      .onInterface(api::kAdapter)
       .withGetter([ap] { return ap->powered; })
       .withSetter([this, ap](const bool& on) {
         if (on == ap->powered) return;
@@ -622,40 +620,40 @@ void FakeBluez::State::exportAdapter(Adapter& a) {
             linkDown(*d, true);
           }
         }
-        emit(ap->object.get(), kAdapterIface, {"Powered"});
+        emit(ap->object.get(), api::kAdapter, {"Powered"});
       });
   obj->registerProperty("Discoverable")
-      .onInterface(kAdapterIface)
+      .onInterface(api::kAdapter)
       .withGetter([ap] { return ap->discoverable; })
       .withSetter([this, ap](const bool& v) {
         ap->discoverable = v;
-        emit(ap->object.get(), kAdapterIface, {"Discoverable"});
+        emit(ap->object.get(), api::kAdapter, {"Discoverable"});
       });
-  obj->registerProperty("DiscoverableTimeout").onInterface(kAdapterIface).withGetter([] {
+  obj->registerProperty("DiscoverableTimeout").onInterface(api::kAdapter).withGetter([] {
     return std::uint32_t{180};
   });
   obj->registerProperty("Pairable")
-      .onInterface(kAdapterIface)
+      .onInterface(api::kAdapter)
       .withGetter([ap] { return ap->pairable; })
       .withSetter([this, ap](const bool& v) {
         ap->pairable = v;
-        emit(ap->object.get(), kAdapterIface, {"Pairable"});
+        emit(ap->object.get(), api::kAdapter, {"Pairable"});
       });
-  obj->registerProperty("PairableTimeout").onInterface(kAdapterIface).withGetter([] {
+  obj->registerProperty("PairableTimeout").onInterface(api::kAdapter).withGetter([] {
     return std::uint32_t{0};
   });
-  obj->registerProperty("Discovering").onInterface(kAdapterIface).withGetter([ap] {
+  obj->registerProperty("Discovering").onInterface(api::kAdapter).withGetter([ap] {
     return ap->discovering;
   });
-  obj->registerProperty("UUIDs").onInterface(kAdapterIface).withGetter([] {
+  obj->registerProperty("UUIDs").onInterface(api::kAdapter).withGetter([] {
     return std::vector<std::string>{"00001801-0000-1000-8000-00805f9b34fb",   // GATT
                                     "00001800-0000-1000-8000-00805f9b34fb",   // GAP
                                     "0000180a-0000-1000-8000-00805f9b34fb"};  // Device Info
   });
-  obj->registerProperty("Modalias").onInterface(kAdapterIface).withGetter([] {
+  obj->registerProperty("Modalias").onInterface(api::kAdapter).withGetter([] {
     return std::string("usb:v1D6Bp0246d0542");  // BlueZ 5.66
   });
-  obj->registerProperty("Roles").onInterface(kAdapterIface).withGetter([] {
+  obj->registerProperty("Roles").onInterface(api::kAdapter).withGetter([] {
     return std::vector<std::string>{"central", "peripheral"};
   });
   obj->finishRegistration();
@@ -684,7 +682,7 @@ void FakeBluez::State::stopDiscovery(Adapter& a, const std::string& sender) {
 
 void FakeBluez::State::startScan(Adapter& a) {
   a.discovering = true;
-  emit(a.object.get(), kAdapterIface, {"Discovering"});
+  emit(a.object.get(), api::kAdapter, {"Discovering"});
   Adapter* ap = &a;
   int k = 0;
   for (auto& d : devices) {
@@ -714,7 +712,7 @@ void FakeBluez::State::stopScan(Adapter& a) {
   cancel(a.advertTimer);
   for (auto& d : devices)
     if (d->adapter == &a) d->rssiStale = true;
-  emit(a.object.get(), kAdapterIface, {"Discovering"});
+  emit(a.object.get(), api::kAdapter, {"Discovering"});
 }
 
 bool FakeBluez::State::wanted(const Adapter& a, const Device& d, std::int16_t rssi,
@@ -777,7 +775,7 @@ void FakeBluez::State::advertise(Device& d) {
       if (d.alias.empty()) changed.push_back("Alias");
     }
   }
-  if (!changed.empty()) emit(d.object.get(), kDeviceIface, changed);
+  if (!changed.empty()) emit(d.object.get(), api::kDevice, changed);
 }
 
 void FakeBluez::State::clientGone(const std::string& uniqueName) {
@@ -790,7 +788,7 @@ void FakeBluez::State::clientGone(const std::string& uniqueName) {
   for (auto& d : devices) {
     Characteristic* ch = d->readChar.get();
     if (ch && ch->notifySessions.erase(uniqueName) && ch->notifySessions.empty())
-      emit(ch->object.get(), kCharIface, {"Notifying"});
+      emit(ch->object.get(), api::kGattCharacteristic, {"Notifying"});
   }
 }
 
@@ -802,47 +800,47 @@ void FakeBluez::State::exportDevice(Device& d) {
   Device* dp = &d;
 
   obj->registerMethod("Connect")
-      .onInterface(kDeviceIface)
+      .onInterface(api::kDevice)
       .implementedAs([this, dp](sdbus::Result<>&& result) { connect(*dp, std::move(result)); });
-  obj->registerMethod("Disconnect").onInterface(kDeviceIface).implementedAs([this, dp] {
+  obj->registerMethod("Disconnect").onInterface(api::kDevice).implementedAs([this, dp] {
     if (!dp->connected) throw notConnected();
     log::debug(kComponent, dp->address + ": disconnected by the client");
     linkDown(*dp, true);
   });
   for (const char* m : {"ConnectProfile", "DisconnectProfile"}) {
     obj->registerMethod(m)
-        .onInterface(kDeviceIface)
+        .onInterface(api::kDevice)
         .withInputParamNames("UUID")
         .implementedAs([](const std::string&) { throw notSupported(); });
   }
-  obj->registerMethod("Pair").onInterface(kDeviceIface).implementedAs([] { throw notSupported(); });
-  obj->registerMethod("CancelPairing").onInterface(kDeviceIface).implementedAs([] {
+  obj->registerMethod("Pair").onInterface(api::kDevice).implementedAs([] { throw notSupported(); });
+  obj->registerMethod("CancelPairing").onInterface(api::kDevice).implementedAs([] {
     throw doesNotExist();
   });
 
-  obj->registerProperty("Address").onInterface(kDeviceIface).withGetter([dp] {
+  obj->registerProperty("Address").onInterface(api::kDevice).withGetter([dp] {
     return dp->address;
   });
-  obj->registerProperty("AddressType").onInterface(kDeviceIface).withGetter([] {
+  obj->registerProperty("AddressType").onInterface(api::kDevice).withGetter([] {
     return std::string("random");
   });
   d.hasName = !d.name.empty();
   if (d.hasName)
-    obj->registerProperty("Name").onInterface(kDeviceIface).withGetter([dp] { return dp->name; });
+    obj->registerProperty("Name").onInterface(api::kDevice).withGetter([dp] { return dp->name; });
   obj->registerProperty("Alias")
-      .onInterface(kDeviceIface)
+      .onInterface(api::kDevice)
       .withGetter([dp] { return dp->currentAlias(); })
       .withSetter([this, dp](const std::string& v) {
         dp->alias = v;  // "" goes back to the name (or the address)
-        emit(dp->object.get(), kDeviceIface, {"Alias"});
+        emit(dp->object.get(), api::kDevice, {"Alias"});
       });
-  obj->registerProperty("Adapter").onInterface(kDeviceIface).withGetter([dp] {
+  obj->registerProperty("Adapter").onInterface(api::kDevice).withGetter([dp] {
     return sdbus::ObjectPath(dp->adapter->path);
   });
-  obj->registerProperty("UUIDs").onInterface(kDeviceIface).withGetter([] {
+  obj->registerProperty("UUIDs").onInterface(api::kDevice).withGetter([] {
     return std::vector<std::string>{std::string(anki::kServiceUuid)};
   });
-  obj->registerProperty("ManufacturerData").onInterface(kDeviceIface).withGetter([dp] {
+  obj->registerProperty("ManufacturerData").onInterface(api::kDevice).withGetter([dp] {
     // BlueZ splits the first two bytes off as the company id, little-endian: BE EF → 0xEFBE.
     std::map<std::uint16_t, sdbus::Variant> out;
     const auto& m = dp->manufacturer;
@@ -852,37 +850,37 @@ void FakeBluez::State::exportDevice(Device& d) {
     }
     return out;
   });
-  obj->registerProperty("AdvertisingData").onInterface(kDeviceIface).withGetter([dp] {
+  obj->registerProperty("AdvertisingData").onInterface(api::kDevice).withGetter([dp] {
     std::map<std::uint8_t, sdbus::Variant> out;
     out[0x09] = sdbus::Variant(dp->localName);  // Complete Local Name, raw
     return out;
   });
-  obj->registerProperty("AdvertisingFlags").onInterface(kDeviceIface).withGetter([] {
+  obj->registerProperty("AdvertisingFlags").onInterface(api::kDevice).withGetter([] {
     return std::vector<std::uint8_t>{0x06};  // LE General Discoverable, BR/EDR not supported
   });
-  obj->registerProperty("RSSI").onInterface(kDeviceIface).withGetter([dp] { return dp->rssi; });
-  obj->registerProperty("TxPower").onInterface(kDeviceIface).withGetter([] { return kTxPower; });
-  obj->registerProperty("Connected").onInterface(kDeviceIface).withGetter([dp] {
+  obj->registerProperty("RSSI").onInterface(api::kDevice).withGetter([dp] { return dp->rssi; });
+  obj->registerProperty("TxPower").onInterface(api::kDevice).withGetter([] { return kTxPower; });
+  obj->registerProperty("Connected").onInterface(api::kDevice).withGetter([dp] {
     return dp->connected;
   });
-  obj->registerProperty("ServicesResolved").onInterface(kDeviceIface).withGetter([dp] {
+  obj->registerProperty("ServicesResolved").onInterface(api::kDevice).withGetter([dp] {
     return dp->resolved;
   });
-  obj->registerProperty("Paired").onInterface(kDeviceIface).withGetter([] { return false; });
-  obj->registerProperty("LegacyPairing").onInterface(kDeviceIface).withGetter([] { return false; });
+  obj->registerProperty("Paired").onInterface(api::kDevice).withGetter([] { return false; });
+  obj->registerProperty("LegacyPairing").onInterface(api::kDevice).withGetter([] { return false; });
   obj->registerProperty("Trusted")
-      .onInterface(kDeviceIface)
+      .onInterface(api::kDevice)
       .withGetter([dp] { return dp->trusted; })
       .withSetter([this, dp](const bool& v) {
         dp->trusted = v;
-        emit(dp->object.get(), kDeviceIface, {"Trusted"});
+        emit(dp->object.get(), api::kDevice, {"Trusted"});
       });
   obj->registerProperty("Blocked")
-      .onInterface(kDeviceIface)
+      .onInterface(api::kDevice)
       .withGetter([dp] { return dp->blocked; })
       .withSetter([this, dp](const bool& v) {
         dp->blocked = v;
-        emit(dp->object.get(), kDeviceIface, {"Blocked"});
+        emit(dp->object.get(), api::kDevice, {"Blocked"});
       });
   obj->finishRegistration();
   d.object = std::move(o);
@@ -928,54 +926,62 @@ std::unique_ptr<Characteristic> FakeBluez::State::makeCharacteristic(
   std::string servicePath = d.path + "/service000a";
 
   obj->registerMethod("ReadValue")
-      .onInterface(kCharIface)
+      .onInterface(api::kGattCharacteristic)
       .withInputParamNames("options")
       .withOutputParamNames("value")
       .implementedAs([this, dp, cp](const Dict& options) { return readValue(*dp, *cp, options); });
   obj->registerMethod("WriteValue")
-      .onInterface(kCharIface)
+      .onInterface(api::kGattCharacteristic)
       .withInputParamNames("value", "options")
       .implementedAs([this, dp, cp](const std::vector<std::uint8_t>& value, const Dict& options) {
         writeValue(*dp, *cp, value, options);
       });
   obj->registerMethod("AcquireWrite")
-      .onInterface(kCharIface)
+      .onInterface(api::kGattCharacteristic)
       .withInputParamNames("options")
       .withOutputParamNames("fd", "mtu")
       .implementedAs([this, dp, cp](const Dict&) { return acquire(*dp, *cp, true); });
   obj->registerMethod("AcquireNotify")
-      .onInterface(kCharIface)
+      .onInterface(api::kGattCharacteristic)
       .withInputParamNames("options")
       .withOutputParamNames("fd", "mtu")
       .implementedAs([this, dp, cp](const Dict&) { return acquire(*dp, *cp, false); });
-  obj->registerMethod("StartNotify").onInterface(kCharIface).implementedAs([this, dp, cp] {
-    startNotify(*dp, *cp);
-  });
-  obj->registerMethod("StopNotify").onInterface(kCharIface).implementedAs([this, cp] {
+  obj->registerMethod("StartNotify")
+      .onInterface(api::kGattCharacteristic)
+      .implementedAs([this, dp, cp] { startNotify(*dp, *cp); });
+  obj->registerMethod("StopNotify").onInterface(api::kGattCharacteristic).implementedAs([this, cp] {
     stopNotify(*cp);
   });
 
-  obj->registerProperty("UUID").onInterface(kCharIface).withGetter([cp] { return cp->uuid; });
-  obj->registerProperty("Service").onInterface(kCharIface).withGetter([servicePath] {
+  obj->registerProperty("UUID").onInterface(api::kGattCharacteristic).withGetter([cp] {
+    return cp->uuid;
+  });
+  obj->registerProperty("Service").onInterface(api::kGattCharacteristic).withGetter([servicePath] {
     return sdbus::ObjectPath(servicePath);
   });
-  obj->registerProperty("Value").onInterface(kCharIface).withGetter([cp] { return cp->value; });
-  obj->registerProperty("Flags").onInterface(kCharIface).withGetter([cp] { return cp->flags; });
+  obj->registerProperty("Value").onInterface(api::kGattCharacteristic).withGetter([cp] {
+    return cp->value;
+  });
+  obj->registerProperty("Flags").onInterface(api::kGattCharacteristic).withGetter([cp] {
+    return cp->flags;
+  });
   // Like gatt-client.c, the notify and acquire properties exist only where the flags allow.
   if (ch->notify) {
-    obj->registerProperty("Notifying").onInterface(kCharIface).withGetter([cp] {
+    obj->registerProperty("Notifying").onInterface(api::kGattCharacteristic).withGetter([cp] {
       return !cp->notifySessions.empty();
     });
-    obj->registerProperty("NotifyAcquired").onInterface(kCharIface).withGetter([cp] {
+    obj->registerProperty("NotifyAcquired").onInterface(api::kGattCharacteristic).withGetter([cp] {
       return cp->notifyIo != nullptr;
     });
   }
   if (ch->writeCommand) {
-    obj->registerProperty("WriteAcquired").onInterface(kCharIface).withGetter([cp] {
+    obj->registerProperty("WriteAcquired").onInterface(api::kGattCharacteristic).withGetter([cp] {
       return cp->writeIo != nullptr;
     });
   }
-  obj->registerProperty("MTU").onInterface(kCharIface).withGetter([] { return kMtu; });
+  obj->registerProperty("MTU").onInterface(api::kGattCharacteristic).withGetter([] {
+    return kMtu;
+  });
   obj->finishRegistration();
   ch->object = std::move(o);
   return ch;
@@ -985,14 +991,14 @@ void FakeBluez::State::exportGatt(Device& d) {
   std::string servicePath = d.path + "/service000a";
   auto s = sdbus::createObject(conn, servicePath);
   Device* dp = &d;
-  s->registerProperty("UUID").onInterface(kServiceIface).withGetter([] {
+  s->registerProperty("UUID").onInterface(api::kGattService).withGetter([] {
     return std::string(anki::kServiceUuid);
   });
-  s->registerProperty("Primary").onInterface(kServiceIface).withGetter([] { return true; });
-  s->registerProperty("Device").onInterface(kServiceIface).withGetter([dp] {
+  s->registerProperty("Primary").onInterface(api::kGattService).withGetter([] { return true; });
+  s->registerProperty("Device").onInterface(api::kGattService).withGetter([dp] {
     return sdbus::ObjectPath(dp->path);
   });
-  s->registerProperty("Includes").onInterface(kServiceIface).withGetter([] {
+  s->registerProperty("Includes").onInterface(api::kGattService).withGetter([] {
     return std::vector<sdbus::ObjectPath>{};
   });
   s->finishRegistration();
@@ -1089,11 +1095,11 @@ std::tuple<sdbus::UnixFd, std::uint16_t> FakeBluez::State::acquire(Device& d, Ch
   if (write) {
     ch.writeIo = std::make_unique<Io>(loop.io(), fds[0]);
     watchWriteIo(d, ch);
-    emit(ch.object.get(), kCharIface, {"WriteAcquired"});
+    emit(ch.object.get(), api::kGattCharacteristic, {"WriteAcquired"});
   } else {
     ch.notifyIo = std::make_unique<Io>(loop.io(), fds[0]);
     watchNotifyIo(d, ch);
-    emit(ch.object.get(), kCharIface, {"NotifyAcquired"});
+    emit(ch.object.get(), api::kGattCharacteristic, {"NotifyAcquired"});
   }
   log::debug(kComponent, d.address + (write ? ": write" : ": notify") + " socket acquired");
   return {sdbus::UnixFd(fds[1], sdbus::adopt_fd), kMtu};
@@ -1151,13 +1157,13 @@ void FakeBluez::State::watchWriteIo(Device& d, Characteristic& ch) {
 void FakeBluez::State::closeNotifyIo(Characteristic& ch) {
   if (!ch.notifyIo) return;
   closeIo(ch.notifyIo);
-  emit(ch.object.get(), kCharIface, {"NotifyAcquired"});
+  emit(ch.object.get(), api::kGattCharacteristic, {"NotifyAcquired"});
 }
 
 void FakeBluez::State::closeWriteIo(Characteristic& ch) {
   if (!ch.writeIo) return;
   closeIo(ch.writeIo);
-  emit(ch.object.get(), kCharIface, {"WriteAcquired"});
+  emit(ch.object.get(), api::kGattCharacteristic, {"WriteAcquired"});
 }
 
 void FakeBluez::State::startNotify(Device& d, Characteristic& ch) {
@@ -1167,7 +1173,7 @@ void FakeBluez::State::startNotify(Device& d, Characteristic& ch) {
   if (!ch.notify) throw notSupported();
   std::string sender = ch.object->getCurrentlyProcessedMessage()->getSender();
   if (!ch.notifySessions.insert(sender).second) return;  // one session per client
-  if (ch.notifySessions.size() == 1) emit(ch.object.get(), kCharIface, {"Notifying"});
+  if (ch.notifySessions.size() == 1) emit(ch.object.get(), api::kGattCharacteristic, {"Notifying"});
 }
 
 void FakeBluez::State::stopNotify(Characteristic& ch) {
@@ -1177,7 +1183,7 @@ void FakeBluez::State::stopNotify(Characteristic& ch) {
   }
   std::string sender = ch.object->getCurrentlyProcessedMessage()->getSender();
   if (!ch.notifySessions.erase(sender)) throw failed("No notify session started");
-  if (ch.notifySessions.empty()) emit(ch.object.get(), kCharIface, {"Notifying"});
+  if (ch.notifySessions.empty()) emit(ch.object.get(), api::kGattCharacteristic, {"Notifying"});
 }
 
 // ---- links ----
@@ -1216,7 +1222,7 @@ void FakeBluez::State::linkUp(Device& d) {
   d.connected = true;
   ++d.generation;
   ++d.counters.connects;
-  emit(d.object.get(), kDeviceIface, {"Connected"});
+  emit(d.object.get(), api::kDevice, {"Connected"});
   exportGatt(d);  // services come with the link; ServicesResolved says when they are complete
 
   Device* dp = &d;
@@ -1243,7 +1249,7 @@ void FakeBluez::State::linkUp(Device& d) {
   d.resolveTimer = after(kResolveDelay, [this, dp] {
     dp->resolveTimer = 0;
     dp->resolved = true;
-    emit(dp->object.get(), kDeviceIface, {"ServicesResolved"});
+    emit(dp->object.get(), api::kDevice, {"ServicesResolved"});
   });
   log::debug(kComponent, d.address + ": connected");
 
@@ -1261,7 +1267,7 @@ void FakeBluez::State::linkDown(Device& d, bool tellCar) {
   ++d.counters.disconnects;
   cancel(d.resolveTimer);
   removeGatt(d);
-  emit(d.object.get(), kDeviceIface, {"ServicesResolved", "Connected"});
+  emit(d.object.get(), api::kDevice, {"ServicesResolved", "Connected"});
   if (tellCar) d.car->disconnect();  // the car stops, as on a lost link
 }
 
@@ -1290,7 +1296,7 @@ bool FakeBluez::State::toClient(Device& d, std::span<const std::uint8_t> frame) 
   }
   if (!ch->notifySessions.empty()) {
     ch->value.assign(frame.begin(), frame.end());
-    emit(ch->object.get(), kCharIface, {"Value"});
+    emit(ch->object.get(), api::kGattCharacteristic, {"Value"});
     ++d.counters.framesToClient;
     return true;
   }

@@ -16,6 +16,7 @@
 #include "engine/protocol/anki/advertisement.hpp"
 #include "engine/transport/bluez_api.hpp"
 #include "tests/support/private_bus.hpp"
+#include "tests/support/run_until.hpp"
 
 using namespace pitwall;
 using namespace std::chrono_literals;
@@ -23,17 +24,12 @@ using testing::FakeBluez;
 
 namespace {
 
+namespace api = ble::api;
+
 using Bytes = std::vector<std::uint8_t>;
 using Dict = std::map<std::string, sdbus::Variant>;
 using Interfaces = std::map<std::string, Dict>;
 using Objects = std::map<sdbus::ObjectPath, Interfaces>;
-
-constexpr const char* kAdapterIface = ble::api::kAdapter;
-constexpr const char* kDeviceIface = ble::api::kDevice;
-constexpr const char* kServiceIface = ble::api::kGattService;
-constexpr const char* kCharIface = ble::api::kGattCharacteristic;
-constexpr const char* kPropsIface = ble::api::kProperties;
-constexpr const char* kManagerIface = ble::api::kObjectManager;
 
 constexpr const char* kCar = "E0:00:00:00:00:01";
 const std::string kHci0 = "/org/bluez/hci0";
@@ -88,31 +84,10 @@ class Rig {
     pump_.kick();
   }
 
-  // Runs the loop until `done` holds (checked every millisecond) or `limit` passes.
   bool waitFor(const std::function<bool()>& done, Duration limit = 5s) {
-    if (done()) return true;
-    bool timedOut = false;
-    Loop::TimerId poll = 0;
-    std::function<void()> check = [&] {
-      poll = 0;
-      if (done()) return loop.stop();
-      poll = loop.after(1ms, check);
-    };
-    poll = loop.after(1ms, check);
-    auto deadline = loop.after(limit, [&] {
-      timedOut = true;
-      loop.stop();
-    });
-    loop.run();
-    loop.cancel(deadline);
-    if (poll) loop.cancel(poll);
-    return !timedOut || done();
+    return testing::runUntil(loop, done, limit);
   }
-
-  void runFor(Duration d) {
-    auto end = loop.now() + d;
-    waitFor([&] { return loop.now() >= end; }, d + 1s);
-  }
+  void runFor(Duration d) { testing::runFor(loop, d); }
 
   template <class... Args>
   Reply call(const std::string& path, const std::string& iface, const std::string& method,
@@ -144,7 +119,7 @@ class Rig {
   }
 
   sdbus::Variant get(const std::string& path, const std::string& iface, const std::string& prop) {
-    auto r = call(path, kPropsIface, "Get", iface, prop);
+    auto r = call(path, api::kProperties, "Get", iface, prop);
     REQUIRE_MESSAGE(r.ok(), "Get " << prop << ": " << r.error << ": " << r.message);
     sdbus::Variant v;
     *r.reply >> v;
@@ -152,7 +127,7 @@ class Rig {
   }
 
   Objects managedObjects() {
-    auto r = call("/", kManagerIface, "GetManagedObjects");
+    auto r = call("/", api::kObjectManager, "GetManagedObjects");
     REQUIRE(r.ok());
     Objects objects;
     *r.reply >> objects;
@@ -189,12 +164,12 @@ class Rig {
 
   // StartDiscovery on hci0 and wait for the first car.
   void discover() {
-    ok(kHci0, kAdapterIface, "StartDiscovery");
+    ok(kHci0, api::kAdapter, "StartDiscovery");
     REQUIRE(waitFor([&] { return added(kDev) != nullptr; }));
   }
   // Connect to the first car and wait until its services are resolved.
   void connect() {
-    ok(kDev, kDeviceIface, "Connect");
+    ok(kDev, api::kDevice, "Connect");
     REQUIRE(waitFor([&] { return changedTo(kDev, "ServicesResolved", true); }));
   }
 
@@ -258,13 +233,13 @@ TEST_CASE("fake bluez: the object manager shows the adapters, and no device befo
   for (const std::string path : {"/org/bluez/hci0", "/org/bluez/hci1"}) {
     CAPTURE(path);
     REQUIRE(objects.count(sdbus::ObjectPath(path)));
-    const Dict& adapter = objects[sdbus::ObjectPath(path)].at(kAdapterIface);
+    const Dict& adapter = objects[sdbus::ObjectPath(path)].at(api::kAdapter);
     CHECK(adapter.at("Powered").get<bool>());
     CHECK_FALSE(adapter.at("Discovering").get<bool>());
     CHECK(adapter.at("AddressType").get<std::string>() == "public");
     CHECK(adapter.at("Address").get<std::string>().size() == 17);
   }
-  for (const auto& [path, interfaces] : objects) CHECK_FALSE(interfaces.count(kDeviceIface));
+  for (const auto& [path, interfaces] : objects) CHECK_FALSE(interfaces.count(api::kDevice));
   CHECK(rig.fake.adapterPath(1) == "/org/bluez/hci1");
   CHECK(rig.fake.devicePath("E0:00:00:00:00:02") == "/org/bluez/hci1/dev_E0_00_00_00_00_02");
 }
@@ -274,13 +249,13 @@ TEST_CASE("fake bluez: StartDiscovery brings the cars of that adapter with Anki 
   Dict filter = {
       {"UUIDs", sdbus::Variant(std::vector<std::string>{"BE15BEEF-6186-407E-8381-0BD89C4D8DF4"})},
       {"Transport", sdbus::Variant(std::string("le"))}};
-  REQUIRE(rig.call(kHci0, kAdapterIface, "SetDiscoveryFilter", filter).ok());
+  REQUIRE(rig.call(kHci0, api::kAdapter, "SetDiscoveryFilter", filter).ok());
   auto start = rig.loop.now();
   rig.discover();
   CHECK(rig.loop.now() - start >= 10ms);  // BlueZ reports what the radio hears, not at once
   CHECK(rig.changedTo(kHci0, "Discovering", true));
 
-  const Dict& device = rig.added(kDev)->added.at(kDeviceIface);
+  const Dict& device = rig.added(kDev)->added.at(api::kDevice);
   sim::SimCar& car = rig.fake.car(kCar);
   CHECK(device.at("Address").get<std::string>() == kCar);
   CHECK(device.at("AddressType").get<std::string>() == "random");
@@ -320,28 +295,28 @@ TEST_CASE("fake bluez: StartDiscovery brings the cars of that adapter with Anki 
 
 TEST_CASE("fake bluez: discovery answers with BlueZ's errors and respects the UUID filter") {
   Rig rig;
-  rig.ok(kHci0, kAdapterIface, "StartDiscovery");
-  auto again = rig.call(kHci0, kAdapterIface, "StartDiscovery");
+  rig.ok(kHci0, api::kAdapter, "StartDiscovery");
+  auto again = rig.call(kHci0, api::kAdapter, "StartDiscovery");
   CHECK(again.error == "org.bluez.Error.InProgress");
   CHECK(again.message == "Operation already in progress");
-  rig.ok(kHci0, kAdapterIface, "StopDiscovery");
-  auto stop = rig.call(kHci0, kAdapterIface, "StopDiscovery");
+  rig.ok(kHci0, api::kAdapter, "StopDiscovery");
+  auto stop = rig.call(kHci0, api::kAdapter, "StopDiscovery");
   CHECK(stop.error == "org.bluez.Error.Failed");
   CHECK(stop.message == "No discovery started");
   CHECK(rig.changedTo(kHci0, "Discovering", false));
 
-  auto bogus = rig.call(kHci0, kAdapterIface, "SetDiscoveryFilter",
+  auto bogus = rig.call(kHci0, api::kAdapter, "SetDiscoveryFilter",
                         Dict{{"Colour", sdbus::Variant(std::string("red"))}});
   CHECK(bogus.error == "org.bluez.Error.InvalidArguments");
-  auto filters = rig.call(kHci0, kAdapterIface, "GetDiscoveryFilters");
+  auto filters = rig.call(kHci0, api::kAdapter, "GetDiscoveryFilters");
   std::vector<std::string> names;
   *filters.reply >> names;
   CHECK(std::count(names.begin(), names.end(), "UUIDs") == 1);
 
   // Heart-rate devices only: the car is not reported.
   Dict heartRate = {{"UUIDs", sdbus::Variant(std::vector<std::string>{"180d"})}};
-  REQUIRE(rig.call(kHci0, kAdapterIface, "SetDiscoveryFilter", heartRate).ok());
-  rig.ok(kHci0, kAdapterIface, "StartDiscovery");
+  REQUIRE(rig.call(kHci0, api::kAdapter, "SetDiscoveryFilter", heartRate).ok());
+  rig.ok(kHci0, api::kAdapter, "StartDiscovery");
   rig.runFor(100ms);
   CHECK(rig.added(kDev) == nullptr);
   CHECK_FALSE(rig.fake.exported(kCar));
@@ -355,14 +330,14 @@ TEST_CASE("fake bluez: discovery ends when the client that started it leaves the
     auto adapter = sdbus::createProxy(*other, "org.bluez", kHci0);
     bool started = false;
     adapter->callMethodAsync("StartDiscovery")
-        .onInterface(kAdapterIface)
+        .onInterface(api::kAdapter)
         .uponReplyInvoke([&](const sdbus::Error* e) { started = e == nullptr; });
     otherPump.kick();
     REQUIRE(rig.waitFor([&] { return started; }));
     REQUIRE(rig.waitFor([&] { return rig.added(kDev) != nullptr; }));
   }  // the other client's connection closes
   CHECK(rig.waitFor([&] { return rig.changedTo(kHci0, "Discovering", false); }));
-  CHECK_FALSE(rig.get(kHci0, kAdapterIface, "Discovering").get<bool>());
+  CHECK_FALSE(rig.get(kHci0, api::kAdapter, "Discovering").get<bool>());
   CHECK(rig.fake.exported(kCar));  // BlueZ keeps the devices it found
 }
 
@@ -370,7 +345,7 @@ TEST_CASE("fake bluez: Connect makes Connected, the GATT objects, then ServicesR
   Rig rig;
   rig.discover();
   auto start = rig.loop.now();
-  rig.ok(kDev, kDeviceIface, "Connect");
+  rig.ok(kDev, api::kDevice, "Connect");
   CHECK(rig.loop.now() - start >= 20ms);
   CHECK(rig.changedTo(kDev, "Connected", true));
   REQUIRE(rig.added(kService));
@@ -379,12 +354,12 @@ TEST_CASE("fake bluez: Connect makes Connected, the GATT objects, then ServicesR
   CHECK_FALSE(rig.changed(kDev, "ServicesResolved"));  // not yet
   REQUIRE(rig.waitFor([&] { return rig.changedTo(kDev, "ServicesResolved", true); }));
 
-  const Dict& service = rig.added(kService)->added.at(kServiceIface);
+  const Dict& service = rig.added(kService)->added.at(api::kGattService);
   CHECK(service.at("UUID").get<std::string>() == anki::kServiceUuid);
   CHECK(service.at("Primary").get<bool>());
   CHECK(service.at("Device").get<sdbus::ObjectPath>() == kDev);
 
-  const Dict& read = rig.added(kReadChar)->added.at(kCharIface);
+  const Dict& read = rig.added(kReadChar)->added.at(api::kGattCharacteristic);
   CHECK(read.at("UUID").get<std::string>() == anki::kReadCharUuid);
   CHECK(read.at("Service").get<sdbus::ObjectPath>() == kService);
   CHECK(read.at("Flags").get<std::vector<std::string>>() ==
@@ -393,13 +368,13 @@ TEST_CASE("fake bluez: Connect makes Connected, the GATT objects, then ServicesR
   CHECK_FALSE(read.at("NotifyAcquired").get<bool>());
   CHECK(read.at("MTU").get<std::uint16_t>() == 23);
 
-  const Dict& write = rig.added(kWriteChar)->added.at(kCharIface);
+  const Dict& write = rig.added(kWriteChar)->added.at(api::kGattCharacteristic);
   CHECK(write.at("UUID").get<std::string>() == anki::kWriteCharUuid);
   CHECK(write.at("Flags").get<std::vector<std::string>>() ==
         std::vector<std::string>{"read", "write-without-response", "write"});
   CHECK_FALSE(write.at("WriteAcquired").get<bool>());
 
-  rig.ok(kDev, kDeviceIface, "Connect");  // already connected: BlueZ says yes at once
+  rig.ok(kDev, api::kDevice, "Connect");  // already connected: BlueZ says yes at once
   CHECK(rig.fake.counters(kCar).connectCalls == 2);
   CHECK(rig.fake.counters(kCar).connects == 1);
   CHECK(rig.fake.car(kCar).truth().connected);
@@ -409,14 +384,14 @@ TEST_CASE("fake bluez: StartNotify and WriteValue carry a ping and its response"
   Rig rig;
   rig.discover();
   rig.connect();
-  rig.ok(kReadChar, kCharIface, "StartNotify");
+  rig.ok(kReadChar, api::kGattCharacteristic, "StartNotify");
   CHECK(rig.changedTo(kReadChar, "Notifying", true));
-  REQUIRE(rig.call(kWriteChar, kCharIface, "WriteValue", kPing, command()).ok());
+  REQUIRE(rig.call(kWriteChar, api::kGattCharacteristic, "WriteValue", kPing, command()).ok());
   REQUIRE(rig.waitFor([&] {
     auto v = rig.changed(kReadChar, "Value");
     return v && v->get<Bytes>() == kPingResponse;
   }));
-  auto read = rig.call(kReadChar, kCharIface, "ReadValue", Dict{});
+  auto read = rig.call(kReadChar, api::kGattCharacteristic, "ReadValue", Dict{});
   Bytes value;
   *read.reply >> value;
   CHECK(value == kPingResponse);
@@ -424,13 +399,13 @@ TEST_CASE("fake bluez: StartNotify and WriteValue carry a ping and its response"
   CHECK(rig.fake.counters(kCar).framesToClient >= 1);
 
   // A write request (no type) goes through too; a command to the read characteristic does not.
-  REQUIRE(rig.call(kWriteChar, kCharIface, "WriteValue", kPing, Dict{}).ok());
-  CHECK(rig.call(kReadChar, kCharIface, "WriteValue", kPing, command()).error ==
+  REQUIRE(rig.call(kWriteChar, api::kGattCharacteristic, "WriteValue", kPing, Dict{}).ok());
+  CHECK(rig.call(kReadChar, api::kGattCharacteristic, "WriteValue", kPing, command()).error ==
         "org.bluez.Error.NotSupported");
 
-  rig.ok(kReadChar, kCharIface, "StopNotify");
+  rig.ok(kReadChar, api::kGattCharacteristic, "StopNotify");
   CHECK(rig.changedTo(kReadChar, "Notifying", false));
-  auto again = rig.call(kReadChar, kCharIface, "StopNotify");
+  auto again = rig.call(kReadChar, api::kGattCharacteristic, "StopNotify");
   CHECK(again.error == "org.bluez.Error.Failed");
   CHECK(again.message == "No notify session started");
 }
@@ -439,9 +414,9 @@ TEST_CASE("fake bluez: AcquireNotify and AcquireWrite carry frames as datagrams"
   Rig rig;
   rig.discover();
   rig.connect();
-  auto n = rig.call(kReadChar, kCharIface, "AcquireNotify", Dict{});
+  auto n = rig.call(kReadChar, api::kGattCharacteristic, "AcquireNotify", Dict{});
   REQUIRE_MESSAGE(n.ok(), n.error << ": " << n.message);
-  auto w = rig.call(kWriteChar, kCharIface, "AcquireWrite", Dict{});
+  auto w = rig.call(kWriteChar, api::kGattCharacteristic, "AcquireWrite", Dict{});
   REQUIRE_MESSAGE(w.ok(), w.error << ": " << w.message);
   sdbus::UnixFd notifyFd, writeFd;
   std::uint16_t notifyMtu = 0, writeMtu = 0;
@@ -451,8 +426,8 @@ TEST_CASE("fake bluez: AcquireNotify and AcquireWrite carry frames as datagrams"
   w.reply.reset();
   CHECK(notifyMtu == 23);
   CHECK(writeMtu == 23);
-  CHECK(rig.get(kReadChar, kCharIface, "NotifyAcquired").get<bool>());
-  CHECK(rig.get(kWriteChar, kCharIface, "WriteAcquired").get<bool>());
+  CHECK(rig.get(kReadChar, api::kGattCharacteristic, "NotifyAcquired").get<bool>());
+  CHECK(rig.get(kWriteChar, api::kGattCharacteristic, "WriteAcquired").get<bool>());
 
   REQUIRE(::send(writeFd.get(), kPing.data(), kPing.size(), MSG_NOSIGNAL) == 2);
   Bytes got;
@@ -463,10 +438,10 @@ TEST_CASE("fake bluez: AcquireNotify and AcquireWrite carry frames as datagrams"
   CHECK(rig.fake.counters(kCar).framesToCar == 1);
 
   // While acquired, the D-Bus ways are closed (gatt-client.c).
-  auto write = rig.call(kWriteChar, kCharIface, "WriteValue", kPing, command());
+  auto write = rig.call(kWriteChar, api::kGattCharacteristic, "WriteValue", kPing, command());
   CHECK(write.error == "org.bluez.Error.NotPermitted");
   CHECK(write.message == "Write acquired");
-  auto start = rig.call(kReadChar, kCharIface, "StartNotify");
+  auto start = rig.call(kReadChar, api::kGattCharacteristic, "StartNotify");
   CHECK(start.error == "org.bluez.Error.NotPermitted");
   CHECK(start.message == "Notify acquired");
 
@@ -486,13 +461,13 @@ TEST_CASE("fake bluez: a set-speed write makes the simulated car drive") {
   rig.connect();
   Bytes sdkMode = {0x03, 0x90, 0x01, 0x01};
   Bytes setSpeed = {0x06, 0x24, 0xe8, 0x03, 0xa8, 0x61, 0x00};  // 1000 mm/s, 25000 mm/s²
-  REQUIRE(rig.call(kWriteChar, kCharIface, "WriteValue", sdkMode, Dict{}).ok());
-  REQUIRE(rig.call(kWriteChar, kCharIface, "WriteValue", setSpeed, command()).ok());
+  REQUIRE(rig.call(kWriteChar, api::kGattCharacteristic, "WriteValue", sdkMode, Dict{}).ok());
+  REQUIRE(rig.call(kWriteChar, api::kGattCharacteristic, "WriteValue", setSpeed, command()).ok());
   sim::SimCar& car = rig.fake.car(kCar);
   CHECK(rig.waitFor([&] { return car.truth().speed_mm_s > 0; }, 2s));
   CHECK(car.truth().target_speed_mm_s == doctest::Approx(1000));
 
-  rig.ok(kDev, kDeviceIface, "Disconnect");  // the controller goes away: the car stops
+  rig.ok(kDev, api::kDevice, "Disconnect");  // the controller goes away: the car stops
   CHECK_FALSE(car.truth().connected);
   CHECK(car.truth().target_speed_mm_s == 0);
 }
@@ -501,10 +476,10 @@ TEST_CASE("fake bluez: a refused car's Connect fails like an aborted LE connecti
   Rig rig;
   rig.fake.refuse(kCar);
   rig.discover();
-  auto r = rig.call(kDev, kDeviceIface, "Connect");
+  auto r = rig.call(kDev, api::kDevice, "Connect");
   CHECK(r.error == "org.bluez.Error.Failed");
   CHECK(r.message == "le-connection-abort-by-local");
-  CHECK_FALSE(rig.get(kDev, kDeviceIface, "Connected").get<bool>());
+  CHECK_FALSE(rig.get(kDev, api::kDevice, "Connected").get<bool>());
   CHECK(rig.added(kService) == nullptr);
   CHECK(rig.fake.counters(kCar).connectCalls == 1);
   CHECK(rig.fake.counters(kCar).connects == 0);
@@ -521,10 +496,11 @@ TEST_CASE("fake bluez: a dropped link takes the GATT objects; the device stays a
   REQUIRE(rig.waitFor([&] { return rig.changedTo(kDev, "Connected", false); }));
   CHECK(rig.changedTo(kDev, "ServicesResolved", false));
   CHECK(rig.waitFor([&] {
-    return rig.removed(kReadChar, kCharIface) && rig.removed(kWriteChar, kCharIface) &&
-           rig.removed(kService, kServiceIface);
+    return rig.removed(kReadChar, api::kGattCharacteristic) &&
+           rig.removed(kWriteChar, api::kGattCharacteristic) &&
+           rig.removed(kService, api::kGattService);
   }));
-  CHECK_FALSE(rig.removed(kDev, kDeviceIface));
+  CHECK_FALSE(rig.removed(kDev, api::kDevice));
   CHECK(rig.managedObjects().count(sdbus::ObjectPath(kDev)));
   CHECK_FALSE(rig.fake.car(kCar).truth().connected);
 
@@ -540,14 +516,14 @@ TEST_CASE("fake bluez: a vanished car is removed and does not come back") {
   rig.discover();  // and it keeps discovering
   rig.connect();
   rig.fake.vanish(kCar);
-  REQUIRE(rig.waitFor([&] { return rig.removed(kDev, kDeviceIface); }));
+  REQUIRE(rig.waitFor([&] { return rig.removed(kDev, api::kDevice); }));
   CHECK(rig.changedTo(kDev, "Connected", false));
-  CHECK(rig.removed(kReadChar, kCharIface));
+  CHECK(rig.removed(kReadChar, api::kGattCharacteristic));
   std::size_t sightings = rig.seen("InterfacesAdded", kDev).size();
   rig.runFor(250ms);  // longer than the advertising period
   CHECK(rig.seen("InterfacesAdded", kDev).size() == sightings);
   CHECK_FALSE(rig.managedObjects().count(sdbus::ObjectPath(kDev)));
-  CHECK(rig.call(kDev, kDeviceIface, "Connect").error ==
+  CHECK(rig.call(kDev, api::kDevice, "Connect").error ==
         "org.freedesktop.DBus.Error.UnknownObject");
 }
 
@@ -555,20 +531,21 @@ TEST_CASE("fake bluez: a car that hangs up ends the link") {
   Rig rig;
   rig.discover();
   rig.connect();
-  REQUIRE(rig.call(kWriteChar, kCharIface, "WriteValue", Bytes{0x01, 0x0d}, command()).ok());
+  REQUIRE(rig.call(kWriteChar, api::kGattCharacteristic, "WriteValue", Bytes{0x01, 0x0d}, command())
+              .ok());
   CHECK(rig.waitFor([&] { return rig.changedTo(kDev, "Connected", false); }));
-  CHECK(rig.waitFor([&] { return rig.removed(kService, kServiceIface); }));
+  CHECK(rig.waitFor([&] { return rig.removed(kService, api::kGattService); }));
   CHECK_FALSE(rig.fake.connected(kCar));
 }
 
 TEST_CASE("fake bluez: RemoveDevice forgets a device until it is heard again") {
   Rig rig;
   rig.discover();
-  auto notConnected = rig.call(kDev, kDeviceIface, "Disconnect");
+  auto notConnected = rig.call(kDev, api::kDevice, "Disconnect");
   CHECK(notConnected.error == "org.bluez.Error.NotConnected");
-  REQUIRE(rig.call(kHci0, kAdapterIface, "RemoveDevice", sdbus::ObjectPath(kDev)).ok());
-  CHECK(rig.removed(kDev, kDeviceIface));
-  CHECK(rig.call(kHci0, kAdapterIface, "RemoveDevice", sdbus::ObjectPath(kDev)).error ==
+  REQUIRE(rig.call(kHci0, api::kAdapter, "RemoveDevice", sdbus::ObjectPath(kDev)).ok());
+  CHECK(rig.removed(kDev, api::kDevice));
+  CHECK(rig.call(kHci0, api::kAdapter, "RemoveDevice", sdbus::ObjectPath(kDev)).error ==
         "org.bluez.Error.DoesNotExist");
   // Discovery still runs: the next advertisement brings the car back.
   CHECK(rig.waitFor([&] { return rig.seen("InterfacesAdded", kDev).size() == 2; }));
@@ -580,12 +557,12 @@ TEST_CASE("fake bluez: without acquire, AcquireNotify and AcquireWrite are not s
   Rig rig(options);
   rig.discover();
   rig.connect();
-  CHECK(rig.call(kReadChar, kCharIface, "AcquireNotify", Dict{}).error ==
+  CHECK(rig.call(kReadChar, api::kGattCharacteristic, "AcquireNotify", Dict{}).error ==
         "org.bluez.Error.NotSupported");
-  CHECK(rig.call(kWriteChar, kCharIface, "AcquireWrite", Dict{}).error ==
+  CHECK(rig.call(kWriteChar, api::kGattCharacteristic, "AcquireWrite", Dict{}).error ==
         "org.bluez.Error.NotSupported");
-  rig.ok(kReadChar, kCharIface, "StartNotify");  // the fallback works
-  REQUIRE(rig.call(kWriteChar, kCharIface, "WriteValue", kPing, command()).ok());
+  rig.ok(kReadChar, api::kGattCharacteristic, "StartNotify");  // the fallback works
+  REQUIRE(rig.call(kWriteChar, api::kGattCharacteristic, "WriteValue", kPing, command()).ok());
   CHECK(rig.waitFor([&] {
     auto v = rig.changed(kReadChar, "Value");
     return v && v->get<Bytes>() == kPingResponse;
@@ -597,9 +574,9 @@ TEST_CASE("fake bluez: scheduled faults count from the first connection") {
   rig.fake.schedule(FakeBluez::Fault::Garbage, kCar, 150ms);
   rig.fake.schedule(FakeBluez::Fault::Drop, kCar, 250ms);
   rig.discover();
-  rig.ok(kDev, kDeviceIface, "Connect");
+  rig.ok(kDev, api::kDevice, "Connect");
   auto connectedAt = rig.loop.now();
-  rig.ok(kReadChar, kCharIface, "StartNotify");
+  rig.ok(kReadChar, api::kGattCharacteristic, "StartNotify");
   std::vector<Bytes> values;
   REQUIRE(rig.waitFor([&] { return rig.changedTo(kDev, "Connected", false); }));
   CHECK(rig.loop.now() - connectedAt >= 200ms);

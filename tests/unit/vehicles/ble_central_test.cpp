@@ -9,6 +9,7 @@
 
 #include "tests/fake_bluez/fake_bluez.hpp"
 #include "tests/support/private_bus.hpp"
+#include "tests/support/run_until.hpp"
 
 using namespace pitwall;
 using namespace std::chrono_literals;
@@ -40,22 +41,8 @@ struct Rig {
     return c;
   }
 
-  // Runs the loop until cond() holds or the deadline passes; returns cond().
   bool waitFor(const std::function<bool()>& cond, Duration deadline = 5s) {
-    if (cond()) return true;
-    bool expired = false;
-    auto limit = loop.after(deadline, [&] {
-      expired = true;
-      loop.stop();
-    });
-    std::function<void()> poll = [&] {
-      if (cond()) return loop.stop();
-      loop.after(2ms, poll);
-    };
-    loop.post(poll);
-    loop.run();
-    loop.cancel(limit);
-    return cond() && !expired ? true : cond();
+    return testing::runUntil(loop, cond, deadline);
   }
 
   std::optional<std::string> start() {
@@ -191,7 +178,7 @@ TEST_CASE("ble: a vanished car is reported and looked for, without connection at
     return it != a.end() && it->second.discovering;
   }));
   int attempts = rig.central->attempts()[kCar2];
-  rig.waitFor([] { return false; }, 200ms);
+  testing::runFor(rig.loop, 200ms);
   CHECK(rig.central->attempts()[kCar2] == attempts);
   CHECK_FALSE(car->state().connected);
   CHECK(rig.car(kCar1)->state().connected);  // the other car is untouched
@@ -288,7 +275,7 @@ TEST_CASE("ble: shutdown disconnects every car") {
   CHECK(rig.fleet.connectedCount() == 0);
   // and nothing reconnects afterwards
   int attempts = rig.central->attempts()[kCar1];
-  rig.waitFor([] { return false; }, 200ms);
+  testing::runFor(rig.loop, 200ms);
   CHECK(rig.central->attempts()[kCar1] == attempts);
 }
 
@@ -300,15 +287,7 @@ TEST_CASE("ble: bluetoothd restarting: the cars go down, then are found and conn
   Fleet fleet(loop);
   ble::Central central(loop, fleet, Rig::quick());
   auto waitFor = [&](const std::function<bool()>& cond) {
-    auto limit = loop.after(10s, [&] { loop.stop(); });
-    std::function<void()> poll = [&] {
-      if (cond()) return loop.stop();
-      loop.after(2ms, poll);
-    };
-    loop.post(poll);
-    loop.run();
-    loop.cancel(limit);
-    return cond();
+    return testing::runUntil(loop, cond, 10s);
   };
   bool started = false;
   central.start([&](std::optional<std::string> e) {
