@@ -49,29 +49,23 @@ void DbusPump::process() {
   rearm();
 }
 
+void DbusPump::wait(boost::asio::posix::stream_descriptor::wait_type type, bool& waiting) {
+  if (waiting) return;
+  waiting = true;
+  std::weak_ptr<bool> alive = alive_;
+  fd_.async_wait(type, [this, alive, &waiting](const boost::system::error_code& ec) {
+    if (alive.expired()) return;
+    waiting = false;
+    if (ec == boost::asio::error::operation_aborted) return;
+    process();
+  });
+}
+
 void DbusPump::rearm() {
   auto poll = connection_.getEventLoopPollData();
   std::weak_ptr<bool> alive = alive_;
-  if ((poll.events & POLLIN) && !readWaiting_) {
-    readWaiting_ = true;
-    fd_.async_wait(boost::asio::posix::stream_descriptor::wait_read,
-                   [this, alive](const boost::system::error_code& ec) {
-                     if (alive.expired()) return;
-                     readWaiting_ = false;
-                     if (ec == boost::asio::error::operation_aborted) return;
-                     process();
-                   });
-  }
-  if ((poll.events & POLLOUT) && !writeWaiting_) {
-    writeWaiting_ = true;
-    fd_.async_wait(boost::asio::posix::stream_descriptor::wait_write,
-                   [this, alive](const boost::system::error_code& ec) {
-                     if (alive.expired()) return;
-                     writeWaiting_ = false;
-                     if (ec == boost::asio::error::operation_aborted) return;
-                     process();
-                   });
-  }
+  if (poll.events & POLLIN) wait(boost::asio::posix::stream_descriptor::wait_read, readWaiting_);
+  if (poll.events & POLLOUT) wait(boost::asio::posix::stream_descriptor::wait_write, writeWaiting_);
   if (poll.timeout_usec == armedTimeout_) return;
   armedTimeout_ = poll.timeout_usec;
   if (poll.timeout_usec == UINT64_MAX) {

@@ -34,6 +34,7 @@ class DbusPump {
 
  private:
   void rearm();
+  void wait(boost::asio::posix::stream_descriptor::wait_type type, bool& waiting);
 
   Loop& loop_;
   sdbus::IConnection& connection_;

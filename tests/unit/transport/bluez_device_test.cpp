@@ -1,6 +1,8 @@
 // What the BlueZ client makes of a device's advertisement (engine/transport/bluez.hpp).
 #include <doctest/doctest.h>
 
+#include <algorithm>
+
 #include "engine/transport/bluez.hpp"
 
 using namespace pitwall;
@@ -8,9 +10,11 @@ using ble::Device;
 
 namespace {
 std::vector<std::uint8_t> ankiName(std::uint8_t state, const std::string& user) {
-  std::vector<std::uint8_t> raw{state, 0x70, 0x2b, 0, 0, 0, 0, 0};
-  raw.insert(raw.end(), user.begin(), user.end());
-  raw.push_back(0);
+  std::vector<std::uint8_t> raw(8 + user.size() + 1, 0);  // reserved bytes and the final NUL
+  raw[0] = state;
+  raw[1] = 0x70;  // version 0x2b70, little-endian
+  raw[2] = 0x2b;
+  std::copy(user.begin(), user.end(), raw.begin() + 8);
   return raw;
 }
 }  // namespace
