@@ -59,8 +59,6 @@ for b in /usr/libexec/bluetooth/bluetoothd /usr/lib/bluetooth/bluetoothd /usr/sb
   [ -x "$b" ] && { BLUETOOTHD=$b; break; }
 done
 [ -n "$BLUETOOTHD" ] || skip "no bluetoothd binary found (package bluez)"
-# The guest sees the host's / read-only: everything it runs must live there, not in a private /tmp.
-case "$PITWALL$SRC" in /tmp/* | */tmp/*) echo "note: paths under /tmp are the guest's own tmpfs" ;; esac
 
 # ---- the kernel: Debian's linux-image-6.1.0-*-amd64, extracted (not installed), cached ----
 CACHE=$(dirname "$PITWALL")/qemu-cache
@@ -120,8 +118,20 @@ rc=1
 if mount -t 9p -o trans=virtio,version=9p2000.L,ro,msize=512000,cache=loose host /host; then
   mount -t proc proc /host/proc && mount -t sysfs sys /host/sys && mount -t devtmpfs dev /host/dev
   ln -s /proc/self/fd /host/dev/fd
+  # Writable scratch for the guest; where the source tree or the binary lives below one of these
+  # folders (a clone in /tmp or /root), that folder's entry is bound back in, read-only still.
   for d in /tmp /run /var/lib/bluetooth /root; do
-    [ -d /host\$d ] && mount -t tmpfs tmpfs /host\$d
+    [ -d /host\$d ] || continue
+    mkdir -p /orig\$d && mount -o bind /host\$d /orig\$d
+    mount -t tmpfs tmpfs /host\$d
+    for p in "$SRC" "$(dirname "$PITWALL")"; do
+      case "\$p" in
+        \$d/*)
+          top=\${p#\$d/}; top=\${top%%/*}
+          mkdir -p "/host\$d/\$top" && mount -o bind "/orig\$d/\$top" "/host\$d/\$top"
+          ;;
+      esac
+    done
   done
   chroot /host /usr/bin/env -i PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin \
     HOME=/root TERM=dumb PITWALL_QEMU_LOG="${PITWALL_QEMU_LOG:-info}" \
