@@ -82,10 +82,12 @@ say "pitwall emulate-car started (pid $CAR_PID)"
 
 # ---- the central on hci1 ----
 central_pitwall() {
+  local status=0
   "$PITWALL" run "$SRC/tests/qemu/laps_ble.lua" --ble --adapter hci1 --car "$ADDR0" --duration 30 \
-    > >(tee "$LOGS/central.out" | sed -u 's/^/[central] /') 2>&1 || return
+    2>&1 | tee "$LOGS/central.out" | sed -u 's/^/[central] /'
+  status=${PIPESTATUS[0]}
+  [ "$status" -eq 0 ] || return "$status"
   # --duration ending the run is status 0 too: only the script's last line says it drove.
-  sleep 0.1  # let tee finish
   grep -q "laps driven over BLE" "$LOGS/central.out" || {
     say "the script never reported its laps"
     return 1
