@@ -382,7 +382,7 @@ CarBinding::CarBinding(ScriptHost& host) : host_(host), L_(host.state()) {}
 CarBinding::~CarBinding() {
   for (auto& [car, proxy] : proxies_) {
     car->onMessage = nullptr;
-    car->onConnection = nullptr;
+    car->onConnection = std::move(proxy->previousOnConnection);
     car->onMalformed = nullptr;
   }
 }

@@ -148,7 +148,10 @@ void CarBinding::finish(Proxy& p, CarEvent e) {
 void CarBinding::hookEvents(Proxy& p) {
   AnkiCar& car = *p.car;
   car.onMessage = [this, &p](const Message& m) { dispatch(p, m); };
+  // The fleet watches connections too (a car joins the run on its first one): chain, don't replace.
+  p.previousOnConnection = std::move(car.onConnection);
   car.onConnection = [this, &p](bool up, const std::string& reason) {
+    if (p.previousOnConnection) p.previousOnConnection(up, reason);
     if (up) {
       if (begin(p, CarEvent::Connect)) finish(p, CarEvent::Connect);
     } else if (begin(p, CarEvent::Disconnect)) {

@@ -1,7 +1,9 @@
 #pragma once
 // What CarBinding keeps per car (private to bindings/car_binding.cpp and car_events.cpp).
 #include <array>
+#include <functional>
 #include <limits>
+#include <string>
 
 #include "bindings/car_binding.hpp"
 
@@ -20,6 +22,8 @@ struct CarBinding::Proxy {
     Written() { value.fill(std::numeric_limits<double>::quiet_NaN()); }
   };
   Written position, transition;
+  // What watched the car's connection before the binding did (the fleet): called first.
+  std::function<void(bool, const std::string&)> previousOnConnection;
   Proxy() {
     handlers.fill(LUA_NOREF);
     tables.fill(LUA_NOREF);

@@ -179,8 +179,9 @@ namespace {
 CaptureLink* g_injectInto = nullptr;
 }
 
-TEST_CASE_FIXTURE(LuaFixture,
-                  "an event delivered while a handler runs is complete and does not leak into the next") {
+TEST_CASE_FIXTURE(
+    LuaFixture,
+    "an event delivered while a handler runs is complete and does not leak into the next") {
   // inject(piece) makes the car send a position update at once, from inside a handler.
   g_injectInto = link;
   lua_pushcfunction(host->state(), [](lua_State* L) {
@@ -205,4 +206,35 @@ TEST_CASE_FIXTURE(LuaFixture,
   CHECK(run("assert(table.concat(seen, ' ') == '17/500 40/321 mv 3777 17/500', "
             "table.concat(seen, ' '))") == "");
   g_injectInto = nullptr;
+}
+
+TEST_CASE("a car that connects after the script started joins it: pitwall.onCar, then onConnect") {
+  // Real cars: the run starts with every car found, some not connected yet (docs/bluetooth.md).
+  Loop loop{ClockKind::Virtual};
+  Fleet fleet{loop};
+  auto owned = std::make_unique<CaptureLink>();
+  CaptureLink* link = owned.get();
+  fleet.add(std::move(owned), CarIdentity{0, "skull", 9, 1});
+  setenv("PITWALL_SCRIPTS", PITWALL_SOURCE_DIR "/scripts", 1);
+  ScriptHost host(loop, fleet, nullptr, HostOptions{});
+  REQUIRE(
+      host.startString("joined, connects = {}, 0\n"
+                       "local car = pitwall.cars()[1]\n"
+                       "assert(not car.connected)\n"
+                       "car.onConnect = function() connects = connects + 1 end\n"
+                       "pitwall.onCar = function(c) joined[#joined + 1] = c.name end\n",
+                       "join.lua"));
+  loop.run();
+  link->setConnected(true);
+  loop.run();
+  lua_State* L = host.state();
+  CHECK(luaL_dostring(L, "return #joined == 1 and joined[1] == 'skull' and connects == 1") ==
+        LUA_OK);
+  CHECK(lua_toboolean(L, -1));
+  // a reconnection is an onConnect, not a second join
+  link->setConnected(false);
+  link->setConnected(true);
+  loop.run();
+  CHECK(luaL_dostring(L, "return #joined == 1 and connects == 2") == LUA_OK);
+  CHECK(lua_toboolean(L, -1));
 }
