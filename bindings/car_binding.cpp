@@ -418,6 +418,25 @@ void CarBinding::registerType(lua_State* L) {
   lua_pop(L, 1);
 }
 
+int CarBinding::setHub(lua_State* L) {
+  auto& p = proxyAt(L, 1);
+  std::string name = lua::checkString(L, 2, "event name");
+  int e = eventIndex(name);
+  if (e < 0 || name == "onMessage")
+    throw LuaError("cannot listen to '" + name + "'; the events are " + eventList() +
+                   " (onMessage only through car.onMessage)");
+  if (!lua_isnil(L, 3) && !lua_isfunction(L, 3))
+    throw LuaError(std::string("a listener hub must be a function or nil, got ") +
+                   luaL_typename(L, 3));
+  luaL_unref(L, LUA_REGISTRYINDEX, p.hubs[e]);
+  p.hubs[e] = LUA_NOREF;
+  if (lua_isfunction(L, 3)) {
+    lua_pushvalue(L, 3);
+    p.hubs[e] = luaL_ref(L, LUA_REGISTRYINDEX);
+  }
+  return 0;
+}
+
 AnkiCar& CarBinding::check(lua_State* L, int idx) {
   return *proxyAt(L, idx).car;
 }

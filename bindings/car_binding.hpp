@@ -46,6 +46,9 @@ class CarBinding {
   void bind(AnkiCar& car);
   void push(lua_State* L, AnkiCar& car);
   static AnkiCar& check(lua_State* L, int idx);
+  // pitwall._setHub(car, "onPosition", fn | nil): the function that runs the library's
+  // listeners of that event (scripts/pitwall/core.lua, pitwall.listen).
+  static int setHub(lua_State* L);
 
   struct Proxy;
 

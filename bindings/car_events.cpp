@@ -84,6 +84,13 @@ constexpr std::array<const char*, kCarEventCount> kHandlerNames = {
     "onStatus handler",   "onCollision handler",  "onSpeed handler",        "onLaneChange handler",
     "onRecovery handler", "onConnect handler",    "onDisconnect handler",   "onMalformed handler",
     "onMessage handler"};
+constexpr std::array<const char*, kCarEventCount> kListenerNames = {
+    "onPosition listeners",    "onTransition listeners", "onIntersection listeners",
+    "onDelocalized listeners", "onOffset listeners",     "onBattery listeners",
+    "onVersion listeners",     "onPing listeners",       "onStatus listeners",
+    "onCollision listeners",   "onSpeed listeners",      "onLaneChange listeners",
+    "onRecovery listeners",    "onConnect listeners",    "onDisconnect listeners",
+    "onMalformed listeners",   "onMessage listeners"};
 
 }  // namespace
 
@@ -130,7 +137,9 @@ class CarBinding::EventTable {
 };
 
 bool CarBinding::begin(Proxy& p, CarEvent e) {
-  int h = p.handlers[static_cast<std::size_t>(e)];
+  // Listeners first (their hub), then the car's own handler: see finish().
+  int h = p.hubs[static_cast<std::size_t>(e)];
+  if (h == LUA_NOREF) h = p.handlers[static_cast<std::size_t>(e)];
   if (h == LUA_NOREF) return false;
   lua_State* L = L_;
   lua_pushcfunction(L, lua::traceback);
@@ -142,7 +151,19 @@ bool CarBinding::begin(Proxy& p, CarEvent e) {
 }
 
 void CarBinding::finish(Proxy& p, CarEvent e) {
-  host_.callAboveHandler(2, kHandlerNames[static_cast<std::size_t>(e)], p.car);
+  auto i = static_cast<std::size_t>(e);
+  bool hubFirst = p.hubs[i] != LUA_NOREF;
+  host_.callAboveHandler(2, hubFirst ? kListenerNames[i] : kHandlerNames[i], p.car);
+  // The listeners ran: now the car's own handler, with the same event table (read after the
+  // listeners, which may have changed it).
+  if (hubFirst && p.handlers[i] != LUA_NOREF) {
+    lua_State* L = L_;
+    lua_pushcfunction(L, lua::traceback);
+    lua_rawgeti(L, LUA_REGISTRYINDEX, p.handlers[i]);
+    lua_rawgeti(L, LUA_REGISTRYINDEX, p.selfRef);
+    lua_rawgeti(L, LUA_REGISTRYINDEX, p.tables[i]);
+    host_.callAboveHandler(2, kHandlerNames[i], p.car);
+  }
 }
 
 void CarBinding::hookEvents(Proxy& p) {

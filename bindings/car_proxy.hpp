@@ -13,6 +13,9 @@ struct CarBinding::Proxy {
   AnkiCar* car = nullptr;
   int selfRef = LUA_NOREF;
   std::array<int, kCarEventCount> handlers;
+  // The library's listeners of each event (pitwall.listen): one Lua function per event that runs
+  // them all, called before the handler (scripts/pitwall/core.lua).
+  std::array<int, kCarEventCount> hubs;
   std::array<int, kCarEventCount> tables;
   // What the reused onPosition / onTransition tables hold now: a field is written only when its
   // value changed (at a steady speed a position event rewrites just time and location). This is
@@ -26,6 +29,7 @@ struct CarBinding::Proxy {
   std::function<void(bool, const std::string&)> previousOnConnection;
   Proxy() {
     handlers.fill(LUA_NOREF);
+    hubs.fill(LUA_NOREF);
     tables.fill(LUA_NOREF);
   }
 };

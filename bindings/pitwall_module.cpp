@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 
 #include "bindings/car_binding.hpp"
 #include "bindings/lua_support.hpp"
 #include "bindings/script_host.hpp"
 #include "engine/core/log.hpp"
+#include "engine/protocol/anki/pieces.hpp"
 
 namespace pitwall {
 
@@ -149,6 +151,48 @@ int logBody(lua_State* L) {
   return 0;
 }
 
+// pitwall._reportError(where, message): an error caught by the Lua library (a listener's),
+// reported like an error in a handler: the log, or pitwall.onError; in tests a failure.
+int reportError(lua_State* L) {
+  std::string where = lua::checkString(L, 1, "where the error happened");
+  std::string message = luaL_tolstring(L, 2, nullptr);
+  ScriptHost::from(L).reportError(where, message);
+  return 0;
+}
+
+// pitwall.piece(id): what a road piece is (docs/lua-api.md "Track pieces"), nil when unknown.
+int piece(lua_State* L) {
+  auto id = lua::checkInteger(L, 1, "piece id");
+  if (id < 0 || id > 255) {
+    lua_pushnil(L);
+    return 1;
+  }
+  auto type = anki::pieceType(static_cast<std::uint8_t>(id));
+  if (type == anki::PieceType::Unknown) {
+    lua_pushnil(L);
+    return 1;
+  }
+  lua_createtable(L, 0, 4);
+  lua::setInteger(L, "id", id);
+  lua::setString(L, "type", anki::pieceTypeName(type));
+  switch (type) {
+    case anki::PieceType::StartLong:
+      lua::setNumber(L, "length", anki::kStartLongLengthMm);
+      break;
+    case anki::PieceType::StartShort:
+      lua::setNumber(L, "length", anki::kStartShortLengthMm);
+      break;
+    case anki::PieceType::Curve:
+      lua::setNumber(L, "length", anki::kCurveRadiusMm * std::acos(-1.0) / 2);
+      lua::setNumber(L, "radius", anki::kCurveRadiusMm);
+      break;
+    default:
+      lua::setNumber(L, "length", anki::kStraightLengthMm);
+      break;
+  }
+  return 1;
+}
+
 int timerToString(lua_State* L) {
   auto* h = static_cast<int*>(luaL_checkudata(L, 1, kTimerMetatable));
   lua_pushfstring(L, "timer %d", *h);
@@ -178,6 +222,9 @@ void openPitwallModule(ScriptHost& host) {
                                        {"sleep", sleep},
                                        {"stop", stop},
                                        {"log", lua::guarded<logBody>},
+                                       {"piece", lua::guarded<piece>},
+                                       {"_setHub", lua::guarded<&CarBinding::setHub>},
+                                       {"_reportError", lua::guarded<reportError>},
                                        {nullptr, nullptr}};
   luaL_newlib(L, functions);
   lua_pushboolean(L, host.loop().clockKind() == ClockKind::Virtual);

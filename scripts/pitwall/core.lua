@@ -17,6 +17,79 @@ function pitwall.waitUntil(cond, timeout, step)
   return true
 end
 
+-- Listeners: pitwall.listen(car, "onPosition", fn) lets libraries (and scripts) follow a car's
+-- events without taking its `car.onPosition` slot. Each car and event has one hub function in
+-- the engine, which runs that event's listeners in subscription order before the car's own
+-- handler. The lists are copied on write: a listener added or cancelled while an event is
+-- being delivered takes effect from the next event.
+local listeners = setmetatable({}, { __mode = "k" }) -- car → { [event] = { entry, … } }
+
+local Subscription = {}
+Subscription.__index = Subscription
+Subscription.__name = "listener"
+
+--- Ends the subscription; true if it was active.
+function Subscription:cancel()
+  local entry = self.entry
+  if not entry.active then return false end
+  entry.active = false
+  local byEvent = listeners[self.car]
+  local old = byEvent[self.event]
+  local new = {}
+  for _, e in ipairs(old) do
+    if e ~= entry then new[#new + 1] = e end
+  end
+  if #new == 0 then
+    byEvent[self.event] = nil
+    pitwall._setHub(self.car, self.event, nil)
+  else
+    byEvent[self.event] = new
+  end
+  return true
+end
+
+function Subscription:__tostring()
+  return string.format("listener of %s %s%s", tostring(self.car), self.event,
+    self.entry.active and "" or " (cancelled)")
+end
+
+--- Calls fn(car, ev) on every `event` of `car` ("onPosition", …; not "onMessage"), before the
+--- car's own handler. Returns a subscription: sub:cancel() ends it.
+function pitwall.listen(car, event, fn)
+  if type(event) ~= "string" then
+    error("pitwall.listen: the event is a name such as \"onPosition\", got " .. type(event), 2)
+  end
+  if type(fn) ~= "function" then
+    error("pitwall.listen: the listener must be a function, got " .. type(fn), 2)
+  end
+  local byEvent = listeners[car]
+  local list = byEvent and byEvent[event]
+  if not list then
+    -- raises for something that is not a car, and for unknown events
+    local ok, err = pcall(pitwall._setHub, car, event, function(c, ev)
+      local current = listeners[c][event]
+      for i = 1, #current do
+        local e = current[i]
+        if e.active then
+          local fine, message = xpcall(e.fn, debug.traceback, c, ev)
+          if not fine then
+            pitwall._reportError(event .. " listener of " .. tostring(c), message)
+          end
+        end
+      end
+    end)
+    if not ok then error("pitwall.listen: " .. tostring(err), 2) end
+    byEvent = byEvent or {}
+    listeners[car] = byEvent
+    list = {}
+  end
+  local entry = { fn = fn, active = true }
+  local new = table.move(list, 1, #list, 1, {})
+  new[#new + 1] = entry
+  byEvent[event] = new
+  return setmetatable({ car = car, event = event, entry = entry }, Subscription)
+end
+
 --- A shallow copy of a table: event tables are reused, so keep a copy to store one.
 function pitwall.copy(t)
   local c = {}

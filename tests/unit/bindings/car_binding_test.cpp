@@ -238,3 +238,84 @@ TEST_CASE("a car that connects after the script started joins it: pitwall.onCar,
   CHECK(luaL_dostring(L, "return #joined == 1 and connects == 2") == LUA_OK);
   CHECK(lua_toboolean(L, -1));
 }
+
+TEST_CASE_FIXTURE(LuaFixture,
+                  "listeners run before the car's handler, in order, on the same event") {
+  REQUIRE(run("order = {}\n"
+              "local car = pitwall.cars()[1]\n"
+              "a = pitwall.listen(car, 'onBattery', function(c, ev)"
+              " order[#order + 1] = 'a' .. ev.millivolts end)\n"
+              "pitwall.listen(car, 'onBattery', function(c, ev)"
+              " order[#order + 1] = 'b' .. ev.millivolts; assert(c == car) end)\n"
+              "car.onBattery = function(c, ev) order[#order + 1] = 'h' .. ev.millivolts end") ==
+          "");
+  link->carSends(BatteryResponse{3800});
+  CHECK(run("assert(table.concat(order, ' ') == 'a3800 b3800 h3800', table.concat(order, ' '))") ==
+        "");
+  // cancelled: gone from the next event on; a second cancel says it was not active
+  CHECK(run("assert(a:cancel() == true and a:cancel() == false); order = {}") == "");
+  link->carSends(BatteryResponse{3700});
+  CHECK(run("assert(table.concat(order, ' ') == 'b3700 h3700', table.concat(order, ' '))") == "");
+}
+
+TEST_CASE_FIXTURE(LuaFixture, "a listener without a handler, and a handler after every cancel") {
+  REQUIRE(run("seen, handled = 0, 0\n"
+              "local car = pitwall.cars()[1]\n"
+              "sub = pitwall.listen(car, 'onPing', function() seen = seen + 1 end)") == "");
+  link->carSends(PingResponse{});
+  CHECK(number("seen") == 1);
+  REQUIRE(run("sub:cancel(); pitwall.cars()[1].onPing = function() handled = handled + 1 end") ==
+          "");
+  link->carSends(PingResponse{});
+  CHECK(number("seen") == 1);
+  CHECK(number("handled") == 1);
+}
+
+TEST_CASE_FIXTURE(LuaFixture,
+                  "an error in a listener is reported; the others and the handler run") {
+  REQUIRE(run("calls = 0\n"
+              "local car = pitwall.cars()[1]\n"
+              "pitwall.listen(car, 'onBattery', function() error('broken listener') end)\n"
+              "pitwall.listen(car, 'onBattery', function() calls = calls + 1 end)\n"
+              "car.onBattery = function() calls = calls + 10 end") == "");
+  link->carSends(BatteryResponse{3800});
+  CHECK(number("calls") == 11);
+  CHECK(host->errorCount() == 1);
+  REQUIRE_FALSE(logged.empty());
+  CHECK(logged.back().find("onBattery listener of car 1 (skull)") != std::string::npos);
+  CHECK(logged.back().find("broken listener") != std::string::npos);
+  CHECK(logged.back().find("stack traceback") != std::string::npos);
+}
+
+TEST_CASE_FIXTURE(LuaFixture, "a listener added during an event hears from the next one") {
+  REQUIRE(run("late = 0\n"
+              "local car = pitwall.cars()[1]\n"
+              "pitwall.listen(car, 'onPing', function(c)\n"
+              "  if not added then added = true; pitwall.listen(c, 'onPing', function()"
+              " late = late + 1 end) end\n"
+              "end)") == "");
+  link->carSends(PingResponse{});
+  CHECK(number("late") == 0);
+  link->carSends(PingResponse{});
+  CHECK(number("late") == 1);
+}
+
+TEST_CASE_FIXTURE(LuaFixture,
+                  "listening is refused clearly for unknown events, onMessage, non-cars") {
+  CHECK(run("pitwall.listen(pitwall.cars()[1], 'onPostion', print)").find("onPosition, ") !=
+        std::string::npos);
+  CHECK(run("pitwall.listen(pitwall.cars()[1], 'onMessage', print)")
+            .find("onMessage only through car.onMessage") != std::string::npos);
+  CHECK(run("pitwall.listen({}, 'onPing', print)").find("expected a car") != std::string::npos);
+  CHECK(run("pitwall.listen(pitwall.cars()[1], 'onPing', 42)").find("must be a function") !=
+        std::string::npos);
+}
+
+TEST_CASE_FIXTURE(LuaFixture, "pitwall.piece tells what a road piece is") {
+  CHECK(run("local p = pitwall.piece(34); assert(p.type == 'start-long' and p.length == 340)\n"
+            "p = pitwall.piece(33); assert(p.type == 'start-short' and p.length == 220)\n"
+            "p = pitwall.piece(39); assert(p.type == 'straight' and p.length == 560)\n"
+            "p = pitwall.piece(17); assert(p.type == 'curve' and p.radius == 280)\n"
+            "assert(math.abs(p.length - 280 * math.pi / 2) < 1e-9)\n"
+            "assert(pitwall.piece(99) == nil and pitwall.piece(-1) == nil)") == "");
+}
