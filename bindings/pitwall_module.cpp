@@ -6,6 +6,7 @@
 
 #include "bindings/car_binding.hpp"
 #include "bindings/lua_support.hpp"
+#include "bindings/results.hpp"
 #include "bindings/script_host.hpp"
 #include "engine/core/log.hpp"
 #include "engine/protocol/anki/pieces.hpp"
@@ -193,6 +194,48 @@ int piece(lua_State* L) {
   return 1;
 }
 
+// pitwall.writeResults(rows, columns [, path]): rows (tables) as JSON or CSV, by the path's
+// extension; the path defaults to --results.
+int writeResults(lua_State* L) {
+  luaL_checktype(L, 1, LUA_TTABLE);
+  luaL_checktype(L, 2, LUA_TTABLE);
+  results::Table table;
+  for (lua_Integer i = 1, n = luaL_len(L, 2); i <= n; ++i) {
+    if (lua_geti(L, 2, i) != LUA_TSTRING)
+      throw LuaError("pitwall.writeResults: column " + std::to_string(i) + " is not a name");
+    table.columns.emplace_back(lua_tostring(L, -1));
+    lua_pop(L, 1);
+  }
+  for (lua_Integer r = 1, n = luaL_len(L, 1); r <= n; ++r) {
+    if (lua_geti(L, 1, r) != LUA_TTABLE)
+      throw LuaError("pitwall.writeResults: row " + std::to_string(r) + " is not a table");
+    auto& row = table.rows.emplace_back();
+    for (const auto& column : table.columns) {
+      int t = lua_getfield(L, -1, column.c_str());
+      if (t == LUA_TNUMBER)
+        row.emplace_back(static_cast<double>(lua_tonumber(L, -1)));
+      else if (t == LUA_TSTRING)
+        row.emplace_back(std::string(lua_tostring(L, -1)));
+      else if (t == LUA_TBOOLEAN)
+        row.emplace_back(std::string(lua_toboolean(L, -1) ? "true" : "false"));
+      else if (t == LUA_TNIL)
+        row.emplace_back(std::monostate{});
+      else
+        throw LuaError("pitwall.writeResults: row " + std::to_string(r) + ", " + column + ": a " +
+                       luaL_typename(L, -1) + " cannot go in a results file");
+      lua_pop(L, 1);
+    }
+    lua_pop(L, 1);
+  }
+  std::string path = lua_isnoneornil(L, 3) ? ScriptHost::from(L).options().results
+                                           : lua::checkString(L, 3, "results file");
+  if (path.empty())
+    throw LuaError("pitwall.writeResults: no file: run with --results FILE, or pass a path");
+  if (auto written = results::write(path, table); !written) throw LuaError(written.error());
+  lua_pushstring(L, path.c_str());
+  return 1;
+}
+
 int timerToString(lua_State* L) {
   auto* h = static_cast<int*>(luaL_checkudata(L, 1, kTimerMetatable));
   lua_pushfstring(L, "timer %d", *h);
@@ -223,6 +266,7 @@ void openPitwallModule(ScriptHost& host) {
                                        {"stop", stop},
                                        {"log", lua::guarded<logBody>},
                                        {"piece", lua::guarded<piece>},
+                                       {"writeResults", lua::guarded<writeResults>},
                                        {"_setHub", lua::guarded<&CarBinding::setHub>},
                                        {"_reportError", lua::guarded<reportError>},
                                        {nullptr, nullptr}};
@@ -231,6 +275,10 @@ void openPitwallModule(ScriptHost& host) {
   lua_setfield(L, -2, "virtualTime");
   lua_pushinteger(L, static_cast<lua_Integer>(host.options().seed));
   lua_setfield(L, -2, "seed");
+  if (!host.options().results.empty()) {
+    lua_pushstring(L, host.options().results.c_str());
+    lua_setfield(L, -2, "resultsFile");
+  }
   lua_pushvalue(L, -1);
   lua_setglobal(L, "pitwall");
   luaL_getsubtable(L, LUA_REGISTRYINDEX, LUA_LOADED_TABLE);

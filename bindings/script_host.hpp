@@ -32,6 +32,7 @@ struct HostOptions {
   bool test_mode = false;                  // callback errors fail the run; `expect` helpers loaded
   std::uint64_t seed = 1;                  // math.randomseed
   std::vector<std::string> library_paths;  // extra folders searched by require
+  std::string results;                     // --results FILE (pitwall.resultsFile), empty: none
 };
 
 class ScriptHost {

@@ -14,7 +14,8 @@ struct RunOptions {
   std::uint64_t seed = 1;
   int cars = 4;
   std::string track = "oval";
-  std::string record;  // --record FILE, empty: none
+  std::string record;   // --record FILE, empty: none
+  std::string results;  // --results FILE (.json or .csv), empty: none
   // Real cars over Bluetooth LE through BlueZ instead of the simulator (docs/bluetooth.md).
   bool ble = false;
   std::vector<std::string> carAddresses;  // --car ADDR (repeatable): only these; empty: all found

@@ -31,6 +31,8 @@ int main(int argc, char** argv) {
   auto* trackOpt =
       runCmd->add_option("--track", run.track, "Track layout: a name (oval, …) or a layout file");
   runCmd->add_option("--record", run.record, "Write every frame in and out as JSON lines to FILE");
+  runCmd->add_option("--results", run.results,
+                     "Where the race library writes the results: FILE.json or FILE.csv");
   auto* bleFlag = runCmd->add_flag(
       "--ble", run.ble, "Drive real cars over Bluetooth LE (BlueZ) instead of the simulator");
   // Real cars run in real time, on a real track.

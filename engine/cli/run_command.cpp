@@ -4,6 +4,7 @@
 #include <csignal>
 #include <iostream>
 
+#include "bindings/results.hpp"
 #include "engine/cli/commands.hpp"
 #include "engine/cli/session.hpp"
 #include "engine/core/log.hpp"
@@ -48,6 +49,13 @@ int run(const RunOptions& options) {
   if (!made) return status;
   Session& session = *made;
   status = 0;
+  if (!options.results.empty()) {  // refused now, not after the race
+    auto checked = results::writable(options.results);
+    if (!checked) {
+      std::cerr << "pitwall run: " << checked.error() << "\n";
+      return 2;
+    }
+  }
   if (!options.record.empty()) {
     try {
       session.record(options.record);
@@ -90,6 +98,7 @@ int run(const RunOptions& options) {
 
   HostOptions host;
   host.seed = options.seed;
+  host.results = options.results;
   try {
     session.startHost(host);
   } catch (const std::exception& e) {

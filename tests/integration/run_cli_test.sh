@@ -86,4 +86,18 @@ contains "dying script's error is shown with its line" "dies.lua:3: the strategy
 check "a dying script's cars are stopped" "1 0
 2 0
 3 0" "$(last_speed_per_car "$TMP/dies.jsonl")"
+# --results: checked before the race; the script's rows end up in the file
+err=$($PITWALL run "$SRC/examples/hello.lua" --fast --results "$TMP/race.txt" 2>&1 >/dev/null); rc=$?
+check "--results with an unknown extension: exit status" 2 "$rc"
+contains "--results with an unknown extension: says why" "must end in .json or .csv" "$err"
+err=$($PITWALL run "$SRC/examples/hello.lua" --fast --results "$TMP/nowhere/race.json" 2>&1 >/dev/null); rc=$?
+check "--results in a missing folder: exit status" 2 "$rc"
+contains "--results in a missing folder: names it" "cannot write results to" "$err"
+printf '%s\n' "pitwall.writeResults({{position = 1, car = pitwall.cars()[1].name, laps = 0}}," \
+  "  {'position', 'car', 'laps'})" "pitwall.stop()" >"$TMP/results.lua"
+$PITWALL run "$TMP/results.lua" --fast --cars 1 --results "$TMP/race.csv" 2>/dev/null; rc=$?
+check "--results: exit status" 0 "$rc"
+check "--results: the file" "position,car,laps
+1,groundshock,0" "$(cat "$TMP/race.csv")"
+
 finish
