@@ -1,8 +1,12 @@
 #include "bindings/pitwall_module.hpp"
 
+#include <sys/ioctl.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdlib>
 
 #include "bindings/car_binding.hpp"
 #include "bindings/lua_support.hpp"
@@ -236,6 +240,21 @@ int writeResults(lua_State* L) {
   return 1;
 }
 
+// pitwall.terminal(): {tty = stdout is a terminal, columns = its width (COLUMNS, else 80)}.
+int terminal(lua_State* L) {
+  bool tty = ::isatty(STDOUT_FILENO) == 1;
+  long columns = 0;
+  winsize ws{};
+  if (tty && ::ioctl(STDOUT_FILENO, TIOCGWINSZ, &ws) == 0) columns = ws.ws_col;
+  if (columns <= 0)
+    if (const char* c = std::getenv("COLUMNS")) columns = std::strtol(c, nullptr, 10);
+  if (columns <= 0) columns = 80;
+  lua_createtable(L, 0, 2);
+  lua::setBoolean(L, "tty", tty);
+  lua::setInteger(L, "columns", columns);
+  return 1;
+}
+
 int timerToString(lua_State* L) {
   auto* h = static_cast<int*>(luaL_checkudata(L, 1, kTimerMetatable));
   lua_pushfstring(L, "timer %d", *h);
@@ -267,6 +286,7 @@ void openPitwallModule(ScriptHost& host) {
                                        {"log", lua::guarded<logBody>},
                                        {"piece", lua::guarded<piece>},
                                        {"writeResults", lua::guarded<writeResults>},
+                                       {"terminal", terminal},
                                        {"_setHub", lua::guarded<&CarBinding::setHub>},
                                        {"_reportError", lua::guarded<reportError>},
                                        {nullptr, nullptr}};

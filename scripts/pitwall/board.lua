@@ -1,0 +1,133 @@
+-- A table on the terminal that redraws in place: the live leaderboard of a race.
+--
+--   local Board = require "pitwall.board"
+--   local board = Board.new{
+--     title = "Grand prix",
+--     columns = {
+--       { key = "position", title = "POS", align = "right" },
+--       { key = "name", title = "CAR" },
+--       { key = "best", title = "BEST", align = "right", format = Board.time },
+--     },
+--   }
+--   board:show(rows)    -- on a terminal: replaces the previous drawing; elsewhere: nothing
+--   board:final(rows)   -- prints the table wherever stdout goes, and ends the live drawing
+--
+-- A row is a table keyed like the columns; a missing value shows as "-". On a terminal the
+-- board moves the cursor up over its last drawing (ANSI escapes) and redraws it; log lines
+-- (stderr) that come in between push it down, and the next drawing starts below them. When
+-- stdout is not a terminal (a file, a CI log) only `final` prints, so logs stay readable.
+local Board = {}
+Board.__index = Board
+
+--- "1:02.345" from seconds (minutes only from a minute on: "4.125"); "-" for nil.
+function Board.time(seconds)
+  if seconds == nil or seconds ~= seconds or seconds == math.huge then return "-" end
+  if seconds >= 60 then
+    local minutes = math.floor(seconds / 60)
+    return string.format("%d:%06.3f", minutes, seconds - 60 * minutes)
+  end
+  return string.format("%.3f", seconds)
+end
+
+--- The gap to the leader: "+1.234" (seconds) or "+1 lap" / "+2 laps" when laps behind;
+--- "" for the leader itself (gap 0 and no laps).
+function Board.gap(seconds, laps)
+  if laps and laps > 0 then return string.format("+%d lap%s", laps, laps == 1 and "" or "s") end
+  if seconds == nil then return "-" end
+  if seconds <= 0 then return "" end
+  return "+" .. Board.time(seconds)
+end
+
+--- A board with `spec.columns` ({key, title, align = "left"|"right", format = fn(value, row)})
+--- and an optional `spec.title`. `spec.out` (default io.stdout) and `spec.tty` (default: ask
+--- pitwall.terminal()) are for tests.
+function Board.new(spec)
+  if type(spec) ~= "table" or type(spec.columns) ~= "table" or #spec.columns == 0 then
+    error("Board.new needs {columns = {{key = …, title = …}, …}}", 2)
+  end
+  for i, c in ipairs(spec.columns) do
+    if type(c.key) ~= "string" then error("Board.new: column " .. i .. " has no key", 2) end
+  end
+  local tty = spec.tty
+  if tty == nil then tty = pitwall.terminal().tty end
+  return setmetatable({
+    title = spec.title,
+    columns = spec.columns,
+    out = spec.out or io.stdout,
+    tty = tty,
+    drawn = 0, -- lines of the last live drawing
+  }, Board)
+end
+
+local function cell(column, row)
+  local v = row[column.key]
+  if column.format then v = column.format(v, row) end
+  if v == nil then return "-" end
+  return tostring(v)
+end
+
+--- The board's lines for `rows`, as plain text (no escapes).
+function Board:render(rows)
+  local cells, widths = {}, {}
+  for i, c in ipairs(self.columns) do widths[i] = utf8.len(c.title or c.key) or #(c.title or c.key) end
+  for r, row in ipairs(rows) do
+    cells[r] = {}
+    for i, c in ipairs(self.columns) do
+      local text = cell(c, row)
+      cells[r][i] = text
+      widths[i] = math.max(widths[i], utf8.len(text) or #text)
+    end
+  end
+  local function line(texts)
+    local parts = {}
+    for i, c in ipairs(self.columns) do
+      local text = texts[i]
+      local pad = string.rep(" ", widths[i] - (utf8.len(text) or #text))
+      parts[i] = c.align == "right" and pad .. text or text .. pad
+    end
+    return (table.concat(parts, "  "):gsub("%s+$", ""))
+  end
+  local lines = {}
+  if self.title then lines[#lines + 1] = self.title end
+  local titles = {}
+  for i, c in ipairs(self.columns) do titles[i] = c.title or c.key end
+  lines[#lines + 1] = line(titles)
+  for r = 1, #rows do lines[#lines + 1] = line(cells[r]) end
+  return lines
+end
+
+local function write(self, lines, live)
+  local out = self.out
+  if live and self.drawn > 0 then
+    out:write(string.format("\27[%dA", self.drawn)) -- up to the last drawing's first line
+  end
+  for _, l in ipairs(lines) do out:write("\27[2K", l, "\n") end -- clear the line, write it
+  if live and self.drawn > #lines then
+    -- the table shrank: clear what is left of the old drawing, then come back up
+    for _ = #lines + 1, self.drawn do out:write("\27[2K\n") end
+    out:write(string.format("\27[%dA", self.drawn - #lines))
+  end
+  out:flush()
+end
+
+--- Draws `rows` in place of the last drawing (terminals only; elsewhere it does nothing).
+function Board:show(rows)
+  if not self.tty then return end
+  local lines = self:render(rows)
+  write(self, lines, true)
+  self.drawn = #lines
+end
+
+--- Prints `rows` as the final table (on a terminal over the live drawing), wherever stdout goes.
+function Board:final(rows)
+  local lines = self:render(rows)
+  if self.tty then
+    write(self, lines, true)
+  else
+    for _, l in ipairs(lines) do self.out:write(l, "\n") end
+    self.out:flush()
+  end
+  self.drawn = 0
+end
+
+return Board
