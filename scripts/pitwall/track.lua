@@ -1,0 +1,342 @@
+-- pitwall.track: the map of a track, learnt by driving a scan lap (docs/racing.md).
+--
+--   local track = require "pitwall.track"
+--   local map = track.scan(car)                -- inside a task: one slow lap in a fixed lane
+--   map.pieces[i]                               -- {index, id, type, turn, centre, start, radius}
+--   map.pieces[i]:length(offset)                -- mm along the lane at `offset` (+ right)
+--   map:lapLength(offset)                       -- mm of one lap in that lane
+--
+-- Pieces are in driving order starting with the piece after the finish line (33), so
+-- `map.finishIndex` is always 1 and the last piece is 34. A piece's `start` is the centre-line
+-- distance from the finish line to its beginning. Offsets given to a map are in the map's
+-- frame: right of the scan's driving direction (a car that drives reversed sees them mirrored).
+--
+-- The scan learns ids and order from position updates and transitions, types and lengths from
+-- pitwall.piece(id), and which way each curve turns from the transition's wheel distances: in a
+-- curve the outer wheel travels further (anki-overdrive.md, 0x29). A scan lap that lost a
+-- transition (two pieces in one, a length that does not add up) is thrown away and the next
+-- lap is scanned; a piece that got no position update takes its id from another good lap.
+local track = {}
+
+local Piece = {}
+Piece.__index = Piece
+
+--- Length in mm along the lane at `offset` (mm right of the centre, map frame; default 0).
+--- Straights are the same on every lane; a curve's outer lane is longer.
+function Piece:length(offset)
+  if not self.radius then return self.centre end
+  local side = self.turn == "left" and 1 or -1
+  return self.centre * (self.radius + side * (offset or 0)) / self.radius
+end
+
+function Piece:__tostring()
+  return string.format("piece %d: %d %s%s", self.index, self.id, self.type,
+    self.turn and (" " .. self.turn) or "")
+end
+
+local Map = {}
+Map.__index = Map
+
+--- Length in mm of one lap along the lane at `offset` (default 0: the centre line).
+function Map:lapLength(offset)
+  local total = 0
+  for _, p in ipairs(self.pieces) do total = total + p:length(offset) end
+  return total
+end
+
+--- The index after `i` driving forward (dir 1, default) or reversed (dir -1), wrapping around.
+function Map:next(i, dir)
+  local n = #self.pieces
+  return (i - 1 + (dir or 1)) % n + 1
+end
+
+--- The indices of every piece with road piece id `id`, in order.
+function Map:find(id)
+  local out = {}
+  for i, p in ipairs(self.pieces) do
+    if p.id == id then out[#out + 1] = i end
+  end
+  return out
+end
+
+local letters = { straight = "S", curve = "?", intersection = "X" }
+
+--- The map as simulator layout text ("start S L L S S L L"); with `ids`, "S:36 L:17 …".
+function Map:layout(ids)
+  local words = { "start" }
+  local n = #self.pieces
+  -- 34 (last) and 33 (first) are the start pair; the rest in order.
+  for i = 2, n - 1 do
+    local p = self.pieces[i]
+    local letter = p.type == "curve" and (p.turn == "left" and "L" or "R") or letters[p.type]
+      or ("?" .. p.type)
+    words[#words + 1] = ids and (letter .. ":" .. p.id) or letter
+  end
+  return table.concat(words, " ")
+end
+
+function Map:__tostring()
+  return string.format("track map: %s (%d pieces, %.0f mm)", self:layout(), #self.pieces,
+    self:lapLength(0))
+end
+
+-- Builds a map from {id=, turn=, measured=} entries in driving order, 33 first, 34 last.
+local function build(entries, fields)
+  local map = setmetatable(fields or {}, Map)
+  map.pieces, map.finishIndex = {}, 1
+  local start = 0
+  for i, e in ipairs(entries) do
+    local spec = pitwall.piece(e.id)
+    local p = setmetatable({
+      index = i,
+      id = e.id,
+      type = spec and spec.type or "unknown",
+      -- Unknown pieces (specials, jumps): their measured length, the same on every lane.
+      centre = spec and spec.length or e.measured or 0,
+      radius = spec and spec.radius,
+      start = start,
+    }, Piece)
+    if p.radius then p.turn = e.turn end
+    start = start + p.centre
+    map.pieces[i] = p
+  end
+  return map
+end
+
+--- The map of the simulator's track, without driving (simulator runs only: a test's or a
+--- script's shortcut; on real cars use track.scan).
+function track.fromSim()
+  local sim = require "pitwall.sim"
+  local t = sim.track()
+  local n = #t.pieces
+  local entries = {}
+  for k = 0, n - 1 do
+    local p = t.pieces[(t.finishIndex - 1 + k) % n + 1]
+    entries[#entries + 1] = { id = p.id, turn = p.turn > 0 and "left" or p.turn < 0 and "right" or nil,
+      measured = p.length }
+  end
+  if entries[1].id ~= 33 or entries[n].id ~= 34 then
+    error("track.fromSim: the simulator's track " .. t.name .. " has no start pair 34 → 33", 2)
+  end
+  return build(entries, { name = t.name, source = "sim" })
+end
+
+-- ---- the scan lap ----
+
+-- A scan segment: what the car saw between two transitions.
+local function newSegment(time, byTransition)
+  return { ids = {}, idCount = 0, t0 = time, byTransition = byTransition, reckoned = 0 }
+end
+
+-- The one piece id a segment saw, or nil (none, or more than one: a transition was lost).
+local function segmentId(seg)
+  if seg.idCount ~= 1 then return nil end
+  local id = next(seg.ids)
+  return id
+end
+
+local NO_POSITION = "no position update on it"
+
+-- Why a closed segment cannot be used, or nil when it is good. NO_POSITION is a lesser
+-- problem: the piece is there, only its id is missing (another lap may have it).
+local function segmentProblem(seg)
+  if not seg.byTransition then return "it did not start at a transition" end
+  if seg.idCount > 1 then return "two pieces in one (a lost transition)" end
+  local wheels = (seg.left + seg.right) * 5 -- mean of both wheels, cm → mm
+  -- A lost transition between two pieces with the same id: twice the distance driven.
+  if math.abs(seg.reckoned - wheels) > math.max(0.35 * wheels, 80) then
+    return string.format("driven %.0f mm but the wheels say %.0f mm", seg.reckoned, wheels)
+  end
+  if seg.idCount == 0 then return NO_POSITION end
+  local spec = pitwall.piece(segmentId(seg))
+  if spec and spec.type == "curve" and seg.left == seg.right then
+    return "a curve with equal wheel distances"
+  end
+  return nil
+end
+
+-- The piece ids of a clean lap in the closed segments `segs`, and that lap's segments; nil
+-- when there is none yet. A lap runs from a finish crossing to the next; a crossing is the
+-- transition that ends a good segment on 34 or begins a good one on 33 (the two always follow
+-- each other). A lap counts when none of its transitions was lost; a piece without a position
+-- update takes its id from another such lap with as many pieces.
+local function findLap(segs)
+  local function good(i, id)
+    return segs[i] and not segs[i].problem and segmentId(segs[i]) == id
+  end
+  local runs, from = {}, nil
+  for i = 2, #segs + 1 do
+    if good(i - 1, 34) or good(i, 33) then -- segment i begins at the finish line
+      if from then runs[#runs + 1] = table.move(segs, from, i - 1, 1, {}) end
+      from = i
+    end
+  end
+  local usable = {}
+  for _, run in ipairs(runs) do
+    local ok = true
+    for _, s in ipairs(run) do
+      if s.problem and s.problem ~= NO_POSITION then ok = false break end
+    end
+    if ok then usable[#usable + 1] = run end
+  end
+  for r = #usable, 1, -1 do
+    local run, ids, missing = usable[r], {}, false
+    for k, s in ipairs(run) do
+      ids[k] = segmentId(s) or (k == 1 and 33) or nil
+      if not ids[k] then missing = true end
+    end
+    for _, other in ipairs(usable) do
+      if not missing then break end
+      if other ~= run and #other == #run then
+        local agree = true
+        for k, s in ipairs(other) do
+          local id = segmentId(s)
+          if id and ids[k] and id ~= ids[k] then agree = false break end
+        end
+        if agree then
+          missing = false
+          for k, s in ipairs(other) do
+            ids[k] = ids[k] or segmentId(s)
+            if not ids[k] then missing = true end
+          end
+        end
+      end
+    end
+    if not missing then return ids, run end
+  end
+  return nil
+end
+
+--- Drives `car` one lap in a fixed lane and returns the map (inside a task only).
+--- options: speed (mm/s, default 350), offset (mm: change to this lane first; default: stay),
+--- timeout (s, default 120), stop (default true: stop the car once the map is complete, just
+--- past the finish line; false leaves it driving at the scan speed).
+function track.scan(car, options)
+  options = options or {}
+  if not coroutine.isyieldable() then
+    error("track.scan drives a lap and waits for it: call it inside a task (the script's main "
+      .. "chunk or pitwall.spawn), not in a handler or timer", 2)
+  end
+  if type(options) ~= "table" then
+    error("track.scan: options must be a table such as {speed = 350}, got " .. type(options), 2)
+  end
+  local speed = options.speed or 350
+  local timeout = options.timeout or 120
+  if type(speed) ~= "number" or speed < 100 or speed > 1000 then
+    error("track.scan: speed " .. tostring(speed) .. " mm/s is outside 100..1000 (a scan drives "
+      .. "slowly so that no position update is missed; 300–400 is a good choice)", 2)
+  end
+  if not car.connected then
+    error("track.scan: " .. tostring(car) .. " is not connected", 2)
+  end
+
+  local segs, cur = {}, nil
+  local lastTime, lastSpeed = pitwall.now(), car.speed or 0
+  local reversed, delocalized = false, false
+  local function reckon(t)
+    if cur then cur.reckoned = cur.reckoned + lastSpeed * (t - lastTime) end
+    lastTime = t
+  end
+  local subs = {
+    pitwall.listen(car, "onPosition", function(_, ev)
+      reckon(ev.time)
+      lastSpeed = ev.speed
+      reversed = ev.reverse
+      if reversed then
+        -- Driving backwards the pieces come the other way round: nothing of it is kept.
+        segs, cur = {}, nil
+        return
+      end
+      cur = cur or newSegment(ev.time, false)
+      if not cur.ids[ev.piece] then
+        cur.ids[ev.piece] = true
+        cur.idCount = cur.idCount + 1
+      end
+    end),
+    pitwall.listen(car, "onTransition", function(_, ev)
+      reckon(ev.time)
+      if reversed then return end
+      if cur then
+        cur.left, cur.right, cur.offset = ev.leftWheel, ev.rightWheel, ev.offset
+        cur.problem = segmentProblem(cur)
+        segs[#segs + 1] = cur
+      end
+      cur = newSegment(ev.time, true)
+    end),
+    pitwall.listen(car, "onDelocalized", function() delocalized = true end),
+  }
+  local function cancel()
+    for _, s in ipairs(subs) do s:cancel() end
+  end
+
+  local ok, result = pcall(function()
+    local deadline = pitwall.now() + timeout
+    local function waitFor(cond, what)
+      local left = deadline - pitwall.now()
+      if left <= 0 or not pitwall.waitUntil(cond, left) then
+        error(string.format("track.scan: %s within %g s with %s (%d pieces crossed); give a longer "
+          .. "timeout, or check that the car drives and the layout has the start pieces 34 and 33",
+          what, timeout, tostring(car), #segs), 0)
+      end
+    end
+    car:setSpeed(speed, 1000)
+    if options.offset then
+      waitFor(function() return (car.speed or 0) > 0 end, "the car did not start moving")
+      car:changeLane(options.offset)
+      -- Its offset update may be lost: the offsets in position updates tell as well.
+      waitFor(function()
+        return not car.laneChanging or math.abs((car.offset or 0) - options.offset) < 2
+      end, "the lane change did not finish")
+      segs, cur = {}, nil -- what was seen while changing lanes does not count
+    end
+    local ids, run
+    local uturns, turnedAt = 0, nil
+    waitFor(function()
+      if delocalized then
+        error("track.scan: " .. tostring(car) .. " left the track during the scan; put it back "
+          .. "and scan again, slower", 0)
+      end
+      if reversed and (not turnedAt or pitwall.now() - turnedAt > 1) then
+        -- It drives reversed: turn it round (once more if that did not take within 1 s).
+        uturns = uturns + 1
+        if uturns > 3 then
+          error("track.scan: " .. tostring(car) .. " keeps driving reversed after 3 U-turns", 0)
+        end
+        car:uturn()
+        turnedAt = pitwall.now()
+      end
+      ids, run = findLap(segs)
+      return ids ~= nil
+    end, "no complete clean lap from finish line to finish line")
+
+    local entries, turns, offsets = {}, 0, 0
+    for k, s in ipairs(run) do
+      local e = { id = ids[k], measured = (s.left + s.right) * 5 }
+      local spec = pitwall.piece(e.id)
+      if spec and spec.type == "curve" then
+        -- The outer wheel travels further: the right wheel in a left curve.
+        e.turn = s.right > s.left and "left" or "right"
+        turns = turns + (e.turn == "left" and 1 or -1)
+      end
+      offsets = offsets + s.offset
+      entries[#entries + 1] = e
+    end
+    local map = build(entries, {
+      source = "scan",
+      scanOffset = offsets / #entries,
+      scanSpeed = speed,
+      scannedBy = car.name,
+    })
+    if turns % 4 ~= 0 then
+      pitwall.log("warn", string.format("track.scan: the curves turn %d quarter turns in all; a "
+        .. "closed track turns a multiple of 4: a curve's direction may be wrong", turns))
+    end
+    if options.stop ~= false then car:stop() end
+    return map
+  end)
+  cancel()
+  if not ok then error(result, 2) end
+  return result
+end
+
+return track
