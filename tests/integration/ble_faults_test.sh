@@ -9,10 +9,9 @@ A2=E0:00:00:00:00:02
 
 # A dropped link mid-race
 start_fake --cars 2 --drop $A1@1.5
-out=$(CROSSINGS=3 SPEED=1200 TIMEOUT=40 $PITWALL run "$SRC/tests/ble/laps.lua" --ble \
-  --scan-timeout 0.5 2>"$TMP/drop.err"); rc=$?
-check "drop: the race finishes" 0 "$rc"
-line=$(echo "$out" | grep "^car ble:$A1 ")
+drive drop CROSSINGS=3 SPEED=1200 TIMEOUT=40
+check "drop: the race finishes" 0 "$RC"
+line=$(echo "$OUT" | grep "^car ble:$A1 ")
 check "drop: the script saw the car go" 1 "$(field disconnects "$line")"
 check "drop: and come back (onConnect)" 1 "$(field connects "$line")"
 check "drop: a command while it was away failed clearly" 1 "$(field refusedWhileDown "$line")"
@@ -24,10 +23,9 @@ contains "drop: the fake saw two connections" "$A1 connected=false target=0 conn
 
 # A car that vanishes for good: reported, never called again, the other car races on
 start_fake --cars 2 --vanish $A2@1
-out=$(MUST=$A1 CROSSINGS=2 SPEED=1200 TIMEOUT=30 $PITWALL run "$SRC/tests/ble/laps.lua" --ble \
-  --scan-timeout 0.5 2>"$TMP/vanish.err"); rc=$?
-check "vanish: the race finishes" 0 "$rc"
-line=$(echo "$out" | grep "^car ble:$A2 ")
+drive vanish MUST=$A1 CROSSINGS=2 SPEED=1200 TIMEOUT=30
+check "vanish: the race finishes" 0 "$RC"
+line=$(echo "$OUT" | grep "^car ble:$A2 ")
 check "vanish: the script saw it go" 1 "$(field disconnects "$line")"
 check "vanish: it is not connected" false "$(field connected "$line")"
 contains "vanish: the log says so" "$A2 vanished: looking for it again" "$(cat "$TMP/vanish.err")"
@@ -37,24 +35,22 @@ contains "vanish: no second connection" "$A2 connected=false target=0 connects=1
 
 # A car that refuses every connection: retried with growing backoff, the other car races
 start_fake --cars 2 --refuse $A2
-out=$(MUST=$A1 CROSSINGS=2 SPEED=1200 TIMEOUT=30 $PITWALL run "$SRC/tests/ble/laps.lua" --ble \
-  --scan-timeout 0.5 2>"$TMP/refuse.err"); rc=$?
-check "refuse: the race finishes" 0 "$rc"
+drive refuse MUST=$A1 CROSSINGS=2 SPEED=1200 TIMEOUT=30
+check "refuse: the race finishes" 0 "$RC"
 err=$(cat "$TMP/refuse.err")
 contains "refuse: the failure names the step and BlueZ's reason" \
   "connecting to $A2 failed: le-connection-abort-by-local" "$err"
 contains "refuse: first retry" "reconnecting in 0.5 s" "$err"
 contains "refuse: backoff doubles" "reconnecting in 1 s" "$err"
 check "refuse: the script sees it not connected" false \
-  "$(field connected "$(echo "$out" | grep "^car ble:$A2 ")")"
+  "$(field connected "$(echo "$OUT" | grep "^car ble:$A2 ")")"
 stop_fake
 
 # Only the cars asked for
 start_fake --cars 3
-out=$(MUST=$A2 CROSSINGS=1 TIMEOUT=20 $PITWALL run "$SRC/tests/ble/laps.lua" --ble --car $A2 \
-  2>/dev/null); rc=$?
-check "--car: exit status" 0 "$rc"
-check "--car: only that car" "car ble:$A2" "$(echo "$out" | grep -o '^car ble:[^ ]*')"
+drive car MUST=$A2 CROSSINGS=1 TIMEOUT=20 -- --car $A2
+check "--car: exit status" 0 "$RC"
+check "--car: only that car" "car ble:$A2" "$(echo "$OUT" | grep -o '^car ble:[^ ]*')"
 stop_fake
 
 # Nothing found

@@ -5,10 +5,9 @@ A1=E0:00:00:00:00:01
 
 # Malformed notifications: reported to the script and the log, the race goes on
 start_fake --cars 1 --garbage $A1@1
-out=$(CROSSINGS=2 SPEED=1200 TIMEOUT=30 $PITWALL run "$SRC/tests/ble/laps.lua" --ble \
-  --scan-timeout 0.5 2>"$TMP/garbage.err"); rc=$?
-check "garbage: the race finishes" 0 "$rc"
-line=$(echo "$out" | grep "^car ble:$A1 ")
+drive garbage CROSSINGS=2 SPEED=1200 TIMEOUT=30
+check "garbage: the race finishes" 0 "$RC"
+line=$(echo "$OUT" | grep "^car ble:$A1 ")
 check "garbage: both malformed frames reached onMalformed" 2 "$(field malformed "$line")"
 check "garbage: still connected" true "$(field connected "$line")"
 contains "garbage: the log names the frame's id and lengths" "0x17" "$(cat "$TMP/garbage.err")"

@@ -50,3 +50,20 @@ start_fake() {
 field() {
   echo "$2" | sed -n "s/.* $1=\([^ ]*\).*/\1/p"
 }
+
+# drive NAME [VAR=VALUE…] [-- OPTION…]: runs tests/ble/laps.lua over --ble with those variables
+# (CROSSINGS, SPEED, TIMEOUT, MUST) and `pitwall run` options; its stdout in $OUT, its exit
+# status in $RC, its log in $TMP/NAME.err.
+drive() {
+  local name=$1
+  shift
+  local vars=()
+  while [ $# -gt 0 ] && [ "$1" != "--" ]; do
+    vars+=("$1")
+    shift
+  done
+  [ "${1:-}" = "--" ] && shift
+  OUT=$(env "${vars[@]}" "$PITWALL" run "$SRC/tests/ble/laps.lua" --ble --scan-timeout 0.5 "$@" \
+    2>"$TMP/$name.err")
+  RC=$?
+}
