@@ -1,0 +1,94 @@
+-- pitwall.drivers.follower: cruises, but keeps at least `gap` seconds behind the car ahead in its
+-- lane (docs/racing.md "Drivers").
+--
+--   follower.new{gap = 1.0, speed = 1000, margin = 0.1, standstill = 100, decel = 6000, …}
+--
+-- Its free speed is a cruiser's (the other options go to it: lateral, accel). With a car ahead
+-- in its lane (within 45 mm of its offset) it drives at most (d − standstill) / (gap·(1+margin)),
+-- d the smaller of the centre-line distance now and one update + 50 ms from now (as reckoned);
+-- below 60 mm/s it stops, and drives off again from 120 mm/s. At a steady speed behind a steady
+-- car that is a time gap of gap·(1+margin) plus standstill / speed, so the time gap (distance /
+-- own speed) stays above `gap` while it closes, brakes, follows and stops, and it speeds up
+-- again as the gap opens. The car it follows stays its leader while in its lane even when
+-- reckoned a little behind (cars in one lane cannot pass each other).
+local drivers = require "pitwall.drivers"
+local cruiser = require "pitwall.drivers.cruiser"
+
+local follower = { name = "follower" }
+local STICKY = 500 -- mm: how far behind a followed car in our lane may be reckoned
+local Follower = {}
+Follower.__index = Follower
+
+function follower.new(options)
+  options = options or {}
+  local o = pitwall.copy(options)
+  o.decel = o.decel or 6000
+  return setmetatable({
+    name = "follower",
+    gap = options.gap or 1.0,
+    margin = options.margin or 0.1,
+    standstill = options.standstill or 100,
+    decel = o.decel,
+    accel = options.accel or 2000,
+    range = options.range,
+    cruise = cruiser.new(o),
+  }, Follower)
+end
+
+--- The car this follower keeps its gap to (from ctx:nearby), or nil.
+function Follower:leader(car, ctx)
+  local half = ctx.map:lapLength(0) / 2 - 1
+  local range = math.min(self.range or math.max(2000, 3 * self.gap * self.cruise.speed), half)
+  local lead = drivers.aheadIn(ctx, car.offset or 0, range)
+  if drivers.changing(car) and car.targetOffset then
+    local other = drivers.aheadIn(ctx, car.targetOffset, range)
+    if other and (not lead or other.gap < lead.gap) then lead = other end
+  end
+  -- A car cannot pass through another in the same lane: the car we followed, still in our lane
+  -- and now reckoned a little behind us, is an error of the reckoning (our speed update lost,
+  -- say, so our tracker drives on while we stand): it is still just ahead.
+  local last = self.lastLead
+  if last and not (lead and lead.car == last) then
+    for _, o in ipairs(ctx:nearby(STICKY)) do
+      if o.car == last and o.gap <= 0 and o.lane and math.abs(o.lane - (car.offset or 0)) < 45 then
+        lead = { car = o.car, loc = o.loc, gap = 0, lane = o.lane }
+      end
+    end
+  end
+  self.lastLead = lead and lead.car
+  return lead
+end
+
+--- The speed to drive now, and whether it is braking for the car ahead or a curve.
+function Follower:target(car, ctx)
+  local v, braking = self.cruise:target(car, ctx)
+  local lead = self:leader(car, ctx)
+  if lead then
+    -- Where both will be one update and the link's latency from now, as the trackers reckon
+    -- (they follow speed updates, so a car that brakes is seen braking).
+    local t = pitwall.now() + ctx.period + 0.05
+    local a, b = lead.loc:distance(t), ctx.loc:distance(t)
+    local d = (a and b) and (a - b) % ctx.map:lapLength(0) or lead.gap
+    d = math.min(d, lead.gap) -- the gap must hold now and then
+    local allowed = math.max(0, (d - self.standstill) / (self.gap * (1 + self.margin)))
+    -- Below 60 mm/s it stops (a slow car reports its position seldom, and its tracker may
+    -- miss a lost speed update); stopped, it drives off again from 120 mm/s (no creeping).
+    if allowed < (self.held and 120 or 60) then allowed = 0 end
+    self.held = allowed == 0
+    if allowed < v then v, braking = allowed, true end
+  else
+    self.held = false
+  end
+  return v, braking
+end
+
+function Follower:update(car, ctx)
+  local v, braking = self:target(car, ctx)
+  local last = car.targetSpeed or 0
+  local accel = v < last and self.decel or self.accel
+  -- Slowing down is sent at once (10 mm/s steps); speeding up in steps of 40 mm/s, so a
+  -- steady follow does not send a frame every update.
+  drivers.setSpeed(car, v, accel, v > last and 40 or 10)
+end
+
+return follower
