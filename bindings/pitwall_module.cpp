@@ -221,7 +221,7 @@ int writeResults(lua_State* L) {
       else if (t == LUA_TSTRING)
         row.emplace_back(std::string(lua_tostring(L, -1)));
       else if (t == LUA_TBOOLEAN)
-        row.emplace_back(std::string(lua_toboolean(L, -1) ? "true" : "false"));
+        row.emplace_back(lua_toboolean(L, -1) != 0);
       else if (t == LUA_TNIL)
         row.emplace_back(std::monostate{});
       else

@@ -61,6 +61,8 @@ std::string render(const Table& table, Format format) {
                                           : nlohmann::ordered_json(*d);
         else if (auto* s = std::get_if<std::string>(&c))
           o[table.columns[i]] = *s;
+        else if (auto* b = std::get_if<bool>(&c))
+          o[table.columns[i]] = *b;
         else
           o[table.columns[i]] = nullptr;
       }
@@ -80,6 +82,8 @@ std::string render(const Table& table, Format format) {
         out << number(*d);
       else if (auto* s = std::get_if<std::string>(&c))
         out << csvField(*s);
+      else if (auto* b = std::get_if<bool>(&c))
+        out << (*b ? "true" : "false");
     }
     out << "\n";
   }

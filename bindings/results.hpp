@@ -14,8 +14,8 @@ enum class Format { Json, Csv };
 // The format for a path by its extension (.json, .csv; any case), or a sentence saying why not.
 Result<Format, std::string> formatOf(const std::string& path);
 
-// A cell: nothing (JSON null, empty in CSV), a number, or text.
-using Cell = std::variant<std::monostate, double, std::string>;
+// A cell: nothing (JSON null, empty in CSV), a number, text, or a truth value.
+using Cell = std::variant<std::monostate, double, std::string, bool>;
 struct Table {
   std::vector<std::string> columns;
   std::vector<std::vector<Cell>> rows;  // each as long as columns

@@ -17,9 +17,10 @@ using results::Cell;
 namespace {
 results::Table sample() {
   results::Table t;
-  t.columns = {"position", "car", "laps", "bestLap"};
-  t.rows.push_back({Cell{1.0}, Cell{std::string("skull")}, Cell{10.0}, Cell{4.125}});
-  t.rows.push_back({Cell{2.0}, Cell{std::string("say \"hi\", then go")}, Cell{9.0}, Cell{}});
+  t.columns = {"position", "car", "laps", "bestLap", "finished"};
+  t.rows.push_back({Cell{1.0}, Cell{std::string("skull")}, Cell{10.0}, Cell{4.125}, Cell{true}});
+  t.rows.push_back(
+      {Cell{2.0}, Cell{std::string("say \"hi\", then go")}, Cell{9.0}, Cell{}, Cell{false}});
   return t;
 }
 std::string slurp(const std::string& path) {
@@ -42,16 +43,17 @@ TEST_CASE("results: JSON is an array of objects in column order, null for nothin
   auto text = results::render(sample(), results::Format::Json);
   auto j = nlohmann::ordered_json::parse(text);
   REQUIRE(j.size() == 2);
-  CHECK(j[0].dump() == R"({"position":1,"car":"skull","laps":10,"bestLap":4.125})");
+  CHECK(j[0].dump() == R"({"position":1,"car":"skull","laps":10,"bestLap":4.125,"finished":true})");
+  CHECK(j[1]["finished"] == false);
   CHECK(j[1]["bestLap"].is_null());
   CHECK(j[1]["car"] == "say \"hi\", then go");
 }
 
 TEST_CASE("results: CSV has a header and quotes what needs quoting") {
   CHECK(results::render(sample(), results::Format::Csv) ==
-        "position,car,laps,bestLap\n"
-        "1,skull,10,4.125\n"
-        "2,\"say \"\"hi\"\", then go\",9,\n");
+        "position,car,laps,bestLap,finished\n"
+        "1,skull,10,4.125,true\n"
+        "2,\"say \"\"hi\"\", then go\",9,,false\n");
 }
 
 TEST_CASE("results: a folder that does not exist is refused before anything is written") {

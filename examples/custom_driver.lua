@@ -1,0 +1,43 @@
+-- Write your own driver: a table with update(car, ctx), called every ctx.period s while the car
+-- races (start and finish are optional). This one drives fast on straights, slows before curves,
+-- keeps its distance to the car ahead, and always respects ctx.limit (the director's safety cap).
+--
+--   build/pitwall run examples/custom_driver.lua --fast
+local race = require "pitwall.race"
+
+local Careful = {}
+Careful.__index = Careful
+
+function Careful.new(options)
+  return setmetatable({ fast = options.fast or 1100, slow = options.slow or 650 }, Careful)
+end
+
+function Careful:start(car, ctx)
+  pitwall.log("info", tostring(car) .. ": green, on " .. tostring(ctx.map))
+end
+
+function Careful:update(car, ctx)
+  local speed = self.fast
+  for _, piece in ipairs(ctx:upcoming(300)) do -- the next 300 mm of track
+    if piece.type == "curve" then speed = self.slow end
+  end
+  local ahead = ctx:ahead()
+  if ahead and ahead.gap < 250 and math.abs((ahead.lane or 0) - (car.offset or 0)) < 40 then
+    speed = math.min(speed, ahead.car.speed or speed) -- do not ram the car in front
+  end
+  if ctx.limit then speed = math.min(speed, ctx.limit) end
+  if car.targetSpeed ~= speed then car:setSpeed(speed, 2000) end -- only what changes
+end
+
+function Careful:finish(car, ctx)
+  pitwall.log("info", tostring(car) .. ": done, cooling down")
+end
+
+local LAPS = tonumber(os.getenv("LAPS")) or 3
+local drivers = {}
+for i, car in ipairs(pitwall.cars()) do
+  -- car 1 drives the custom driver; the others hold a steady speed to race against
+  drivers[car] = i == 1 and Careful.new {} or race.Steady.new { speed = 600 + 50 * i }
+end
+race.laps { laps = LAPS, drivers = drivers, title = "Custom driver" }
+pitwall.stop()

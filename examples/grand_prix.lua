@@ -1,0 +1,38 @@
+-- A grand prix: four cars with four different AI drivers, a scan lap to learn the track, five
+-- lights, a race of LAPS laps (default 5) with a live leaderboard, and the results at the end.
+--
+--   build/pitwall run examples/grand_prix.lua                        -- simulator, real time
+--   build/pitwall run examples/grand_prix.lua --fast --results gp.csv
+--   build/pitwall run examples/grand_prix.lua --ble                  -- the same, real cars
+--
+-- On a terminal the leaderboard redraws in place; elsewhere only the final table is printed.
+local race = require "pitwall.race"
+local drivers = require "pitwall.drivers"
+
+local LAPS = tonumber(os.getenv("LAPS")) or 5
+-- A driver and its options for cars 1, 2, 3, 4, 5, … On the simulator's grid car 1 starts in
+-- the inside lane (the shortest way round) and car 4 outside: the faster drivers start outside.
+local lineup = {
+  { "cruiser", { speed = 950 } },
+  { "lanekeeper", { speed = 1000 } },
+  { "follower", { speed = 1050 } },
+  { "overtaker", { speed = 1100 } },
+}
+
+local function driverFor(car, i)
+  local pick = lineup[(i - 1) % #lineup + 1]
+  return drivers.load(pick[1]).new(pick[2])
+end
+
+local cars = pitwall.cars()
+print(string.format("Grand prix: %d cars, %d laps", #cars, LAPS))
+local gp = race.laps {
+  laps = LAPS,
+  scan = true,                         -- the first car drives a scan lap (also on real cars)
+  drivers = driverFor,
+  title = string.format("Grand prix, %d laps", LAPS),
+}
+local winner = gp:results()[1]
+print(string.format("Winner: %s, %d laps in %s", winner.car, winner.laps, race.time(winner.totalTime)))
+if gp.resultsPath then print("Results written to " .. gp.resultsPath) end
+pitwall.stop()

@@ -1,0 +1,548 @@
+-- pitwall.race: the race director (docs/racing.md "Races").
+--
+--   local race = require "pitwall.race"
+--   local q = race.qualifying { minutes = 2 }               -- best lap wins
+--   local r = race.laps { laps = 5, grid = q, drivers = { "cruiser", "overtaker" } }
+--   race.timed { minutes = 3 }   race.practice { minutes = 5 }
+--   r:results()   -- {{position, car, number, laps, totalTime, bestLap, lastLap, finished, falseStart}, …}
+--
+-- Each call runs a whole session inside a task (the main chunk) and returns it when every car
+-- has stopped: the map (given, the simulator's, or a scan lap with the first car), the cars to
+-- the grid (piece 34), five lights and green (not in practice), drivers updated every period,
+-- positions by laps then distance, gaps to the leader, the finish, every car stopped, the final
+-- table, and the results file (pitwall.resultsFile). Options and events: docs/racing.md.
+local track = require "pitwall.track"
+local localize = require "pitwall.localize"
+local laps = require "pitwall.laps"
+local Board = require "pitwall.board"
+local drivers = require "pitwall.drivers"
+
+local race = {}
+
+--- Module-wide handlers, called after a session's own (options.onLap, …):
+--- race.onLap(car, lap, session), race.onFinish(car, position, session),
+--- race.onPositionChange(car, position, old, session), race.onFalseStart(car, session).
+race.onLap, race.onFinish, race.onPositionChange, race.onFalseStart = nil, nil, nil, nil
+
+race.columns = { "position", "car", "number", "laps", "totalTime", "bestLap", "lastLap",
+  "finished", "falseStart" }
+
+-- A driver that holds one speed (under ctx.limit): the default when no driver is given and
+-- pitwall.drivers has no "cruiser".
+local Steady = { name = "steady" }
+Steady.__index = Steady
+function Steady.new(options)
+  options = options or {}
+  return setmetatable({ speed = options.speed or 600, accel = options.accel or 1000 }, Steady)
+end
+function Steady:update(car, ctx)
+  local v = ctx.limit and math.min(self.speed, ctx.limit) or self.speed
+  if car.targetSpeed ~= v then car:setSpeed(v, self.accel) end
+end
+race.Steady = Steady
+
+--- "1:02.345" from seconds (Board.time).
+race.time = Board.time
+
+local Race = {}
+Race.__index = Race
+
+-- car → the kind of its last event ("position", "transition"): whether car.piece is still
+-- where it is (kept for the whole run, from a car's first session on)
+local lastKind = setmetatable({}, { __mode = "k" })
+
+local MODES = { practice = "Free practice", qualifying = "Qualifying", laps = "Race",
+  timed = "Timed race" }
+
+local function report(where, err)
+  if pitwall._reportError then pitwall._reportError(where, err)
+  else pitwall.log("error", where .. ": " .. tostring(err)) end
+end
+
+function Race:_emit(name, ...)
+  for _, fn in ipairs { self.options[name] or false, race[name] or false } do
+    if fn then
+      local ok, err = xpcall(fn, debug.traceback, ...)
+      if not ok then report(name .. " handler of the race", err) end
+    end
+  end
+end
+
+-- A driver instance from a name, a class ({new}), an instance ({update}) or nil.
+local function makeDriver(spec, car, i)
+  if type(spec) == "function" then spec = spec(car, i) end
+  if spec == nil then
+    local ok, cls = pcall(drivers.load, "cruiser")
+    spec = ok and cls or Steady
+  end
+  if type(spec) == "string" then spec = drivers.load(spec) end
+  if type(spec) == "table" and type(spec.update) ~= "function" and type(spec.new) == "function" then
+    spec = spec.new {}
+  end
+  if type(spec) ~= "table" or type(spec.update) ~= "function" then
+    error("race: the driver of " .. tostring(car) .. " must be a name, a driver class (with new) "
+      .. "or a driver (with update), got " .. type(spec), 0)
+  end
+  return spec
+end
+
+--- A session, not started yet: race.new{mode = "laps" | "timed" | "qualifying" | "practice", …}.
+function race.new(options)
+  options = options or {}
+  local mode = options.mode or "laps"
+  if not MODES[mode] then error("race.new: unknown mode '" .. tostring(mode) .. "'", 2) end
+  local seconds = options.seconds or (options.minutes and options.minutes * 60)
+  if mode == "laps" and not options.laps then error("race.laps: give laps = N", 2) end
+  if mode == "timed" and not seconds then error("race.timed: give minutes = M (or seconds)", 2) end
+  if (mode == "qualifying" or mode == "practice") and not seconds and not options.laps then
+    error("race." .. mode .. ": give minutes = M (or seconds, or laps)", 2)
+  end
+  local cars = options.cars or pitwall.cars()
+  if #cars == 0 then error("race: no cars", 2) end
+  return setmetatable({
+    mode = mode, options = options, cars = cars, seconds = seconds, laps = options.laps,
+    period = options.period or 0.1, state = "new", entries = {}, order = {},
+    finishers = 0, title = options.title or MODES[mode],
+  }, Race)
+end
+
+-- The grid: a session (its results' order), or a list of cars or names; the rest after.
+function Race:_gridOrder()
+  local grid, out, seen = self.options.grid, {}, {}
+  if type(grid) == "table" and grid.results then grid = grid:grid() end
+  for _, g in ipairs(grid or {}) do
+    local car = type(g) == "string" and pitwall.car(g) or g
+    for _, c in ipairs(self.cars) do
+      if c == car and not seen[c] then out[#out + 1], seen[c] = c, true end
+    end
+  end
+  for _, c in ipairs(self.cars) do
+    if not seen[c] then out[#out + 1], seen[c] = c, true end
+  end
+  return out
+end
+
+function Race:_map()
+  local o = self.options
+  if o.map then return o.map end
+  if pitwall.sim and not o.scan then return track.fromSim() end
+  local scanOptions = type(o.scan) == "table" and o.scan or {}
+  pitwall.log("info", "race: scan lap with " .. tostring(self.cars[1]))
+  return track.scan(self.cars[1], scanOptions)
+end
+
+-- Progress in laps: laps done + fraction of the lap (negative before the first crossing).
+function Race:_progress(e, now)
+  local d, i = e.loc:locate(now)
+  if not d then return nil end
+  local L = self.map:lapLength(0)
+  if e.loc.index and i < e.loc.index and not e.loc.reverse then d = d + L end -- past the line
+  local base = e.timer.start and e.timer.count or -1
+  return base + d / L, d
+end
+
+-- Drives cars that are known to be elsewhere to the grid (piece 34) and stops them there.
+function Race:_toGrid()
+  local n = #self.map.pieces
+  local moving = {}
+  for _, e in ipairs(self.order) do
+    local piece = e.loc.index and self.map.pieces[e.loc.index].id or e.car.piece
+    -- a transition after its last position update: it has left that piece (a scan lap ends so,
+    -- just past the line)
+    if not e.loc.index and self.lastKind[e.car] == "transition" then piece = 0 end
+    if piece and piece ~= 34 and e.car.connected then
+      moving[#moving + 1] = e
+      e.car:setSpeed(self.options.gridSpeed or 500, 1000)
+    end
+  end
+  if #moving == 0 then return end
+  pitwall.log("info", string.format("race: %d car(s) to the grid", #moving))
+  local ok = pitwall.waitUntil(function()
+    local all = true
+    for _, e in ipairs(moving) do
+      if e.loc.localized and e.loc.index == n then
+        if e.car.targetSpeed ~= 0 then e.car:stop() end
+      else
+        all = false
+      end
+    end
+    return all
+  end, self.options.gridTimeout or 90, 0.005)
+  if not ok then error("race: the cars did not reach the grid (piece 34) in time", 0) end
+  pitwall.sleep(1) -- settled: a car still rolling at the first light would be a false start
+end
+
+-- Lights: `lights` (5) one a second, then out after `hold` s: green. A car that moves meanwhile
+-- has jumped the start.
+function Race:_lights()
+  local o = self.options
+  local count, interval, hold = o.lights or 5, o.lightInterval or 1, o.hold or 0.5
+  self.state = "lights"
+  local moved = {}
+  local subs = {}
+  for _, e in ipairs(self.order) do
+    -- a car that moves reports it; one that is only told to (targetSpeed) is caught as well
+    subs[#subs + 1] = pitwall.listen(e.car, "onTransition", function() moved[e] = true end)
+    subs[#subs + 1] = pitwall.listen(e.car, "onPosition", function() moved[e] = true end)
+  end
+  local function check()
+    for _, e in ipairs(self.order) do
+      if not e.falseStart and (moved[e] or (e.car.targetSpeed or 0) > 0) then
+        e.falseStart = true
+        pitwall.log("warn", string.format("race: false start by %s: held %g s after green",
+          tostring(e.car), self.penalty))
+        if e.car.connected then pcall(e.car.stop, e.car) end
+        self:_emit("onFalseStart", e.car, self)
+      end
+    end
+    return false
+  end
+  for k = 1, count do
+    pitwall.log("debug", string.format("race: light %d of %d", k, count))
+    self:_emit("onLights", k, self)
+    if self.board then
+      self.board.title = self.title .. "   " .. string.rep("●", k) .. string.rep("○", count - k)
+      self.board:show(self:_rows())
+    end
+    pitwall.waitUntil(check, k < count and interval or hold, 0.005)
+  end
+  for _, s in ipairs(subs) do s:cancel() end
+  pitwall.log("debug", "race: green")
+end
+
+function Race:_start(e)
+  e.started = true
+  drivers.call(e.driver, "start", e.car, e.ctx)
+end
+
+function Race:_finish(e, t)
+  if e.finished then return end
+  self.finishers = self.finishers + 1
+  e.finished, e.finishTime, e.finishRank = true, t, self.finishers
+  e.progress = e.timer.count
+  if not self.leaderFinished then self.leaderFinished = t end
+  drivers.call(e.driver, "finish", e.car, e.ctx)
+  -- A cool-down: on at a low speed (a parked car would block the lane at the line).
+  if e.car.connected then pcall(e.car.setSpeed, e.car, self.options.cooldown or 300, 1000) end
+  pitwall.log("debug", string.format("race: %s finished (%d laps)", tostring(e.car), e.timer.count))
+  self:_emit("onFinish", e.car, e.finishRank, self)
+end
+
+function Race:_onLap(e, lap)
+  self:_emit("onLap", e.car, lap, self)
+  if e.finished then return end
+  local mode, now = self.mode, lap.finish
+  local timeUp = self.seconds and now >= self.green + self.seconds
+  if mode == "laps" then
+    if e.timer.count >= self.laps or self.leaderFinished then self:_finish(e, now) end
+  elseif mode == "timed" then
+    if self.leaderFinished then self:_finish(e, now)
+    elseif timeUp then
+      self:_standings(now)
+      if self.order[1] == e then self:_finish(e, now) end
+    end
+  else -- practice, qualifying: each car on its own
+    if (self.laps and e.timer.count >= self.laps) or timeUp then self:_finish(e, now) end
+  end
+end
+
+-- Sorts self.order: finishers in finishing order, then by progress; the grid breaks ties.
+function Race:_standings(now)
+  for _, e in ipairs(self.order) do
+    local p, d = self:_progress(e, now)
+    if d then e.distance = d end
+    if p and not e.finished then e.progress = p end
+  end
+  local timing = self.mode == "qualifying" or self.mode == "practice"
+  table.sort(self.order, function(a, b)
+    if timing then
+      local ab, bb = a.timer.best, b.timer.best
+      if ab and bb and ab.time ~= bb.time then return ab.time < bb.time end
+      if (ab == nil) ~= (bb == nil) then return ab ~= nil end
+    else
+      -- classified by laps (a finisher's laps are frozen at the line), then finishing time
+      local pa, pb = a.progress or -math.huge, b.progress or -math.huge
+      if a.finished and b.finished and pa == pb then return a.finishRank < b.finishRank end
+      if pa ~= pb then return pa > pb end
+    end
+    return a.gridSlot < b.gridSlot
+  end)
+end
+
+-- Gap to the leader: seconds and laps behind.
+function Race:_gap(e, leader)
+  if e == leader then return 0, 0 end
+  if self.mode == "qualifying" or self.mode == "practice" then
+    local a, b = e.timer.best, leader.timer.best
+    return a and b and a.time - b.time or nil, 0
+  end
+  if e.finished and leader.finished then
+    return e.finishTime - leader.finishTime, math.max(0, leader.timer.count - e.timer.count)
+  end
+  local behind = 0
+  if leader.progress and e.progress then
+    behind = math.max(0, math.floor(leader.progress - e.progress))
+  end
+  local mine = e.key and e.passes[e.key]
+  local theirs = e.key and leader.passes[e.key]
+  return mine and theirs and mine - theirs or nil, behind
+end
+
+function Race:_safety(now)
+  local s = self.options.safety
+  if s == false then return end
+  s = s or {}
+  local range, speed = s.distance or 1000, s.speed or 300
+  local L = self.map:lapLength(0)
+  for _, e in ipairs(self.order) do e.limit = nil end
+  for _, d in ipairs(self.order) do
+    if d.lost and d.lostDistance then
+      for _, e in ipairs(self.order) do
+        if e ~= d and not e.lost and e.distance and e.loc.localized then
+          local behind = (d.lostDistance - e.distance) % L
+          if behind > 0 and behind <= range then
+            e.limit = speed
+            if e.limitedBy ~= d then
+              pitwall.log("warn", string.format("race: %s slowed to %d mm/s: %s left the track "
+                .. "%.0f mm ahead", tostring(e.car), speed, tostring(d.car), behind))
+            end
+            e.limitedBy = d
+          end
+        end
+      end
+    end
+  end
+  for _, e in ipairs(self.order) do if not e.limit then e.limitedBy = nil end end
+end
+
+function Race:_tick()
+  local now = pitwall.now()
+  local old = {}
+  for k, e in ipairs(self.order) do old[e] = k end
+  for _, e in ipairs(self.order) do
+    if e.lost and e.loc.localized then e.lost = false end
+  end
+  self:_standings(now)
+  for k, e in ipairs(self.order) do
+    e.position = k
+    if old[e] ~= k and self.ticks > 0 then self:_emit("onPositionChange", e.car, k, old[e], self) end
+  end
+  self.ticks = self.ticks + 1
+  self:_safety(now)
+  for _, e in ipairs(self.order) do
+    local car = e.car
+    if not e.started and now >= e.releaseAt then self:_start(e) end
+    if e.started and not e.finished and car.connected then
+      e.ctx.limit = e.limit
+      drivers.call(e.driver, "update", car, e.ctx)
+      if e.limit and (car.targetSpeed or 0) > e.limit then pcall(car.setSpeed, car, e.limit, 2000) end
+    elseif e.finished and car.connected and e.limit and (car.targetSpeed or 0) > e.limit then
+      pcall(car.setSpeed, car, e.limit, 2000)
+    end
+  end
+  -- time up in practice / qualifying: cars that are not moving have nothing left to do
+  if self.seconds and now >= self.green + self.seconds and not self.timeUp then
+    self.timeUp = now
+    pitwall.log("info", "race: time is up")
+  end
+  if self.board and (not self.lastDraw or now - self.lastDraw >= (self.options.redraw or 0.25)) then
+    self.lastDraw = now
+    local status = self:_status(now)
+    self.board.title = status ~= "" and self.title .. "   " .. status or self.title
+    self.board:show(self:_rows())
+  end
+  local all = true
+  for _, e in ipairs(self.order) do if not e.finished and e.car.connected then all = false end end
+  local grace = self.options.finishTimeout or 60
+  local since = self.leaderFinished or self.timeUp
+  if all or (since and now - since > grace) then self.done = true end
+end
+
+-- What the board's title says: the leader's lap, the time left, the chequered flag.
+function Race:_status(now)
+  if self.leaderFinished then return "chequered flag" end
+  local leader = self.order[1]
+  if self.seconds then
+    local left = self.green + self.seconds - now
+    if left <= 0 then return self.mode == "timed" and "last lap" or "time is up: last laps" end
+    return Board.time(left) .. " left"
+  end
+  if self.mode == "laps" then
+    local lap = leader.timer.start and leader.timer.count + 1 or 1
+    return string.format("lap %d/%d", math.min(lap, self.laps), self.laps)
+  end
+  return ""
+end
+
+-- Rows of the live board / results.
+function Race:_rows()
+  local rows, leader = {}, self.order[1]
+  for k, e in ipairs(self.order) do
+    local gap, behind = self:_gap(e, leader)
+    local t = e.timer
+    local lastCross = e.finishTime or (t.last and t.last.finish)
+    rows[k] = {
+      position = k, car = e.car.name, number = e.car.number,
+      laps = t.count,
+      lap = e.finished and t.count or (t.start and math.min(t.count + 1, self.laps or math.huge) or 0),
+      totalTime = lastCross and self.green and lastCross - self.green or nil,
+      bestLap = t.best and t.best.time, lastLap = t.last and t.last.time,
+      gap = gap, lapsBehind = behind,
+      finished = e.finished, falseStart = e.falseStart or false,
+    }
+  end
+  return rows
+end
+
+--- The result rows, in finishing order (qualifying, practice: best lap first).
+function Race:results()
+  local rows = self:_rows()
+  local out = {}
+  for k, r in ipairs(rows) do
+    out[k] = {}
+    for _, c in ipairs(race.columns) do out[k][c] = r[c] end
+    out[k].gap, out[k].lapsBehind = r.gap, r.lapsBehind
+  end
+  return out
+end
+
+--- The cars in result order: a grid for the next session (grid = session works too).
+function Race:grid()
+  local out = {}
+  for k, e in ipairs(self.order) do out[k] = e.car end
+  return out
+end
+
+--- The entry of a car: {car, driver, ctx, loc, timer, position, progress, finished, …}.
+function Race:entry(car)
+  return self.entries[car]
+end
+
+--- Ends the session now (from a handler or another task); run() then stops every car.
+function Race:abort()
+  self.done = true
+end
+
+--- Runs the session to its end inside a task; returns the session.
+function Race:run()
+  if not coroutine.isyieldable() then
+    error("race: a session drives and waits: run it inside a task (the main chunk or "
+      .. "pitwall.spawn), not in a handler", 2)
+  end
+  local o = self.options
+  self.lastKind = lastKind
+  for _, car in ipairs(self.cars) do
+    if not lastKind[car] then
+      lastKind[car] = "none"
+      pitwall.listen(car, "onPosition", function() lastKind[car] = "position" end)
+      pitwall.listen(car, "onTransition", function() lastKind[car] = "transition" end)
+    end
+  end
+  self.map = self:_map()
+  self.penalty = o.falseStartPenalty or 5
+  local field = {}
+  local grid = self:_gridOrder()
+  for slot, car in ipairs(grid) do
+    local loc = localize.follow(car, self.map)
+    field[#field + 1] = { car = car, loc = loc }
+    local e = { car = car, loc = loc, gridSlot = slot, passes = {}, started = false }
+    self.entries[car] = e
+    self.order[slot] = e
+  end
+  local driverSpec = o.drivers
+  for i, car in ipairs(self.cars) do
+    local e = self.entries[car]
+    local spec = driverSpec
+    if type(driverSpec) == "table" and not driverSpec.update and not driverSpec.new then
+      spec = driverSpec[car] or driverSpec[car.name] or driverSpec[i]
+    end
+    e.driver = makeDriver(spec, car, i)
+    e.ctx = drivers.context(car, self.map, field, { period = self.period })
+  end
+  if self.mode ~= "practice" then self:_toGrid() end
+  local n = #self.map.pieces
+  for _, e in ipairs(self.order) do
+    e.timer = laps.timer(e.car, self.map, { onLap = function(_, lap) self:_onLap(e, lap) end })
+    e.unsubscribe = e.loc:subscribe {
+      enter = function(_, i, _, t)
+        local key = (e.timer.start and e.timer.count or -1) * n + i
+        if not e.key or key > e.key then e.key, e.passes[key] = key, t end
+      end,
+      lost = function()
+        if self.state == "racing" and e.distance then
+          e.lost, e.lostDistance = true, e.distance
+        end
+      end,
+    }
+  end
+  -- A car put back on the track (a status "on track" after it left) stands still: it is sent
+  -- its last commanded speed again, so that its driver resumes.
+  for _, e in ipairs(self.order) do
+    e.statusSub = pitwall.listen(e.car, "onStatus", function(car, ev)
+      if not ev.onTrack then e.offTrack = true
+      elseif e.offTrack then
+        e.offTrack = false
+        if self.state == "racing" and e.started and (car.targetSpeed or 0) > 0 then
+          pcall(car.setSpeed, car, car.targetSpeed, 1000)
+        end
+      end
+    end)
+  end
+  if o.board ~= false then
+    self.board = Board.new {
+      title = self.title,
+      columns = {
+        { key = "position", title = "POS", align = "right" },
+        { key = "car", title = "CAR" },
+        { key = "lap", title = "LAP", align = "right" },
+        { key = "lastLap", title = "LAST", align = "right", format = Board.time },
+        { key = "bestLap", title = "BEST", align = "right", format = Board.time },
+        { key = "gap", title = "GAP", align = "right",
+          format = function(v, row) return Board.gap(v, row.lapsBehind) end },
+      },
+    }
+  end
+  if self.mode ~= "practice" and o.lights ~= 0 then self:_lights() end
+  self.state = "racing"
+  self.green = pitwall.now()
+  for _, e in ipairs(self.order) do
+    e.releaseAt = self.green + (e.falseStart and self.penalty or 0)
+  end
+  self.ticks = 0
+  self:_tick()
+  local ticker = pitwall.every(self.period, function()
+    if self.done then return end
+    local ok, err = xpcall(self._tick, debug.traceback, self)
+    if not ok then report("race director", err) end
+  end)
+  pitwall.waitUntil(function() return self.done end, nil, self.period)
+  ticker:cancel()
+  self.state = "done"
+  self:_standings(pitwall.now())
+  -- Every car brought to a stop.
+  for _, e in ipairs(self.order) do
+    if e.started and not e.finished then drivers.call(e.driver, "finish", e.car, e.ctx) end
+    if e.car.connected then pcall(e.car.stop, e.car) end
+  end
+  pitwall.sleep(0.5) -- (car.speed is the last reported one: a stopped car reports nothing)
+  for _, e in ipairs(self.order) do e.unsubscribe(); e.timer:cancel(); e.statusSub:cancel() end
+  if self.board then
+    self.board.title = self.title .. "   results"
+    self.board:final(self:_rows())
+  end
+  local path = o.results
+  if path == nil then path = pitwall.resultsFile end
+  if path then self.resultsPath = pitwall.writeResults(self:results(), race.columns, path) end
+  self:_emit("onEnd", self)
+  return self
+end
+
+for mode in pairs(MODES) do
+  race[mode] = function(options)
+    options = options or {}
+    options.mode = mode
+    return race.new(options):run()
+  end
+end
+
+return race

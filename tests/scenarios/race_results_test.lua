@@ -1,0 +1,64 @@
+-- Qualifying (best lap wins) gives the grid of a race; results as rows, and as CSV and JSON files
+-- that parse back.
+local sim = require "pitwall.sim"
+local race = require "pitwall.race"
+local track = require "pitwall.track"
+
+local speeds = { 600, 800, 1000 }
+local cars = {}
+for i = 1, 3 do cars[i] = sim.addCar {} end
+local map = track.fromSim()
+local function drivers(car, i) return race.Steady.new { speed = speeds[i] } end
+
+local base = os.tmpname()
+local csv, json = base .. ".csv", base .. ".json"
+
+local q = race.qualifying { laps = 2, map = map, drivers = drivers, results = csv, board = false }
+local qrows = q:results()
+expect.eq(qrows[1].car, cars[3].name, "pole: the fastest lap")
+expect.eq(qrows[3].car, cars[1].name, "last: the slowest")
+for k = 2, 3 do expect.ge(qrows[k].bestLap, qrows[k - 1].bestLap, "sorted by best lap") end
+expect.eq(q.resultsPath, csv, "written where asked")
+
+-- the CSV parses back
+local f = assert(io.open(csv))
+local header = f:read("l")
+expect.eq(header, table.concat(race.columns, ","), "CSV header")
+local parsed = {}
+for line in f:lines() do
+  local row, k = {}, 0
+  for field in (line .. ","):gmatch("([^,]*),") do
+    k = k + 1
+    row[race.columns[k]] = field
+  end
+  parsed[#parsed + 1] = row
+end
+f:close()
+expect.eq(#parsed, 3, "a CSV row per car")
+for k, row in ipairs(parsed) do
+  local want = qrows[k]
+  expect.eq(tonumber(row.position), k, "CSV position")
+  expect.eq(row.car:gsub('"', ""), want.car, "CSV car")
+  expect.eq(tonumber(row.laps), 2, "CSV laps")
+  expect.near(tonumber(row.bestLap), want.bestLap, 1e-6, "CSV best lap")
+  expect.near(tonumber(row.lastLap), want.lastLap, 1e-6, "CSV last lap")
+  expect.near(tonumber(row.totalTime), want.totalTime, 1e-6, "CSV total time")
+end
+
+-- the race starts from the qualifying grid
+local r = race.laps { laps = 2, map = map, drivers = drivers, grid = q, results = json, board = false }
+for k, car in ipairs(q:grid()) do
+  expect.eq(r:entry(car).gridSlot, k, "grid slot of " .. tostring(car))
+end
+local f2 = assert(io.open(json))
+local text = f2:read("a")
+f2:close()
+expect.truthy(text:match("^%s*%[") and text:match("%]%s*$"), "a JSON array")
+local n = 0
+for _ in text:gmatch('"position"') do n = n + 1 end
+expect.eq(n, 3, "an object per car")
+for _, c in ipairs(race.columns) do expect.truthy(text:find('"' .. c .. '"', 1, true), "field " .. c) end
+for k, row in ipairs(r:results()) do
+  expect.truthy(text:find('"car":%s*"' .. row.car .. '"'), "car " .. row.car .. " in the JSON")
+end
+os.remove(csv); os.remove(json); os.remove(base)
