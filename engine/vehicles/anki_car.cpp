@@ -140,6 +140,15 @@ void AnkiCar::receive(std::span<const std::uint8_t> frame) {
   if (onMessage) onMessage(*decoded);
 }
 
+// The offset update (0x2d) that ends a lane change may be lost on the radio: a car that reports
+// itself at the target has arrived all the same.
+void AnkiCar::laneChangeReached() {
+  constexpr double kArrivedMm = 2.0;
+  if (state_.lane_change_target_mm &&
+      std::fabs(state_.offset_mm - *state_.lane_change_target_mm) <= kArrivedMm)
+    state_.lane_change_target_mm.reset();
+}
+
 void AnkiCar::apply(const Message& message) {
   // Only the messages that change what we know of the car; the rest pass through as events.
   if (auto* p = std::get_if<PositionUpdate>(&message)) {
@@ -152,14 +161,17 @@ void AnkiCar::apply(const Message& message) {
     state_.on_track = true;
     state_.delocalized = false;
     state_.last_position_time = loop_.seconds();
+    laneChangeReached();
   } else if (auto* t = std::get_if<TransitionUpdate>(&message)) {
     state_.offset_mm = t->offset_mm;
+    laneChangeReached();
   } else if (auto* o = std::get_if<OffsetUpdate>(&message)) {
     state_.offset_mm = o->offset_mm;
     state_.lane_change_target_mm.reset();
   } else if (std::holds_alternative<Delocalized>(message)) {
     state_.delocalized = true;
     state_.speed_mm_s = 0;
+    state_.lane_change_target_mm.reset();  // the car gave up whatever it was doing
   } else if (std::holds_alternative<AutoRecoverySucceeded>(message)) {
     state_.delocalized = false;
   } else if (auto* s = std::get_if<SpeedUpdate>(&message)) {
@@ -188,6 +200,7 @@ void AnkiCar::connectionChanged(bool up, const std::string& reason) {
     requestBattery();
   } else {
     state_.speed_mm_s = 0;
+    state_.lane_change_target_mm.reset();
     pingSentAt_.reset();
   }
   log::info(label(), up ? "connected" : "disconnected: " + reason);

@@ -97,6 +97,7 @@ class AnkiCar {
  private:
   void apply(const anki::Message& message);
   void connectionChanged(bool up, const std::string& reason);
+  void laneChangeReached();
 
   Loop& loop_;
   Link& link_;

@@ -117,3 +117,25 @@ TEST_CASE_FIXTURE(Fixture, "a lane change is under way until the offset update a
   CHECK_FALSE(car.state().lane_change_target_mm);
   CHECK(car.state().offset_mm == doctest::Approx(68.0));
 }
+
+TEST_CASE_FIXTURE(Fixture,
+                  "a lane change ends when the car reports itself there, offset update or not") {
+  link.setConnected(true);
+  REQUIRE(car.changeLane(23));
+  REQUIRE(car.state().lane_change_target_mm);
+  PositionUpdate p;
+  p.piece_id = 39;
+  p.offset_mm = 10.0f;  // on its way
+  link.carSends(p);
+  CHECK(car.state().lane_change_target_mm);
+  p.offset_mm = 22.5f;  // there; its 0x2d was lost
+  link.carSends(p);
+  CHECK_FALSE(car.state().lane_change_target_mm);
+
+  REQUIRE(car.changeLane(-68));
+  link.carSends(Delocalized{});
+  CHECK_FALSE(car.state().lane_change_target_mm);  // a car off the track changes no lane
+  REQUIRE(car.changeLane(68));
+  link.setConnected(false);
+  CHECK_FALSE(car.state().lane_change_target_mm);  // nor one that lost its link
+}
