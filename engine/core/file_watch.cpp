@@ -1,0 +1,108 @@
+#include "engine/core/file_watch.hpp"
+
+#include <sys/inotify.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <stdexcept>
+
+namespace pitwall {
+
+namespace fs = std::filesystem;
+
+namespace {
+// What a save looks like from the folder: the file written and closed, a file renamed onto its
+// name, created, or (a backup-and-rewrite editor) moved away and deleted before the new one.
+constexpr std::uint32_t kMask =
+    IN_CLOSE_WRITE | IN_MOVED_TO | IN_CREATE | IN_DELETE | IN_MOVED_FROM | IN_ATTRIB;
+}  // namespace
+
+FileWatch::FileWatch(Loop& loop, Duration debounce)
+    : loop_(loop), debounce_(debounce), fd_(loop.io()), alive_(std::make_shared<bool>(true)) {
+  int fd = ::inotify_init1(IN_NONBLOCK | IN_CLOEXEC);
+  if (fd < 0) throw std::runtime_error(std::string("cannot watch files: ") + std::strerror(errno));
+  fd_.assign(fd);
+  waitForEvents();
+}
+
+FileWatch::~FileWatch() {
+  *alive_ = false;
+  loop_.cancel(quiet_);
+  boost::system::error_code ec;
+  fd_.close(ec);
+}
+
+Result<bool, std::string> FileWatch::add(const std::string& file) {
+  std::error_code ec;
+  fs::path path = fs::absolute(file, ec).lexically_normal();
+  if (ec) return Unexpected{"cannot watch " + file + ": " + ec.message()};
+  std::string folder = path.parent_path().string();
+  if (!names_.count(folder)) {
+    int wd = ::inotify_add_watch(fd_.native_handle(), folder.c_str(), kMask);
+    if (wd < 0)
+      return Unexpected{"cannot watch " + file + ": its folder " + folder + ": " +
+                        std::strerror(errno)};
+    folders_[wd] = folder;
+  }
+  names_[folder].insert(path.filename().string());
+  return true;
+}
+
+std::vector<std::string> FileWatch::files() const {
+  std::vector<std::string> out;
+  for (const auto& [folder, names] : names_)
+    for (const auto& n : names) out.push_back((fs::path(folder) / n).string());
+  return out;
+}
+
+void FileWatch::waitForEvents() {
+  std::weak_ptr<bool> alive = alive_;
+  fd_.async_wait(boost::asio::posix::stream_descriptor::wait_read,
+                 [this, alive](const boost::system::error_code& ec) {
+                   if (alive.expired() || ec) return;
+                   readEvents();
+                   waitForEvents();
+                 });
+}
+
+void FileWatch::readEvents() {
+  alignas(inotify_event) char buf[4096];
+  for (;;) {
+    ssize_t n = ::read(fd_.native_handle(), buf, sizeof buf);
+    if (n <= 0) return;  // EAGAIN: all read
+    for (char* p = buf; p < buf + n;) {
+      auto* e = reinterpret_cast<inotify_event*>(p);
+      p += sizeof(inotify_event) + e->len;
+      if (e->len == 0) continue;
+      auto folder = folders_.find(e->wd);
+      if (folder == folders_.end()) continue;
+      std::string name = e->name;
+      if (names_[folder->second].count(name)) changed((fs::path(folder->second) / name).string());
+    }
+  }
+}
+
+void FileWatch::changed(const std::string& path) {
+  pending_.insert(path);
+  loop_.cancel(quiet_);
+  std::weak_ptr<bool> alive = alive_;
+  quiet_ = loop_.after(debounce_, [this, alive] {
+    if (alive.expired()) return;
+    quiet_ = 0;
+    // A file that is gone right now is in the middle of a save: report it when it is back.
+    std::vector<std::string> ready;
+    for (auto it = pending_.begin(); it != pending_.end();) {
+      if (fs::exists(*it)) {
+        ready.push_back(*it);
+        it = pending_.erase(it);
+      } else {
+        ++it;
+      }
+    }
+    if (!ready.empty() && onChange) onChange(ready);
+  });
+}
+
+}  // namespace pitwall
