@@ -160,7 +160,7 @@ int addCar(lua_State* L) {
   if (lua_getfield(L, 1, "name") != LUA_TNIL)
     spec.name = lua::checkString(L, -1, "name");
   else
-    spec.name = sim::uniqueCarName(spec.model_id, taken);
+    spec.name = anki::uniqueCarName(spec.model_id, taken);
   lua_pop(L, 1);
   if (std::find(taken.begin(), taken.end(), spec.name) != taken.end())
     throw LuaError("a car named '" + spec.name + "' is already in the run");

@@ -1,6 +1,7 @@
 #include "engine/cli/session.hpp"
 
 #include "engine/core/log.hpp"
+#include "engine/protocol/anki/advertisement.hpp"
 #include "engine/sim/grid.hpp"
 
 namespace pitwall::cli {
@@ -38,7 +39,7 @@ bool Session::addGridCars(int count) {
   std::vector<std::string> names;
   for (int i = 0; i < count; ++i) {
     sim::CarSpec spec = sim::gridSpec(sim_.world->track(), i);
-    spec.name = sim::uniqueCarName(spec.model_id, names);
+    spec.name = anki::uniqueCarName(spec.model_id, names);
     names.push_back(spec.name);
     fleet_.addSimulated(*sim_.world, spec);
   }

@@ -12,17 +12,6 @@ std::uint8_t gridModel(int index) {
   return kModels[index % std::size(kModels)];
 }
 
-std::string uniqueCarName(std::uint8_t model_id, const std::vector<std::string>& taken) {
-  std::string base = anki::modelName(model_id);
-  std::transform(base.begin(), base.end(), base.begin(), [](unsigned char c) {
-    return c == ' ' ? '-' : static_cast<char>(std::tolower(c));
-  });
-  std::string name = base;
-  for (int n = 2; std::find(taken.begin(), taken.end(), name) != taken.end(); ++n)
-    name = base + "-" + std::to_string(n);
-  return name;
-}
-
 CarSpec gridSpec(const Track& track, int index) {
   CarSpec spec;
   spec.model_id = gridModel(index);

@@ -14,7 +14,5 @@ inline constexpr double kLaneOffsets[4] = {-68.0, -23.0, 23.0, 68.0};  // anki-o
 CarSpec gridSpec(const Track& track, int index);
 // The model ids used for grid cars, in order (Groundshock, Skull, Thermo, Nuke, …).
 std::uint8_t gridModel(int index);
-// "groundshock", or "groundshock-2" when that name is in `taken`.
-std::string uniqueCarName(std::uint8_t model_id, const std::vector<std::string>& taken);
 
 }  // namespace pitwall::sim

@@ -5,7 +5,7 @@
 #include <sstream>
 
 #include "engine/core/log.hpp"
-#include "engine/sim/grid.hpp"
+#include "engine/protocol/anki/advertisement.hpp"
 
 namespace pitwall::ble {
 
@@ -216,7 +216,7 @@ void Central::addCars(const std::vector<Sighting>& sightings) {
     // simulator does (groundshock, groundshock2, …).
     identity.name = s.device.localName().user_name;
     if (identity.name.empty() && s.device.manufacturer)
-      identity.name = sim::uniqueCarName(identity.model_id, taken);
+      identity.name = anki::uniqueCarName(identity.model_id, taken);
     taken.push_back(identity.name);
     car->car = &fleet_.add(std::move(link), std::move(identity));
     log::info("ble", "found " + car->car->label() + " at " + s.address + " on " +

@@ -15,6 +15,7 @@
 
 #include "bindings/car_binding.hpp"
 #include "bindings/script_host.hpp"
+#include "engine/protocol/anki/advertisement.hpp"
 #include "engine/sim/grid.hpp"
 #include "engine/sim/track.hpp"
 #include "engine/sim/world.hpp"
@@ -67,7 +68,7 @@ struct SimRig {
     for (int i = 0; i < count; ++i) {
       sim::CarSpec spec =
           count <= 4 ? sim::gridSpec(world->track(), i) : spreadSpec(world->track(), i, count);
-      spec.name = sim::uniqueCarName(spec.model_id, names);
+      spec.name = anki::uniqueCarName(spec.model_id, names);
       names.push_back(spec.name);
       fleet->addSimulated(*world, spec);
     }

@@ -64,7 +64,7 @@ FakeBluez::State::State(Loop& loop_, sdbus::IConnection& connection, Options opt
     sim::CarSpec spec = sim::gridSpec(world->track(), i);
     spec.name = static_cast<std::size_t>(i) < options.names.size()
                     ? options.names[i]
-                    : sim::uniqueCarName(spec.model_id, taken);
+                    : anki::uniqueCarName(spec.model_id, taken);
     taken.push_back(spec.name);
     auto d = std::make_unique<Device>();
     d->index = i;

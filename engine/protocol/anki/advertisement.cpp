@@ -1,6 +1,10 @@
 // What an Anki car advertises (anki-overdrive.md "Advertisement"; seed 000 §4.3.1).
 #include "engine/protocol/anki/advertisement.hpp"
 
+#include <cctype>
+
+#include <algorithm>
+
 #include <array>
 #include <cstdio>
 
@@ -128,6 +132,17 @@ std::string modelName(std::uint8_t model_id) {
     return std::string(kModels[model_id]);
   }
   return "model-" + std::to_string(model_id);
+}
+
+std::string uniqueCarName(std::uint8_t model_id, const std::vector<std::string>& taken) {
+  std::string base = anki::modelName(model_id);
+  std::transform(base.begin(), base.end(), base.begin(), [](unsigned char c) {
+    return c == ' ' ? '-' : static_cast<char>(std::tolower(c));
+  });
+  std::string name = base;
+  for (int n = 2; std::find(taken.begin(), taken.end(), name) != taken.end(); ++n)
+    name = base + "-" + std::to_string(n);
+  return name;
 }
 
 }  // namespace pitwall::anki

@@ -4,6 +4,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "engine/core/result.hpp"
 
@@ -37,5 +38,8 @@ LocalName parseLocalName(std::span<const std::uint8_t> raw);
 
 // "Groundshock", …; unknown ids give "model-<n>".
 std::string modelName(std::uint8_t model_id);
+// A car's default name from its model: "groundshock", or "groundshock-2" when that is in `taken`
+// (simulated cars, and real cars whose user name BlueZ does not pass on).
+std::string uniqueCarName(std::uint8_t model_id, const std::vector<std::string>& taken);
 
 }  // namespace pitwall::anki

@@ -107,3 +107,11 @@ TEST_CASE("model ids name the car, unknown ones print as model-n") {
   CHECK(modelName(0) == "model-0");
   CHECK(modelName(200) == "model-200");
 }
+
+TEST_CASE("default car names come from the model and are made unique") {
+  CHECK(uniqueCarName(8, {}) == "groundshock");
+  CHECK(uniqueCarName(8, {"groundshock"}) == "groundshock-2");
+  CHECK(uniqueCarName(8, {"groundshock", "groundshock-2"}) == "groundshock-3");
+  CHECK(uniqueCarName(14, {}) == "big-bang");  // spaces become dashes
+  CHECK(uniqueCarName(200, {}) == "model-200");
+}
