@@ -54,6 +54,15 @@ out=$($PITWALL scan --timeout 1 --adapter hci1 --json)
 check "--adapter: only that adapter's cars" "E0:00:00:00:00:02" \
   "$(echo "$out" | /usr/bin/python3 -c 'import json,sys; print(" ".join(json.loads(l)["address"] for l in sys.stdin))')"
 
+# An adapter switched off (bluetoothctl power off)
+dbus-send --system --print-reply --dest=org.bluez /org/bluez/hci1 \
+  org.freedesktop.DBus.Properties.Set string:org.bluez.Adapter1 string:Powered \
+  variant:boolean:false >/dev/null
+err=$($PITWALL scan --timeout 0.3 --adapter hci1 2>&1 >/dev/null); rc=$?
+check "powered off: exit status" 2 "$rc"
+contains "powered off: names it and says what to do" \
+  "Bluetooth adapter hci1 is powered off: switch it on with \`bluetoothctl power on\`" "$err"
+
 err=$($PITWALL scan --timeout 1 --adapter hci7 2>&1 >/dev/null); rc=$?
 check "unknown adapter: exit status" 2 "$rc"
 contains "unknown adapter: names what there is" "there is no Bluetooth adapter hci7 (found: hci0, hci1)" "$err"
