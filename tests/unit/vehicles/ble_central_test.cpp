@@ -228,6 +228,23 @@ TEST_CASE("ble: each step of a connection has a timeout that names it") {
   // BlueZ connected after the attempt was given up: the link hangs up again
   CHECK(rig.waitFor([&] { return rig.fake.counters(kCar1).connects == 1; }));
   CHECK(rig.waitFor([&] { return !rig.fake.connected(kCar1); }));
+
+  // the next step: services resolve 50 ms after the link is up
+  timeouts = {};
+  timeouts.resolve = 1ms;
+  ble::BleLink slow(bluez, rig.fake.devicePath(kCar1), kCar1, timeouts);
+  bluez.onDevice = [&, previous = bluez.onDevice](const ble::Device& d) {
+    if (previous) previous(d);
+    if (d.path == slow.devicePath()) slow.deviceChanged(d);
+  };
+  done = false;
+  slow.connect([&](std::optional<std::string> e) {
+    reason = e.value_or("");
+    done = true;
+  });
+  REQUIRE(rig.waitFor([&] { return done; }));
+  CHECK(reason == std::string("service discovery on ") + kCar1 + " timed out after 1 ms");
+  CHECK(rig.waitFor([&] { return !rig.fake.connected(kCar1); }));  // left clean for a retry
 }
 
 TEST_CASE("ble: only the cars asked for, and only on the adapters asked for") {
