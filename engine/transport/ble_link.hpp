@@ -35,7 +35,6 @@ class BleLink : public Link {
   // Runs the connection sequence; done(error) once the link is up or the attempt failed. The
   // state handler (Link::onState) reports up, and later down.
   void connect(Done done);
-  bool connecting() const { return step_ != Step::Idle && step_ != Step::Up; }
 
   bool send(std::span<const std::uint8_t> frame) override;
   bool connected() const override { return step_ == Step::Up; }
@@ -43,7 +42,6 @@ class BleLink : public Link {
   // Asks BlueZ to disconnect; done() when it has (or after the disconnect timeout).
   void disconnect(std::function<void()> done);
   std::string address() const override { return "ble:" + address_; }
-  const std::string& bdaddr() const { return address_; }
 
   // From the Central, which follows BlueZ's tree for all links.
   const std::string& devicePath() const { return devicePath_; }

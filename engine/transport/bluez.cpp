@@ -238,7 +238,6 @@ Bluez::Bluez(Loop& loop) : loop_(loop), alive_(std::make_shared<bool>(true)) {
         if (!oldOwner.empty()) {
           log::warn("ble", "BlueZ left the bus: every car is disconnected");
           reset();
-          if (onBluezGone) onBluezGone();
         }
         if (newOwner.empty()) return;
         // bluetoothd (re)started: read its tree again, then let the subscriber go on

@@ -106,8 +106,9 @@ class Bluez {
   std::function<void(const Device&)> onDevice;  // added or changed
   std::function<void(const std::string& path)> onDeviceRemoved;
   std::function<void(const std::string& charPath, const std::vector<std::uint8_t>&)> onValue;
-  std::function<void()> onBluezGone;  // org.bluez left the bus (bluetoothd stopped)
-  std::function<void()> onBluezBack;  // org.bluez is back and its tree has been read again
+  // org.bluez is back on the bus (bluetoothd restarted) and its tree has been read again. When
+  // it left, every device was reported removed through onDeviceRemoved.
+  std::function<void()> onBluezBack;
 
  private:
   struct Signals;      // the signal subscriptions (sdbus slots and the proxy of "/")
