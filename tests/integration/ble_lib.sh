@@ -4,12 +4,18 @@ source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
 FAKE_BLUEZ=$3
 BUS_PID=""
 FAKE_PID=""
+COPY_PID=""
 
+# stop_fake: ends the fake BlueZ and waits until its last words are in $TMP/fake.out.
 stop_fake() {
   if [ -n "$FAKE_PID" ]; then
     kill -TERM "$FAKE_PID" 2>/dev/null
     wait "$FAKE_PID" 2>/dev/null
     FAKE_PID=""
+  fi
+  if [ -n "$COPY_PID" ]; then
+    wait "$COPY_PID" 2>/dev/null
+    COPY_PID=""
   fi
 }
 
@@ -44,6 +50,8 @@ start_fake() {
     exit 1
   fi
   cat <&3 >"$TMP/fake.out" &  # the rest of its output, for the test to read after stop_fake
+  COPY_PID=$!
+  exec 3<&-
 }
 
 # field NAME LINE: the value of NAME=… in one of laps.lua's summary lines
