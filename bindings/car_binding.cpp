@@ -380,11 +380,19 @@ int tostring(lua_State* L) {
 CarBinding::CarBinding(ScriptHost& host) : host_(host), L_(host.state()) {}
 
 CarBinding::~CarBinding() {
-  for (auto& [car, proxy] : proxies_) {
-    car->onMessage = nullptr;
-    car->onConnection = std::move(proxy->previousOnConnection);
-    car->onMalformed = nullptr;
-  }
+  detach();
+}
+
+void CarBinding::attach() {
+  if (attached_) return;
+  attached_ = true;
+  for (auto& [car, proxy] : proxies_) hookEvents(*proxy);
+}
+
+void CarBinding::detach() {
+  if (!attached_) return;
+  attached_ = false;
+  for (auto& [car, proxy] : proxies_) unhookEvents(*proxy);
 }
 
 void CarBinding::registerType(lua_State* L) {
@@ -405,7 +413,19 @@ void CarBinding::registerType(lua_State* L) {
   luaL_newmetatable(L, kMetatable);
   luaL_newlib(L, methods);
   lua_pushvalue(L, -1);
-  lua_setfield(L, -3, "__methods");  // for completion in the REPL
+  lua_setfield(L, -3, "__methods");  // the REPL completes from these three, without __index
+  lua_createtable(L, static_cast<int>(kFieldNames.size()), 0);
+  for (std::size_t i = 0; i < kFieldNames.size(); ++i) {
+    lua_pushstring(L, kFieldNames[i]);
+    lua_rawseti(L, -2, static_cast<lua_Integer>(i + 1));
+  }
+  lua_setfield(L, -3, "__fields");
+  lua_createtable(L, static_cast<int>(kEventNames.size()), 0);
+  for (std::size_t i = 0; i < kEventNames.size(); ++i) {
+    lua_pushstring(L, kEventNames[i]);
+    lua_rawseti(L, -2, static_cast<lua_Integer>(i + 1));
+  }
+  lua_setfield(L, -3, "__events");
   lua_pushvalue(L, -1);
   lua_pushcclosure(L, lua::guarded<index>, 1);
   lua_setfield(L, -3, "__index");
@@ -441,6 +461,11 @@ AnkiCar& CarBinding::check(lua_State* L, int idx) {
   return *proxyAt(L, idx).car;
 }
 
+AnkiCar* CarBinding::test(lua_State* L, int idx) {
+  auto** p = static_cast<CarBinding::Proxy**>(luaL_testudata(L, idx, kMetatable));
+  return p ? (*p)->car : nullptr;
+}
+
 void CarBinding::bind(AnkiCar& car) {
   if (proxies_.count(&car)) return;
   auto proxy = std::make_unique<Proxy>();
@@ -459,7 +484,7 @@ void CarBinding::bind(AnkiCar& car) {
   }
   proxies_.emplace(&car, std::move(proxy));
 
-  hookEvents(p);
+  if (attached_) hookEvents(p);
 }
 
 void CarBinding::push(lua_State* L, AnkiCar& car) {

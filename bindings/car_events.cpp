@@ -197,6 +197,13 @@ void CarBinding::hookEvents(Proxy& p) {
   };
 }
 
+void CarBinding::unhookEvents(Proxy& p) {
+  p.car->onMessage = nullptr;
+  p.car->onConnection = std::move(p.previousOnConnection);
+  p.previousOnConnection = nullptr;
+  p.car->onMalformed = nullptr;
+}
+
 void CarBinding::dispatch(Proxy& p, const Message& m) {
   auto deliver = [&](CarEvent e, auto&& fill) {
     if (!begin(p, e)) return;

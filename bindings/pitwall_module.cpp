@@ -12,6 +12,7 @@
 #include "bindings/lua_support.hpp"
 #include "bindings/results.hpp"
 #include "bindings/script_host.hpp"
+#include "engine/core/console.hpp"
 #include "engine/core/log.hpp"
 #include "engine/protocol/anki/pieces.hpp"
 
@@ -240,9 +241,10 @@ int writeResults(lua_State* L) {
   return 1;
 }
 
-// pitwall.terminal(): {tty = stdout is a terminal, columns = its width (COLUMNS, else 80)}.
+// pitwall.terminal(): {tty = stdout is a terminal that a script may redraw (not while a REPL
+// prompt is on it), columns = its width (COLUMNS, else 80)}.
 int terminal(lua_State* L) {
-  bool tty = ::isatty(STDOUT_FILENO) == 1;
+  bool tty = ::isatty(STDOUT_FILENO) == 1 && !console::hasWriter();
   long columns = 0;
   winsize ws{};
   if (tty && ::ioctl(STDOUT_FILENO, TIOCGWINSZ, &ws) == 0) columns = ws.ws_col;
@@ -295,6 +297,12 @@ void openPitwallModule(ScriptHost& host) {
   lua_setfield(L, -2, "virtualTime");
   lua_pushinteger(L, static_cast<lua_Integer>(host.options().seed));
   lua_setfield(L, -2, "seed");
+  // What survives a hot reload (docs/hot-reload.md): the Reloader replaces this table with the
+  // previous version's, copied, before the new version's main chunk runs.
+  lua_newtable(L);
+  lua_setfield(L, -2, "persist");
+  lua_pushinteger(L, 0);
+  lua_setfield(L, -2, "reloads");
   if (!host.options().results.empty()) {
     lua_pushstring(L, host.options().results.c_str());
     lua_setfield(L, -2, "resultsFile");
@@ -308,23 +316,9 @@ void openPitwallModule(ScriptHost& host) {
 
   if (host.sim()) openSimModule(host);
 
-  // Cars already known get their Lua objects now; later ones when they join, with onCar.
+  // Cars already known get their Lua objects now; later ones when they join
+  // (ScriptHost::carJoined).
   for (AnkiCar* c : host.fleet().cars()) host.cars().bind(*c);
-  auto previous = host.fleet().onCar;
-  host.fleet().onCar = [&host, previous](AnkiCar& car) {
-    if (previous) previous(car);
-    host.cars().bind(car);
-    lua_State* L = host.state();
-    int top = lua_gettop(L);
-    lua_getglobal(L, "pitwall");
-    if (lua_istable(L, -1) && lua_getfield(L, -1, "onCar") == LUA_TFUNCTION) {
-      lua_remove(L, -2);
-      host.cars().push(L, car);
-      host.call(1, 0, "pitwall.onCar handler", &car);
-    } else {
-      lua_settop(L, top);
-    }
-  };
 }
 
 }  // namespace pitwall

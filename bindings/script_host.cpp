@@ -3,8 +3,10 @@
 #include <filesystem>
 
 #include "bindings/car_binding.hpp"
+#include "bindings/interrupt.hpp"
 #include "bindings/lua_support.hpp"
 #include "bindings/pitwall_module.hpp"
+#include "engine/core/console.hpp"
 #include "engine/core/log.hpp"
 
 #ifndef PITWALL_SCRIPTS_DIR
@@ -34,6 +36,63 @@ void closeThread(lua_State* co) {
 #endif
 }
 
+// print and io.write go to the console: straight to stdout, or above the REPL's prompt.
+int consolePrint(lua_State* L) {
+  int n = lua_gettop(L);
+  luaL_Buffer b;
+  luaL_buffinit(L, &b);
+  for (int i = 1; i <= n; ++i) {
+    luaL_tolstring(L, i, nullptr);
+    luaL_addvalue(&b);
+    luaL_addchar(&b, i < n ? '\t' : '\n');
+  }
+  if (n == 0) luaL_addchar(&b, '\n');
+  luaL_pushresult(&b);
+  size_t len = 0;
+  const char* text = lua_tolstring(L, -1, &len);
+  console::write({text, len});
+  return 0;
+}
+
+// io.write(...) and pitwall.stdout:write(...): strings and numbers, as io.write takes them.
+int consoleWriteFrom(lua_State* L, int first) {
+  int n = lua_gettop(L);
+  luaL_Buffer b;
+  luaL_buffinit(L, &b);
+  for (int i = first; i <= n; ++i) {
+    if (lua_type(L, i) == LUA_TNUMBER) {
+      luaL_tolstring(L, i, nullptr);
+    } else {
+      luaL_checkstring(L, i);
+      lua_pushvalue(L, i);
+    }
+    luaL_addvalue(&b);
+  }
+  luaL_pushresult(&b);
+  size_t len = 0;
+  const char* text = lua_tolstring(L, -1, &len);
+  console::write({text, len});
+  return 0;
+}
+
+int consoleIoWrite(lua_State* L) {
+  consoleWriteFrom(L, 1);
+  lua_getglobal(L, "io");  // io.write returns the file it wrote to
+  lua_getfield(L, -1, "stdout");
+  return 1;
+}
+
+int consoleFileWrite(lua_State* L) {
+  consoleWriteFrom(L, 2);
+  lua_settop(L, 1);
+  return 1;
+}
+
+int consoleFileFlush(lua_State* L) {
+  lua_settop(L, 1);
+  return 1;
+}
+
 std::string scriptsDir() {
   if (const char* env = std::getenv("PITWALL_SCRIPTS")) return env;
   return PITWALL_SCRIPTS_DIR;
@@ -44,12 +103,48 @@ ScriptHost::ScriptHost(Loop& loop, Fleet& fleet, SimSession* sim, HostOptions op
     : loop_(loop), fleet_(fleet), sim_(sim), options_(std::move(options)) {
   L_ = luaL_newstate();
   if (!L_) throw std::runtime_error("cannot create a Lua state (out of memory)");
+  interrupt::watchThisThread();
   *static_cast<ScriptHost**>(lua_getextraspace(L_)) = this;
   cars_ = std::make_unique<CarBinding>(*this);
   openLibraries();
+  if (!options_.detached) attach();
+}
+
+void ScriptHost::attach() {
+  if (attached_) return;
+  attached_ = true;
+  cars_->attach();
+  previousOnCar_ = std::move(fleet_.onCar);
+  fleet_.onCar = [this](AnkiCar& car) {
+    if (previousOnCar_) previousOnCar_(car);
+    carJoined(car);
+  };
+}
+
+void ScriptHost::detach() {
+  if (!attached_) return;
+  attached_ = false;
+  cars_->detach();
+  fleet_.onCar = std::move(previousOnCar_);
+  previousOnCar_ = nullptr;
+}
+
+void ScriptHost::carJoined(AnkiCar& car) {
+  cars_->bind(car);
+  lua_State* L = L_;
+  int top = lua_gettop(L);
+  lua_getglobal(L, "pitwall");
+  if (lua_istable(L, -1) && lua_getfield(L, -1, "onCar") == LUA_TFUNCTION) {
+    lua_remove(L, -2);
+    cars_->push(L, car);
+    call(1, 0, "pitwall.onCar handler", &car);
+  } else {
+    lua_settop(L, top);
+  }
 }
 
 ScriptHost::~ScriptHost() {
+  detach();
   for (auto& [co, task] : tasks_)
     if (task.wake) loop_.cancel(*task.wake);
   for (auto& [handle, timer] : timers_) loop_.cancel(timer.id);
@@ -64,6 +159,14 @@ ScriptHost& ScriptHost::from(lua_State* L) {
 void ScriptHost::openLibraries() {
   lua_State* L = L_;
   luaL_openlibs(L);
+  interrupt::openCoroutineTracking(L);
+  trackRequire();
+  lua_pushcfunction(L, consolePrint);
+  lua_setglobal(L, "print");
+  lua_getglobal(L, "io");
+  lua_pushcfunction(L, consoleIoWrite);
+  lua_setfield(L, -2, "write");
+  lua_pop(L, 1);
   // require: the shipped library first, then the extra folders (the script's own joins later).
   std::string path;
   for (const auto& dir : options_.library_paths) path += dir + "/?.lua;" + dir + "/?/init.lua;";
@@ -86,6 +189,15 @@ void ScriptHost::openLibraries() {
 
   cars_->registerType(L);
   openPitwallModule(*this);
+  // pitwall.stdout: a file-like object (write, flush) that writes to the console.
+  lua_getglobal(L, "pitwall");
+  lua_createtable(L, 0, 2);
+  lua_pushcfunction(L, consoleFileWrite);
+  lua_setfield(L, -2, "write");
+  lua_pushcfunction(L, consoleFileFlush);
+  lua_setfield(L, -2, "flush");
+  lua_setfield(L, -2, "stdout");
+  lua_pop(L, 1);
 
   // The Lua half of the module (waitUntil, copy, …) and, in tests, the expectations.
   const char* prelude = options_.test_mode
@@ -99,18 +211,79 @@ void ScriptHost::openLibraries() {
   }
 }
 
+// require's Lua-file searcher, wrapped: every module file it finds is recorded, so that a hot
+// reload watches the modules of a script as well as the script.
+void ScriptHost::trackRequire() {
+  lua_State* L = L_;
+  lua_getglobal(L, "package");
+  lua_getfield(L, -1, "searchers");
+  lua_rawgeti(L, -1, 2);
+  lua_pushcclosure(L, searchAndRecord, 1);
+  lua_rawseti(L, -2, 2);
+  lua_pop(L, 2);
+}
+
+int ScriptHost::searchAndRecord(lua_State* L) {
+  lua_settop(L, 1);
+  lua_pushvalue(L, lua_upvalueindex(1));
+  lua_insert(L, 1);
+  lua_call(L, 1, 2);
+  if (lua_isfunction(L, 1) && lua_type(L, 2) == LUA_TSTRING) {
+    std::error_code ignored;
+    std::string path =
+        std::filesystem::absolute(lua_tostring(L, 2), ignored).lexically_normal().string();
+    ScriptHost& host = from(L);
+    host.loadedFiles_.push_back(path);
+    if (host.onFileLoaded) host.onFileLoaded(path);
+  }
+  return 2;
+}
+
 bool ScriptHost::call(int nargs, int nresults, const char* what, const AnkiCar* car) {
   lua_State* L = L_;
   int base = lua_gettop(L) - nargs;  // the function's slot
   lua_pushcfunction(L, lua::traceback);
   lua_insert(L, base);
-  int status = lua_pcall(L, nargs, nresults, base);
+  int status;
+  {
+    interrupt::Scope scope(L, interrupt::Kind::Callback);
+    status = lua_pcall(L, nargs, nresults, base);
+  }
   lua_remove(L, base);
   return finishCall(status, what, car);
 }
 
+bool ScriptHost::callInteractive(int nargs, int nresults, std::string& error) {
+  return protectedCall(nargs, nresults, error, true);
+}
+
+bool ScriptHost::callCapturing(int nargs, int nresults, std::string& error) {
+  return protectedCall(nargs, nresults, error, false);
+}
+
+bool ScriptHost::protectedCall(int nargs, int nresults, std::string& error, bool console) {
+  lua_State* L = L_;
+  int base = lua_gettop(L) - nargs;
+  lua_pushcfunction(L, lua::traceback);
+  lua_insert(L, base);
+  int status;
+  {
+    interrupt::Scope scope(L, console ? interrupt::Kind::Console : interrupt::Kind::Callback);
+    status = lua_pcall(L, nargs, nresults, base);
+  }
+  lua_remove(L, base);
+  if (status == LUA_OK) return true;
+  error = lua_tostring(L, -1) ? lua_tostring(L, -1) : "(error without a message)";
+  lua_pop(L, 1);
+  return false;
+}
+
 bool ScriptHost::callAboveHandler(int nargs, const char* what, const AnkiCar* car) {
-  int status = lua_pcall(L_, nargs, 0, -(nargs + 2));
+  int status;
+  {
+    interrupt::Scope scope(L_, interrupt::Kind::Callback);
+    status = lua_pcall(L_, nargs, 0, -(nargs + 2));
+  }
   if (status == LUA_OK) {
     lua_pop(L_, 1);  // the handler
     return true;
@@ -174,7 +347,7 @@ Result<bool, std::string> ScriptHost::startLoaded(int status) {
   return true;
 }
 
-Result<bool, std::string> ScriptHost::startFile(const std::string& path) {
+Result<bool, std::string> ScriptHost::startFile(const std::string& path, StartMode mode) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (!fs::is_regular_file(path, ec)) return Unexpected{"cannot open " + path + ": no such file"};
@@ -188,7 +361,18 @@ Result<bool, std::string> ScriptHost::startFile(const std::string& path) {
   lua_pushlstring(L_, p.data(), p.size());
   lua_setfield(L_, -2, "path");
   lua_pop(L_, 1);
-  return startLoaded(luaL_loadfilex(L_, path.c_str(), "t"));
+  int status = luaL_loadfilex(L_, path.c_str(), "t");
+  if (status == LUA_OK) {
+    std::error_code ignored;
+    loadedFiles_.push_back(fs::absolute(path, ignored).lexically_normal().string());
+  }
+  if (mode == StartMode::Run) return startLoaded(status);
+  trial_ = true;
+  trialError_.reset();
+  auto started = startLoaded(status);
+  trial_ = false;
+  if (started && trialError_) return Unexpected{*trialError_};
+  return started;
 }
 
 Result<bool, std::string> ScriptHost::startString(const std::string& code,
@@ -220,7 +404,11 @@ void ScriptHost::sleepCurrent(lua_State* co, Duration delay) {
 void ScriptHost::resume(lua_State* co, int nargs) {
   if (!tasks_.count(co)) return;
   int nres = 0;
-  int status = lua_resume(co, L_, nargs, &nres);
+  int status;
+  {
+    interrupt::Scope scope(co, interrupt::Kind::Callback);
+    status = lua_resume(co, L_, nargs, &nres);
+  }
   std::string error;
   if (status == LUA_YIELD) {
     lua_pop(co, nres);
@@ -248,6 +436,11 @@ void ScriptHost::endTask(lua_State* co, const std::string& error) {
   if (wasMain) {
     mainTask_ = nullptr;
     mainFinished_ = true;
+  }
+  if (wasMain && trial_ && !error.empty()) {  // a trial start gives the error back instead
+    mainFailed_ = true;
+    trialError_ = error;
+    return;
   }
   if (!error.empty()) reportError(where, error);
   if (wasMain && !error.empty()) {

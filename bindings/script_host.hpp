@@ -33,6 +33,9 @@ struct HostOptions {
   std::uint64_t seed = 1;                  // math.randomseed
   std::vector<std::string> library_paths;  // extra folders searched by require
   std::string results;                     // --results FILE (pitwall.resultsFile), empty: none
+  // Made detached: the cars' events reach this world only after attach() (a hot reload's new
+  // version, until it has started).
+  bool detached = false;
 };
 
 class ScriptHost {
@@ -51,7 +54,10 @@ class ScriptHost {
 
   // Loads SCRIPT and starts its main chunk as a task (so it may pitwall.sleep). A script that
   // does not load gives "FILE:LINE: message". Its folder joins the require path.
-  Result<bool, std::string> startFile(const std::string& path);
+  // As a Trial, an error in the main chunk before its first sleep is returned instead of being
+  // reported, and does not stop the run (a hot reload then keeps the old version).
+  enum class StartMode { Run, Trial };
+  Result<bool, std::string> startFile(const std::string& path, StartMode mode = StartMode::Run);
   // Same for a chunk of text (tests, benchmarks).
   Result<bool, std::string> startString(const std::string& code, const std::string& chunkname);
   bool mainFinished() const { return mainFinished_; }
@@ -65,6 +71,22 @@ class ScriptHost {
   // The same with no results, for a caller that pushed lua::traceback itself right under the
   // function (the event hot path: no stack rotation). Pops the handler too.
   bool callAboveHandler(int nargs, const char* what, const AnkiCar* car = nullptr);
+  // A chunk typed at the REPL (the function under the top `nargs` values): Ctrl-C interrupts
+  // it, the callback budget does not apply. On failure returns false with the message and
+  // traceback in `error` (not reported: the REPL prints it). Results are left on the stack.
+  bool callInteractive(int nargs, int nresults, std::string& error);
+  // The same for a call from the engine that wants the error rather than a report (a hot
+  // reload's onReload hook): budgeted like any callback.
+  bool callCapturing(int nargs, int nresults, std::string& error);
+
+  // Routes the cars' events (and cars that join) into this world; detach() hands them back.
+  void attach();
+  void detach();
+  bool attached() const { return attached_; }
+
+  // The files this world loaded from disk: the script and every module found by require.
+  const std::vector<std::string>& loadedFiles() const { return loadedFiles_; }
+  std::function<void(const std::string& path)> onFileLoaded;
   // Reports a script error: to pitwall.onError if set, else the log; in test mode, a failure.
   void reportError(const std::string& where, const std::string& message);
 
@@ -101,6 +123,10 @@ class ScriptHost {
     TimePoint due{};
   };
   void openLibraries();
+  void trackRequire();
+  void carJoined(AnkiCar& car);
+  static int searchAndRecord(lua_State* L);
+  bool protectedCall(int nargs, int nresults, std::string& error, bool console);
   bool finishCall(int status, const char* what, const AnkiCar* car);
   void resume(lua_State* co, int nargs);
   void endTask(lua_State* co, const std::string& error);  // error empty: it returned
@@ -123,6 +149,11 @@ class ScriptHost {
   bool inOnError_ = false;
   std::optional<std::string> failure_;
   int errors_ = 0;
+  bool attached_ = false;
+  std::function<void(AnkiCar&)> previousOnCar_;
+  bool trial_ = false;
+  std::optional<std::string> trialError_;
+  std::vector<std::string> loadedFiles_;
 };
 
 }  // namespace pitwall

@@ -21,13 +21,33 @@ struct RunOptions {
   std::vector<std::string> carAddresses;  // --car ADDR (repeatable): only these; empty: all found
   std::vector<std::string> adapters;      // --adapter hciN (repeatable); empty: every adapter
   double scanTimeout = 5;                 // seconds to look for cars before the script starts
+  // Issue 5: a prompt beside the script, reload on save, the callback budget.
+  bool repl = false;    // --repl: open the REPL in the script's Lua world
+  bool watch = false;   // --watch: reload the script when one of its files is saved
+  double budget = 0.1;  // --budget SECONDS a callback may run before it is interrupted; 0: off
+  std::string history;  // --history FILE for the REPL; empty: the default (docs/repl.md)
 };
 int run(const RunOptions& options);
+
+// pitwall repl: a Lua prompt with the cars bound, on the simulator (real time) or --ble.
+struct ReplOptions {
+  std::uint64_t seed = 1;
+  int cars = 4;
+  std::string track = "oval";
+  bool ble = false;
+  std::vector<std::string> carAddresses;
+  std::vector<std::string> adapters;
+  double scanTimeout = 5;
+  double budget = 0.1;  // for callbacks the user sets up at the prompt
+  std::string history;  // empty: the default history file (docs/repl.md)
+};
+int repl(const ReplOptions& options);
 
 struct TestOptions {
   std::vector<std::string> paths;
   std::uint64_t seed = 1;
   double timeout = 600;  // seconds of virtual time per scenario
+  double budget = 0.1;   // seconds a callback may run (real time) before it is interrupted
 };
 int test(const TestOptions& options);
 

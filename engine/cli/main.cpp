@@ -49,6 +49,44 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber)
       ->needs(bleFlag);
 
+  auto* replFlag = runCmd->add_flag("--repl", run.repl,
+                                    "Open a Lua prompt beside the script, in the same Lua world");
+  runCmd->add_flag("--watch", run.watch,
+                   "Reload the script when one of its files is saved (docs/hot-reload.md)");
+  runCmd
+      ->add_option("--budget", run.budget,
+                   "Seconds a callback may run before it is interrupted (default 0.1; 0: no limit)")
+      ->check(CLI::NonNegativeNumber);
+  runCmd->add_option("--history", run.history, "With --repl: the history file")->needs(replFlag);
+  // A prompt needs the real clock: virtual time would race ahead while the operator types.
+  replFlag->excludes(fastFlag);
+
+  cli::ReplOptions repl;
+  auto* replCmd = app.add_subcommand(
+      "repl", "A Lua prompt with the cars bound; the simulator runs behind it in real time");
+  replCmd->add_option("--seed", repl.seed, "Seed of the simulator");
+  auto* replCars = replCmd->add_option("--cars", repl.cars, "Simulated cars (default 4)")
+                       ->check(CLI::Range(0, 64));
+  auto* replTrack = replCmd->add_option("--track", repl.track, "Track layout (default oval)");
+  auto* replBle =
+      replCmd->add_flag("--ble", repl.ble, "Real cars over Bluetooth LE instead of the simulator");
+  replBle->excludes(replCars)->excludes(replTrack);
+  replCmd->add_option("--car", repl.carAddresses, "With --ble: only this car (repeatable)")
+      ->needs(replBle);
+  replCmd->add_option("--adapter", repl.adapters, "With --ble: use this controller (repeatable)")
+      ->needs(replBle);
+  replCmd
+      ->add_option("--scan-timeout", repl.scanTimeout,
+                   "With --ble: seconds to look for cars (default 5)")
+      ->check(CLI::PositiveNumber)
+      ->needs(replBle);
+  replCmd
+      ->add_option("--budget", repl.budget,
+                   "Seconds a callback may run before it is interrupted (default 0.1; 0: no limit)")
+      ->check(CLI::NonNegativeNumber);
+  replCmd->add_option("--history", repl.history,
+                      "History file (default $PITWALL_HISTORY, else ~/.pitwall_history)");
+
   cli::ScanOptions scan;
   auto* scanCmd = app.add_subcommand("scan", "List the Anki cars in Bluetooth range");
   scanCmd->add_option("--timeout", scan.timeout, "Seconds to listen (default 5)")
@@ -74,6 +112,10 @@ int main(int argc, char** argv) {
   testCmd->add_option("--seed", test.seed, "Seed of the simulator's and the scripts' randomness");
   testCmd->add_option("--timeout", test.timeout, "Virtual seconds a scenario may run (default 600)")
       ->check(CLI::PositiveNumber);
+  testCmd
+      ->add_option("--budget", test.budget,
+                   "Seconds a callback may run before it is interrupted (default 0.1; 0: no limit)")
+      ->check(CLI::NonNegativeNumber);
 
   std::string protocol;
   std::vector<std::string> words;
@@ -111,6 +153,7 @@ int main(int argc, char** argv) {
   }
 
   if (runCmd->parsed()) return cli::run(run);
+  if (replCmd->parsed()) return cli::repl(repl);
   if (scanCmd->parsed()) return cli::scan(scan);
   if (emulateCmd->parsed()) return cli::emulateCar(emulate);
   if (testing) {

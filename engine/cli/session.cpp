@@ -22,7 +22,7 @@ Session::Session(ble::CentralOptions options) : loop_(ClockKind::Real), fleet_(l
 }
 
 Session::~Session() {
-  host_.reset();
+  scripts_.reset();
   central_.reset();
   log::setTimeSource(nullptr);
 }
@@ -66,9 +66,9 @@ std::optional<std::string> Session::connectRealCars() {
 }
 
 void Session::startHost(HostOptions options) {
-  host_ =
-      std::make_unique<ScriptHost>(loop_, fleet_, sim_.world ? &sim_ : nullptr, std::move(options));
-  host_->onStopRequested = [this] { finish(); };
+  scripts_ =
+      std::make_unique<Reloader>(loop_, fleet_, sim_.world ? &sim_ : nullptr, std::move(options));
+  scripts_->onStopRequested = [this] { finish(); };
 }
 
 void Session::finish() {

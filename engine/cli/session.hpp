@@ -4,7 +4,7 @@
 #include <memory>
 #include <string>
 
-#include "bindings/script_host.hpp"
+#include "bindings/reloader.hpp"
 #include "engine/core/loop.hpp"
 #include "engine/vehicles/ble_central.hpp"
 #include "engine/vehicles/fleet.hpp"
@@ -23,7 +23,8 @@ class Session {
   Loop& loop() { return loop_; }
   Fleet& fleet() { return fleet_; }
   SimSession& sim() { return sim_; }
-  ScriptHost& host() { return *host_; }
+  ScriptHost& host() { return scripts_->host(); }  // the Lua world now (hot reload replaces it)
+  Reloader& scripts() { return *scripts_; }
 
   void record(const std::string& path);  // throws std::runtime_error naming the file
   // Puts `count` cars on the starting grid and runs the loop until all are connected.
@@ -41,7 +42,7 @@ class Session {
   Fleet fleet_;
   std::unique_ptr<Recorder> recorder_;
   std::unique_ptr<ble::Central> central_;  // real cars; after the fleet: its links live there
-  std::unique_ptr<ScriptHost> host_;
+  std::unique_ptr<Reloader> scripts_;
   bool finishing_ = false;
 };
 

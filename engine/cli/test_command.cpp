@@ -1,9 +1,11 @@
 // pitwall test [PATH…]: scenario scripts in virtual time, each in a world of its own.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 
+#include "bindings/interrupt.hpp"
 #include "engine/cli/commands.hpp"
 #include "engine/cli/session.hpp"
 #include "engine/core/log.hpp"
@@ -89,6 +91,7 @@ int test(const TestOptions& options) {
     std::cerr << "pitwall test: " << files.error() << "\n";
     return 2;
   }
+  interrupt::setBudget(std::chrono::milliseconds(std::lround(options.budget * 1000)));
   int passed = 0, failed = 0;
   for (const auto& file : *files) {
     auto begin = std::chrono::steady_clock::now();

@@ -39,7 +39,7 @@ function Board.gap(seconds, laps)
 end
 
 --- A board with `spec.columns` ({key, title, align = "left"|"right", format = fn(value, row)})
---- and an optional `spec.title`. `spec.out` (default io.stdout) and `spec.tty` (default: ask
+--- and an optional `spec.title`. `spec.out` (default pitwall.stdout) and `spec.tty` (default: ask
 --- pitwall.terminal()) are for tests.
 function Board.new(spec)
   if type(spec) ~= "table" or type(spec.columns) ~= "table" or #spec.columns == 0 then
@@ -53,7 +53,7 @@ function Board.new(spec)
   return setmetatable({
     title = spec.title,
     columns = spec.columns,
-    out = spec.out or io.stdout,
+    out = spec.out or pitwall.stdout,
     tty = tty,
     drawn = 0, -- lines of the last live drawing
   }, Board)

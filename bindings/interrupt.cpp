@@ -1,0 +1,250 @@
+#include "bindings/interrupt.hpp"
+
+#include <pthread.h>
+#include <signal.h>
+
+#include <atomic>
+#include <cerrno>
+#include <mutex>
+#include <thread>
+
+namespace pitwall::interrupt {
+
+namespace {
+
+enum Reason : int { kNone = 0, kUser = 1, kBudget = 2 };
+
+// All of this is written on the loop's thread; the watchdog only reads. The signal handler runs
+// on the loop's thread too (the watchdog sends it there), so it sees the loop's own writes.
+std::atomic<lua_State*> g_running{nullptr};  // the Lua thread running now, if any
+std::atomic<int> g_depth{0};                 // scopes on the stack
+std::atomic<int> g_kind{0};                  // Kind of the outermost scope
+std::atomic<std::uint64_t> g_call{0};        // numbers the outermost scopes
+std::atomic<std::uint64_t> g_target{0};      // the call the watchdog found over budget
+std::atomic<int> g_reason{kNone};            // why the current call is being interrupted
+std::atomic<std::uint64_t> g_reasonCall{0};  // … and which call that is
+std::atomic<long long> g_budgetMs{100};
+std::atomic<pthread_t> g_loopThread{};
+static_assert(std::atomic<lua_State*>::is_always_lock_free);
+static_assert(std::atomic<std::uint64_t>::is_always_lock_free);
+static_assert(std::atomic<pthread_t>::is_always_lock_free);
+
+void hook(lua_State* L, lua_Debug*) {
+  int reason = g_reason.load(std::memory_order_relaxed);
+  if (reason == kNone ||
+      g_reasonCall.load(std::memory_order_relaxed) != g_call.load(std::memory_order_relaxed)) {
+    lua_sethook(L, nullptr, 0, 0);  // left over from a call that has ended: remove itself
+    return;
+  }
+  // The hook stays set: code that catches this error with pcall is interrupted again at its
+  // next instruction, until the engine's call returns.
+  if (reason == kUser) luaL_error(L, "interrupted");
+  luaL_error(L,
+             "still running after %d ms: interrupted (a callback must return quickly; run long "
+             "work in a task with pitwall.spawn and pitwall.sleep, or raise --budget)",
+             static_cast<int>(g_budgetMs.load(std::memory_order_relaxed)));
+}
+
+constexpr int kHookMask = LUA_MASKCALL | LUA_MASKRET | LUA_MASKLINE | LUA_MASKCOUNT;
+
+void arm(lua_State* L, int reason) {
+  g_reasonCall.store(g_call.load(std::memory_order_relaxed), std::memory_order_relaxed);
+  g_reason.store(reason, std::memory_order_relaxed);
+  lua_sethook(L, hook, kHookMask, 1);  // lua_sethook may be called from a signal handler
+}
+
+void onBudgetSignal(int) {
+  int saved = errno;
+  lua_State* L = g_running.load(std::memory_order_relaxed);
+  if (L && g_depth.load(std::memory_order_relaxed) > 0 &&
+      g_kind.load(std::memory_order_relaxed) == static_cast<int>(Kind::Callback) &&
+      g_target.load(std::memory_order_relaxed) == g_call.load(std::memory_order_relaxed) &&
+      g_reason.load(std::memory_order_relaxed) == kNone)
+    arm(L, kBudget);
+  errno = saved;
+}
+
+// Wakes a quarter budget apart; a call seen in progress twice, a budget apart, is over budget.
+void watch() {
+  std::uint64_t seen = 0;
+  std::chrono::steady_clock::time_point since{};
+  bool sent = false;
+  for (;;) {
+    long long ms = g_budgetMs.load(std::memory_order_relaxed);
+    auto nap = std::chrono::milliseconds(ms > 0 ? std::max(1LL, ms / 4) : 100);
+    std::this_thread::sleep_for(nap);
+    if (ms <= 0) continue;
+    bool busy = g_depth.load(std::memory_order_relaxed) > 0 &&
+                g_kind.load(std::memory_order_relaxed) == static_cast<int>(Kind::Callback);
+    std::uint64_t call = g_call.load(std::memory_order_relaxed);
+    auto now = std::chrono::steady_clock::now();
+    if (!busy) {
+      seen = 0;
+      continue;
+    }
+    if (call != seen) {
+      seen = call;
+      since = now;
+      sent = false;
+      continue;
+    }
+    if (!sent && now - since >= std::chrono::milliseconds(ms)) {
+      g_target.store(call, std::memory_order_relaxed);
+      sent = true;
+      pthread_kill(g_loopThread.load(std::memory_order_relaxed), SIGURG);
+    }
+  }
+}
+
+void startWatchdog() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    struct sigaction sa {};
+    sa.sa_handler = onBudgetSignal;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = SA_RESTART;
+    sigaction(SIGURG, &sa, nullptr);
+    // The watchdog takes no signals: SIGINT and SIGURG must reach the loop's thread, where the
+    // Lua code runs. It lives as long as the process and touches only the atomics.
+    sigset_t all, old;
+    sigfillset(&all);
+    pthread_sigmask(SIG_BLOCK, &all, &old);
+    std::thread(watch).detach();
+    pthread_sigmask(SIG_SETMASK, &old, nullptr);
+  });
+}
+
+// coroutine.resume and coroutine.wrap that say which thread runs.
+int resumeIn(lua_State* L, lua_State* co, int nargs) {
+  if (!lua_checkstack(co, nargs)) {
+    lua_pushliteral(L, "too many arguments to resume");
+    return -1;
+  }
+  lua_xmove(L, co, nargs);
+  int nres = 0;
+  int status;
+  {
+    Running running(co);
+    status = lua_resume(co, L, nargs, &nres);
+  }
+  if (status == LUA_OK || status == LUA_YIELD) {
+    if (!lua_checkstack(L, nres + 1)) {
+      lua_pop(co, nres);
+      lua_pushliteral(L, "too many results to resume");
+      return -1;
+    }
+    lua_xmove(co, L, nres);
+    return nres;
+  }
+  lua_xmove(co, L, 1);  // the error
+  return -1;
+}
+
+int trackedResume(lua_State* L) {
+  lua_State* co = lua_tothread(L, 1);
+  luaL_argexpected(L, co, 1, "coroutine");
+  int r = resumeIn(L, co, lua_gettop(L) - 1);
+  lua_pushboolean(L, r >= 0);
+  lua_insert(L, r >= 0 ? -(r + 1) : -2);
+  return r >= 0 ? r + 1 : 2;
+}
+
+int wrapped(lua_State* L) {
+  lua_State* co = lua_tothread(L, lua_upvalueindex(1));
+  int r = resumeIn(L, co, lua_gettop(L));
+  if (r >= 0) return r;
+  int status = lua_status(co);
+  if (status != LUA_OK && status != LUA_YIELD) {  // the coroutine died: close it, as 5.4 does
+#if LUA_VERSION_RELEASE_NUM >= 50406
+    lua_closethread(co, L);
+#else
+    lua_resetthread(co);
+#endif
+    lua_xmove(co, L, 1);
+  }
+  if (lua_type(L, -1) == LUA_TSTRING) {  // where the wrapper was called, as 5.4 adds
+    luaL_where(L, 1);
+    lua_insert(L, -2);
+    lua_concat(L, 2);
+  }
+  return lua_error(L);
+}
+
+int trackedWrap(lua_State* L) {
+  luaL_checktype(L, 1, LUA_TFUNCTION);
+  lua_State* co = lua_newthread(L);
+  lua_pushvalue(L, 1);
+  lua_xmove(L, co, 1);
+  lua_pushcclosure(L, wrapped, 1);
+  return 1;
+}
+
+}  // namespace
+
+Scope::Scope(lua_State* running, Kind kind)
+    : outermost_(g_depth.load(std::memory_order_relaxed) == 0),
+      previous_(g_running.load(std::memory_order_relaxed)) {
+  if (outermost_) {
+    g_call.store(g_call.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+    g_kind.store(static_cast<int>(kind), std::memory_order_relaxed);
+  }
+  g_running.store(running, std::memory_order_relaxed);
+  std::atomic_signal_fence(std::memory_order_seq_cst);
+  g_depth.store(g_depth.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+}
+
+Scope::~Scope() {
+  g_depth.store(g_depth.load(std::memory_order_relaxed) - 1, std::memory_order_relaxed);
+  std::atomic_signal_fence(std::memory_order_seq_cst);
+  g_running.store(previous_, std::memory_order_relaxed);
+  if (outermost_) g_reason.store(kNone, std::memory_order_relaxed);  // hooks remove themselves
+}
+
+Running::Running(lua_State* co) : previous_(g_running.load(std::memory_order_relaxed)) {
+  g_running.store(co, std::memory_order_relaxed);
+  // Interrupted while switching threads: the new one is interrupted too.
+  if (g_reason.load(std::memory_order_relaxed) != kNone &&
+      g_reasonCall.load(std::memory_order_relaxed) == g_call.load(std::memory_order_relaxed))
+    lua_sethook(co, hook, kHookMask, 1);
+}
+
+Running::~Running() {
+  g_running.store(previous_, std::memory_order_relaxed);
+}
+
+void setBudget(std::chrono::milliseconds budget) {
+  g_budgetMs.store(budget.count() > 0 ? budget.count() : 0, std::memory_order_relaxed);
+  if (budget.count() > 0 && g_loopThread.load(std::memory_order_relaxed) != pthread_t{})
+    startWatchdog();
+}
+
+void watchThisThread() {
+  g_loopThread.store(pthread_self(), std::memory_order_relaxed);
+  if (g_budgetMs.load(std::memory_order_relaxed) > 0) startWatchdog();
+}
+
+std::chrono::milliseconds budget() {
+  return std::chrono::milliseconds(g_budgetMs.load(std::memory_order_relaxed));
+}
+
+bool requestFromSignal() {
+  lua_State* L = g_running.load(std::memory_order_relaxed);
+  if (!L || g_depth.load(std::memory_order_relaxed) == 0) return false;
+  arm(L, kUser);
+  return true;
+}
+
+void openCoroutineTracking(lua_State* L) {
+  lua_getglobal(L, "coroutine");
+  if (!lua_istable(L, -1)) {
+    lua_pop(L, 1);
+    return;
+  }
+  lua_pushcfunction(L, trackedResume);
+  lua_setfield(L, -2, "resume");
+  lua_pushcfunction(L, trackedWrap);
+  lua_setfield(L, -2, "wrap");
+  lua_pop(L, 1);
+}
+
+}  // namespace pitwall::interrupt

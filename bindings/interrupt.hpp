@@ -1,0 +1,64 @@
+#pragma once
+// Stopping Lua code that does not return: a runaway callback (the time budget, default 100 ms)
+// and a chunk typed at the REPL (Ctrl-C). Both work the way lua.c's Ctrl-C does: a hook is set
+// on the running Lua thread from a signal handler on the loop's own thread, and the hook raises
+// an error at the next instruction. The hook stays set until the engine's call returns, so code
+// cannot pcall its way out (Redis's rule). Nothing is paid on the hot path but two relaxed
+// atomic stores per call into Lua: no count hook runs while nothing is wrong.
+//
+// The budget is watched by one thread that only reads the start time of the call in progress;
+// when a call is over budget it signals the loop's thread (SIGURG), whose handler sets the hook.
+#include <lua.hpp>
+
+#include <chrono>
+
+namespace pitwall::interrupt {
+
+enum class Kind {
+  Callback,  // a call from the engine (event, timer, task): subject to the budget
+  Console,   // a chunk typed at the REPL: no budget, Ctrl-C interrupts it
+};
+
+// Around every call from the engine into Lua (ScriptHost does this). Only the outermost scope
+// on the stack counts; nested ones (a handler that triggers an event) are free.
+class Scope {
+ public:
+  Scope(lua_State* running, Kind kind);
+  ~Scope();
+  Scope(const Scope&) = delete;
+  Scope& operator=(const Scope&) = delete;
+
+ private:
+  bool outermost_;
+  lua_State* previous_;
+};
+
+// The Lua thread now running changes (a task's coroutine resumed inside a scope, or a coroutine
+// the script resumes itself): the hook must go on the thread that runs.
+class Running {
+ public:
+  explicit Running(lua_State* co);
+  ~Running();
+  Running(const Running&) = delete;
+  Running& operator=(const Running&) = delete;
+
+ private:
+  lua_State* previous_;
+};
+
+// The budget for Kind::Callback calls; zero turns it off. Default 100 ms.
+void setBudget(std::chrono::milliseconds budget);
+std::chrono::milliseconds budget();
+// The calling thread runs the Lua code (ScriptHost's constructor says so): the watchdog signals
+// it. Starts the watchdog (once) while the budget is on.
+void watchThisThread();
+
+// For a SIGINT handler (async-signal-safe): interrupts the Lua code running now with the error
+// "interrupted". Returns false when no Lua code is running (the caller then cancels the line).
+bool requestFromSignal();
+
+// Replaces coroutine.resume and coroutine.wrap in L with versions that tell the interrupter
+// which thread runs (so a runaway loop inside a script's own coroutine is caught too).
+void openCoroutineTracking(lua_State* L);
+
+}  // namespace pitwall::interrupt

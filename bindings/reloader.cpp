@@ -1,0 +1,281 @@
+#include "bindings/reloader.hpp"
+
+#include <cstdio>
+#include <filesystem>
+
+#include "bindings/car_binding.hpp"
+#include "bindings/lua_support.hpp"
+#include "engine/core/log.hpp"
+
+namespace pitwall {
+
+namespace {
+
+// Deep copy between two Lua worlds; tables already copied are found again through `memo` (a
+// table on `to`'s stack keyed by the source table's address), so sharing and cycles survive.
+class Copier {
+ public:
+  Copier(lua_State* from, lua_State* to, std::vector<std::string>& dropped)
+      : from_(from), to_(to), dropped_(dropped) {}
+
+  // Copies the value at `from` index idx onto `to`'s stack; false (nothing pushed) when it
+  // cannot be copied.
+  bool copy(int idx, const std::string& path, int depth) {
+    idx = lua_absindex(from_, idx);
+    switch (lua_type(from_, idx)) {
+      case LUA_TNIL:
+        lua_pushnil(to_);
+        return true;
+      case LUA_TBOOLEAN:
+        lua_pushboolean(to_, lua_toboolean(from_, idx));
+        return true;
+      case LUA_TNUMBER:
+        if (lua_isinteger(from_, idx))
+          lua_pushinteger(to_, lua_tointeger(from_, idx));
+        else
+          lua_pushnumber(to_, lua_tonumber(from_, idx));
+        return true;
+      case LUA_TSTRING: {
+        size_t n = 0;
+        const char* s = lua_tolstring(from_, idx, &n);
+        lua_pushlstring(to_, s, n);
+        return true;
+      }
+      case LUA_TTABLE:
+        return table(idx, path, depth);
+      case LUA_TUSERDATA:
+        if (AnkiCar* car = CarBinding::test(from_, idx)) {
+          ScriptHost::from(to_).cars().push(to_, *car);
+          return true;
+        }
+        break;
+      default:
+        break;
+    }
+    dropped_.push_back(path + " (a " + luaL_typename(from_, idx) + ")");
+    return false;
+  }
+
+  void openMemo() {
+    lua_newtable(to_);
+    memo_ = lua_gettop(to_);
+  }
+  void closeMemo() { lua_remove(to_, memo_); }
+
+ private:
+  bool table(int idx, const std::string& path, int depth) {
+    if (depth > 200 || !lua_checkstack(to_, 8) || !lua_checkstack(from_, 8)) {
+      dropped_.push_back(path + " (nested too deep)");
+      return false;
+    }
+    const void* key = lua_topointer(from_, idx);
+    if (lua_rawgetp(to_, memo_, key) == LUA_TTABLE) return true;
+    lua_pop(to_, 1);
+    lua_newtable(to_);
+    lua_pushvalue(to_, -1);
+    lua_rawsetp(to_, memo_, key);
+    if (lua_getmetatable(from_, idx)) {
+      lua_pop(from_, 1);
+      dropped_.push_back(path + "'s metatable");
+    }
+    lua_pushnil(from_);
+    while (lua_next(from_, idx)) {  // raw traversal: no __pairs, no __index
+      std::string keyPath = path + keyText(-2);
+      if (copy(-2, keyPath + " (as a key)", depth + 1)) {
+        if (copy(-1, keyPath, depth + 1))
+          lua_rawset(to_, -3);
+        else
+          lua_pop(to_, 1);
+      }
+      lua_pop(from_, 1);
+    }
+    return true;
+  }
+
+  std::string keyText(int idx) {
+    if (lua_type(from_, idx) == LUA_TSTRING) return "." + std::string(lua_tostring(from_, idx));
+    if (lua_type(from_, idx) == LUA_TNUMBER) {
+      lua_pushvalue(from_, idx);  // tostring of a copy: lua_next needs the key unchanged
+      std::string s = "[" + std::string(lua_tostring(from_, -1)) + "]";
+      lua_pop(from_, 1);
+      return s;
+    }
+    return std::string("[") + luaL_typename(from_, idx) + "]";
+  }
+
+  lua_State* from_;
+  lua_State* to_;
+  std::vector<std::string>& dropped_;
+  int memo_ = 0;
+};
+
+}  // namespace
+
+void copyPersist(ScriptHost& from, ScriptHost& to, std::vector<std::string>& dropped) {
+  lua_State* F = from.state();
+  lua_State* T = to.state();
+  int fromTop = lua_gettop(F);
+  Copier copier(F, T, dropped);
+  copier.openMemo();
+  lua_getglobal(F, "pitwall");
+  bool copied = lua_istable(F, -1) && lua_getfield(F, -1, "persist") == LUA_TTABLE &&
+                copier.copy(-1, "pitwall.persist", 0);
+  if (!copied) lua_newtable(T);
+  copier.closeMemo();
+  lua_settop(F, fromTop);
+}
+
+Reloader::Reloader(Loop& loop, Fleet& fleet, SimSession* sim, HostOptions options)
+    : loop_(loop), fleet_(fleet), sim_(sim), options_(std::move(options)) {
+  current_ = makeWorld(false);
+}
+
+Reloader::~Reloader() {
+  watch_.reset();
+  current_.reset();
+}
+
+std::unique_ptr<ScriptHost> Reloader::makeWorld(bool detached) {
+  HostOptions options = options_;
+  options.detached = detached;
+  auto host = std::make_unique<ScriptHost>(loop_, fleet_, sim_, std::move(options));
+  host->onFileLoaded = [this](const std::string& path) { watchFile(path); };
+  hookStop(*host);
+  return host;
+}
+
+void Reloader::hookStop(ScriptHost& host) {
+  host.onStopRequested = [this, &host] {
+    if (&host != current_.get()) return;  // a version still on trial asks for nothing
+    if (keepRunning_ && host.mainFailed()) {
+      fleet_.stopAll();
+      log::warn("pitwall",
+                "the script stopped with an error; its cars are stopped. Save a fix and it "
+                "reloads" +
+                    std::string(watch_ ? "" : " (with --watch)"));
+      return;
+    }
+    if (onStopRequested) onStopRequested();
+  };
+}
+
+Result<bool, std::string> Reloader::start(const std::string& script) {
+  script_ = script;
+  return current_->startFile(script);
+}
+
+Result<bool, std::string> Reloader::reload(const std::vector<std::string>& changed) {
+  auto began = std::chrono::steady_clock::now();
+  auto refuse = [this](std::string error) -> Result<bool, std::string> {
+    ++stats_.failures;
+    return Unexpected{std::move(error)};
+  };
+  if (script_.empty()) return refuse("there is no script to reload");
+  auto next = makeWorld(true);
+
+  // 1. It must compile before the running version hears of it.
+  lua_State* N = next->state();
+  if (luaL_loadfilex(N, script_.c_str(), "t") != LUA_OK) {
+    std::string error = lua_tostring(N, -1) ? lua_tostring(N, -1) : "cannot load the script";
+    return refuse(error);
+  }
+  lua_pop(N, 1);
+
+  // 2. The running version's last word: pitwall.onUnload(persist).
+  ScriptHost& old = *current_;
+  lua_State* O = old.state();
+  int top = lua_gettop(O);
+  lua_getglobal(O, "pitwall");
+  if (lua_istable(O, -1) && lua_getfield(O, -1, "onUnload") == LUA_TFUNCTION) {
+    lua_getfield(O, -2, "persist");
+    old.call(1, 0, "pitwall.onUnload");
+  }
+  lua_settop(O, top);
+
+  // 3. What survives: pitwall.persist, copied into the new world.
+  std::vector<std::string> dropped;
+  copyPersist(old, *next, dropped);
+  lua_getglobal(N, "pitwall");
+  lua_insert(N, -2);
+  lua_setfield(N, -2, "persist");
+  lua_pushinteger(N, stats_.reloads + 1);
+  lua_setfield(N, -2, "reloads");
+  lua_pop(N, 1);
+  for (const auto& d : dropped)
+    log::warn("reload", d + " cannot cross into the new version; left out");
+
+  // 4. The new version starts, up to its first sleep; then its pitwall.onReload(persist, info).
+  if (auto started = next->startFile(script_, ScriptHost::StartMode::Trial); !started)
+    return refuse(started.error());
+  lua_getglobal(N, "pitwall");
+  if (lua_getfield(N, -1, "onReload") == LUA_TFUNCTION) {
+    lua_getfield(N, -2, "persist");
+    lua_createtable(N, 0, 2);
+    lua::setInteger(N, "reloads", stats_.reloads + 1);
+    lua_createtable(N, static_cast<int>(changed.size()), 0);
+    for (std::size_t i = 0; i < changed.size(); ++i) {
+      lua_pushlstring(N, changed[i].data(), changed[i].size());
+      lua_rawseti(N, -2, static_cast<lua_Integer>(i + 1));
+    }
+    lua_setfield(N, -2, "files");
+    std::string error;
+    bool ok = next->callCapturing(2, 0, error);
+    lua_pop(N, 1);
+    if (!ok) return refuse("pitwall.onReload: " + error);
+  } else {
+    lua_pop(N, 2);
+  }
+
+  // 5. The swap: the cars' events go to the new version from the next one on; the old
+  // version's timers, tasks and handlers die with its Lua world.
+  old.detach();
+  next->attach();
+  std::unique_ptr<ScriptHost> retired = std::move(current_);
+  current_ = std::move(next);
+  ++stats_.reloads;
+  stats_.last = std::chrono::steady_clock::now() - began;
+  retired.reset();
+  if (onNewVersion) onNewVersion(*current_);
+  return true;
+}
+
+Result<bool, std::string> Reloader::watch(Duration debounce) {
+  try {
+    watch_ = std::make_unique<FileWatch>(loop_, debounce);
+  } catch (const std::exception& e) {
+    return Unexpected{std::string("cannot watch the script's files: ") + e.what()};
+  }
+  watch_->onChange = [this](const std::vector<std::string>& paths) { changed(paths); };
+  if (!script_.empty()) {
+    if (auto added = watch_->add(script_); !added) return Unexpected{added.error()};
+  }
+  for (const auto& f : current_->loadedFiles()) watchFile(f);
+  return true;
+}
+
+void Reloader::watchFile(const std::string& path) {
+  if (!watch_) return;
+  for (const auto& w : watched_)
+    if (w == path) return;
+  watched_.push_back(path);
+  if (auto added = watch_->add(path); !added)
+    log::warn("reload", "not watching " + path + ": " + added.error());
+}
+
+void Reloader::changed(const std::vector<std::string>& paths) {
+  std::string names;
+  for (const auto& p : paths)
+    names += (names.empty() ? "" : ", ") + std::filesystem::path(p).filename().string();
+  auto reloaded = reload(paths);
+  if (!reloaded) {
+    log::error("reload", names + " changed; the new version was not started: " + reloaded.error() +
+                             "\n  the running version carries on");
+    return;
+  }
+  char took[32];
+  std::snprintf(took, sizeof took, "%.1f ms", toSeconds(stats_.last) * 1000);
+  log::info("reload", names + " changed: version " + std::to_string(stats_.reloads + 1) +
+                          " took over in " + took);
+}
+
+}  // namespace pitwall
