@@ -92,15 +92,21 @@ class Copier {
     return true;
   }
 
+  // How a key reads in a path: ".name", "[3]", "[boolean]". (Built with append: GCC 12's
+  // -Wrestrict misfires on "literal" + std::string in optimised builds.)
   std::string keyText(int idx) {
-    if (lua_type(from_, idx) == LUA_TSTRING) return "." + std::string(lua_tostring(from_, idx));
-    if (lua_type(from_, idx) == LUA_TNUMBER) {
+    std::string text;
+    int type = lua_type(from_, idx);
+    if (type == LUA_TSTRING) {
+      text.append(".").append(lua_tostring(from_, idx));
+    } else if (type == LUA_TNUMBER) {
       lua_pushvalue(from_, idx);  // tostring of a copy: lua_next needs the key unchanged
-      std::string s = "[" + std::string(lua_tostring(from_, -1)) + "]";
+      text.append("[").append(lua_tostring(from_, -1)).append("]");
       lua_pop(from_, 1);
-      return s;
+    } else {
+      text.append("[").append(luaL_typename(from_, idx)).append("]");
     }
-    return std::string("[") + luaL_typename(from_, idx) + "]";
+    return text;
   }
 
   lua_State* from_;

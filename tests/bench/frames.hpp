@@ -1,6 +1,9 @@
 #pragma once
-// The frames the benchmarks feed the engine.
+// The frames the benchmarks feed the engine, and a link that takes them in.
+#include <string>
+
 #include "engine/protocol/anki/codec.hpp"
+#include "engine/transport/link.hpp"
 
 namespace pitwall::bench {
 
@@ -16,5 +19,17 @@ inline anki::Frame positionFrame() {
   m.last_desired_speed_mm_s = 650;
   return anki::encode(m);
 }
+
+// A link that accepts everything and delivers nothing: frames enter through AnkiCar::receive.
+class BenchLink final : public Link {
+ public:
+  bool send(std::span<const std::uint8_t>) override { return true; }
+  bool connected() const override { return true; }
+  void disconnect() override {}
+  std::string address() const override { return "bench"; }
+};
+
+// Byte 2 of a position update is its location id ([size][id][location][piece]…).
+constexpr std::size_t kLocationByte = 2;
 
 }  // namespace pitwall::bench

@@ -25,19 +25,9 @@
 namespace {
 
 using namespace pitwall;
+using bench::BenchLink;
+using bench::kLocationByte;
 using bench::positionFrame;
-
-// A link that accepts everything and delivers nothing: frames enter through AnkiCar::receive.
-class BenchLink final : public Link {
- public:
-  bool send(std::span<const std::uint8_t>) override { return true; }
-  bool connected() const override { return true; }
-  void disconnect() override {}
-  std::string address() const override { return "bench"; }
-};
-
-// Byte 2 of a position update is its location id ([size][id][location][piece]…).
-constexpr std::size_t kLocationByte = 2;
 
 // The handler of the path and the function of the floor do the same work.
 constexpr const char* kPathHandler =
