@@ -1,13 +1,53 @@
-// pitwall repl (placeholder until the REPL lands; being written now).
+// pitwall repl: a Lua prompt with the cars bound (docs/repl.md). The simulator runs behind it in
+// real time, or real cars are driven over Bluetooth LE with --ble.
 #include <iostream>
 
 #include "engine/cli/commands.hpp"
+#include "engine/cli/repl.hpp"
+#include "engine/cli/session.hpp"
+#include "engine/core/log.hpp"
 
 namespace pitwall::cli {
 
-int repl(const ReplOptions&) {
-  std::cerr << "pitwall repl: not built yet\n";
-  return 2;
+namespace {
+
+std::string banner(const ReplOptions& options, std::size_t cars) {
+  std::string where =
+      options.ble ? "over Bluetooth LE" : "on the simulator (" + options.track + ", real time)";
+  return "pitwall repl: " + std::to_string(cars) + (cars == 1 ? " car " : " cars ") + where +
+         " as `cars`; :help for commands and keys, Ctrl-D to quit\n";
+}
+
+}  // namespace
+
+int repl(const ReplOptions& options) {
+  // Real time: the world must not race ahead while the operator types.
+  auto made = Session::open(options, false, "repl");
+  if (!made) return 2;
+  Session& session = *made;
+  Loop& loop = session.loop();
+  // Until the prompt is up, Ctrl-C and SIGTERM end the start-up (the cars are stopped); once it
+  // is, SIGINT is the REPL's and SIGTERM stays with the session.
+  if (int status = session.connectCars("repl"); status != 0) return status;
+
+  HostOptions host;
+  host.seed = options.seed;
+  try {
+    session.startHost(host);
+  } catch (const std::exception& e) {
+    std::cerr << "pitwall repl: " << e.what() << "\n";
+    return 1;
+  }
+
+  Repl prompt(loop, [&]() -> ScriptHost& { return session.host(); },
+              {replHistoryFile(options.history)});
+  prompt.onQuit = [&] { session.finish(); };
+  session.releaseSigint();  // the REPL's own handler takes SIGINT from here on
+  if (prompt.interactive()) prompt.print(banner(options, session.fleet().cars().size()));
+  prompt.start();
+  loop.run();  // ends through Session::finish: :quit, Ctrl-D, end of input, SIGTERM, pitwall.stop()
+  if (session.interrupted()) return 130;
+  return !prompt.interactive() && prompt.failures() > 0 ? 1 : 0;
 }
 
 }  // namespace pitwall::cli
