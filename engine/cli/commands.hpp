@@ -7,38 +7,33 @@
 
 namespace pitwall::cli {
 
-struct RunOptions {
-  std::string script;
-  bool fast = false;
-  std::optional<double> duration;  // seconds of engine time
-  std::uint64_t seed = 1;
-  int cars = 4;
+// Where the cars of a run or a REPL come from: the simulator's starting grid, or real cars over
+// Bluetooth LE through BlueZ (docs/bluetooth.md).
+struct CarSource {
+  std::uint64_t seed = 1;  // the simulator's noise and the script's math.random
+  int cars = 4;            // simulated cars on the grid
   std::string track = "oval";
-  std::string record;   // --record FILE, empty: none
-  std::string results;  // --results FILE (.json or .csv), empty: none
-  // Real cars over Bluetooth LE through BlueZ instead of the simulator (docs/bluetooth.md).
   bool ble = false;
   std::vector<std::string> carAddresses;  // --car ADDR (repeatable): only these; empty: all found
   std::vector<std::string> adapters;      // --adapter hciN (repeatable); empty: every adapter
   double scanTimeout = 5;                 // seconds to look for cars before the script starts
-  // Issue 5: a prompt beside the script, reload on save, the callback budget.
-  bool repl = false;    // --repl: open the REPL in the script's Lua world
-  bool watch = false;   // --watch: reload the script when one of its files is saved
   double budget = 0.1;  // --budget SECONDS a callback may run before it is interrupted; 0: off
-  std::string history;  // --history FILE for the REPL; empty: the default (docs/repl.md)
+};
+
+struct RunOptions : CarSource {
+  std::string script;
+  bool fast = false;
+  std::optional<double> duration;  // seconds of engine time
+  std::string record;              // --record FILE, empty: none
+  std::string results;             // --results FILE (.json or .csv), empty: none
+  bool repl = false;               // --repl: open the REPL in the script's Lua world
+  bool watch = false;              // --watch: reload the script when one of its files is saved
+  std::string history;             // --history FILE for the REPL; empty: the default
 };
 int run(const RunOptions& options);
 
 // pitwall repl: a Lua prompt with the cars bound, on the simulator (real time) or --ble.
-struct ReplOptions {
-  std::uint64_t seed = 1;
-  int cars = 4;
-  std::string track = "oval";
-  bool ble = false;
-  std::vector<std::string> carAddresses;
-  std::vector<std::string> adapters;
-  double scanTimeout = 5;
-  double budget = 0.1;  // for callbacks the user sets up at the prompt
+struct ReplOptions : CarSource {
   std::string history;  // empty: the default history file (docs/repl.md)
 };
 int repl(const ReplOptions& options);

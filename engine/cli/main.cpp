@@ -6,6 +6,37 @@
 #include "engine/core/log.hpp"
 #include "engine/protocol/anki/command_text.hpp"
 
+namespace {
+
+// The options that say where the cars come from, shared by `run` and `repl` (docs/cli.md).
+// Returns the --ble flag.
+CLI::Option* addCarSource(CLI::App* cmd, pitwall::cli::CarSource& source, const char* when) {
+  cmd->add_option("--seed", source.seed, "Seed of the simulator's and the script's randomness");
+  auto* cars =
+      cmd->add_option("--cars", source.cars, "Number of simulated cars on the grid (default 4)")
+          ->check(CLI::Range(0, 64));
+  auto* track =
+      cmd->add_option("--track", source.track, "Track layout: a name (oval, …) or a layout file");
+  auto* ble = cmd->add_flag("--ble", source.ble,
+                            "Drive real cars over Bluetooth LE (BlueZ) instead of the simulator");
+  ble->excludes(cars)->excludes(track);  // real cars are on a real track
+  cmd->add_option("--car", source.carAddresses, "With --ble: only this car (repeatable)")
+      ->needs(ble);
+  cmd->add_option("--adapter", source.adapters,
+                  "With --ble: use this controller, hci0, … (repeatable; default: all)")
+      ->needs(ble);
+  cmd->add_option("--scan-timeout", source.scanTimeout,
+                  std::string("With --ble: seconds to look for cars ") + when + " (default 5)")
+      ->check(CLI::PositiveNumber)
+      ->needs(ble);
+  cmd->add_option("--budget", source.budget,
+                  "Seconds a callback may run before it is interrupted (default 0.1; 0: no limit)")
+      ->check(CLI::NonNegativeNumber);
+  return ble;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   using namespace pitwall;
   CLI::App app{"pitwall — an automation engine for robot race cars, scripted in Lua"};
@@ -24,39 +55,16 @@ int main(int argc, char** argv) {
   runCmd
       ->add_option("--duration", run.duration, "End the run after this many seconds of engine time")
       ->check(CLI::PositiveNumber);
-  runCmd->add_option("--seed", run.seed, "Seed of the simulator's and the script's randomness");
-  auto* carsOpt =
-      runCmd->add_option("--cars", run.cars, "Number of simulated cars on the grid (default 4)")
-          ->check(CLI::Range(0, 64));
-  auto* trackOpt =
-      runCmd->add_option("--track", run.track, "Track layout: a name (oval, …) or a layout file");
   runCmd->add_option("--record", run.record, "Write every frame in and out as JSON lines to FILE");
   runCmd->add_option("--results", run.results,
                      "Where the race library writes the results: FILE.json or FILE.csv");
-  auto* bleFlag = runCmd->add_flag(
-      "--ble", run.ble, "Drive real cars over Bluetooth LE (BlueZ) instead of the simulator");
-  // Real cars run in real time, on a real track.
-  bleFlag->excludes(fastFlag)->excludes(carsOpt)->excludes(trackOpt);
-  runCmd->add_option("--car", run.carAddresses, "With --ble: only this car (repeatable)")
-      ->needs(bleFlag);
-  runCmd
-      ->add_option("--adapter", run.adapters,
-                   "With --ble: use this controller, hci0, … (repeatable; default: all)")
-      ->needs(bleFlag);
-  runCmd
-      ->add_option("--scan-timeout", run.scanTimeout,
-                   "With --ble: seconds to look for cars before the script starts (default 5)")
-      ->check(CLI::PositiveNumber)
-      ->needs(bleFlag);
+  // Real cars run in real time.
+  addCarSource(runCmd, run, "before the script starts")->excludes(fastFlag);
 
   auto* replFlag = runCmd->add_flag("--repl", run.repl,
                                     "Open a Lua prompt beside the script, in the same Lua world");
   runCmd->add_flag("--watch", run.watch,
                    "Reload the script when one of its files is saved (docs/hot-reload.md)");
-  runCmd
-      ->add_option("--budget", run.budget,
-                   "Seconds a callback may run before it is interrupted (default 0.1; 0: no limit)")
-      ->check(CLI::NonNegativeNumber);
   runCmd->add_option("--history", run.history, "With --repl: the history file")->needs(replFlag);
   // A prompt needs the real clock: virtual time would race ahead while the operator types.
   replFlag->excludes(fastFlag);
@@ -64,26 +72,7 @@ int main(int argc, char** argv) {
   cli::ReplOptions repl;
   auto* replCmd = app.add_subcommand(
       "repl", "A Lua prompt with the cars bound; the simulator runs behind it in real time");
-  replCmd->add_option("--seed", repl.seed, "Seed of the simulator");
-  auto* replCars = replCmd->add_option("--cars", repl.cars, "Simulated cars (default 4)")
-                       ->check(CLI::Range(0, 64));
-  auto* replTrack = replCmd->add_option("--track", repl.track, "Track layout (default oval)");
-  auto* replBle =
-      replCmd->add_flag("--ble", repl.ble, "Real cars over Bluetooth LE instead of the simulator");
-  replBle->excludes(replCars)->excludes(replTrack);
-  replCmd->add_option("--car", repl.carAddresses, "With --ble: only this car (repeatable)")
-      ->needs(replBle);
-  replCmd->add_option("--adapter", repl.adapters, "With --ble: use this controller (repeatable)")
-      ->needs(replBle);
-  replCmd
-      ->add_option("--scan-timeout", repl.scanTimeout,
-                   "With --ble: seconds to look for cars (default 5)")
-      ->check(CLI::PositiveNumber)
-      ->needs(replBle);
-  replCmd
-      ->add_option("--budget", repl.budget,
-                   "Seconds a callback may run before it is interrupted (default 0.1; 0: no limit)")
-      ->check(CLI::NonNegativeNumber);
+  addCarSource(replCmd, repl, "before the prompt opens");
   replCmd->add_option("--history", repl.history,
                       "History file (default $PITWALL_HISTORY, else ~/.pitwall_history)");
 

@@ -1,5 +1,10 @@
 #include "engine/cli/session.hpp"
 
+#include <cmath>
+#include <csignal>
+#include <iostream>
+
+#include "bindings/interrupt.hpp"
 #include "engine/core/log.hpp"
 #include "engine/protocol/anki/advertisement.hpp"
 #include "engine/sim/grid.hpp"
@@ -22,9 +27,86 @@ Session::Session(ble::CentralOptions options) : loop_(ClockKind::Real), fleet_(l
 }
 
 Session::~Session() {
+  if (signals_) {
+    boost::system::error_code ignored;
+    signals_->cancel(ignored);
+  }
   scripts_.reset();
   central_.reset();
   log::setTimeSource(nullptr);
+}
+
+std::unique_ptr<Session> Session::open(const CarSource& source, bool fast, const char* command) {
+  std::unique_ptr<Session> session;
+  if (!source.ble) {
+    auto track = sim::loadLayout(source.track);
+    if (!track) {
+      std::cerr << "pitwall " << command << ": " << track.error() << "\n";
+      return nullptr;
+    }
+    session = std::make_unique<Session>(fast ? ClockKind::Virtual : ClockKind::Real,
+                                        std::move(*track), source.seed);
+  } else {
+    ble::CentralOptions central;
+    central.adapters = source.adapters;
+    central.cars = source.carAddresses;
+    central.scan = fromSeconds(source.scanTimeout);
+    try {
+      session = std::make_unique<Session>(std::move(central));
+    } catch (const ble::BleError& e) {
+      std::cerr << "pitwall " << command << ": " << e.what() << "\n";
+      return nullptr;
+    }
+  }
+  session->source_ = source;
+  session->catchSignals();
+  interrupt::setBudget(std::chrono::milliseconds(std::llround(source.budget * 1000)));
+  return session;
+}
+
+void Session::catchSignals() {
+  signals_ = std::make_unique<boost::asio::signal_set>(loop_.io(), SIGINT, SIGTERM);
+  awaitSignal();
+}
+
+void Session::awaitSignal() {
+  signals_->async_wait([this](const boost::system::error_code& ec, int sig) {
+    if (ec) return;
+    if (interrupted_) {  // a second one: leave now
+      loop_.stop();
+      return;
+    }
+    interrupted_ = true;
+    log::warn("pitwall",
+              std::string(sig == SIGINT ? "interrupted" : "terminated") + ": stopping the cars");
+    finish();
+    awaitSignal();
+  });
+}
+
+void Session::releaseSigint() {
+  boost::system::error_code ignored;
+  if (signals_) signals_->remove(SIGINT, ignored);
+}
+
+int Session::connectCars(const char* command) {
+  if (source_.ble) {
+    auto error = connectRealCars();
+    if (interrupted_) return 130;
+    if (error) {
+      std::cerr << "pitwall " << command << ": " << *error << "\n";
+      finish();
+      loop_.run();
+      return 2;
+    }
+    return 0;
+  }
+  if (!addGridCars(source_.cars)) {
+    if (interrupted_) return 130;
+    std::cerr << "pitwall " << command << ": not every simulated car connected\n";
+    return 1;
+  }
+  return 0;
 }
 
 void Session::record(const std::string& path) {

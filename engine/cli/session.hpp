@@ -1,10 +1,12 @@
 #pragma once
 // One run, as `pitwall run` and `pitwall test` set it up: the loop, the cars (simulated in a
 // world, or real ones over Bluetooth LE) and the Lua host, destroyed in the right order.
+#include <boost/asio/signal_set.hpp>
 #include <memory>
 #include <string>
 
 #include "bindings/reloader.hpp"
+#include "engine/cli/commands.hpp"
 #include "engine/core/loop.hpp"
 #include "engine/vehicles/ble_central.hpp"
 #include "engine/vehicles/fleet.hpp"
@@ -19,6 +21,18 @@ class Session {
   // Real cars through BlueZ, on the real clock. Throws ble::BleError when there is no bus.
   explicit Session(ble::CentralOptions options);
   ~Session();
+
+  // The session `pitwall COMMAND` asks for with `source` (the simulator in real time, or in
+  // virtual time when `fast`; or BLE), catching SIGINT and SIGTERM: the first stops the cars
+  // and ends the run with status 130, a second leaves at once. nullptr after printing
+  // "pitwall COMMAND: why" (exit status 2).
+  static std::unique_ptr<Session> open(const CarSource& source, bool fast, const char* command);
+  // Puts the cars of the source on the run (the grid, or the real cars found). 0, or the exit
+  // status after printing why not: 1 (simulated cars did not connect), 2 (no BLE cars), 130.
+  int connectCars(const char* command);
+  // From here on SIGINT is someone else's (the REPL's); SIGTERM still ends the run.
+  void releaseSigint();
+  bool interrupted() const { return interrupted_; }
 
   Loop& loop() { return loop_; }
   Fleet& fleet() { return fleet_; }
@@ -44,6 +58,11 @@ class Session {
   std::unique_ptr<ble::Central> central_;  // real cars; after the fleet: its links live there
   std::unique_ptr<Reloader> scripts_;
   bool finishing_ = false;
+  void catchSignals();
+  void awaitSignal();
+  CarSource source_;
+  std::unique_ptr<boost::asio::signal_set> signals_;
+  bool interrupted_ = false;
 };
 
 }  // namespace pitwall::cli
