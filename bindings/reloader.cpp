@@ -179,13 +179,10 @@ Result<bool, std::string> Reloader::reload(const std::vector<std::string>& chang
   if (script_.empty()) return refuse("there is no script to reload");
   auto next = makeWorld(true);
 
-  // 1. It must compile before the running version hears of it.
+  // 1. It must compile before the running version hears of it. The chunk stays on the new
+  // world's stack until step 4 runs it.
   lua_State* N = next->state();
-  if (luaL_loadfilex(N, script_.c_str(), "t") != LUA_OK) {
-    std::string error = lua_tostring(N, -1) ? lua_tostring(N, -1) : "cannot load the script";
-    return refuse(error);
-  }
-  lua_pop(N, 1);
+  if (auto loaded = next->loadFile(script_); !loaded) return refuse(loaded.error());
 
   // 2. The running version's last word: pitwall.onUnload(persist).
   ScriptHost& old = *current_;
@@ -211,7 +208,7 @@ Result<bool, std::string> Reloader::reload(const std::vector<std::string>& chang
     log::warn("reload", d + " cannot cross into the new version; left out");
 
   // 4. The new version starts, up to its first sleep; then its pitwall.onReload(persist, info).
-  if (auto started = next->startFile(script_, ScriptHost::StartMode::Trial); !started)
+  if (auto started = next->startLoadedFile(ScriptHost::StartMode::Trial); !started)
     return refuse(started.error());
   lua_getglobal(N, "pitwall");
   if (lua_getfield(N, -1, "onReload") == LUA_TFUNCTION) {

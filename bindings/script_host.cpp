@@ -347,7 +347,7 @@ Result<bool, std::string> ScriptHost::startLoaded(int status) {
   return true;
 }
 
-Result<bool, std::string> ScriptHost::startFile(const std::string& path, StartMode mode) {
+Result<bool, std::string> ScriptHost::loadFile(const std::string& path) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (!fs::is_regular_file(path, ec)) return Unexpected{"cannot open " + path + ": no such file"};
@@ -361,18 +361,28 @@ Result<bool, std::string> ScriptHost::startFile(const std::string& path, StartMo
   lua_pushlstring(L_, p.data(), p.size());
   lua_setfield(L_, -2, "path");
   lua_pop(L_, 1);
-  int status = luaL_loadfilex(L_, path.c_str(), "t");
-  if (status == LUA_OK) {
-    std::error_code ignored;
-    loadedFiles_.push_back(fs::absolute(path, ignored).lexically_normal().string());
+  if (luaL_loadfilex(L_, path.c_str(), "t") != LUA_OK) {
+    std::string err = lua_tostring(L_, -1) ? lua_tostring(L_, -1) : "cannot load the script";
+    lua_pop(L_, 1);
+    return Unexpected{err};
   }
-  if (mode == StartMode::Run) return startLoaded(status);
+  loadedFiles_.push_back(fs::absolute(path, ec).lexically_normal().string());
+  return true;
+}
+
+Result<bool, std::string> ScriptHost::startLoadedFile(StartMode mode) {
+  if (mode == StartMode::Run) return startLoaded(LUA_OK);
   trial_ = true;
   trialError_.reset();
-  auto started = startLoaded(status);
+  auto started = startLoaded(LUA_OK);
   trial_ = false;
   if (started && trialError_) return Unexpected{*trialError_};
   return started;
+}
+
+Result<bool, std::string> ScriptHost::startFile(const std::string& path, StartMode mode) {
+  if (auto loaded = loadFile(path); !loaded) return loaded;
+  return startLoadedFile(mode);
 }
 
 Result<bool, std::string> ScriptHost::startString(const std::string& code,

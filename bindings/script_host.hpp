@@ -58,6 +58,10 @@ class ScriptHost {
   // reported, and does not stop the run (a hot reload then keeps the old version).
   enum class StartMode { Run, Trial };
   Result<bool, std::string> startFile(const std::string& path, StartMode mode = StartMode::Run);
+  // The two halves of startFile: compile SCRIPT and leave its chunk on the stack (a hot reload
+  // compiles before it tells the running version anything), then start that chunk.
+  Result<bool, std::string> loadFile(const std::string& path);
+  Result<bool, std::string> startLoadedFile(StartMode mode);
   // Same for a chunk of text (tests, benchmarks).
   Result<bool, std::string> startString(const std::string& code, const std::string& chunkname);
   bool mainFinished() const { return mainFinished_; }
