@@ -152,7 +152,7 @@ std::unique_ptr<ScriptHost> Reloader::makeWorld(bool detached) {
 
 void Reloader::hookStop(ScriptHost& host) {
   host.onStopRequested = [this, &host] {
-    if (&host != current_.get()) return;  // a version still on trial asks for nothing
+    if (&host != current_.get()) return;  // on trial: reload() acts on it once it took over
     if (keepRunning_ && host.mainFailed()) {
       fleet_.stopAll();
       log::warn("pitwall",
@@ -239,6 +239,8 @@ Result<bool, std::string> Reloader::reload(const std::vector<std::string>& chang
   stats_.last = std::chrono::steady_clock::now() - began;
   retired.reset();
   if (onNewVersion) onNewVersion(*current_);
+  // A pitwall.stop() of the new version's first run was held until it took over.
+  if (current_->stopRequested() && !current_->mainFailed() && onStopRequested) onStopRequested();
   return true;
 }
 

@@ -299,3 +299,18 @@ TEST_CASE("saving the script or one of its modules reloads it (inotify, real tim
   REQUIRE(waitForReloads(2));
   CHECK(f.number("pitwall.persist.speed") == 1);
 }
+
+TEST_CASE("pitwall.stop() in a new version's first run ends the run once it took over") {
+  ReloadFixture f;
+  int stops = 0;
+  f.scripts->onStopRequested = [&] { ++stops; };
+  auto script = f.write("once.lua", counting(1, 500));
+  REQUIRE(f.scripts->start(script));
+  f.write("once.lua", "pitwall.persist.done = true\npitwall.stop()\n");
+  REQUIRE(f.scripts->reload());
+  CHECK(stops == 1);
+  // A refused version's stop is not obeyed.
+  f.write("once.lua", "pitwall.stop()\nerror('no')\n");
+  REQUIRE_FALSE(f.scripts->reload());
+  CHECK(stops == 1);
+}
