@@ -36,12 +36,6 @@ int eventIndex(std::string_view key) {
   return -1;
 }
 
-std::string eventList() {
-  std::string s;
-  for (auto* n : kEventNames) s += (s.empty() ? "" : ", ") + std::string(n);
-  return s;
-}
-
 }  // namespace
 
 namespace {
@@ -302,35 +296,21 @@ constexpr std::array<const char*, 27> kFieldNames = {
     "batteryLow",  "batteryFull", "firmware",     "lastPing",     "lastPositionTime",
     "frames",      "malformed"};
 
-bool isField(std::string_view key) {
-  for (auto* f : kFieldNames)
-    if (key == f) return true;
-  return false;
-}
-
 int index(lua_State* L) {
-  // 1: car, 2: key. Methods first (upvalue 1), then state, then the car's own fields.
-  lua_pushvalue(L, 2);
-  if (lua_rawget(L, lua_upvalueindex(1)) != LUA_TNIL) return 1;
-  lua_pop(L, 1);
+  // 1: car, 2: key. Methods first, then state, then the car's own fields.
   auto& p = proxyAt(L, 1);
-  if (lua_type(L, 2) == LUA_TSTRING) {
-    std::string_view key = lua_tostring(L, 2);
+  return lua::indexObject(L, [&](std::string_view key) {
+    const CarState& s = p.car->state();
     if (key == "frames") {
-      lua_pushinteger(
-          L, static_cast<lua_Integer>(p.car->state().frames_in + p.car->state().frames_out));
-      return 1;
+      lua_pushinteger(L, static_cast<lua_Integer>(s.frames_in + s.frames_out));
+      return true;
     }
     if (key == "malformed") {
-      lua_pushinteger(L, static_cast<lua_Integer>(p.car->state().malformed));
-      return 1;
+      lua_pushinteger(L, static_cast<lua_Integer>(s.malformed));
+      return true;
     }
-    if (pushField(L, *p.car, key)) return 1;
-  }
-  lua_getiuservalue(L, 1, 1);
-  lua_pushvalue(L, 2);
-  lua_rawget(L, -2);
-  return 1;
+    return pushField(L, *p.car, key);
+  });
 }
 
 int newindex(lua_State* L) {
@@ -340,32 +320,18 @@ int newindex(lua_State* L) {
     std::string key = lua_tostring(L, 2);
     int e = eventIndex(key);
     if (e >= 0) {
-      if (!lua_isnil(L, 3) && !lua_isfunction(L, 3))
-        throw LuaError("car." + key + " must be a function or nil, got " + luaL_typename(L, 3));
+      lua::checkHandler(L, "car", key);
       luaL_unref(L, LUA_REGISTRYINDEX, p.handlers[e]);
       p.handlers[e] = LUA_NOREF;
       if (lua_isfunction(L, 3)) {
         lua_pushvalue(L, 3);
         p.handlers[e] = luaL_ref(L, LUA_REGISTRYINDEX);
       }
-    } else if (key.size() > 2 && key[0] == 'o' && key[1] == 'n' &&
-               std::isupper(static_cast<unsigned char>(key[2]))) {
-      throw LuaError("car." + key + " is not an event; the events are " + eventList());
-    } else if (isField(key)) {
-      throw LuaError("car." + key + " is read-only (it is the car's state)");
     } else {
-      lua_pushvalue(L, 2);
-      bool isMethod = lua_rawget(L, lua_upvalueindex(1)) != LUA_TNIL;
-      lua_pop(L, 1);
-      if (isMethod) throw LuaError("car:" + key + " is a method and cannot be replaced");
+      lua::refuseReserved(L, "car", key, kFieldNames, kEventNames);
     }
   }
-  lua_settop(L, 3);
-  lua_getiuservalue(L, 1, 1);
-  lua_pushvalue(L, 2);
-  lua_pushvalue(L, 3);
-  lua_rawset(L, 4);
-  return 0;
+  return lua::storeOwnField(L);
 }
 
 int tostring(lua_State* L) {
@@ -410,32 +376,9 @@ void CarBinding::registerType(lua_State* L) {
                                      {"version", lua::guarded<version>},
                                      {"disconnect", lua::guarded<disconnect>},
                                      {nullptr, nullptr}};
-  luaL_newmetatable(L, kMetatable);
-  luaL_newlib(L, methods);
-  lua_pushvalue(L, -1);
-  lua_setfield(L, -3, "__methods");  // the REPL completes from these three, without __index
-  lua_createtable(L, static_cast<int>(kFieldNames.size()), 0);
-  for (std::size_t i = 0; i < kFieldNames.size(); ++i) {
-    lua_pushstring(L, kFieldNames[i]);
-    lua_rawseti(L, -2, static_cast<lua_Integer>(i + 1));
-  }
-  lua_setfield(L, -3, "__fields");
-  lua_createtable(L, static_cast<int>(kEventNames.size()), 0);
-  for (std::size_t i = 0; i < kEventNames.size(); ++i) {
-    lua_pushstring(L, kEventNames[i]);
-    lua_rawseti(L, -2, static_cast<lua_Integer>(i + 1));
-  }
-  lua_setfield(L, -3, "__events");
-  lua_pushvalue(L, -1);
-  lua_pushcclosure(L, lua::guarded<index>, 1);
-  lua_setfield(L, -3, "__index");
-  lua_pushcclosure(L, lua::guarded<newindex>, 1);
-  lua_setfield(L, -2, "__newindex");
-  lua_pushcfunction(L, lua::guarded<tostring>);
-  lua_setfield(L, -2, "__tostring");
-  lua_pushliteral(L, "car");
-  lua_setfield(L, -2, "__name");
-  lua_pop(L, 1);
+  lua::registerObjectType(
+      L, {kMetatable, "car", methods, kFieldNames, kEventNames, lua::guarded<index>,
+          lua::guarded<newindex>, lua::guarded<tostring>, nullptr});
 }
 
 int CarBinding::setHub(lua_State* L) {
@@ -443,8 +386,8 @@ int CarBinding::setHub(lua_State* L) {
   std::string name = lua::checkString(L, 2, "event name");
   int e = eventIndex(name);
   if (e < 0 || name == "onMessage")
-    throw LuaError("cannot listen to '" + name + "'; the events are " + eventList() +
-                   " (onMessage only through car.onMessage)");
+    throw LuaError("cannot listen to '" + name + "'; the events are " +
+                   lua::joinNames(kEventNames) + " (onMessage only through car.onMessage)");
   if (!lua_isnil(L, 3) && !lua_isfunction(L, 3))
     throw LuaError(std::string("a listener hub must be a function or nil, got ") +
                    luaL_typename(L, 3));

@@ -234,6 +234,11 @@ bool requestFromSignal() {
   return true;
 }
 
+bool inConsole() {
+  return g_depth.load(std::memory_order_relaxed) > 0 &&
+         g_kind.load(std::memory_order_relaxed) == static_cast<int>(Kind::Console);
+}
+
 void openCoroutineTracking(lua_State* L) {
   lua_getglobal(L, "coroutine");
   if (!lua_istable(L, -1)) {

@@ -57,6 +57,10 @@ void watchThisThread();
 // "interrupted". Returns false when no Lua code is running (the caller then cancels the line).
 bool requestFromSignal();
 
+// True while a chunk typed at the REPL runs (the outermost call into Lua is Kind::Console):
+// commands that need the operator's confirmation ask for it then.
+bool inConsole();
+
 // Replaces coroutine.resume and coroutine.wrap in L with versions that tell the interrupter
 // which thread runs (so a runaway loop inside a script's own coroutine is caught too).
 void openCoroutineTracking(lua_State* L);

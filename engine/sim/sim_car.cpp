@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "engine/core/overload.hpp"
 #include "engine/protocol/anki/codec.hpp"
 
 namespace pitwall::sim {
@@ -26,13 +27,6 @@ constexpr double kLowBatteryMv = 3600;
 constexpr double kFullBatteryMv = 4200;
 constexpr std::uint8_t kBitsRead = 0x07;  // parsing flags low nibble: 7-bit codes (§4.5.1)
 constexpr std::uint8_t kReverseDriving = 0x20;
-
-template <class... F>
-struct Overloaded : F... {
-  using F::operator()...;
-};
-template <class... F>
-Overloaded(F...) -> Overloaded<F...>;
 
 std::uint16_t clampU16(double v) {
   return static_cast<std::uint16_t>(std::clamp(std::lround(v), 0L, 65535L));
@@ -126,7 +120,7 @@ void Car::receive(std::span<const std::uint8_t> frame) {
   // Driving commands need SDK mode (anki-overdrive.md "GATT"); answers are always given.
   const bool sdk = sdk_;
   std::visit(
-      Overloaded{
+      Overload{
           [&](const anki::PingRequest&) { emit(anki::PingResponse{}); },
           [&](const anki::VersionRequest&) { emit(anki::VersionResponse{spec_.version}); },
           [&](const anki::BatteryRequest&) { emit(anki::BatteryResponse{clampU16(battery_mv_)}); },

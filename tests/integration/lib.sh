@@ -25,6 +25,16 @@ contains() {
   esac
 }
 
+# wait_for FILE PATTERN [SECONDS]: until FILE has a line matching PATTERN (grep -E), at most
+# SECONDS (default 20): it awaits output, polling the file. False when it never came.
+wait_for() {
+  local deadline=$((SECONDS + ${3:-20}))
+  until grep -qE -- "$2" "$1" 2>/dev/null; do
+    [ $SECONDS -ge $deadline ] && return 1
+    sleep 0.02
+  done
+}
+
 finish() {
   [ "$FAILURES" -eq 0 ] || { echo "$FAILURES check(s) failed"; exit 1; }
 }

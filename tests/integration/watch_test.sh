@@ -2,14 +2,6 @@
 # a broken save is refused and the running version carries on; a script that dies waits for a fix.
 source "$(dirname "$0")/lib.sh"
 
-# wait_for FILE PATTERN: until FILE has a line matching PATTERN (grep -E), at most 20 s.
-wait_for() {
-  local deadline=$((SECONDS + 20))
-  until grep -qE "$2" "$1" 2>/dev/null; do
-    [ $SECONDS -ge $deadline ] && return 1
-    sleep 0.05
-  done
-}
 # count FILE PATTERN
 count() { grep -cE "$2" "$1" 2>/dev/null || true; }
 

@@ -9,18 +9,12 @@
 #include <span>
 #include <variant>
 
+#include "engine/protocol/frame.hpp"
+
 namespace pitwall::anki {
 
 // A frame as sent over the air: [size][id][payload], at most 20 bytes.
-struct Frame {
-  static constexpr std::size_t kMax = 20;
-  std::array<std::uint8_t, kMax> bytes{};
-  std::uint8_t length = 0;
-  std::span<const std::uint8_t> span() const { return {bytes.data(), length}; }
-  bool operator==(const Frame& o) const {
-    return length == o.length && std::equal(bytes.begin(), bytes.begin() + length, o.bytes.begin());
-  }
-};
+using Frame = BoundedFrame<20>;
 
 namespace id {
 // controller → vehicle
