@@ -315,6 +315,8 @@ void openPitwallModule(ScriptHost& host) {
   lua_pop(L, 2);
 
   if (host.sim()) openSimModule(host);
+  openMindroadModule(host);
+  openAlphabotModule(host);
 
   // Cars already known get their Lua objects now; later ones when they join
   // (ScriptHost::carJoined).

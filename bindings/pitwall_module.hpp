@@ -5,4 +5,8 @@ namespace pitwall {
 class ScriptHost;
 void openPitwallModule(ScriptHost& host);
 void openSimModule(ScriptHost& host);  // leaves nothing on the stack; sets pitwall.sim
+// pitwall.mindroad{…} and pitwall.alphabot{…}: the seed robots (docs/robots.md). Each leaves
+// nothing on the stack and sets its function in the `pitwall` table.
+void openMindroadModule(ScriptHost& host);
+void openAlphabotModule(ScriptHost& host);
 }  // namespace pitwall

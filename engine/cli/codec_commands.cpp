@@ -12,7 +12,7 @@ namespace pitwall::cli {
 
 namespace {
 
-constexpr const char* kProtocols = "anki";
+constexpr const char* kProtocols = "anki, mindroad, alphabot";
 
 // "06 24 e8", "06:24:e8", "0624e8" and "0x06 0x24" all give the same bytes.
 Result<std::vector<std::uint8_t>, std::string> parseHex(const std::vector<std::string>& words) {
@@ -44,16 +44,31 @@ Result<std::vector<std::uint8_t>, std::string> parseHex(const std::vector<std::s
 }  // namespace
 
 int decode(const std::string& protocol, const std::vector<std::string>& hex) {
-  if (protocol != "anki") {
+  // `pitwall decode alphabot-ble CHARACTERISTIC HEX`: the first word names the characteristic.
+  bool alphabotBle = protocol == "alphabot-ble";
+  if (protocol != "anki" && protocol != "mindroad" && protocol != "alphabot" && !alphabotBle) {
     std::cerr << "pitwall decode: unknown protocol '" << protocol << "'; known: " << kProtocols
-              << "\n";
+              << ", alphabot-ble\n";
     return 2;
   }
-  auto bytes = parseHex(hex);
+  std::vector<std::string> words = hex;
+  std::string side;
+  if (alphabotBle) {
+    if (words.size() < 2) {
+      std::cerr << "pitwall decode: alphabot-ble needs a characteristic name and the bytes, e.g. "
+                   "pitwall decode alphabot-ble sensor \"80 2d 64 00 00\"\n";
+      return 2;
+    }
+    side = words.front();
+    words.erase(words.begin());
+  }
+  auto bytes = parseHex(words);
   if (!bytes) {
     std::cerr << "pitwall decode: " << bytes.error() << "\n";
     return 2;
   }
+  if (protocol == "mindroad") return decodeMindroad(*bytes);
+  if (protocol == "alphabot" || alphabotBle) return decodeAlphabot(*bytes, side);
   auto message = anki::decode(*bytes);
   if (!message) {
     std::cerr << "pitwall decode: " << message.error().message() << "\n";
@@ -64,6 +79,8 @@ int decode(const std::string& protocol, const std::vector<std::string>& hex) {
 }
 
 int encode(const std::string& protocol, const std::vector<std::string>& words) {
+  if (protocol == "mindroad") return encodeMindroad(words);
+  if (protocol == "alphabot") return encodeAlphabot(words);
   if (protocol != "anki") {
     std::cerr << "pitwall encode: unknown protocol '" << protocol << "'; known: " << kProtocols
               << "\n";

@@ -68,4 +68,25 @@ int emulateCar(const EmulateOptions& options);
 int decode(const std::string& protocol, const std::vector<std::string>& hex);
 int encode(const std::string& protocol, const std::vector<std::string>& words);
 
+// The seed robots' codecs from the shell (docs/robots.md): the bytes are already parsed from hex;
+// print JSON (decode) or hex (encode) on stdout, or the error on stderr with status 2.
+int decodeMindroad(const std::vector<std::uint8_t>& bytes);
+int encodeMindroad(const std::vector<std::string>& words);
+int decodeAlphabot(const std::vector<std::uint8_t>& bytes, const std::string& side);
+int encodeAlphabot(const std::vector<std::string>& words);
+
+// pitwall sim-robot mindroad|alphabot --listen HOST:PORT: the robot side, simulated.
+struct SimRobotOptions {
+  std::string kind;                    // "mindroad" or "alphabot"
+  std::string listen = "127.0.0.1:0";  // port 0: any free port, printed on stdout
+  bool udp = false;                    // mindroad: UDP instead of TCP
+  double watchdog = 0.5;               // mindroad: seconds without an instruction before it stops
+  std::uint64_t seed = 1;
+  std::optional<double> duration;  // seconds; none: until SIGINT/SIGTERM
+  std::string room;                // alphabot: a room file; empty: the default room
+};
+int simRobot(const SimRobotOptions& options);
+int simRobotMindroad(const SimRobotOptions& options);
+int simRobotAlphabot(const SimRobotOptions& options);
+
 }  // namespace pitwall::cli

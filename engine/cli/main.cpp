@@ -95,6 +95,22 @@ int main(int argc, char** argv) {
   emulateCmd->add_option("--duration", emulate.duration, "Stop after this many seconds")
       ->check(CLI::PositiveNumber);
 
+  cli::SimRobotOptions robot;
+  auto* robotCmd = app.add_subcommand(
+      "sim-robot", "Be a seed robot (mindroad or alphabot), simulated, listening on the network");
+  robotCmd->add_option("kind", robot.kind, "mindroad or alphabot")->required();
+  robotCmd->add_option("--listen", robot.listen,
+                       "HOST:PORT to listen on (default 127.0.0.1:0: a free port, printed)");
+  robotCmd->add_flag("--udp", robot.udp, "mindroad: UDP instead of TCP");
+  robotCmd
+      ->add_option("--watchdog", robot.watchdog,
+                   "mindroad: seconds without an instruction before the robot stops (0.5)")
+      ->check(CLI::PositiveNumber);
+  robotCmd->add_option("--seed", robot.seed, "Seed of the simulation's noise");
+  robotCmd->add_option("--room", robot.room, "alphabot: a room file (docs/robots.md)");
+  robotCmd->add_option("--duration", robot.duration, "Stop after this many seconds")
+      ->check(CLI::PositiveNumber);
+
   cli::TestOptions test;
   auto* testCmd = app.add_subcommand("test", "Run scenario test scripts in virtual time");
   testCmd->add_option("paths", test.paths, "Scenario files, or folders of *_test.lua files");
@@ -109,11 +125,12 @@ int main(int argc, char** argv) {
   std::string protocol;
   std::vector<std::string> words;
   auto* decodeCmd = app.add_subcommand("decode", "Decode one frame: pitwall decode anki \"01 17\"");
-  decodeCmd->add_option("protocol", protocol, "Protocol (anki)")->required();
+  decodeCmd->add_option("protocol", protocol, "Protocol (anki, mindroad, alphabot, alphabot-ble)")
+      ->required();
   decodeCmd->add_option("hex", words, "The frame's bytes in hex")->required();
   auto* encodeCmd =
       app.add_subcommand("encode", "Encode one command: pitwall encode anki set-speed 600 1000");
-  encodeCmd->add_option("protocol", protocol, "Protocol (anki)")->required();
+  encodeCmd->add_option("protocol", protocol, "Protocol (anki, mindroad, alphabot)")->required();
   encodeCmd->add_option("message", words, "The command and its arguments")->required();
   std::string forms;
   for (const auto& f : anki::commandForms()) forms += "\n  " + f;
@@ -145,6 +162,7 @@ int main(int argc, char** argv) {
   if (replCmd->parsed()) return cli::repl(repl);
   if (scanCmd->parsed()) return cli::scan(scan);
   if (emulateCmd->parsed()) return cli::emulateCar(emulate);
+  if (robotCmd->parsed()) return cli::simRobot(robot);
   if (testing) {
     if (test.paths.empty()) test.paths.push_back("tests/scenarios");
     return cli::test(test);

@@ -334,10 +334,11 @@ std::vector<const Adapter*> Bluez::pickAdapters(const std::vector<std::string>& 
 }
 
 void Bluez::startDiscovery(const std::string& adapter,
-                           std::function<void(std::optional<std::string> error)> done) {
+                           std::function<void(std::optional<std::string> error)> done,
+                           std::vector<std::string> serviceUuids) {
   std::weak_ptr<bool> alive = alive_;
   Properties filter;
-  filter["UUIDs"] = sdbus::Variant(std::vector<std::string>{std::string(anki::kServiceUuid)});
+  if (!serviceUuids.empty()) filter["UUIDs"] = sdbus::Variant(std::move(serviceUuids));
   filter["Transport"] = sdbus::Variant(std::string("le"));
   filter["DuplicateData"] = sdbus::Variant(true);  // RSSI updates while scanning
   auto& p = proxy(adapter);

@@ -92,9 +92,11 @@ class Bluez {
   // Adapters by name (hci0), all when `names` is empty; throws BleError naming what is missing.
   std::vector<const Adapter*> pickAdapters(const std::vector<std::string>& names) const;
 
-  // Discovery of LE devices advertising the Anki service on one adapter.
+  // Discovery of LE devices on one adapter: those advertising one of `serviceUuids` (the Anki
+  // service unless told otherwise), every LE device when it is empty.
   void startDiscovery(const std::string& adapter,
-                      std::function<void(std::optional<std::string> error)> done);
+                      std::function<void(std::optional<std::string> error)> done,
+                      std::vector<std::string> serviceUuids = {std::string(anki::kServiceUuid)});
   void stopDiscovery(const std::string& adapter, std::function<void()> done = {});
 
   // A method call on org.bluez; reply(error or nullptr, reply message) on the loop.

@@ -83,6 +83,37 @@ FakeBluez::State::State(Loop& loop_, sdbus::IConnection& connection, Options opt
     d->baseRssi = static_cast<std::int16_t>(-50 - 6 * (i % 6));
     devices.push_back(std::move(d));
   }
+  // Alphabots after the cars (fake_alphabot.hpp).
+  if (options.alphabots < 0 || (options.alphabots > 0 && adapters.empty()))
+    throw std::invalid_argument("alphabots need an adapter, and cannot be negative (" +
+                                std::to_string(options.alphabots) + ")");
+  if (options.alphabotAddresses.size() > static_cast<std::size_t>(options.alphabots))
+    throw std::invalid_argument(std::to_string(options.alphabotAddresses.size()) +
+                                " addresses for " + std::to_string(options.alphabots) +
+                                " alphabots: give at most one address per robot");
+  for (int i = 0; i < options.alphabots; ++i) {
+    auto d = std::make_unique<Device>();
+    d->index = i;
+    if (static_cast<std::size_t>(i) < options.alphabotAddresses.size()) {
+      d->address = normalizeAddress(options.alphabotAddresses[i]);
+    } else {
+      char buf[18];
+      std::snprintf(buf, sizeof buf, "AB:00:00:00:%02X:%02X", ((i + 1) >> 8) & 0xff,
+                    (i + 1) & 0xff);
+      d->address = buf;
+    }
+    for (const auto& other : devices)
+      if (other->address == d->address)
+        throw std::invalid_argument("two devices have the address " + d->address +
+                                    ": give each its own");
+    d->adapter = adapters[(options.cars + i) % adapters.size()].get();
+    std::string tail = d->address;
+    std::replace(tail.begin(), tail.end(), ':', '_');
+    d->path = d->adapter->path + "/dev_" + tail;
+    d->robot = std::make_unique<FakeAlphabot>(loop, i);
+    d->baseRssi = static_cast<std::int16_t>(-55 - 5 * (i % 6));
+    devices.push_back(std::move(d));
+  }
 
   root = sdbus::createObject(conn, "/");
   root->addObjectManager();
@@ -116,7 +147,11 @@ FakeBluez::State::~State() {
   timers.clear();
   nameWatch.reset();
   for (auto& d : devices) {
-    if (d->connected) d->car->disconnect();  // without telling us: we are going away
+    if (d->connected && d->car) d->car->disconnect();  // without telling us: we are going away
+    if (d->robot) d->robot->disconnect();
+    for (auto& ch : d->robotChars)
+      if (ch) closeIo(ch->notifyIo);
+    for (auto& ch : d->robotChars) ch.reset();
     if (d->readChar) closeIo(d->readChar->notifyIo);
     if (d->writeChar) closeIo(d->writeChar->writeIo);
     d->readChar.reset();
@@ -363,7 +398,7 @@ bool FakeBluez::State::wanted(const Adapter& a, const Device& d, std::int16_t rs
     const DiscoveryFilter& f = *c.filter;
     if (f.transport == "bredr") continue;  // the cars are LE only
     if (!f.uuids.empty() &&
-        std::find(f.uuids.begin(), f.uuids.end(), anki::kServiceUuid) == f.uuids.end())
+        std::find(f.uuids.begin(), f.uuids.end(), serviceUuid(d)) == f.uuids.end())
       continue;
     if (f.rssi && rssi < *f.rssi) continue;
     if (f.pathloss && kTxPower - rssi > *f.pathloss) continue;
@@ -380,8 +415,8 @@ void FakeBluez::State::advertise(Device& d) {
   if (!a.discovering || !a.powered || d.vanished || d.connected) return;
   std::uniform_int_distribution<int> jitter(-12, 12);
   auto rssi = static_cast<std::int16_t>(d.baseRssi + jitter(rng));
-  auto manufacturer = d.car->manufacturerData();
-  auto localName = d.car->localName();
+  auto manufacturer = d.car ? d.car->manufacturerData() : std::vector<std::uint8_t>{};
+  auto localName = d.car ? d.car->localName() : d.robot->localName();
   std::string name = FakeBluez::bluezName(localName);
   if (!wanted(a, d, rssi, name)) return;
 
@@ -424,9 +459,11 @@ void FakeBluez::State::clientGone(const std::string& uniqueName) {
     }
   }
   for (auto& d : devices) {
-    Characteristic* ch = d->readChar.get();
-    if (ch && ch->notifySessions.erase(uniqueName) && ch->notifySessions.empty())
-      emit(ch->object.get(), api::kGattCharacteristic, {"Notifying"});
+    std::vector<Characteristic*> chars{d->readChar.get()};
+    for (auto& c : d->robotChars) chars.push_back(c.get());
+    for (Characteristic* ch : chars)
+      if (ch && ch->notifySessions.erase(uniqueName) && ch->notifySessions.empty())
+        emit(ch->object.get(), api::kGattCharacteristic, {"Notifying"});
   }
 }
 
@@ -475,8 +512,8 @@ void FakeBluez::State::exportDevice(Device& d) {
   obj->registerProperty("Adapter").onInterface(api::kDevice).withGetter([dp] {
     return sdbus::ObjectPath(dp->adapter->path);
   });
-  obj->registerProperty("UUIDs").onInterface(api::kDevice).withGetter([] {
-    return std::vector<std::string>{std::string(anki::kServiceUuid)};
+  obj->registerProperty("UUIDs").onInterface(api::kDevice).withGetter([this, dp] {
+    return std::vector<std::string>{serviceUuid(*dp)};
   });
   obj->registerProperty("ManufacturerData").onInterface(api::kDevice).withGetter([dp] {
     // BlueZ splits the first two bytes off as the company id, little-endian: BE EF → 0xEFBE.
@@ -557,6 +594,10 @@ void FakeBluez::State::vanish(Device& d) {
   log::debug(kComponent, d.address + ": vanished (fault)");
 }
 
+std::string FakeBluez::State::serviceUuid(const Device& d) const {
+  return d.robot ? FakeAlphabot::kServiceUuid : std::string(anki::kServiceUuid);
+}
+
 bool FakeBluez::State::inject(Device& d, std::span<const std::uint8_t> bytes) {
   if (!d.connected) {
     log::warn(kComponent, d.address + ": not connected, injected bytes dropped");
@@ -577,6 +618,15 @@ void FakeBluez::State::arm(Device& d, Fault fault, Duration delay) {
         vanish(*dp);
         break;
       case Fault::Garbage:
+        if (dp->robot) {
+          // Malformed SENSOR answers: degree 511, and 1 byte of 5.
+          auto* sensor =
+              dp->robotChars[static_cast<std::size_t>(alphabot::ble::Characteristic::Sensor)].get();
+          for (const auto& f :
+               std::vector<std::vector<std::uint8_t>>{{0x81, 0xff, 0, 0, 0}, {0x81}})
+            if (dp->connected) notify(*dp, sensor, f);
+          break;
+        }
         for (const auto& f : FakeBluez::garbageFrames()) inject(*dp, f);
         break;
     }
@@ -594,12 +644,26 @@ sim::World& FakeBluez::world() {
   return *state_->world;
 }
 sim::SimCar& FakeBluez::car(std::string_view address) {
-  return *state_->device(address).car;
+  Device& d = state_->device(address);
+  if (!d.car) throw std::out_of_range(d.address + " is an Alphabot, not a car");
+  return *d.car;
 }
 std::vector<std::string> FakeBluez::addresses() const {
   std::vector<std::string> out;
-  for (const auto& d : state_->devices) out.push_back(d->address);
+  for (const auto& d : state_->devices)
+    if (d->car) out.push_back(d->address);
   return out;
+}
+std::vector<std::string> FakeBluez::alphabotAddresses() const {
+  std::vector<std::string> out;
+  for (const auto& d : state_->devices)
+    if (d->robot) out.push_back(d->address);
+  return out;
+}
+FakeAlphabot& FakeBluez::alphabot(std::string_view address) {
+  Device& d = state_->device(address);
+  if (!d.robot) throw std::out_of_range(d.address + " is a car, not an Alphabot");
+  return *d.robot;
 }
 std::string FakeBluez::adapterPath(int index) const {
   return state_->adapters.at(static_cast<std::size_t>(index))->path;
@@ -634,6 +698,16 @@ void FakeBluez::vanish(std::string_view address) {
 void FakeBluez::inject(std::string_view address, std::span<const std::uint8_t> bytes) {
   // Only a D-Bus signal needs the pump; a frame written to an acquired socket does not.
   if (state_->inject(state_->device(address), bytes)) state_->pump.kick();
+}
+void FakeBluez::inject(std::string_view address, alphabot::ble::Characteristic characteristic,
+                       std::span<const std::uint8_t> bytes) {
+  Device& d = state_->device(address);
+  if (!d.connected || !d.robot) {
+    log::warn(kComponent, d.address + ": not a connected Alphabot, injected bytes dropped");
+    return;
+  }
+  auto& ch = d.robotChars[static_cast<std::size_t>(characteristic)];
+  if (state_->notify(d, ch.get(), bytes)) state_->pump.kick();
 }
 void FakeBluez::schedule(Fault fault, std::string_view address, Duration after) {
   Device& d = state_->device(address);

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "engine/core/loop.hpp"
+#include "engine/protocol/alphabot/ble_codec.hpp"
 #include "engine/sim/world.hpp"
 #include "engine/transport/dbus_pump.hpp"
 
@@ -22,6 +23,8 @@ class IConnection;
 
 namespace pitwall::testing {
 
+class FakeAlphabot;
+
 struct FakeBluezOptions {
   int adapters = 1;                    // hci0, hci1, …
   int cars = 1;                        // car i sits on adapter i % adapters
@@ -30,6 +33,10 @@ struct FakeBluezOptions {
   std::vector<std::string> addresses;  // car i's address; default E0:00:00:00:00:<i+1>
   std::vector<std::string> names;      // car i's user name; default from the grid
   bool noAcquire = false;  // AcquireNotify/AcquireWrite → org.bluez.Error.NotSupported
+  // Alphabot robots (tests/fake_bluez/fake_alphabot.hpp), after the cars: robot i sits on
+  // adapter (cars + i) % adapters; its address is alphabotAddresses[i], else AB:00:00:00:00:<i+1>.
+  int alphabots = 0;
+  std::vector<std::string> alphabotAddresses;
 };
 
 // What happened to one device, for tests to check.
@@ -59,7 +66,9 @@ class FakeBluez {
   // Ground truth.
   sim::World& world();
   sim::SimCar& car(std::string_view address);              // throws std::out_of_range
-  std::vector<std::string> addresses() const;              // car order
+  std::vector<std::string> addresses() const;              // car order (cars only)
+  std::vector<std::string> alphabotAddresses() const;      // robot order
+  FakeAlphabot& alphabot(std::string_view address);        // throws std::out_of_range
   std::string adapterPath(int index) const;                // "/org/bluez/hci0"
   std::string devicePath(std::string_view address) const;  // where its object is (or would be)
   bool exported(std::string_view address) const;           // its Device1 object is on the bus
@@ -72,6 +81,9 @@ class FakeBluez {
   void drop(std::string_view address);    // the link drops; the device stays known
   void vanish(std::string_view address);  // disconnect, then the device is gone for good
   void inject(std::string_view address, std::span<const std::uint8_t> bytes);  // as a notification
+  // An Alphabot notifies `bytes` on `characteristic` (malformed ones too).
+  void inject(std::string_view address, alphabot::ble::Characteristic characteristic,
+              std::span<const std::uint8_t> bytes);
   // A fault `after` the device's first successful Connect (at once if that time has passed).
   // Garbage sends garbageFrames().
   void schedule(Fault fault, std::string_view address, Duration after);

@@ -1,6 +1,7 @@
-// The fake BlueZ's GATT side and links: the Anki service and characteristics of a connected car,
-// notifications (PropertiesChanged, or an AcquireNotify socket), writes (WriteValue, or an
-// AcquireWrite socket), and the link to the simulated car behind them.
+// The fake BlueZ's GATT side and links: the Anki service and characteristics of a connected car
+// (or the Alphabot service and its eight characteristics), notifications (PropertiesChanged, or
+// an AcquireNotify socket), writes (WriteValue, or an AcquireWrite socket), and the link to the
+// simulated car or robot behind them.
 
 #include "tests/fake_bluez/state.hpp"
 
@@ -89,12 +90,13 @@ std::unique_ptr<Characteristic> FakeBluez::State::makeCharacteristic(
   return ch;
 }
 
-void FakeBluez::State::exportGatt(Device& d) {
+// The device's primary service object (its UUID from serviceUuid), at <device>/service000a.
+void FakeBluez::State::exportService(Device& d) {
   std::string servicePath = d.path + "/service000a";
   auto s = sdbus::createObject(conn, servicePath);
   Device* dp = &d;
-  s->registerProperty("UUID").onInterface(api::kGattService).withGetter([] {
-    return std::string(anki::kServiceUuid);
+  s->registerProperty("UUID").onInterface(api::kGattService).withGetter([this, dp] {
+    return serviceUuid(*dp);
   });
   s->registerProperty("Primary").onInterface(api::kGattService).withGetter([] { return true; });
   s->registerProperty("Device").onInterface(api::kGattService).withGetter([dp] {
@@ -105,6 +107,12 @@ void FakeBluez::State::exportGatt(Device& d) {
   });
   s->finishRegistration();
   d.service = std::move(s);
+}
+
+void FakeBluez::State::exportGatt(Device& d) {
+  if (d.robot) return exportAlphabotGatt(d);
+  std::string servicePath = d.path + "/service000a";
+  exportService(d);
   d.readChar =
       makeCharacteristic(d, servicePath + "/char000b", anki::kReadCharUuid, {"read", "notify"});
   d.writeChar = makeCharacteristic(d, servicePath + "/char000d", anki::kWriteCharUuid,
@@ -114,7 +122,33 @@ void FakeBluez::State::exportGatt(Device& d) {
   d.writeChar->object->emitInterfacesAddedSignal();
 }
 
+// The Alphabot's service (alphabot.md §2): each characteristic with the flags of its access
+// column — "write" (with response; the reference does not allow write-without-response).
+void FakeBluez::State::exportAlphabotGatt(Device& d) {
+  std::string servicePath = d.path + "/service000a";
+  exportService(d);
+  int handle = 0x0b;
+  for (const auto& info : alphabot::ble::characteristics()) {
+    std::vector<std::string> flags{"read"};
+    if (info.write) flags.push_back("write");
+    if (info.notify) flags.push_back("notify");
+    char tail[16];
+    std::snprintf(tail, sizeof tail, "/char%04x", handle);
+    handle += 3;
+    d.robotChars[static_cast<std::size_t>(info.id)] =
+        makeCharacteristic(d, servicePath + tail, info.uuid, std::move(flags));
+  }
+  d.service->emitInterfacesAddedSignal();
+  for (auto& ch : d.robotChars) ch->object->emitInterfacesAddedSignal();
+}
+
 void FakeBluez::State::removeGatt(Device& d) {
+  for (auto& ch : d.robotChars) {
+    if (!ch) continue;
+    closeIo(ch->notifyIo);
+    ch->object->emitInterfacesRemovedSignal();
+    ch.reset();
+  }
   for (Characteristic* ch : {d.readChar.get(), d.writeChar.get()}) {
     if (!ch) continue;
     closeIo(ch->notifyIo);
@@ -175,7 +209,7 @@ void FakeBluez::State::writeValue(Device& d, Characteristic& ch,
   if (request && !ch.writeRequest)
     throw notPermitted("Write not permitted");  // the car's ATT error
   if (!request && value.size() > kMtu - 3u) throw failed("Failed to initiate write");
-  toCar(d, value);
+  toDevice(d, ch, value);
 }
 
 std::tuple<sdbus::UnixFd, std::uint16_t> FakeBluez::State::acquire(Device& d, Characteristic& ch,
@@ -241,7 +275,7 @@ void FakeBluez::State::watchWriteIo(Device& d, Characteristic& ch) {
                                 ssize_t n = ::recv(cp->writeIo->fd.native_handle(), buf, sizeof buf,
                                                    MSG_DONTWAIT);
                                 if (n > 0) {
-                                  toCar(*dp, std::span<const std::uint8_t>(buf, n));
+                                  toDevice(*dp, *cp, std::span<const std::uint8_t>(buf, n));
                                   if (token.expired()) return pump.kick();
                                   continue;
                                 }
@@ -330,21 +364,32 @@ void FakeBluez::State::linkUp(Device& d) {
   Device* dp = &d;
   std::uint64_t generation = d.generation;
   std::weak_ptr<bool> a = alive;
-  d.car->connect(
-      [this, dp, generation](std::span<const std::uint8_t> frame) {
-        if (dp->generation != generation || !dp->connected) return;
-        if (toClient(*dp, frame)) pump.kick();
-      },
-      [this, a, dp, generation] {
-        // The car hung up (it got a disconnect frame, or went away): the link is gone. Later,
-        // not now: we may be inside a method handler of an object this tears down.
-        if (a.expired()) return;
-        later([this, dp, generation] {
+  if (d.robot) {
+    d.robot->connect([this, dp, generation](alphabot::ble::Characteristic c,
+                                            std::span<const std::uint8_t> bytes, bool notifies) {
+      if (dp->generation != generation || !dp->connected) return;
+      Characteristic* ch = dp->robotChars[static_cast<std::size_t>(c)].get();
+      if (!ch) return;
+      ch->value.assign(bytes.begin(), bytes.end());  // served on the next read
+      if (notifies && notify(*dp, ch, bytes)) pump.kick();
+    });
+  } else {
+    d.car->connect(
+        [this, dp, generation](std::span<const std::uint8_t> frame) {
           if (dp->generation != generation || !dp->connected) return;
-          log::debug(kComponent, dp->address + ": the car dropped the connection");
-          linkDown(*dp, false);
+          if (toClient(*dp, frame)) pump.kick();
+        },
+        [this, a, dp, generation] {
+          // The car hung up (it got a disconnect frame, or went away): the link is gone. Later,
+          // not now: we may be inside a method handler of an object this tears down.
+          if (a.expired()) return;
+          later([this, dp, generation] {
+            if (dp->generation != generation || !dp->connected) return;
+            log::debug(kComponent, dp->address + ": the car dropped the connection");
+            linkDown(*dp, false);
+          });
         });
-      });
+  }
 
   auto pending = std::move(d.pendingConnect);
   if (pending) pending->returnResults();
@@ -370,7 +415,8 @@ void FakeBluez::State::linkDown(Device& d, bool tellCar) {
   cancel(d.resolveTimer);
   removeGatt(d);
   emit(d.object.get(), api::kDevice, {"ServicesResolved", "Connected"});
-  if (tellCar) d.car->disconnect();  // the car stops, as on a lost link
+  if (tellCar && d.car) d.car->disconnect();  // the car stops, as on a lost link
+  if (d.robot) d.robot->disconnect();
 }
 
 void FakeBluez::State::toCar(Device& d, std::span<const std::uint8_t> frame) {
@@ -378,8 +424,20 @@ void FakeBluez::State::toCar(Device& d, std::span<const std::uint8_t> frame) {
   d.car->receive(frame);
 }
 
+void FakeBluez::State::toDevice(Device& d, Characteristic& ch,
+                                std::span<const std::uint8_t> frame) {
+  if (!d.robot) return toCar(d, frame);
+  ++d.counters.framesToCar;
+  for (std::size_t i = 0; i < d.robotChars.size(); ++i)
+    if (d.robotChars[i].get() == &ch)
+      return d.robot->receive(static_cast<alphabot::ble::Characteristic>(i), frame);
+}
+
 bool FakeBluez::State::toClient(Device& d, std::span<const std::uint8_t> frame) {
-  Characteristic* ch = d.readChar.get();
+  return notify(d, d.readChar.get(), frame);
+}
+
+bool FakeBluez::State::notify(Device& d, Characteristic* ch, std::span<const std::uint8_t> frame) {
   if (!ch) {
     ++d.counters.framesDropped;
     return false;

@@ -1,6 +1,7 @@
-// fake_bluez — a fake org.bluez with simulated Anki cars, on the bus named by
-// DBUS_SYSTEM_BUS_ADDRESS. Prints `ready` once it owns org.bluez; runs until SIGTERM or SIGINT,
-// then prints one line per car: `ADDR connected=… target=… connects=… disconnects=… …`.
+// fake_bluez — a fake org.bluez with simulated Anki cars (and, with --alphabots, Alphabot robots),
+// on the bus named by DBUS_SYSTEM_BUS_ADDRESS. Prints `ready` once it owns org.bluez; runs until
+// SIGTERM or SIGINT, then prints one line per car: `ADDR connected=… target=… connects=… …`,
+// and one per Alphabot: `ADDR connected=… speed=… writes=… connects=… disconnects=…`.
 #include <CLI/CLI.hpp>
 #include <boost/asio/signal_set.hpp>
 #include <csignal>
@@ -9,6 +10,7 @@
 #include <sdbus-c++/sdbus-c++.h>
 
 #include "engine/core/log.hpp"
+#include "tests/fake_bluez/fake_alphabot.hpp"
 #include "tests/fake_bluez/fake_bluez.hpp"
 
 namespace {
@@ -59,6 +61,11 @@ int main(int argc, char** argv) {
   app.add_option("--drop", drop, "ADDR@SECONDS: the link drops, the car stays known (repeatable)");
   app.add_option("--vanish", vanish, "ADDR@SECONDS: the car disconnects and is gone for good");
   app.add_option("--garbage", garbage, "ADDR@SECONDS: the car sends malformed frames");
+  app.add_option("--alphabots", options.alphabots,
+                 "Number of Alphabot robots (BLE GATT service of alphabot.md §2; default 0)")
+      ->check(CLI::Range(0, 64));
+  app.add_option("--alphabot-address", options.alphabotAddresses,
+                 "Address of Alphabot 1, 2, … in order (repeatable; default AB:00:00:00:00:01, …)");
   app.add_flag("--no-acquire", options.noAcquire,
                "AcquireNotify/AcquireWrite answer org.bluez.Error.NotSupported");
   app.add_option("--log-level", logLevel, "debug, info, warn, error or off (default info)");
@@ -94,8 +101,11 @@ int main(int argc, char** argv) {
     });
     std::string list;
     for (const auto& a : fake.addresses()) list += " " + a;
+    std::string robots;
+    for (const auto& a : fake.alphabotAddresses()) robots += " " + a;
     log::info("fake-bluez", std::to_string(options.adapters) + " adapter(s), cars:" +
-                                (list.empty() ? std::string(" none") : list));
+                                (list.empty() ? std::string(" none") : list) +
+                                (robots.empty() ? std::string() : ", alphabots:" + robots));
     std::cout << "ready" << std::endl;
     loop.run();
     // What each car went through, for the tests to check: one line per car.
@@ -106,6 +116,14 @@ int main(int argc, char** argv) {
                 << " target=" << truth.target_speed_mm_s << " connects=" << c.connects
                 << " disconnects=" << c.disconnects << " framesToCar=" << c.framesToCar
                 << " framesToClient=" << c.framesToClient << " laps=" << truth.laps << "\n";
+    }
+    for (const auto& a : fake.alphabotAddresses()) {
+      const auto& c = fake.counters(a);
+      auto& robot = fake.alphabot(a);
+      std::cout << a << " connected=" << (fake.connected(a) ? "true" : "false")
+                << " speed=" << int(robot.speed()) << " writes=" << robot.writes().size()
+                << " malformed=" << robot.malformedWrites() << " connects=" << c.connects
+                << " disconnects=" << c.disconnects << "\n";
     }
     std::cout.flush();
     return 0;

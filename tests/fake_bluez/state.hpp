@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <boost/asio/posix/stream_descriptor.hpp>
 #include <cerrno>
 #include <cstdio>
@@ -24,6 +25,7 @@
 #include "engine/sim/grid.hpp"
 #include "engine/sim/track.hpp"
 #include "engine/transport/bluez_api.hpp"
+#include "tests/fake_bluez/fake_alphabot.hpp"
 #include "tests/fake_bluez/fake_bluez.hpp"
 
 namespace pitwall::testing::fake {
@@ -246,6 +248,10 @@ struct Device {
   std::unique_ptr<sdbus::IObject> service;
   std::unique_ptr<Characteristic> readChar;   // be15bee0: read, notify
   std::unique_ptr<Characteristic> writeChar;  // be15bee1: read, write-without-response, write
+  // An Alphabot instead of a car (car is then null): the robot, and its eight characteristics
+  // by alphabot::ble::Characteristic.
+  std::unique_ptr<FakeAlphabot> robot;
+  std::array<std::unique_ptr<Characteristic>, 8> robotChars;
 
   // Faults.
   bool refused = false;
@@ -327,6 +333,9 @@ struct FakeBluez::State {
   void unexportDevice(Device& d);
   void exportGatt(Device& d);
   void removeGatt(Device& d);
+  void exportService(Device& d);
+  void exportAlphabotGatt(Device& d);
+  std::string serviceUuid(const Device& d) const;
   std::unique_ptr<Characteristic> makeCharacteristic(Device& d, const std::string& path,
                                                      std::string_view uuid,
                                                      std::vector<std::string> flags);
@@ -350,6 +359,9 @@ struct FakeBluez::State {
   void linkDown(Device& d, bool tellCar);
   void forget(Device& d);
   void toCar(Device& d, std::span<const std::uint8_t> frame);
+  void toDevice(Device& d, Characteristic& ch, std::span<const std::uint8_t> frame);
+  // A notification on `ch` (socket or PropertiesChanged); true: a D-Bus signal went out.
+  bool notify(Device& d, Characteristic* ch, std::span<const std::uint8_t> frame);
   bool toClient(Device& d, std::span<const std::uint8_t>
                                frame);  // true: a D-Bus signal went out (the pump needs a kick)
   void watchNotifyIo(Device& d, Characteristic& ch);

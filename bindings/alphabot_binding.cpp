@@ -1,0 +1,527 @@
+// pitwall.alphabot{host=…, port=…} / {ble=ADDR}: an Alphabot robot as a Lua object
+// (docs/robots.md). One full userdata per robot, owning its C++ state (the link and
+// the handler references); the world keeps it in the registry until robot:close() or the end
+// of the world (lua_close runs __gc: the robot is sent a stop and its link is closed, so
+// nothing reaches a Lua state that is gone).
+#include <array>
+#include <cctype>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "bindings/lua_support.hpp"
+#include "bindings/pitwall_module.hpp"
+#include "bindings/script_host.hpp"
+#include "engine/core/log.hpp"
+#include "engine/core/overload.hpp"
+#include "engine/protocol/alphabot/command_text.hpp"
+#include "engine/protocol/alphabot/toggles.hpp"
+#include "engine/vehicles/alphabot_ble_link.hpp"
+#include "engine/vehicles/alphabot_tcp_link.hpp"
+
+namespace pitwall {
+
+namespace ab = alphabot;
+using lua::LuaError;
+
+namespace {
+
+constexpr const char* kMetatable = "pitwall.alphabot";
+constexpr const char* kComponent = "alphabot";
+
+enum Event {
+  kDistance,
+  kPosition,
+  kCompass,
+  kObstacle,
+  kPath,
+  kPing,
+  kConnect,
+  kDisconnect,
+  kMalformed,
+  kMapSize,
+  kAnchor,
+  kCalibrated,
+  kEventCount
+};
+constexpr std::array<const char*, kEventCount> kEventNames = {
+    "onDistance", "onPosition",   "onCompass",   "onObstacle", "onPath",   "onPing",
+    "onConnect",  "onDisconnect", "onMalformed", "onMapSize",  "onAnchor", "onCalibrated"};
+
+constexpr std::array<const char*, 10> kFieldNames = {
+    "connected", "x",         "y",       "heading",   "address",
+    "lastPing",  "lastError", "toggles", "malformed", "path"};
+
+struct Robot {
+  ScriptHost* host = nullptr;
+  std::unique_ptr<ab::RobotLink> link;
+  std::array<int, kEventCount> handlers;
+  int selfRef = LUA_NOREF;
+  ab::Toggles toggles;
+  std::optional<int> x, y, heading;
+  std::optional<double> lastPing;
+  std::vector<ab::Waypoint> path;
+  bool everConnected = false;
+  std::size_t malformed = 0;
+  std::string label;  // "alphabot tcp:127.0.0.1:4000"
+
+  Robot() { handlers.fill(LUA_NOREF); }
+
+  // Ends the robot's part in the world: a stop for a connected robot, the link closed, no more
+  // events. Safe to call twice, and from __gc during lua_close.
+  void close(lua_State* L) {
+    // The link's handlers stay set (one of them may be running: a handler that calls
+    // robot:close()); a closed link calls none of them again, and dispatch() checks closed().
+    if (link) {
+      if (link->connected()) link->send(ab::Drive{0, 0});
+      link->close();
+    }
+    for (auto& h : handlers) {
+      luaL_unref(L, LUA_REGISTRYINDEX, h);
+      h = LUA_NOREF;
+    }
+    luaL_unref(L, LUA_REGISTRYINDEX, selfRef);
+    selfRef = LUA_NOREF;
+  }
+  bool closed() const { return selfRef == LUA_NOREF; }
+};
+
+Robot& robotAt(lua_State* L, int idx) {
+  auto** p = static_cast<Robot**>(luaL_testudata(L, idx, kMetatable));
+  if (!p || !*p) throw LuaError(std::string("expected an alphabot, got ") + luaL_typename(L, idx));
+  return **p;
+}
+
+// ---- events ----
+
+// Calls robot.onX(robot, ev) with ev filled by `fill` (the table on top of the stack).
+template <class Fill>
+void dispatch(Robot& r, Event e, Fill fill) {
+  if (r.closed() || r.handlers[e] == LUA_NOREF) return;
+  lua_State* L = r.host->state();
+  lua_rawgeti(L, LUA_REGISTRYINDEX, r.handlers[e]);
+  lua_rawgeti(L, LUA_REGISTRYINDEX, r.selfRef);
+  lua_createtable(L, 0, 4);
+  fill(L);
+  lua::setNumber(L, "time", r.host->loop().seconds());
+  std::string what = std::string(kEventNames[e]) + " handler of " + r.label;
+  r.host->call(2, 0, what.c_str());
+}
+
+void pushWaypoints(lua_State* L, const std::vector<ab::Waypoint>& waypoints) {
+  lua_createtable(L, static_cast<int>(waypoints.size()), 0);
+  for (std::size_t i = 0; i < waypoints.size(); ++i) {
+    lua_createtable(L, 0, 2);
+    lua::setInteger(L, "x", waypoints[i].x);
+    lua::setInteger(L, "y", waypoints[i].y);
+    lua_rawseti(L, -2, static_cast<lua_Integer>(i + 1));
+  }
+}
+
+void received(Robot& r, const ab::Response& response) {
+  std::visit(
+      Overload{
+          [&](const ab::Distance& d) {
+            dispatch(r, kDistance, [&](lua_State* L) {
+              lua::setInteger(L, "degree", d.degree);
+              lua::setInteger(L, "distance", d.distance);
+            });
+          },
+          [&](const ab::Position& p) {
+            r.x = p.x;
+            r.y = p.y;
+            dispatch(r, kPosition, [&](lua_State* L) {
+              lua::setInteger(L, "x", p.x);
+              lua::setInteger(L, "y", p.y);
+            });
+          },
+          [&](const ab::Path& p) {
+            r.path = p.waypoints;
+            dispatch(r, kPath, [&](lua_State* L) {
+              pushWaypoints(L, p.waypoints);
+              lua_setfield(L, -2, "waypoints");
+              lua::setBoolean(L, "reachable", !p.waypoints.empty());
+            });
+          },
+          [&](const ab::Compass& c) {
+            r.heading = c.degree;
+            dispatch(r, kCompass, [&](lua_State* L) { lua::setInteger(L, "degree", c.degree); });
+          },
+          [&](const ab::PingReply& p) {
+            // The time we sent is the loop clock in µs (ping()); the robot echoes it.
+            auto now = std::chrono::duration_cast<std::chrono::microseconds>(r.host->loop().now());
+            double rtt = static_cast<double>(now.count() - p.time) / 1e6;
+            r.lastPing = rtt;
+            dispatch(r, kPing, [&](lua_State* L) { lua::setNumber(L, "rtt", rtt); });
+          },
+          [&](const ab::ObstacleRegistered& o) {
+            dispatch(r, kObstacle, [&](lua_State* L) {
+              lua::setInteger(L, "id", o.id);
+              lua::setInteger(L, "x", o.x);
+              lua::setInteger(L, "y", o.y);
+              lua::setInteger(L, "width", o.width);
+              lua::setInteger(L, "height", o.height);
+            });
+          },
+          [&](const ab::MapSize& m) {
+            dispatch(r, kMapSize, [&](lua_State* L) {
+              lua::setInteger(L, "length", m.length);
+              lua::setInteger(L, "width", m.width);
+            });
+          },
+          [&](const ab::AnchorPosition& a) {
+            dispatch(r, kAnchor, [&](lua_State* L) {
+              lua::setInteger(L, "id", a.id);
+              lua::setInteger(L, "x", a.x);
+              lua::setInteger(L, "y", a.y);
+            });
+          },
+          [&](const ab::CalibrationFinished&) { dispatch(r, kCalibrated, [](lua_State*) {}); },
+      },
+      response);
+}
+
+void hook(Robot& r) {
+  r.link->onResponse = [&r](const ab::Response& response) { received(r, response); };
+  r.link->onState = [&r](bool up, const std::string& reason) {
+    if (up) {
+      r.everConnected = true;
+      log::info(kComponent, r.label + ": connected");
+      dispatch(r, kConnect, [](lua_State*) {});
+      return;
+    }
+    log::warn(kComponent, r.label + ": " + (r.everConnected ? "lost: " : "cannot connect: ") +
+                              reason + "; retrying");
+    if (!r.everConnected) return;  // onDisconnect follows a connection, not a failed attempt
+    dispatch(r, kDisconnect, [&](lua_State* L) { lua::setString(L, "reason", reason); });
+  };
+  r.link->onMalformed = [&r](const std::string& error) {
+    ++r.malformed;
+    log::warn(kComponent, r.label + ": malformed packet: " + error);
+    dispatch(r, kMalformed, [&](lua_State* L) { lua::setString(L, "error", error); });
+  };
+}
+
+// ---- commands ----
+
+void sendOrRaise(Robot& r, const ab::Request& request) {
+  if (r.closed()) throw LuaError(r.label + " is closed");
+  if (!r.link->send(request)) {
+    std::string why = r.link->lastError();
+    throw LuaError(r.label + ": nothing sent: " + (why.empty() ? "not connected" : why));
+  }
+}
+
+long long ranged(lua_State* L, int idx, const char* what, long long lo, long long hi) {
+  auto v = lua::checkInteger(L, idx, what);
+  auto error = ab::checkRange(what, v, lo, hi);
+  if (!error.empty()) throw LuaError(error);
+  return v;
+}
+
+std::int16_t coord(lua_State* L, int idx, const char* what) {
+  return static_cast<std::int16_t>(ranged(L, idx, what, ab::kCoordMin, ab::kCoordMax));
+}
+
+int drive(lua_State* L) {
+  Robot& r = robotAt(L, 1);
+  auto speed = ranged(L, 2, "speed", ab::kDriveMin, ab::kDriveMax);
+  auto steer = ranged(L, 3, "steer", ab::kDriveMin, ab::kDriveMax);
+  sendOrRaise(r, ab::Drive{static_cast<std::int8_t>(speed), static_cast<std::int8_t>(steer)});
+  return 0;
+}
+int stop(lua_State* L) {
+  sendOrRaise(robotAt(L, 1), ab::Drive{0, 0});
+  return 0;
+}
+int measureDistance(lua_State* L) {
+  Robot& r = robotAt(L, 1);
+  auto degree = ranged(L, 2, "degree", ab::kDegreeMin, ab::kDegreeMax);
+  sendOrRaise(r, ab::MeasureDistance{static_cast<std::int16_t>(degree)});
+  return 0;
+}
+int calibrateSteering(lua_State* L) {
+  sendOrRaise(robotAt(L, 1), ab::CalibrateSteering{});
+  return 0;
+}
+int calibrateCompass(lua_State* L) {
+  sendOrRaise(robotAt(L, 1), ab::CalibrateCompass{});
+  return 0;
+}
+int set(lua_State* L) {
+  Robot& r = robotAt(L, 1);
+  if (!lua_istable(L, 2))
+    throw LuaError("set takes a table of toggles, e.g. {collisionAvoidance = true}; names: " +
+                   ab::toggleNames());
+  ab::Toggles next = r.toggles;
+  lua_pushnil(L);
+  while (lua_next(L, 2) != 0) {
+    if (lua_type(L, -2) != LUA_TSTRING)
+      throw LuaError("set: toggle names are strings, got a " + lua::typeName(L, -2) +
+                     " key; names: " + ab::toggleNames());
+    std::string name = lua_tostring(L, -2);
+    const ab::ToggleBit* bit = ab::findToggle(name);
+    if (!bit) throw LuaError("set: unknown toggle '" + name + "'; names: " + ab::toggleNames());
+    if (!lua_isboolean(L, -1))
+      throw LuaError("set: toggle " + name + " must be true or false, got " + lua::typeName(L, -1));
+    ab::setBit(next, *bit, lua_toboolean(L, -1));
+    lua_pop(L, 1);
+  }
+  // The robot takes the whole field: every bit not named keeps its last value.
+  sendOrRaise(r, ab::SetToggles{next});
+  r.toggles = next;
+  return 0;
+}
+int ping(lua_State* L) {
+  Robot& r = robotAt(L, 1);
+  auto now = std::chrono::duration_cast<std::chrono::microseconds>(r.host->loop().now());
+  sendOrRaise(r, ab::Ping{static_cast<std::int64_t>(now.count())});
+  return 0;
+}
+int setAnchor(lua_State* L) {
+  Robot& r = robotAt(L, 1);
+  auto id = ranged(L, 2, "anchor id", ab::kIdMin, ab::kIdMax);
+  auto x = coord(L, 3, "x (cm)");
+  auto y = coord(L, 4, "y (cm)");
+  sendOrRaise(r, ab::SetAnchor{static_cast<std::uint8_t>(id), x, y});
+  return 0;
+}
+int navigateTo(lua_State* L) {
+  Robot& r = robotAt(L, 1);
+  auto x = coord(L, 2, "x (cm)");
+  auto y = coord(L, 3, "y (cm)");
+  sendOrRaise(r, ab::NavigateTo{x, y});
+  return 0;
+}
+int addObstacle(lua_State* L) {
+  Robot& r = robotAt(L, 1);
+  auto x = coord(L, 2, "x (cm)");
+  auto y = coord(L, 3, "y (cm)");
+  auto w = ranged(L, 4, "width (cm)", ab::kSizeMin, ab::kSizeMax);
+  auto h = ranged(L, 5, "height (cm)", ab::kSizeMin, ab::kSizeMax);
+  sendOrRaise(r,
+              ab::AddObstacle{x, y, static_cast<std::uint16_t>(w), static_cast<std::uint16_t>(h)});
+  return 0;
+}
+int removeObstacle(lua_State* L) {
+  Robot& r = robotAt(L, 1);
+  if (lua_isnoneornil(L, 3)) {
+    auto id = ranged(L, 2, "obstacle id", ab::kIdMin, ab::kIdMax);
+    sendOrRaise(r, ab::RemoveObstacleById{static_cast<std::uint8_t>(id)});
+  } else {
+    auto x = coord(L, 2, "x (cm)");
+    auto y = coord(L, 3, "y (cm)");
+    sendOrRaise(r, ab::RemoveObstacleAt{x, y});
+  }
+  return 0;
+}
+int clearObstacles(lua_State* L) {
+  sendOrRaise(robotAt(L, 1), ab::ClearObstacles{});
+  return 0;
+}
+int close(lua_State* L) {
+  robotAt(L, 1).close(L);
+  return 0;
+}
+
+// ---- fields and metamethods ----
+
+bool pushField(lua_State* L, Robot& r, std::string_view key) {
+  auto integer = [&](const std::optional<int>& v) {
+    if (v)
+      lua_pushinteger(L, *v);
+    else
+      lua_pushnil(L);
+    return true;
+  };
+  if (key == "connected") {
+    lua_pushboolean(L, !r.closed() && r.link->connected());
+    return true;
+  }
+  if (key == "x") return integer(r.x);
+  if (key == "y") return integer(r.y);
+  if (key == "heading") return integer(r.heading);
+  if (key == "lastPing") {
+    if (r.lastPing)
+      lua_pushnumber(L, *r.lastPing);
+    else
+      lua_pushnil(L);
+    return true;
+  }
+  if (key == "address") {
+    lua_pushstring(L, r.link->address().c_str());
+    return true;
+  }
+  if (key == "lastError") {
+    std::string e = r.closed() ? r.label + " is closed" : r.link->lastError();
+    if (e.empty())
+      lua_pushnil(L);
+    else
+      lua_pushstring(L, e.c_str());
+    return true;
+  }
+  if (key == "malformed") {
+    lua_pushinteger(L, static_cast<lua_Integer>(r.malformed));
+    return true;
+  }
+  if (key == "toggles") {
+    lua_createtable(L, 0, static_cast<int>(ab::toggleBits().size()));
+    for (const auto& bit : ab::toggleBits())
+      lua::setBoolean(L, bit.name, ab::isSet(r.toggles, bit));
+    return true;
+  }
+  if (key == "path") {
+    pushWaypoints(L, r.path);
+    return true;
+  }
+  return false;
+}
+
+int index(lua_State* L) {
+  // 1: robot, 2: key. Methods, then state, then the script's own fields.
+  Robot& r = robotAt(L, 1);
+  return lua::indexObject(L, [&](std::string_view key) { return pushField(L, r, key); });
+}
+
+int newindex(lua_State* L) {
+  Robot& r = robotAt(L, 1);
+  if (lua_type(L, 2) == LUA_TSTRING) {
+    std::string key = lua_tostring(L, 2);
+    int e = -1;
+    for (int i = 0; i < kEventCount; ++i)
+      if (key == kEventNames[static_cast<std::size_t>(i)]) e = i;
+    if (e >= 0) {
+      lua::checkHandler(L, "alphabot", key);
+      if (r.closed()) {
+        if (!lua_isnil(L, 3)) throw LuaError(r.label + " is closed: it has no more events");
+        return 0;
+      }
+      luaL_unref(L, LUA_REGISTRYINDEX, r.handlers[static_cast<std::size_t>(e)]);
+      r.handlers[static_cast<std::size_t>(e)] = LUA_NOREF;
+      if (lua_isfunction(L, 3)) {
+        lua_pushvalue(L, 3);
+        r.handlers[static_cast<std::size_t>(e)] = luaL_ref(L, LUA_REGISTRYINDEX);
+      }
+      return 0;
+    }
+    lua::refuseReserved(L, "alphabot", key, kFieldNames, kEventNames);
+  }
+  return lua::storeOwnField(L);
+}
+
+int tostring(lua_State* L) {
+  Robot& r = robotAt(L, 1);
+  lua_pushstring(L, r.label.c_str());
+  return 1;
+}
+
+int gc(lua_State* L) {
+  auto** p = static_cast<Robot**>(luaL_testudata(L, 1, kMetatable));
+  if (p && *p) {
+    (*p)->close(L);
+    delete *p;
+    *p = nullptr;
+  }
+  return 0;
+}
+
+// ---- pitwall.alphabot{…} ----
+
+int newRobot(lua_State* L) {
+  if (!lua_istable(L, 1))
+    throw LuaError(
+        "pitwall.alphabot takes a table: {host = \"127.0.0.1\", port = 4000} or "
+        "{ble = \"AA:BB:CC:DD:EE:FF\"}");
+  std::string host, ble;
+  long long port = 0;
+  double timeout = 3.0;
+  lua_pushnil(L);
+  while (lua_next(L, 1) != 0) {
+    std::string key = lua_type(L, -2) == LUA_TSTRING ? lua_tostring(L, -2) : "";
+    if (key == "host")
+      host = lua::checkString(L, -1, "host");
+    else if (key == "port")
+      port = ranged(L, -1, "port", 1, 65535);
+    else if (key == "ble")
+      ble = lua::checkString(L, -1, "ble (the robot's Bluetooth address)");
+    else if (key == "connectTimeout") {
+      timeout = lua::checkNumber(L, -1, "connectTimeout (s)");
+      if (timeout <= 0 || timeout > 60)
+        throw LuaError("connectTimeout " + lua::show(timeout) + " is out of range (0, 60] s");
+    } else {
+      throw LuaError("pitwall.alphabot: unknown option '" +
+                     (key.empty() ? lua::typeName(L, -2) : key) +
+                     "'; the options are host, port, connectTimeout, ble");
+    }
+    lua_pop(L, 1);
+  }
+  if (host.empty() == ble.empty())
+    throw LuaError("pitwall.alphabot needs either host (and port) for WLAN or ble for Bluetooth");
+  ScriptHost& scriptHost = ScriptHost::from(L);
+  Loop& loop = scriptHost.loop();
+  std::unique_ptr<ab::RobotLink> link;
+  if (!host.empty()) {
+    if (port == 0) throw LuaError("pitwall.alphabot{host=…} needs a port (1..65535)");
+    if (loop.clockKind() == ClockKind::Virtual)
+      throw LuaError(
+          "pitwall.alphabot{host=…} talks to a robot over the network and needs the real clock: "
+          "run without --fast (not in `pitwall test`)");
+    ab::TcpLinkOptions options;
+    options.connectTimeout = timeout;
+    link =
+        std::make_unique<ab::TcpRobotLink>(loop, host, static_cast<std::uint16_t>(port), options);
+  } else {
+    std::string error;
+    link = ab::makeBleRobotLink(loop, ble, error);
+    if (!link) throw LuaError("pitwall.alphabot{ble=\"" + ble + "\"}: " + error);
+  }
+
+  auto robot = std::make_unique<Robot>();
+  robot->host = &scriptHost;
+  robot->label = "alphabot " + link->address();
+  robot->link = std::move(link);
+  auto** ud = static_cast<Robot**>(lua_newuserdatauv(L, sizeof(Robot*), 1));
+  *ud = nullptr;
+  luaL_setmetatable(L, kMetatable);
+  lua_newtable(L);
+  lua_setiuservalue(L, -2, 1);
+  *ud = robot.release();
+  lua_pushvalue(L, -1);
+  (*ud)->selfRef = luaL_ref(L, LUA_REGISTRYINDEX);  // lives until close() or the world's end
+  hook(**ud);
+  return 1;
+}
+
+void registerType(lua_State* L) {
+  static const luaL_Reg methods[] = {{"drive", lua::guarded<drive>},
+                                     {"stop", lua::guarded<stop>},
+                                     {"measureDistance", lua::guarded<measureDistance>},
+                                     {"calibrateSteering", lua::guarded<calibrateSteering>},
+                                     {"calibrateCompass", lua::guarded<calibrateCompass>},
+                                     {"set", lua::guarded<set>},
+                                     {"ping", lua::guarded<ping>},
+                                     {"setAnchor", lua::guarded<setAnchor>},
+                                     {"navigateTo", lua::guarded<navigateTo>},
+                                     {"addObstacle", lua::guarded<addObstacle>},
+                                     {"removeObstacle", lua::guarded<removeObstacle>},
+                                     {"clearObstacles", lua::guarded<clearObstacles>},
+                                     {"close", lua::guarded<close>},
+                                     {nullptr, nullptr}};
+  lua::registerObjectType(
+      L, {kMetatable, "alphabot", methods, kFieldNames, kEventNames, lua::guarded<index>,
+          lua::guarded<newindex>, lua::guarded<tostring>, gc});
+}
+
+}  // namespace
+
+void openAlphabotModule(ScriptHost& host) {
+  lua_State* L = host.state();
+  registerType(L);
+  lua_getglobal(L, "pitwall");
+  lua_pushcfunction(L, lua::guarded<newRobot>);
+  lua_setfield(L, -2, "alphabot");
+  lua_pop(L, 1);
+}
+
+}  // namespace pitwall

@@ -1,0 +1,346 @@
+// pitwall.mindroad{host=…, port=…}: a MindRoad robot car as a Lua object (docs/robots.md).
+// One full userdata per robot holding its client link; a uservalue table keeps the event
+// handlers and the script's own fields, as cars do. The object belongs to the Lua world that
+// made it: a registry reference keeps it (and its connection) alive until robot:close() or the
+// end of that world (end of the run, a hot reload), when __gc closes the link — the robot then
+// gets a stop, or stops by its watchdog.
+#include <lua.hpp>
+
+#include <array>
+#include <cctype>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "bindings/interrupt.hpp"
+#include "bindings/lua_support.hpp"
+#include "bindings/pitwall_module.hpp"
+#include "bindings/script_host.hpp"
+#include "engine/core/console.hpp"
+#include "engine/core/log.hpp"
+#include "engine/vehicles/mindroad_client.hpp"
+
+namespace pitwall {
+
+using lua::LuaError;
+
+namespace {
+
+constexpr const char* kMetatable = "pitwall.mindroad";
+constexpr double kConfirmWindow = 5;  // s: shutdown() typed at the REPL must be repeated within it
+
+constexpr std::array<const char*, 2> kEvents = {"onContact", "onLost"};
+constexpr std::array<const char*, 8> kFields = {"connected", "host",  "port",      "udp",
+                                                "watchdog",  "phase", "lastError", "contacts"};
+
+struct Robot {
+  std::shared_ptr<MindroadClient> client;
+  ScriptHost* host = nullptr;
+  int selfRef = LUA_NOREF;            // held while open: events need the object, the script may not
+  std::string label;                  // "mindroad tcp 127.0.0.1:4000"
+  std::string contactWhat, lostWhat;  // how errors in the handlers are reported
+  std::optional<TimePoint> shutdownAsked;
+  MindroadOptions options;  // host, port, … stay readable after close()
+};
+
+Robot& robotAt(lua_State* L, int idx) {
+  auto* r = static_cast<Robot*>(luaL_testudata(L, idx, kMetatable));
+  if (!r) throw LuaError(std::string("expected a mindroad robot, got ") + luaL_typename(L, idx));
+  return *r;
+}
+
+MindroadClient& open(lua_State* L, int idx) {
+  Robot& r = robotAt(L, idx);
+  if (!r.client) throw LuaError(r.label + " is closed");
+  return *r.client;
+}
+
+void raiseIfRefused(const MindroadClient::Sent& sent) {
+  if (!sent) throw LuaError(sent.error());
+}
+
+bool isEvent(std::string_view key) {
+  for (auto* e : kEvents)
+    if (key == e) return true;
+  return false;
+}
+// Calls robot.<event>(robot, args…) if the script set it; `push` pushes the extra arguments.
+template <class Push>
+void dispatch(Robot& r, const char* event, const std::string& what, int nargs, Push push) {
+  if (r.selfRef == LUA_NOREF) return;
+  lua_State* L = r.host->state();
+  const int top = lua_gettop(L);
+  lua_rawgeti(L, LUA_REGISTRYINDEX, r.selfRef);
+  lua_getiuservalue(L, -1, 1);
+  if (lua_getfield(L, -1, event) != LUA_TFUNCTION) {
+    lua_settop(L, top);
+    return;
+  }
+  lua_pushvalue(L, top + 1);  // the robot
+  push(L);
+  r.host->call(1 + nargs, 0, what.c_str());
+  lua_settop(L, top);
+}
+
+// ---- methods ----
+int steer(lua_State* L) {
+  auto& c = open(L, 1);
+  raiseIfRefused(c.steer(lua::checkInteger(L, 2, "steer x (forward/backward)"),
+                         lua::checkInteger(L, 3, "steer y (right/left)")));
+  return 0;
+}
+
+int click(lua_State* L) {
+  auto& c = open(L, 1);
+  raiseIfRefused(c.click(lua::checkInteger(L, 2, "click x"), lua::checkInteger(L, 3, "click y")));
+  return 0;
+}
+
+std::uint8_t buttonByName(const std::string& name) {
+  if (auto b = mindroad::buttonFromName(name)) return static_cast<std::uint8_t>(*b);
+  throw LuaError("button '" + name +
+                 "' is unknown; use manual, automatic, sensitivity-up or sensitivity-down");
+}
+
+// buttons("automatic"): the byte is that button's id (seed table 2); buttons{"manual",
+// "sensitivity-up"}: a bit mask, bit n for button n (seed §5.2); buttons(0x05): the raw byte.
+int buttons(lua_State* L) {
+  auto& c = open(L, 1);
+  long long raw = 0;
+  if (lua_type(L, 2) == LUA_TSTRING) {
+    raw = buttonByName(lua_tostring(L, 2));
+  } else if (lua_istable(L, 2)) {
+    const auto n = luaL_len(L, 2);
+    for (lua_Integer i = 1; i <= n; ++i) {
+      lua_geti(L, 2, i);
+      if (lua_type(L, -1) != LUA_TSTRING)
+        throw LuaError("buttons{…} takes button names, got " + lua::typeName(L, -1) + " at " +
+                       std::to_string(i));
+      raw |= 1 << buttonByName(lua_tostring(L, -1));
+      lua_pop(L, 1);
+    }
+  } else if (lua_type(L, 2) == LUA_TNUMBER) {
+    raw = lua::checkInteger(L, 2, "buttons byte");
+  } else {
+    throw LuaError("buttons takes a button name, a list of names or a byte 0..255, got " +
+                   lua::typeName(L, 2));
+  }
+  raiseIfRefused(c.buttons(raw));
+  return 0;
+}
+
+int pictureMode(lua_State* L) {
+  auto& c = open(L, 1);
+  raiseIfRefused(c.pictureMode(lua::checkString(L, 2, "picture mode")));
+  return 0;
+}
+
+int stop(lua_State* L) {
+  raiseIfRefused(open(L, 1).stop());
+  return 0;
+}
+
+int ping(lua_State* L) {
+  raiseIfRefused(open(L, 1).ping());
+  return 0;
+}
+
+// Turns the robot off. Typed at the REPL it asks first: the first call prints a warning, a
+// second one within 5 s sends it. Returns true when sent, false when waiting for confirmation.
+int shutdown(lua_State* L) {
+  Robot& r = robotAt(L, 1);
+  auto& c = open(L, 1);
+  if (interrupt::inConsole()) {
+    const TimePoint now = r.host->loop().now();
+    if (!r.shutdownAsked || now - *r.shutdownAsked > fromSeconds(kConfirmWindow)) {
+      if (!c.connected()) raiseIfRefused(c.shutdown());  // the same error as without asking
+      r.shutdownAsked = now;
+      console::write(r.label +
+                     ": shutdown() turns the robot OFF (it needs a person to turn it on again). "
+                     "Call shutdown() again within 5 s to confirm.\n");
+      lua_pushboolean(L, 0);
+      return 1;
+    }
+    r.shutdownAsked.reset();
+  }
+  raiseIfRefused(c.shutdown());
+  lua_pushboolean(L, 1);
+  return 1;
+}
+
+void closeRobot(lua_State* L, Robot& r) {
+  if (r.client) {
+    r.client->close();
+    r.client.reset();
+  }
+  if (r.selfRef != LUA_NOREF) {
+    luaL_unref(L, LUA_REGISTRYINDEX, r.selfRef);
+    r.selfRef = LUA_NOREF;
+  }
+}
+
+int close(lua_State* L) {
+  closeRobot(L, robotAt(L, 1));
+  return 0;
+}
+
+int gc(lua_State* L) {
+  auto* r = static_cast<Robot*>(luaL_testudata(L, 1, kMetatable));
+  if (r) {
+    if (r->client) r->client->close();  // no unref here: the registry may be going away
+    r->~Robot();
+  }
+  return 0;
+}
+
+int tostring(lua_State* L) {
+  Robot& r = robotAt(L, 1);
+  std::string s = r.label + " (" + (r.client ? r.client->phaseName() : "closed") + ")";
+  lua_pushlstring(L, s.data(), s.size());
+  return 1;
+}
+
+bool pushField(lua_State* L, Robot& r, std::string_view key) {
+  const MindroadOptions* o = &r.options;
+  if (key == "connected") {
+    lua_pushboolean(L, r.client && r.client->connected());
+  } else if (key == "phase") {
+    lua_pushstring(L, r.client ? r.client->phaseName().c_str() : "closed");
+  } else if (key == "lastError") {
+    if (r.client && !r.client->lastError().empty())
+      lua_pushstring(L, r.client->lastError().c_str());
+    else
+      lua_pushnil(L);
+  } else if (key == "contacts") {
+    lua_pushinteger(L, r.client ? static_cast<lua_Integer>(r.client->contacts()) : 0);
+  } else if (key == "host") {
+    lua_pushstring(L, o->host.c_str());
+  } else if (key == "port") {
+    lua_pushinteger(L, o->port);
+  } else if (key == "udp") {
+    lua_pushboolean(L, o->udp);
+  } else if (key == "watchdog") {
+    lua_pushnumber(L, o->watchdog);
+  } else {
+    return false;
+  }
+  return true;
+}
+
+int index(lua_State* L) {
+  // 1: robot, 2: key. Methods, then state fields, then the script's own fields.
+  Robot& r = robotAt(L, 1);
+  return lua::indexObject(L, [&](std::string_view key) { return pushField(L, r, key); });
+}
+
+int newindex(lua_State* L) {
+  robotAt(L, 1);
+  if (lua_type(L, 2) == LUA_TSTRING) {
+    std::string key = lua_tostring(L, 2);
+    if (isEvent(key))
+      lua::checkHandler(L, "robot", key);  // kept in the robot's own table, read on each event
+    else
+      lua::refuseReserved(L, "robot", key, kFields, kEvents);
+  }
+  return lua::storeOwnField(L);
+}
+
+void registerType(lua_State* L) {
+  static const luaL_Reg methods[] = {{"steer", lua::guarded<steer>},
+                                     {"click", lua::guarded<click>},
+                                     {"buttons", lua::guarded<buttons>},
+                                     {"pictureMode", lua::guarded<pictureMode>},
+                                     {"stop", lua::guarded<stop>},
+                                     {"ping", lua::guarded<ping>},
+                                     {"shutdown", lua::guarded<shutdown>},
+                                     {"close", lua::guarded<close>},
+                                     {nullptr, nullptr}};
+  lua::registerObjectType(L,
+                          {kMetatable, "mindroad", methods, kFields, kEvents, lua::guarded<index>,
+                           lua::guarded<newindex>, lua::guarded<tostring>, gc});
+}
+
+// Reads the options table at idx into o; unknown keys are refused (a typo would silently fall
+// back to a default).
+MindroadOptions readOptions(lua_State* L, int idx) {
+  MindroadOptions o;
+  if (lua_isnoneornil(L, idx)) return o;
+  if (!lua_istable(L, idx))
+    throw LuaError("pitwall.mindroad takes a table {host=, port=, udp=, watchdog=}, got " +
+                   lua::typeName(L, idx));
+  lua_pushnil(L);
+  while (lua_next(L, idx)) {
+    const int v = lua_gettop(L);
+    if (lua_type(L, v - 1) != LUA_TSTRING)
+      throw LuaError("pitwall.mindroad: option names are strings, got " + lua::typeName(L, v - 1));
+    const std::string key = lua_tostring(L, v - 1);
+    if (key == "host") {
+      o.host = lua::checkString(L, v, "host");
+      if (o.host.empty()) throw LuaError("host must not be empty");
+    } else if (key == "port") {
+      auto port = lua::checkInteger(L, v, "port");
+      if (port < 1 || port > 65535)
+        throw LuaError("port " + std::to_string(port) + " is out of range 1..65535");
+      o.port = static_cast<std::uint16_t>(port);
+    } else if (key == "udp") {
+      if (!lua_isboolean(L, v)) throw LuaError("udp must be a boolean, got " + lua::typeName(L, v));
+      o.udp = lua_toboolean(L, v);
+    } else if (key == "watchdog") {
+      o.watchdog = lua::checkNumber(L, v, "watchdog (s)");
+      if (o.watchdog < 0.03 || o.watchdog > 60)
+        throw LuaError("watchdog " + lua::show(o.watchdog) + " s is out of range 0.03..60 s");
+    } else if (key == "contactTimeout") {
+      o.contactTimeout = lua::checkNumber(L, v, "contactTimeout (s)");
+      if (o.contactTimeout < 0.1 || o.contactTimeout > 600)
+        throw LuaError("contactTimeout " + lua::show(o.contactTimeout) +
+                       " s is out of range 0.1..600 s");
+    } else {
+      throw LuaError("pitwall.mindroad: unknown option '" + key +
+                     "'; the options are host, port, udp, watchdog, contactTimeout");
+    }
+    lua_pop(L, 1);
+  }
+  return o;
+}
+
+int newRobot(lua_State* L) {
+  MindroadOptions options = readOptions(L, 1);
+  ScriptHost& host = ScriptHost::from(L);
+  auto* r = new (lua_newuserdatauv(L, sizeof(Robot), 1)) Robot();
+  luaL_setmetatable(L, kMetatable);
+  lua_newtable(L);
+  lua_setiuservalue(L, -2, 1);
+  r->host = &host;
+  r->options = options;
+  r->client = MindroadClient::create(host.loop(), options);
+  r->label = "mindroad " + r->client->address();
+  r->contactWhat = "onContact handler of " + r->label;
+  r->lostWhat = "onLost handler of " + r->label;
+  lua_pushvalue(L, -1);
+  r->selfRef = luaL_ref(L, LUA_REGISTRYINDEX);
+  r->client->onContact = [r] { dispatch(*r, "onContact", r->contactWhat, 0, [](lua_State*) {}); };
+  r->client->onLost = [r](const std::string& reason) {
+    dispatch(*r, "onLost", r->lostWhat, 1,
+             [&reason](lua_State* S) { lua_pushlstring(S, reason.data(), reason.size()); });
+  };
+  if (host.loop().clockKind() == ClockKind::Virtual)
+    log::warn("mindroad", r->label +
+                              ": virtual time (--fast, tests) races past the timeouts of a real "
+                              "socket; a robot needs a real-time run");
+  r->client->start();
+  return 1;
+}
+
+}  // namespace
+
+void openMindroadModule(ScriptHost& host) {
+  lua_State* L = host.state();
+  registerType(L);
+  lua_getglobal(L, "pitwall");
+  lua_pushcfunction(L, lua::guarded<newRobot>);
+  lua_setfield(L, -2, "mindroad");
+  lua_pop(L, 1);
+}
+
+}  // namespace pitwall

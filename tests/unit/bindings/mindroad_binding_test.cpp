@@ -1,0 +1,268 @@
+// pitwall.mindroad from Lua against the simulated robot over loopback: the object, its events,
+// errors naming the range with nothing sent, the REPL's shutdown confirmation, and the link's
+// end with the Lua world that made it.
+#include <doctest/doctest.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bindings/script_host.hpp"
+#include "engine/core/console.hpp"
+#include "engine/core/log.hpp"
+#include "engine/sim/mindroad_robot_server.hpp"
+#include "tests/support/run_until.hpp"
+
+using namespace pitwall;
+using pitwall::testing::runFor;
+using pitwall::testing::runUntil;
+
+namespace {
+
+struct RobotLua {
+  Loop loop{ClockKind::Real};
+  Fleet fleet{loop};
+  std::unique_ptr<sim::MindroadRobotServer> robot;
+  std::unique_ptr<ScriptHost> host;
+  std::vector<std::string> logged;
+  std::string printed;
+
+  RobotLua() {
+    setenv("PITWALL_SCRIPTS", PITWALL_SOURCE_DIR "/scripts", 1);
+    log::setSink([this](log::Level, std::string_view line) { logged.emplace_back(line); });
+    console::setWriter([this](std::string_view text) { printed += text; });
+    startRobot(0);
+    host = std::make_unique<ScriptHost>(loop, fleet, nullptr, HostOptions{});
+  }
+  ~RobotLua() {
+    host.reset();
+    robot.reset();
+    console::setWriter(nullptr);
+    log::setSink(nullptr);
+  }
+  void startRobot(std::uint16_t port) {
+    sim::MindroadServerOptions o;
+    o.port = port;
+    robot = std::make_unique<sim::MindroadRobotServer>(loop, o);
+  }
+  std::string port() { return std::to_string(robot->port()); }
+  // Starts code as a task (the robot's port in the global PORT).
+  void start(const std::string& code) {
+    lua_pushinteger(host->state(), robot->port());
+    lua_setglobal(host->state(), "PORT");
+    auto started = host->startString(code, "test.lua");
+    REQUIRE_MESSAGE(started.ok(), (started.ok() ? "" : started.error()));
+  }
+  bool global(const char* name) {
+    lua_getglobal(host->state(), name);
+    bool v = lua_toboolean(host->state(), -1);
+    lua_pop(host->state(), 1);
+    return v;
+  }
+  std::string string(const char* name) {
+    lua_getglobal(host->state(), name);
+    const char* s = lua_tostring(host->state(), -1);
+    std::string v = s ? s : "";
+    lua_pop(host->state(), 1);
+    return v;
+  }
+  bool waitFor(const char* name, Duration limit = std::chrono::seconds(5)) {
+    return runUntil(
+        loop, [&] { return global(name); }, limit);
+  }
+  const sim::MindroadRobotState& state() { return robot->robot().state(); }
+};
+
+}  // namespace
+
+TEST_CASE_FIXTURE(RobotLua,
+                  "mindroad: pitwall.mindroad makes a robot object that shakes hands and steers") {
+  start(R"(
+    robot = pitwall.mindroad{host = "127.0.0.1", port = PORT}
+    name = getmetatable(robot).__name
+    label = tostring(robot)
+    robot.onContact = function(r) contacted = (r == robot) end
+    pitwall.waitUntil(function() return robot.connected end, 3)
+    robot:steer(127, 0)
+    robot:click(80, 60)
+    robot:buttons("automatic")
+    robot:pictureMode("hsv")
+    robot.laps = 3  -- the script's own field
+    fields = robot.host == "127.0.0.1" and robot.port == PORT and robot.udp == false
+      and robot.watchdog == 0.5 and robot.phase == "contact" and robot.laps == 3
+    done = true
+  )");
+  REQUIRE(waitFor("done"));
+  CHECK(string("name") == "mindroad");
+  CHECK(string("label") == "mindroad tcp 127.0.0.1:" + port() + " (connecting)");
+  CHECK(global("contacted"));
+  CHECK(global("fields"));
+  REQUIRE(runUntil(loop, [&] { return state().picture == mindroad::Picture::Hsv; }));
+  CHECK(state().steerX == 127);
+  CHECK(state().clickX == 80);
+  CHECK(state().mode == "automatic");
+}
+
+TEST_CASE_FIXTURE(RobotLua,
+                  "bad input from Lua raises an error naming the range; nothing is sent") {
+  start(R"(
+    robot = pitwall.mindroad{port = PORT}
+    pitwall.waitUntil(function() return robot.connected end, 3)
+    local function try(f) local ok, e = pcall(f); return e end
+    clickError = try(function() robot:click(0, 60) end)
+    steerError = try(function() robot:steer(0, 300) end)
+    modeError = try(function() robot:pictureMode("cmyk") end)
+    buttonError = try(function() robot:buttons("turbo") end)
+    typeError = try(function() robot:steer("fast", 0) end)
+    eventError = try(function() robot.onCrash = print end)
+    fieldError = try(function() robot.connected = true end)
+    optionError = try(function() pitwall.mindroad{prot = 4000} end)
+    portError = try(function() pitwall.mindroad{port = 70000} end)
+    done = true
+  )");
+  REQUIRE(waitFor("done"));
+  CHECK(string("clickError") == "test.lua:5: click x 0 is out of range 1..160; nothing sent");
+  CHECK(string("steerError") ==
+        "test.lua:6: steer y (right/left) 300 is out of range -128..127; nothing sent");
+  CHECK(string("modeError") ==
+        "test.lua:7: picture mode 'cmyk' is unknown; use rgb, hsv or filter; nothing sent");
+  CHECK(string("buttonError") ==
+        "test.lua:8: button 'turbo' is unknown; use manual, automatic, sensitivity-up or "
+        "sensitivity-down");
+  CHECK(string("typeError") ==
+        "test.lua:9: steer x (forward/backward) must be a whole number, "
+        "got string");
+  CHECK(string("eventError") ==
+        "test.lua:10: robot.onCrash is not an event; the events are onContact, onLost");
+  CHECK(string("fieldError") ==
+        "test.lua:11: robot.connected is read-only (it is the robot's state)");
+  CHECK(string("optionError") ==
+        "test.lua:12: pitwall.mindroad: unknown option 'prot'; the options are host, port, udp, "
+        "watchdog, contactTimeout");
+  CHECK(string("portError") == "test.lua:13: port 70000 is out of range 1..65535");
+  runFor(loop, std::chrono::milliseconds(50));
+  CHECK(state().clickX == 0);  // no click arrived
+  CHECK(state().steerX == 0);
+  CHECK(state().malformed == 0);
+}
+
+TEST_CASE_FIXTURE(RobotLua,
+                  "mindroad: a robot that disappears reaches onLost; when it is back, onContact") {
+  start(R"(
+    robot = pitwall.mindroad{port = PORT}
+    contacts = 0
+    robot.onContact = function() contacts = contacts + 1; contactedAgain = contacts >= 2 end
+    robot.onLost = function(r, reason) lostReason = reason; gone = true end
+    pitwall.waitUntil(function() return robot.connected end, 3)
+    up = true
+    pitwall.waitUntil(function() return gone end, 5)
+    steerError = select(2, pcall(robot.steer, robot, 10, 0))
+  )");
+  REQUIRE(waitFor("up"));
+  const auto port = robot->port();
+  robot.reset();
+  REQUIRE(waitFor("gone"));
+  CHECK(string("lostReason") == "tcp 127.0.0.1:" + std::to_string(port) + " closed the connection");
+  REQUIRE(runUntil(loop, [&] { return !string("steerError").empty(); }));
+  CHECK(string("steerError").find("has no contact (reconnecting: tcp 127.0.0.1:") !=
+        std::string::npos);
+  startRobot(port);
+  REQUIRE(waitFor("contactedAgain", std::chrono::seconds(6)));
+}
+
+TEST_CASE_FIXTURE(RobotLua,
+                  "mindroad: an error in onLost is reported naming the handler; the run goes on") {
+  start(R"(
+    robot = pitwall.mindroad{port = PORT}
+    robot.onLost = function() error("boom") end
+    pitwall.waitUntil(function() return robot.connected end, 3)
+    up = true
+  )");
+  REQUIRE(waitFor("up"));
+  robot.reset();
+  REQUIRE(runUntil(loop, [&] { return host->errorCount() > 0; }));
+  bool named = false;
+  for (const auto& l : logged)
+    if (l.find("onLost handler of mindroad tcp 127.0.0.1:") != std::string::npos &&
+        l.find("boom") != std::string::npos)
+      named = true;
+  CHECK(named);
+}
+
+TEST_CASE_FIXTURE(RobotLua,
+                  "the connection ends with the Lua world that made it; the robot stops") {
+  start(R"(
+    robot = pitwall.mindroad{port = PORT}
+    pitwall.waitUntil(function() return robot.connected end, 3)
+    robot:steer(100, 0)
+    robot = nil  -- even unreferenced, the robot is kept until its world ends
+    collectgarbage()
+    up = true
+  )");
+  REQUIRE(waitFor("up"));
+  REQUIRE(runUntil(loop, [&] { return state().moving(); }));
+  runFor(loop, std::chrono::milliseconds(300));  // past the watchdog: pings still go out
+  CHECK(state().moving());
+  host.reset();  // end of the run, or a hot reload replacing this world
+  REQUIRE(runUntil(loop, [&] { return !state().moving(); }));
+  CHECK(state().lastStop == "stop instruction");
+  REQUIRE(runUntil(loop, [&] { return robot->connections() == 0; }));
+}
+
+TEST_CASE_FIXTURE(RobotLua,
+                  "shutdown at the REPL asks first: only a second call within 5 s sends") {
+  start(R"(
+    robot = pitwall.mindroad{port = PORT}
+    pitwall.waitUntil(function() return robot.connected end, 3)
+    up = true
+  )");
+  REQUIRE(waitFor("up"));
+  auto typed = [&](const std::string& line) {
+    lua_State* L = host->state();
+    REQUIRE(luaL_loadbuffer(L, line.data(), line.size(), "=stdin") == LUA_OK);
+    std::string error;
+    REQUIRE_MESSAGE(host->callInteractive(0, 1, error), error);
+    bool sent = lua_toboolean(L, -1);
+    lua_pop(L, 1);
+    return sent;
+  };
+  CHECK_FALSE(typed("return robot:shutdown()"));
+  CHECK(printed.find("shutdown() turns the robot OFF") != std::string::npos);
+  runFor(loop, std::chrono::milliseconds(50));
+  CHECK_FALSE(state().shutdown);
+  CHECK(typed("return robot:shutdown()"));
+  REQUIRE(runUntil(loop, [&] { return state().shutdown; }));
+}
+
+TEST_CASE_FIXTURE(RobotLua, "mindroad: shutdown from a script is sent at once") {
+  start(R"(
+    robot = pitwall.mindroad{port = PORT}
+    pitwall.waitUntil(function() return robot.connected end, 3)
+    robot.onLost = function(r, reason) lostReason = reason end
+    sent = robot:shutdown()
+  )");
+  REQUIRE(waitFor("sent"));
+  REQUIRE(runUntil(loop, [&] { return state().shutdown; }));
+  CHECK(printed.find("turns the robot OFF") == std::string::npos);
+  robot->close();  // the robot turns off
+  REQUIRE(runUntil(loop, [&] { return !string("lostReason").empty(); }));
+  CHECK(string("lostReason").find("(after shutdown: not reconnecting)") != std::string::npos);
+  lua_getglobal(host->state(), "robot");
+  lua_getfield(host->state(), -1, "phase");
+  CHECK(std::string(lua_tostring(host->state(), -1)) == "closed");
+  lua_pop(host->state(), 2);
+}
+
+TEST_CASE_FIXTURE(RobotLua, "mindroad: a closed robot refuses commands and says so") {
+  start(R"(
+    robot = pitwall.mindroad{port = PORT}
+    pitwall.waitUntil(function() return robot.connected end, 3)
+    robot:close()
+    label = tostring(robot)
+    closedError = select(2, pcall(robot.steer, robot, 1, 1))
+    done = true
+  )");
+  REQUIRE(waitFor("done"));
+  CHECK(string("label") == "mindroad tcp 127.0.0.1:" + port() + " (closed)");
+  CHECK(string("closedError") == "mindroad tcp 127.0.0.1:" + port() + " is closed");
+}
