@@ -5,6 +5,7 @@
 // nothing reaches a Lua state that is gone).
 #include <array>
 #include <cctype>
+#include <cstring>
 #include <memory>
 #include <optional>
 #include <string>
@@ -49,9 +50,9 @@ constexpr std::array<const char*, kEventCount> kEventNames = {
     "onDistance", "onPosition",   "onCompass",   "onObstacle", "onPath",   "onPing",
     "onConnect",  "onDisconnect", "onMalformed", "onMapSize",  "onAnchor", "onCalibrated"};
 
-constexpr std::array<const char*, 10> kFieldNames = {
-    "connected", "x",         "y",       "heading",   "address",
-    "lastPing",  "lastError", "toggles", "malformed", "path"};
+constexpr std::array<const char*, 11> kFieldNames = {"connected", "x",         "y",     "heading",
+                                                     "address",   "lastPing",  "pings", "lastError",
+                                                     "toggles",   "malformed", "path"};
 
 struct Robot {
   ScriptHost* host = nullptr;
@@ -61,6 +62,7 @@ struct Robot {
   ab::Toggles toggles;
   std::optional<int> x, y, heading;
   std::optional<double> lastPing;
+  std::size_t pings = 0;  // ping replies received
   std::vector<ab::Waypoint> path;
   bool everConnected = false;
   std::size_t malformed = 0;
@@ -153,6 +155,7 @@ void received(Robot& r, const ab::Response& response) {
             auto now = std::chrono::duration_cast<std::chrono::microseconds>(r.host->loop().now());
             double rtt = static_cast<double>(now.count() - p.time) / 1e6;
             r.lastPing = rtt;
+            ++r.pings;
             dispatch(r, kPing, [&](lua_State* L) { lua::setNumber(L, "rtt", rtt); });
           },
           [&](const ab::ObstacleRegistered& o) {
@@ -342,6 +345,10 @@ bool pushField(lua_State* L, Robot& r, std::string_view key) {
   if (key == "x") return integer(r.x);
   if (key == "y") return integer(r.y);
   if (key == "heading") return integer(r.heading);
+  if (key == "pings") {
+    lua_pushinteger(L, static_cast<lua_Integer>(r.pings));
+    return true;
+  }
   if (key == "lastPing") {
     if (r.lastPing)
       lua_pushnumber(L, *r.lastPing);
@@ -515,9 +522,33 @@ void registerType(lua_State* L) {
 
 }  // namespace
 
+// robot:ping([timeout]) in a task waits for the reply and returns the round-trip time in seconds
+// (nil and a message after `timeout`, 2 s by default); anywhere else (a callback, the REPL) it
+// only sends, and the time arrives in onPing and robot.lastPing.
+constexpr const char* kPingWaits = R"(
+local methods = ...
+local send = methods.ping
+methods.ping = function(robot, timeout)
+  local before = robot.pings
+  send(robot)
+  if not coroutine.isyieldable() then return nil end
+  timeout = timeout or 2
+  if pitwall.waitUntil(function() return robot.pings > before end, timeout, 0.001) then
+    return robot.lastPing
+  end
+  return nil, string.format("%s: no ping reply within %g s", tostring(robot), timeout)
+end)";
+
 void openAlphabotModule(ScriptHost& host) {
   lua_State* L = host.state();
   registerType(L);
+  luaL_getmetatable(L, kMetatable);
+  lua_getfield(L, -1, "__methods");
+  if (luaL_loadbufferx(L, kPingWaits, std::strlen(kPingWaits), "=alphabot ping", "t") != LUA_OK)
+    throw std::logic_error(lua_tostring(L, -1));
+  lua_insert(L, -2);
+  lua_call(L, 1, 0);
+  lua_pop(L, 1);
   lua_getglobal(L, "pitwall");
   lua_pushcfunction(L, lua::guarded<newRobot>);
   lua_setfield(L, -2, "alphabot");

@@ -198,6 +198,19 @@ TEST_CASE_FIXTURE(AlphabotFixture,
   CHECK(again.requests() == 1);
 }
 
+TEST_CASE_FIXTURE(AlphabotFixture, "ping() in a task returns the round-trip time") {
+  REQUIRE(run(std::string(kConnect) +
+              "local rtt = r:ping()\n"
+              "assert(type(rtt) == 'number' and rtt >= 0 and rtt < 1, tostring(rtt))\n"
+              "assert(rtt == r.lastPing and r.pings == 1)\n"
+              "-- in a callback it only sends: the time arrives in onPing\n"
+              "r.onPing = function(_, ev) viaEvent = ev.rtt end\n"
+              "pitwall.after(0, function() fromCallback = r:ping() end)\n"
+              "assert(pitwall.waitUntil(function() return viaEvent ~= nil end, 3), 'no onPing')\n"
+              "assert(fromCallback == nil and r.pings == 2)\n"
+              "DONE = true") == "");
+}
+
 TEST_CASE_FIXTURE(AlphabotFixture, "the end of the Lua world stops and closes its robots") {
   REQUIRE(run(std::string(kConnect) + "r:drive(40, 0)\nDONE = true") == "");
   REQUIRE(runUntilRobot([&] { return robot.moving(); }));
