@@ -1,0 +1,388 @@
+// The seed's MQTT topic tree (seed 000 §4.4, ../shared/protocols/mqtt-topics.md) as pure
+// functions. Payloads keep the seed's key order (ordered_json), so golden strings are stable.
+#include "engine/vehicles/mqtt_topics.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "engine/core/overload.hpp"
+#include "engine/protocol/anki/advertisement.hpp"
+#include "engine/protocol/anki/limits.hpp"
+
+namespace pitwall::topics {
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+constexpr int kEventQos = 0;   // events: QoS 0, not retained (mqtt-topics.md)
+constexpr int kStatusQos = 1;  // status: QoS 1, retained
+
+std::string carTopic(std::string_view car, std::string_view rest) {
+  return "Anki/Car/" + std::string(car) + "/" + std::string(rest);
+}
+std::string hostTopic(std::string_view host, std::string_view rest) {
+  return "Anki/Host/" + std::string(host) + "/" + std::string(rest);
+}
+
+// Offsets are floats on the wire; 0.01 mm is far below what a car measures, and rounding keeps
+// payloads free of float noise (-23.1f would print as -23.100000381469727).
+double mm(double v) {
+  return std::round(v * 100.0) / 100.0;
+}
+
+Publication event(std::string_view car, std::string_view name, const Json& value, Millis now) {
+  Json j{{"timestamp", now}, {"value", value}};
+  return {carTopic(car, "E/" + std::string(name)), j.dump(), kEventQos, false};
+}
+
+Publication status(std::string topic, const Json& payload) {
+  return {std::move(topic), payload.dump(), kStatusQos, true};
+}
+
+Publication valueStatus(std::string_view car, std::string_view name, const Json& value,
+                        Millis now) {
+  return status(carTopic(car, "S/" + std::string(name)),
+                Json{{"timestamp", now}, {"value", value}});
+}
+
+Publication onlineStatus(std::string_view car, bool online, bool charging, bool onTrack,
+                         Millis now) {
+  return status(
+      carTopic(car, "S/CarStatus"),
+      Json{{"timestamp", now}, {"online", online}, {"charging", charging}, {"onTrack", onTrack}});
+}
+
+std::string safe(std::string_view s, bool lower) {
+  std::string out;
+  out.reserve(s.size());
+  for (char c : s) {
+    auto u = static_cast<unsigned char>(c);
+    if (lower) u = static_cast<unsigned char>(std::tolower(u));
+    out += (std::isalnum(u) || c == '.' || c == '_' || c == '-') ? static_cast<char>(u) : '_';
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string carId(std::string_view address) {
+  std::string id;
+  if (address.starts_with("ble:")) address.remove_prefix(4);
+  // A bare BLE address: six hex pairs separated by ':'.
+  bool ble = address.size() == 17;
+  for (std::size_t i = 0; ble && i < address.size(); ++i) {
+    ble = (i % 3 == 2) ? address[i] == ':' : std::isxdigit(static_cast<unsigned char>(address[i]));
+  }
+  if (ble) {
+    for (char c : address) {
+      if (c != ':') id += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    }
+    return id;
+  }
+  std::string dashed(address);
+  std::replace(dashed.begin(), dashed.end(), ':', '-');
+  id = safe(dashed, true);
+  if (id.empty() || id == "all") id = "_" + id;
+  return id;
+}
+
+std::string hostId(std::string_view host) {
+  std::string id = safe(host, false);
+  return id.empty() ? "_" : id;
+}
+
+// ---- car → broker ----
+
+std::vector<Publication> fromMessage(std::string_view car, const anki::Message& message,
+                                     std::optional<double> pingRttSeconds, Millis now) {
+  std::vector<Publication> out;
+  auto ev = [&](std::string_view name, const Json& value) {
+    out.push_back(event(car, name, value, now));
+  };
+  auto st = [&](std::string_view name, const Json& value) {
+    out.push_back(valueStatus(car, name, value, now));
+  };
+  std::visit(Overload{
+                 [&](const anki::PositionUpdate& m) {
+                   ev("speed", m.speed_mm_s);
+                   ev("last_desired_speed", m.last_desired_speed_mm_s);
+                   ev("track_piece_id", m.piece_id);
+                   ev("track_location_id", m.location_id);
+                   ev("lane/offset/actual", mm(m.offset_mm));
+                   ev("lane/desired_lane_change_speed", m.last_desired_lane_change_speed_mm_s);
+                   st("Speed/Actual", m.speed_mm_s);
+                   st("Lane/Actual", mm(m.offset_mm));
+                 },
+                 [&](const anki::TransitionUpdate& m) {
+                   ev("lane/offset/actual", mm(m.offset_mm));
+                   ev("lane/desired_lane_change_speed", m.last_desired_lane_change_speed_mm_s);
+                   ev("ave_follow_line_drift_pixels", m.average_follow_line_drift_px);
+                   ev("had_lane_change_activity", m.had_lane_change_activity);
+                   ev("uphill_counter", m.uphill_counter);
+                   ev("downhill_counter", m.downhill_counter);
+                   ev("left_wheel_dist_cm", m.left_wheel_distance_cm);
+                   ev("right_wheel_dist_cm", m.right_wheel_distance_cm);
+                   st("Lane/Actual", mm(m.offset_mm));
+                 },
+                 [&](const anki::IntersectionUpdate& m) {
+                   ev("intersection_code", m.intersection_code);
+                   ev("mm_since_last_transition_bar", m.mm_since_last_transition_bar);
+                   // absent in the older layout: nothing to report then
+                   if (m.mm_since_last_intersection_code)
+                     ev("mm_since_last_intersection_code", *m.mm_since_last_intersection_code);
+                 },
+                 [&](const anki::Delocalized&) {
+                   // seed 000 §4.4.2.16: timestamp only
+                   out.push_back({carTopic(car, "E/Delocalized"), Json{{"timestamp", now}}.dump(),
+                                  kEventQos, false});
+                 },
+                 [&](const anki::OffsetUpdate& m) { st("Lane/Actual", mm(m.offset_mm)); },
+                 [&](const anki::SpeedUpdate& m) { st("Speed/Actual", m.actual_mm_s); },
+                 [&](const anki::PingResponse&) {
+                   // round-trip time in ms (µs precision); null when no ping of ours was waiting
+                   Json rtt = nullptr;
+                   if (pingRttSeconds) rtt = std::round(*pingRttSeconds * 1e6) / 1e3;
+                   out.push_back(status(carTopic(car, "S/PingResponse"),
+                                        Json{{"timestamp", now}, {"rtt_ms", rtt}}));
+                 },
+                 [&](const anki::VersionResponse& m) { st("Version", m.version); },
+                 [&](const anki::BatteryResponse& m) { st("BatteryLevel", m.millivolts); },
+                 [&](const anki::CarStatus& m) {
+                   out.push_back(onlineStatus(car, true, m.on_charger, m.on_track, now));
+                 },
+                 [&](const auto&) {},
+             },
+             message);
+  return out;
+}
+
+std::vector<Publication> commandStatus(std::string_view car, const anki::Message& sent,
+                                       Millis now) {
+  std::vector<Publication> out;
+  std::visit(Overload{
+                 [&](const anki::SetSpeed& m) {
+                   out.push_back(valueStatus(car, "Speed/Desired", m.speed_mm_s, now));
+                 },
+                 [&](const anki::ChangeLane& m) {
+                   out.push_back(valueStatus(car, "Lane/Desired", mm(m.offset_mm), now));
+                 },
+                 [&](const anki::SetOffset& m) {
+                   out.push_back(valueStatus(car, "Lane/Desired", mm(m.offset_mm), now));
+                 },
+                 [&](const auto&) {},
+             },
+             sent);
+  return out;
+}
+
+std::vector<Publication> carJoined(const CarInfo& info, const CarState& state, Millis now) {
+  // seed 000 §4.4.4.10 and §4.4.4.12
+  return {status(carTopic(info.id, "S/Information"), Json{{"address", info.address},
+                                                          {"identifier", info.identifier},
+                                                          {"model", anki::modelName(info.model_id)},
+                                                          {"modelId", info.model_id},
+                                                          {"productId", info.product_id}}),
+          status(carTopic(info.id, "S/DiscoveryTime"), Json{{"timestamp", now}}),
+          onlineStatus(info.id, true, state.on_charger, state.on_track, now)};
+}
+
+Publication carLeft(std::string_view car, const CarState& state, Millis now) {
+  return onlineStatus(car, false, state.on_charger, state.on_track, now);
+}
+
+Publication hostOnline(std::string_view host) {
+  return status(hostTopic(host, "S/HostStatus"), Json{{"value", true}});
+}
+
+Publication hostWill(std::string_view host) {
+  return status(hostTopic(host, "S/HostStatus"), Json{{"value", false}});
+}
+
+Publication hostCars(std::string_view host, std::span<const std::string> cars, Millis now) {
+  Json list = Json::array();
+  for (const auto& c : cars) list.push_back(c);
+  return status(hostTopic(host, "S/Cars"), Json{{"timestamp", now}, {"value", list}});
+}
+
+Publication carDiscovered(std::string_view host, std::string_view car, Millis now) {
+  // seed 000 §4.4.2.17: an event, so not retained
+  return {hostTopic(host, "E/CarDiscovered"),
+          Json{{"timestamp", now}, {"Car", std::string(car)}}.dump(), kEventQos, false};
+}
+
+// ---- broker → intents ----
+
+std::vector<std::string> intentSubscriptions(std::string_view host) {
+  return {hostTopic(host, "I/connection"), hostTopic(host, "I"), "Anki/Car/+/I"};
+}
+
+namespace {
+
+using Parsed = Result<Action, std::string>;
+
+std::string typeName(const Json& v) {
+  if (v.is_number_integer()) return "an integer";
+  if (v.is_number()) return "a number";
+  std::string name = v.type_name();
+  return (name[0] == 'a' || name[0] == 'o' ? "an " : "a ") + name;
+}
+
+// The key, present and of the right kind; otherwise the sentence saying why not.
+Result<const Json*, std::string> field(const Json& j, const char* key, const char* kind) {
+  auto it = j.find(key);
+  if (it == j.end()) return Unexpected{std::string("missing key \"") + key + "\" (" + kind + ")"};
+  return &*it;
+}
+
+// An integer within [lo, hi], checked as a double so that 1e30 or 2^64 cannot wrap.
+Result<int, std::string> integer(const Json& j, const char* key, int lo, int hi,
+                                 std::string_view unit) {
+  auto f = field(j, key, "an integer");
+  if (!f) return Unexpected{f.error()};
+  const Json& v = **f;
+  if (!v.is_number_integer())
+    return Unexpected{std::string("\"") + key + "\" must be an integer, not " + typeName(v) + " (" +
+                      v.dump() + ")"};
+  double d = v.get<double>();
+  std::string u = unit.empty() ? "" : " " + std::string(unit);
+  if (d < lo || d > hi)
+    return Unexpected{std::string(key) + " " + v.dump() + u + " is out of range " +
+                      std::to_string(lo) + ".." + std::to_string(hi) + u};
+  return static_cast<int>(d);
+}
+
+Parsed speedIntent(const Json& j) {
+  namespace L = anki::limits;
+  auto speed = integer(j, "speed", L::kSpeedMin, L::kSpeedMax, "mm/s");
+  if (!speed) return Unexpected{speed.error()};
+  auto accel = integer(j, "acceleration", L::kAccelMin, L::kAccelMax, "mm/s²");
+  if (!accel) return Unexpected{accel.error()};
+  return Action{SpeedIntent{*speed, *accel}};
+}
+
+Parsed laneIntent(const Json& j) {
+  namespace L = anki::limits;
+  auto f = field(j, "offset", "a number, mm from road centre");
+  if (!f) return Unexpected{f.error()};
+  const Json& v = **f;
+  if (!v.is_number())
+    return Unexpected{"\"offset\" must be a number, not " + typeName(v) + " (" + v.dump() + ")"};
+  double d = v.get<double>();
+  if (!(d >= L::kOffsetMin && d <= L::kOffsetMax))
+    return Unexpected{"offset " + v.dump() + " mm is out of range " +
+                      std::to_string(static_cast<int>(L::kOffsetMin)) + ".." +
+                      std::to_string(static_cast<int>(L::kOffsetMax)) + " mm"};
+  return Action{LaneIntent{d}};
+}
+
+Parsed turnIntent(const Json& j) {
+  // anki-overdrive.md: type 0 none … 4 U-turn jump; trigger 0 immediate, 1 at next intersection
+  auto type = integer(j, "turnType", 0, static_cast<int>(anki::TurnType::UTurnJump), "");
+  if (!type) return Unexpected{type.error()};
+  auto trigger = integer(j, "trigger", 0, static_cast<int>(anki::TurnTrigger::Intersection), "");
+  if (!trigger) return Unexpected{trigger.error()};
+  return Action{
+      TurnIntent{static_cast<anki::TurnType>(*type), static_cast<anki::TurnTrigger>(*trigger)}};
+}
+
+Parsed commandIntent(const Json& j) {
+  auto f = field(j, "type", "one of speed, lane, turn, battery, version, ping");
+  if (!f) return Unexpected{f.error()};
+  const Json& t = **f;
+  if (!t.is_string())
+    return Unexpected{"\"type\" must be a string, not " + typeName(t) + " (" + t.dump() + ")"};
+  const auto& type = t.get_ref<const std::string&>();
+  if (type == "speed") return speedIntent(j);
+  if (type == "lane") return laneIntent(j);
+  if (type == "turn") return turnIntent(j);
+  if (type == "battery") return Action{BatteryIntent{}};
+  if (type == "version") return Action{VersionIntent{}};
+  if (type == "ping") return Action{PingIntent{}};
+  return Unexpected{"unknown intent type " + t.dump() +
+                    "; expected one of speed, lane, turn, battery, version, ping"};
+}
+
+Parsed connectionIntent(const Json& j) {
+  auto f = field(j, "connecting", "true or false");
+  if (!f) return Unexpected{f.error()};
+  const Json& v = **f;
+  if (!v.is_boolean())
+    return Unexpected{"\"connecting\" must be true or false, not " + typeName(v) + " (" + v.dump() +
+                      ")"};
+  return Action{ConnectIntent{v.get<bool>()}};
+}
+
+std::vector<std::string_view> split(std::string_view s) {
+  std::vector<std::string_view> parts;
+  while (true) {
+    auto slash = s.find('/');
+    parts.push_back(s.substr(0, slash));
+    if (slash == std::string_view::npos) return parts;
+    s.remove_prefix(slash + 1);
+  }
+}
+
+}  // namespace
+
+Result<Intent, IntentError> parseIntent(std::string_view host, std::string_view topic,
+                                        std::string_view payload,
+                                        std::span<const std::string> knownCars) {
+  auto fail = [&](std::string message) {
+    return Unexpected{IntentError{std::string(topic), std::move(message)}};
+  };
+  // Which intent the topic names.
+  auto parts = split(topic);
+  Target target;
+  bool connection = false;
+  if (parts.size() >= 3 && parts[0] == "Anki" && parts[1] == "Host" && parts[2] != host &&
+      (parts.size() == 4 || parts.size() == 5) && parts[3] == "I") {
+    return fail("intent addressed to host \"" + std::string(parts[2]) + "\", this host is \"" +
+                std::string(host) + "\"");
+  }
+  if (parts.size() == 5 && parts[0] == "Anki" && parts[1] == "Host" && parts[2] == host &&
+      parts[3] == "I" && parts[4] == "connection") {
+    target.kind = Target::Kind::Host;
+    connection = true;
+  } else if (parts.size() == 4 && parts[0] == "Anki" && parts[1] == "Host" && parts[2] == host &&
+             parts[3] == "I") {
+    target.kind = Target::Kind::AllCars;
+  } else if (parts.size() == 4 && parts[0] == "Anki" && parts[1] == "Car" && parts[3] == "I") {
+    if (parts[2] == "all") {
+      target.kind = Target::Kind::AllCars;
+    } else {
+      target.car = std::string(parts[2]);
+      if (std::find(knownCars.begin(), knownCars.end(), target.car) == knownCars.end()) {
+        std::string known;
+        for (const auto& c : knownCars) known += (known.empty() ? "" : ", ") + c;
+        return fail("unknown car \"" + target.car +
+                    "\"; known cars: " + (known.empty() ? "none" : known) + " (or \"all\")");
+      }
+    }
+  } else {
+    return fail("not an intent topic; intents go to Anki/Host/" + std::string(host) +
+                "/I/connection, Anki/Host/" + std::string(host) +
+                "/I, Anki/Car/all/I or Anki/Car/<car>/I");
+  }
+
+  Json j;
+  try {
+    j = Json::parse(payload);
+  } catch (const Json::parse_error& e) {
+    return fail(std::string("payload is not JSON: ") + e.what());
+  }
+  if (!j.is_object())
+    return fail("payload must be a JSON object, not " + typeName(j) + " (" + j.dump() + ")");
+
+  Parsed action = connection ? connectionIntent(j) : commandIntent(j);
+  if (!action) return fail(action.error());
+  return Intent{std::move(target), std::move(*action)};
+}
+
+Publication intentError(std::string_view host, const IntentError& error, Millis now) {
+  Json j{{"timestamp", now}, {"topic", error.topic}, {"error", error.message}};
+  return {hostTopic(host, "S/IntentError"), j.dump(), kStatusQos, false};
+}
+
+}  // namespace pitwall::topics

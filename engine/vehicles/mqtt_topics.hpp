@@ -1,0 +1,141 @@
+#pragma once
+// The seed's MQTT topic tree (../shared/protocols/mqtt-topics.md, seed 000 §4.4) as pure
+// functions: car messages and car/host life-cycle → publications, and (topic, payload) of an
+// intent → a typed Intent or an error that says what is wrong. No sockets and no cars are touched
+// here; the bridge publishes the results and executes valid intents. docs/mqtt-topics.md is the
+// user-facing description of the same tree.
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "engine/core/result.hpp"
+#include "engine/protocol/anki/messages.hpp"
+#include "engine/vehicles/anki_car.hpp"
+
+namespace pitwall::topics {
+
+struct Publication {
+  std::string topic;
+  std::string payload;  // JSON text
+  int qos = 0;
+  bool retain = false;
+  bool operator==(const Publication&) const = default;
+};
+
+// Milliseconds since the epoch; passed in so that output is deterministic.
+using Millis = std::int64_t;
+
+// ---- identities ----
+
+// The `<car>` of a topic from a link address. BLE ("ble:E8:5A:0F:11:22:33", or a bare address)
+// gives the seed's (noble's) device id: the address in lowercase hex without separators
+// ("e85a0f112233"). Any other link ("sim:0000002a") gives its address in lowercase with ':'
+// replaced by '-' ("sim-0000002a"). Every character outside [a-z0-9._-] becomes '_', so the
+// result never holds '/', '+' or '#'; "all" (reserved for every car) becomes "_all".
+std::string carId(std::string_view linkAddress);
+// A host id made topic-safe the same way (any character outside [A-Za-z0-9._-] becomes '_').
+std::string hostId(std::string_view host);
+
+// What S/Information carries (the car's advertisement).
+struct CarInfo {
+  std::string id;       // carId(address)
+  std::string address;  // the link address without its "ble:" prefix
+  std::uint32_t identifier = 0;
+  std::uint8_t model_id = 0;
+  std::uint16_t product_id = 0xBEEF;
+};
+
+// ---- car → broker ----
+
+// Events (QoS 0, not retained) and status (QoS 1, retained) for one decoded vehicle message.
+// `pingRttSeconds` is AnkiCar::lastPingRtt() when `message` is a ping response. Messages with
+// nothing in the tree (controller→vehicle ones, collisions, …) give no publication.
+std::vector<Publication> fromMessage(std::string_view car, const anki::Message& message,
+                                     std::optional<double> pingRttSeconds, Millis now);
+
+// Status for a command that was sent to a car: S/Speed/Desired for a set-speed, S/Lane/Desired
+// for a change-lane or set-offset; nothing for other commands.
+std::vector<Publication> commandStatus(std::string_view car, const anki::Message& sent, Millis now);
+
+// A car joined: S/Information, S/DiscoveryTime and S/CarStatus online (charging and onTrack
+// from `state`).
+std::vector<Publication> carJoined(const CarInfo& info, const CarState& state, Millis now);
+// A car left: S/CarStatus with online false.
+Publication carLeft(std::string_view car, const CarState& state, Millis now);
+
+// Host status and events.
+Publication hostOnline(std::string_view host);  // S/HostStatus {"value":true}
+Publication hostWill(std::string_view host);    // the same topic with {"value":false}
+Publication hostCars(std::string_view host, std::span<const std::string> cars, Millis now);
+Publication carDiscovered(std::string_view host, std::string_view car, Millis now);
+
+// ---- broker → intents ----
+
+// The topic filters a bridge subscribes to for intents.
+std::vector<std::string> intentSubscriptions(std::string_view host);
+
+struct Target {
+  enum class Kind { Car, AllCars, Host };
+  Kind kind = Kind::Car;
+  std::string car;  // for Kind::Car
+  bool operator==(const Target&) const = default;
+};
+
+struct ConnectIntent {  // Anki/Host/<host>/I/connection {"connecting":…}
+  bool connecting = false;
+  bool operator==(const ConnectIntent&) const = default;
+};
+struct SpeedIntent {
+  int speed_mm_s = 0;
+  int accel_mm_s2 = 0;
+  bool operator==(const SpeedIntent&) const = default;
+};
+struct LaneIntent {
+  double offset_mm = 0;
+  bool operator==(const LaneIntent&) const = default;
+};
+struct TurnIntent {
+  anki::TurnType type = anki::TurnType::None;
+  anki::TurnTrigger trigger = anki::TurnTrigger::Immediate;
+  bool operator==(const TurnIntent&) const = default;
+};
+struct BatteryIntent {
+  bool operator==(const BatteryIntent&) const = default;
+};
+struct VersionIntent {
+  bool operator==(const VersionIntent&) const = default;
+};
+struct PingIntent {
+  bool operator==(const PingIntent&) const = default;
+};
+
+using Action = std::variant<ConnectIntent, SpeedIntent, LaneIntent, TurnIntent, BatteryIntent,
+                            VersionIntent, PingIntent>;
+
+struct Intent {
+  Target target;
+  Action action;
+  bool operator==(const Intent&) const = default;
+};
+
+struct IntentError {
+  std::string topic;    // the intent's topic
+  std::string message;  // one sentence: what is wrong, with the value and what is accepted
+};
+
+// Parses an intent received on `topic`. `knownCars` are the car ids a single-car intent may
+// name. Values are checked against engine/protocol/anki/limits.hpp.
+Result<Intent, IntentError> parseIntent(std::string_view host, std::string_view topic,
+                                        std::string_view payload,
+                                        std::span<const std::string> knownCars);
+
+// The answer to a rejected intent: Anki/Host/<host>/S/IntentError, QoS 1, not retained (an
+// error belongs to one intent; a late subscriber must not see it as current state), payload
+// {"timestamp":…,"topic":…,"error":…}.
+Publication intentError(std::string_view host, const IntentError& error, Millis now);
+
+}  // namespace pitwall::topics
