@@ -7,6 +7,15 @@
 
 namespace pitwall::cli {
 
+// How to reach an MQTT broker (docs/mqtt.md): --mqtt URL and its companions.
+struct MqttSettings {
+  std::string url;           // mqtt://HOST[:PORT] or mqtts://HOST[:PORT]; empty: no broker
+  std::string user;          // --mqtt-user
+  std::string passwordFile;  // --mqtt-password-file; else $PITWALL_MQTT_PASSWORD when set
+  std::string caFile;        // --mqtt-ca: the CA of the broker's certificate (mqtts://)
+  std::string clientId;      // --mqtt-client-id; empty: a random one
+};
+
 // Where the cars of a run or a REPL come from: the simulator's starting grid, or real cars over
 // Bluetooth LE through BlueZ (docs/bluetooth.md).
 struct CarSource {
@@ -18,6 +27,10 @@ struct CarSource {
   std::vector<std::string> adapters;      // --adapter hciN (repeatable); empty: every adapter
   double scanTimeout = 5;                 // seconds to look for cars before the script starts
   double budget = 0.1;  // --budget SECONDS a callback may run before it is interrupted; 0: off
+  // --mqtt: the cars bridged by other hosts join as remote cars (docs/mqtt.md)
+  MqttSettings mqtt;
+  int remoteCars = 0;  // --remote-cars N: wait (up to --mqtt-timeout) until N are online
+  double mqttTimeout = 5;
 };
 
 struct RunOptions : CarSource {
@@ -52,6 +65,14 @@ struct ScanOptions {
   std::vector<std::string> adapters;
 };
 int scan(const ScanOptions& options);
+
+// pitwall bridge: the cars (simulated, or --ble) on an MQTT broker under the seed's topic tree.
+struct BridgeOptions : CarSource {
+  std::string hostId;  // empty: the machine's host name
+  bool readOnly = false;
+  std::optional<double> duration;  // seconds; none: until SIGINT/SIGTERM
+};
+int bridge(const BridgeOptions& options);
 
 // A BLE peripheral that looks like an Anki car to a central, driven by the simulator
 // (tests/qemu: the real bluetoothd end to end).

@@ -35,6 +35,39 @@ CLI::Option* addCarSource(CLI::App* cmd, pitwall::cli::CarSource& source, const 
   return ble;
 }
 
+// --mqtt URL and how to log in; `what` says what the broker is for.
+CLI::Option* addMqtt(CLI::App* cmd, pitwall::cli::MqttSettings& mqtt, double& timeout,
+                     const char* what) {
+  auto* url = cmd->add_option(
+      "--mqtt", mqtt.url,
+      std::string("MQTT broker, mqtt://HOST[:PORT] or mqtts://HOST[:PORT]: ") + what);
+  cmd->add_option("--mqtt-user", mqtt.user, "Username for the broker")->needs(url);
+  cmd->add_option("--mqtt-password-file", mqtt.passwordFile,
+                  "File whose first line is the password (default: $PITWALL_MQTT_PASSWORD)")
+      ->needs(url);
+  cmd->add_option("--mqtt-ca", mqtt.caFile,
+                  "With mqtts://: the CA certificate (PEM) that signed the broker's")
+      ->needs(url);
+  cmd->add_option("--mqtt-client-id", mqtt.clientId, "MQTT client id (default: a random one)")
+      ->needs(url);
+  cmd->add_option("--mqtt-timeout", timeout,
+                  "Seconds to wait for the broker (and --remote-cars) at start (default 5)")
+      ->check(CLI::PositiveNumber)
+      ->needs(url);
+  return url;
+}
+
+// Remote cars for run and repl: the cars bridged by other hosts.
+CLI::Option* addRemoteCars(CLI::App* cmd, pitwall::cli::CarSource& source) {
+  auto* url = addMqtt(cmd, source.mqtt, source.mqttTimeout,
+                      "the cars that bridges on other hosts publish join as remote cars");
+  cmd->add_option("--remote-cars", source.remoteCars,
+                  "With --mqtt: wait until this many remote cars are online (default 0)")
+      ->check(CLI::Range(0, 64))
+      ->needs(url);
+  return url;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -60,6 +93,8 @@ int main(int argc, char** argv) {
                      "Where the race library writes the results: FILE.json or FILE.csv");
   // Real cars run in real time.
   addCarSource(runCmd, run, "before the script starts")->excludes(fastFlag);
+  // a broker lives in real time
+  addRemoteCars(runCmd, run)->excludes(fastFlag);
 
   auto* replFlag = runCmd->add_flag("--repl", run.repl,
                                     "Open a Lua prompt beside the script, in the same Lua world");
@@ -73,8 +108,21 @@ int main(int argc, char** argv) {
   auto* replCmd = app.add_subcommand(
       "repl", "A Lua prompt with the cars bound; the simulator runs behind it in real time");
   addCarSource(replCmd, repl, "before the prompt opens");
+  addRemoteCars(replCmd, repl);
   replCmd->add_option("--history", repl.history,
                       "History file (default $PITWALL_HISTORY, else ~/.pitwall_history)");
+
+  cli::BridgeOptions bridge;
+  auto* bridgeCmd = app.add_subcommand("bridge",
+                                       "Publish the cars (simulated, or --ble) on an MQTT broker "
+                                       "and execute intents (docs/mqtt.md)");
+  addCarSource(bridgeCmd, bridge, "before the bridge starts");
+  addMqtt(bridgeCmd, bridge.mqtt, bridge.mqttTimeout, "where the cars are published")->required();
+  bridgeCmd->add_option("--host-id", bridge.hostId,
+                        "The <host> of Anki/Host/<host>/… (default: this machine's host name)");
+  bridgeCmd->add_flag("--read-only", bridge.readOnly, "Publish only; never execute intents");
+  bridgeCmd->add_option("--duration", bridge.duration, "Stop after this many seconds")
+      ->check(CLI::PositiveNumber);
 
   cli::ScanOptions scan;
   auto* scanCmd = app.add_subcommand("scan", "List the Anki cars in Bluetooth range");
@@ -160,6 +208,7 @@ int main(int argc, char** argv) {
 
   if (runCmd->parsed()) return cli::run(run);
   if (replCmd->parsed()) return cli::repl(repl);
+  if (bridgeCmd->parsed()) return cli::bridge(bridge);
   if (scanCmd->parsed()) return cli::scan(scan);
   if (emulateCmd->parsed()) return cli::emulateCar(emulate);
   if (robotCmd->parsed()) return cli::simRobot(robot);

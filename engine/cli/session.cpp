@@ -1,13 +1,18 @@
 #include "engine/cli/session.hpp"
 
+#include <unistd.h>
+
 #include <cmath>
 #include <csignal>
+#include <cstdlib>
+#include <fstream>
 #include <iostream>
 
 #include "bindings/interrupt.hpp"
 #include "engine/core/log.hpp"
 #include "engine/protocol/anki/advertisement.hpp"
 #include "engine/sim/grid.hpp"
+#include "engine/transport/sim_link.hpp"
 
 namespace pitwall::cli {
 
@@ -32,6 +37,9 @@ Session::~Session() {
     signals_->cancel(ignored);
   }
   scripts_.reset();
+  bridge_.reset();
+  remote_.reset();
+  mqtt_.reset();
   central_.reset();
   log::setTimeSource(nullptr);
 }
@@ -89,7 +97,168 @@ void Session::releaseSigint() {
   if (signals_) signals_->remove(SIGINT, ignored);
 }
 
+namespace {
+
+// The client's options from the command line; an error sentence names the option at fault.
+Result<MqttOptions, std::string> mqttOptions(const MqttSettings& settings) {
+  MqttOptions options;
+  try {
+    options = MqttOptions::fromUrl(settings.url);
+  } catch (const std::invalid_argument& e) {
+    return Unexpected{std::string("--mqtt: ") + e.what()};
+  }
+  options.clientId = settings.clientId;
+  options.username = settings.user;
+  if (!settings.passwordFile.empty()) {
+    std::ifstream in(settings.passwordFile);
+    if (!in || !std::getline(in, options.password))
+      return Unexpected{"--mqtt-password-file: cannot read a password from " +
+                        settings.passwordFile};
+    if (!options.password.empty() && options.password.back() == '\r') options.password.pop_back();
+  } else if (const char* env = std::getenv("PITWALL_MQTT_PASSWORD")) {
+    options.password = env;
+  }
+  if (!options.password.empty() && options.username.empty())
+    return Unexpected{std::string(settings.passwordFile.empty() ? "$PITWALL_MQTT_PASSWORD"
+                                                                : "--mqtt-password-file") +
+                      " gives a password without --mqtt-user"};
+  options.caFile = settings.caFile;
+  if (!options.caFile.empty() && !options.tls)
+    return Unexpected{"--mqtt-ca needs an mqtts:// URL (TLS)"};
+  return options;
+}
+
+std::string machineName() {
+  char name[256] = {};
+  if (::gethostname(name, sizeof name - 1) != 0 || !name[0]) return "pitwall";
+  return name;
+}
+
+}  // namespace
+
+int Session::startBridge(const MqttSettings& settings, const std::string& hostId, bool readOnly,
+                         const char* command) {
+  auto options = mqttOptions(settings);
+  if (!options) {
+    std::cerr << "pitwall " << command << ": " << options.error() << "\n";
+    return 2;
+  }
+  std::string host = topics::hostId(hostId.empty() ? machineName() : hostId);
+  options->will = MqttBridge::will(host);
+  CarConnections connections;
+  connections.connectAll = [this] {
+    if (central_) return central_->reconnect();
+    for (auto* car : fleet_.cars())
+      if (auto* sim = dynamic_cast<SimLink*>(&car->link()); sim && !sim->connected())
+        sim->connect();
+  };
+  connections.disconnectAll = [this] {
+    if (central_) return central_->shutdown(nullptr);
+    for (auto* car : fleet_.cars())
+      if (car->state().connected) (void)car->disconnect();
+  };
+  try {
+    mqtt_ = std::make_unique<MqttClient>(loop_, std::move(*options));
+    bridge_ = std::make_unique<MqttBridge>(
+        loop_, fleet_, *mqtt_, pitwall::BridgeOptions{host, readOnly}, std::move(connections));
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "pitwall " << command << ": " << e.what() << "\n";
+    return 2;
+  }
+  // The first answer decides: a refusal (credentials, authorisation) ends the bridge; a broker
+  // that cannot be reached yet is retried for as long as the bridge runs.
+  std::optional<std::string> refused;
+  bool answered = false;
+  mqtt_->onDisconnected = [&](const std::string& reason, bool retrying) {
+    if (!retrying) refused = reason;
+    answered = true;
+    loop_.stop();
+  };
+  auto previousConnected = mqtt_->onConnected;
+  mqtt_->onConnected = [&] {
+    if (previousConnected) previousConnected();
+    answered = true;
+    loop_.stop();
+  };
+  mqtt_->connect();
+  auto timeout = loop_.after(fromSeconds(source_.mqttTimeout), [this] { loop_.stop(); });
+  loop_.run();
+  loop_.cancel(timeout);
+  mqtt_->onConnected = previousConnected;
+  mqtt_->onDisconnected = nullptr;  // the client logs why; it reconnects by itself
+  if (interrupted_) return 130;
+  if (refused) {
+    std::cerr << "pitwall " << command << ": the broker refused the connection: " << *refused
+              << "\n";
+    return 2;
+  }
+  return 0;
+}
+
+int Session::connectRemoteCars(const char* command) {
+  auto options = mqttOptions(source_.mqtt);
+  if (!options) {
+    std::cerr << "pitwall " << command << ": " << options.error() << "\n";
+    return 2;
+  }
+  try {
+    mqtt_ = std::make_unique<MqttClient>(loop_, std::move(*options));
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "pitwall " << command << ": " << e.what() << "\n";
+    return 2;
+  }
+  remote_ = std::make_unique<RemoteCars>(loop_, fleet_, *mqtt_);
+  bool synced = false;
+  std::optional<std::string> failed;
+  auto enough = [&] {
+    return synced && remote_->onlineCount() >= static_cast<std::size_t>(source_.remoteCars);
+  };
+  remote_->onChange = [&] {
+    if (enough()) loop_.stop();
+  };
+  remote_->start(
+      [&] {
+        synced = true;
+        if (enough()) loop_.stop();
+      },
+      [&](const std::string& reason) {
+        failed = reason;
+        loop_.stop();
+      });
+  auto timeout = loop_.after(fromSeconds(source_.mqttTimeout), [this] { loop_.stop(); });
+  loop_.run();
+  loop_.cancel(timeout);
+  remote_->onChange = nullptr;
+  if (interrupted_) return 130;
+  std::string where = " (" + source_.mqtt.url + ")";
+  if (failed) {
+    std::cerr << "pitwall " << command << ": the broker refused the connection" << where << ": "
+              << *failed << "\n";
+    return 2;
+  }
+  if (!synced) {
+    std::cerr << "pitwall " << command << ": no answer from the MQTT broker" << where << " in "
+              << source_.mqttTimeout << " s\n";
+    return 2;
+  }
+  if (!enough()) {
+    std::cerr << "pitwall " << command << ": " << remote_->onlineCount() << " remote car"
+              << (remote_->onlineCount() == 1 ? "" : "s") << " online after " << source_.mqttTimeout
+              << " s, --remote-cars asked for " << source_.remoteCars << "\n";
+    return 2;
+  }
+  log::info("mqtt", std::to_string(remote_->onlineCount()) + " remote car" +
+                        (remote_->onlineCount() == 1 ? "" : "s") + " through " + source_.mqtt.url);
+  return 0;
+}
+
 int Session::connectCars(const char* command) {
+  int status = connectLocalCars(command);
+  if (status != 0 || source_.mqtt.url.empty()) return status;
+  return connectRemoteCars(command);
+}
+
+int Session::connectLocalCars(const char* command) {
   if (source_.ble) {
     auto error = connectRealCars();
     if (interrupted_) return 130;
@@ -158,8 +327,16 @@ void Session::finish() {
   finishing_ = true;
   fleet_.stopAll();
   loop_.after(kFlush, [this] {
-    if (!central_) return loop_.stop();
-    central_->shutdown([this] { loop_.stop(); });
+    auto done = [this] {
+      if (!mqtt_) return loop_.stop();
+      // A clean goodbye: the bridge says its cars and itself are offline (the broker drops the
+      // will on DISCONNECT), then the client disconnects.
+      if (bridge_) bridge_->goOffline();
+      mqtt_->disconnect();
+      loop_.after(kFlush, [this] { loop_.stop(); });
+    };
+    if (!central_) return done();
+    central_->shutdown(done);
   });
 }
 

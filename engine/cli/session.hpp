@@ -8,8 +8,11 @@
 #include "bindings/reloader.hpp"
 #include "engine/cli/commands.hpp"
 #include "engine/core/loop.hpp"
+#include "engine/transport/mqtt_client.hpp"
 #include "engine/vehicles/ble_central.hpp"
 #include "engine/vehicles/fleet.hpp"
+#include "engine/vehicles/mqtt_bridge.hpp"
+#include "engine/vehicles/mqtt_remote.hpp"
 #include "engine/vehicles/recorder.hpp"
 
 namespace pitwall::cli {
@@ -27,9 +30,15 @@ class Session {
   // and ends the run with status 130, a second leaves at once. nullptr after printing
   // "pitwall COMMAND: why" (exit status 2).
   static std::unique_ptr<Session> open(const CarSource& source, bool fast, const char* command);
-  // Puts the cars of the source on the run (the grid, or the real cars found). 0, or the exit
-  // status after printing why not: 1 (simulated cars did not connect), 2 (no BLE cars), 130.
+  // Puts the cars of the source on the run (the grid, or the real cars found, then with --mqtt the
+  // remote cars). 0, or the exit status after printing why not: 1 (simulated cars did not
+  // connect), 2 (no BLE cars, no broker, too few remote cars), 130.
   int connectCars(const char* command);
+  // pitwall bridge: publishes this session's cars on the broker and executes intents. 0, or 2
+  // after printing why not (a bad setting, or the broker refused this client).
+  int startBridge(const MqttSettings& mqtt, const std::string& hostId, bool readOnly,
+                  const char* command);
+  MqttBridge* bridge() { return bridge_.get(); }
   // From here on SIGINT is someone else's (the REPL's); SIGTERM still ends the run.
   void releaseSigint();
   bool interrupted() const { return interrupted_; }
@@ -57,6 +66,12 @@ class Session {
   std::unique_ptr<Recorder> recorder_;
   std::unique_ptr<ble::Central> central_;  // real cars; after the fleet: its links live there
   std::unique_ptr<Reloader> scripts_;
+  // MQTT (docs/mqtt.md): the client, and either remote cars (--mqtt) or the bridge
+  std::unique_ptr<MqttClient> mqtt_;
+  std::unique_ptr<RemoteCars> remote_;
+  std::unique_ptr<MqttBridge> bridge_;
+  int connectLocalCars(const char* command);
+  int connectRemoteCars(const char* command);
   bool finishing_ = false;
   void catchSignals();
   void awaitSignal();

@@ -328,7 +328,10 @@ void MqttClient::report(const std::string& reason, bool retrying) {
   // A broker that stays away is reported once, not at every attempt.
   if (retrying && reason == lastReported_) return;
   lastReported_ = reason;
-  log::warn("mqtt", reason + (retrying ? "; retrying" : ""));
+  if (state_ == State::Disconnected)  // on request
+    log::info("mqtt", reason);
+  else
+    log::warn("mqtt", reason + (retrying ? "; retrying" : ""));
   if (onDisconnected) onDisconnected(reason, retrying);
 }
 

@@ -227,7 +227,7 @@ void Central::addCars(const std::vector<Sighting>& sightings) {
 }
 
 void Central::enqueue(Car& car) {
-  if (shuttingDown_ || car.vanished) return;
+  if (shuttingDown_ || car.vanished || car.car->state().connected) return;
   auto& q = queues_[car.adapter];
   if (q.busy == &car || std::find(q.waiting.begin(), q.waiting.end(), &car) != q.waiting.end())
     return;
@@ -313,6 +313,30 @@ void Central::maybeFinishFirstRound() {
   auto done = std::move(firstRoundDone_);
   firstRoundDone_ = nullptr;
   done(std::nullopt);
+}
+
+void Central::reconnect() {
+  shuttingDown_ = false;
+  std::vector<const Adapter*> adapters;
+  try {
+    adapters = bluez_->pickAdapters(options_.adapters);
+  } catch (const BleError& e) {
+    log::warn("ble", e.what());
+    return;
+  }
+  for (auto& c : cars_) enqueue(*c);
+  std::weak_ptr<bool> alive = alive_;
+  scanForCars(*bluez_, adapters, options_.scan, options_.cars,
+              [this, alive](std::optional<std::string> error, std::vector<Sighting> found) {
+                if (alive.expired() || shuttingDown_) return;
+                if (error) return log::warn("ble", *error);
+                std::vector<Sighting> fresh;
+                for (auto& s : found)
+                  if (std::none_of(cars_.begin(), cars_.end(),
+                                   [&](const auto& c) { return c->address == s.address; }))
+                    fresh.push_back(std::move(s));
+                if (!fresh.empty()) addCars(fresh);
+              });
 }
 
 void Central::shutdown(std::function<void()> done) {

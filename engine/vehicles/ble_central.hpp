@@ -62,6 +62,10 @@ class Central {
   // links' disconnect timeout).
   void shutdown(std::function<void()> done);
 
+  // After shutdown() (or at any time): scans again, adds the cars not known yet, and connects
+  // every car that is not connected (the MQTT connection intent).
+  void reconnect();
+
   Bluez& bluez() { return *bluez_; }
   std::size_t carCount() const { return cars_.size(); }
   // Connection attempts so far, for tests: address → attempts.

@@ -23,11 +23,12 @@ AnkiCar& Fleet::add(std::unique_ptr<Link> link, CarIdentity identity) {
   entry->car = std::make_unique<AnkiCar>(loop_, *entry->link, std::move(identity));
   Entry* e = entry.get();
   AnkiCar& car = *e->car;
-  car.onConnection = [this, e](bool up, const std::string&) {
+  car.onConnection = [this, e](bool up, const std::string& reason) {
     if (up && !e->joined) {
       e->joined = true;
       if (onCar) onCar(*e->car);
     }
+    if (onConnectionChange) onConnectionChange(*e->car, up, reason);
   };
   car.onFrame = [this, e](AnkiCar::Direction d, std::span<const std::uint8_t> f,
                           const anki::Message& m) {

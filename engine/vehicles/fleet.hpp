@@ -29,7 +29,9 @@ class Fleet {
 
   // Called once per car, the first time it connects.
   std::function<void(AnkiCar&)> onCar;
-  // Every frame of every car (for --record).
+  // Every connection change of every car, after the car's own handler (the MQTT bridge).
+  std::function<void(AnkiCar&, bool connected, const std::string& reason)> onConnectionChange;
+  // Every frame of every car (for --record, and the MQTT bridge).
   std::function<void(AnkiCar&, AnkiCar::Direction, std::span<const std::uint8_t>,
                      const anki::Message&)>
       onFrame;

@@ -5,16 +5,26 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <limits>
 #include <nlohmann/json.hpp>
 
 #include "engine/core/overload.hpp"
 #include "engine/protocol/anki/advertisement.hpp"
+#include "engine/protocol/anki/codec.hpp"
 #include "engine/protocol/anki/limits.hpp"
 
 namespace pitwall::topics {
 namespace {
 
 using Json = nlohmann::ordered_json;
+
+template <typename T, std::size_t I = 0>
+constexpr std::size_t variantIndex() {
+  if constexpr (std::is_same_v<std::variant_alternative_t<I, anki::Message>, T>)
+    return I;
+  else
+    return variantIndex<T, I + 1>();
+}
 
 constexpr int kEventQos = 0;   // events: QoS 0, not retained (mqtt-topics.md)
 constexpr int kStatusQos = 1;  // status: QoS 1, retained
@@ -63,6 +73,42 @@ std::string safe(std::string_view s, bool lower) {
     out += (std::isalnum(u) || c == '.' || c == '_' || c == '-') ? static_cast<char>(u) : '_';
   }
   return out;
+}
+
+std::string hex(std::span<const std::uint8_t> bytes) {
+  static constexpr char kDigits[] = "0123456789abcdef";
+  std::string out;
+  out.reserve(bytes.size() * 2);
+  for (auto b : bytes) {
+    out += kDigits[b >> 4];
+    out += kDigits[b & 0xf];
+  }
+  return out;
+}
+
+// "0624e803" → bytes; an error names the problem.
+Result<std::vector<std::uint8_t>, std::string> unhex(std::string_view text) {
+  if (text.size() % 2)
+    return Unexpected{"odd number of hex digits (" + std::to_string(text.size()) + ")"};
+  std::vector<std::uint8_t> out;
+  out.reserve(text.size() / 2);
+  auto digit = [](char c) -> int {
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    return -1;
+  };
+  for (std::size_t i = 0; i < text.size(); i += 2) {
+    int hi = digit(text[i]), lo = digit(text[i + 1]);
+    if (hi < 0 || lo < 0)
+      return Unexpected{"\"" + std::string(text.substr(i, 2)) + "\" is not a hex byte"};
+    out.push_back(static_cast<std::uint8_t>(hi * 16 + lo));
+  }
+  return out;
+}
+
+bool isCommand(const anki::Message& m) {
+  return m.index() <= variantIndex<anki::SdkMode>();
 }
 
 }  // namespace
@@ -158,6 +204,10 @@ std::vector<Publication> fromMessage(std::string_view car, const anki::Message& 
   return out;
 }
 
+Publication frameEvent(std::string_view car, std::span<const std::uint8_t> frame, Millis now) {
+  return event(car, "frame", hex(frame), now);
+}
+
 std::vector<Publication> commandStatus(std::string_view car, const anki::Message& sent,
                                        Millis now) {
   std::vector<Publication> out;
@@ -183,9 +233,14 @@ std::vector<Publication> carJoined(const CarInfo& info, const CarState& state, M
                                                           {"identifier", info.identifier},
                                                           {"model", anki::modelName(info.model_id)},
                                                           {"modelId", info.model_id},
-                                                          {"productId", info.product_id}}),
+                                                          {"productId", info.product_id},
+                                                          {"name", info.name}}),
           status(carTopic(info.id, "S/DiscoveryTime"), Json{{"timestamp", now}}),
-          onlineStatus(info.id, true, state.on_charger, state.on_track, now)};
+          carOnline(info.id, state, now)};
+}
+
+Publication carOnline(std::string_view car, const CarState& state, Millis now) {
+  return onlineStatus(car, true, state.on_charger, state.on_track, now);
 }
 
 Publication carLeft(std::string_view car, const CarState& state, Millis now) {
@@ -274,7 +329,37 @@ Parsed laneIntent(const Json& j) {
     return Unexpected{"offset " + v.dump() + " mm is out of range " +
                       std::to_string(static_cast<int>(L::kOffsetMin)) + ".." +
                       std::to_string(static_cast<int>(L::kOffsetMax)) + " mm"};
-  return Action{LaneIntent{d}};
+  LaneIntent lane;
+  lane.offset_mm = d;
+  if (j.contains("horizontalSpeed")) {
+    auto v = integer(j, "horizontalSpeed", L::kLaneSpeedMin, L::kLaneSpeedMax, "mm/s");
+    if (!v) return Unexpected{v.error()};
+    lane.h_speed_mm_s = *v;
+  }
+  if (j.contains("horizontalAcceleration")) {
+    auto v = integer(j, "horizontalAcceleration", L::kLaneAccelMin, L::kLaneAccelMax, "mm/s²");
+    if (!v) return Unexpected{v.error()};
+    lane.h_accel_mm_s2 = *v;
+  }
+  return Action{lane};
+}
+
+Parsed messageIntent(const Json& j) {
+  auto f = field(j, "frame", "a string of hex digits");
+  if (!f) return Unexpected{f.error()};
+  const Json& v = **f;
+  if (!v.is_string())
+    return Unexpected{"\"frame\" must be a string of hex digits, not " + typeName(v) + " (" +
+                      v.dump() + ")"};
+  auto bytes = unhex(v.get_ref<const std::string&>());
+  if (!bytes) return Unexpected{"\"frame\": " + bytes.error()};
+  auto message = anki::decode(*bytes);
+  if (!message) return Unexpected{"\"frame\": " + message.error().message()};
+  if (!isCommand(*message))
+    return Unexpected{"\"frame\" holds " + std::string(anki::name(*message)) +
+                      ", which a car sends; only controller→vehicle messages can be sent"};
+  if (auto problem = anki::limits::validate(*message)) return Unexpected{*problem};
+  return Action{MessageIntent{std::move(*message)}};
 }
 
 Parsed turnIntent(const Json& j) {
@@ -288,7 +373,7 @@ Parsed turnIntent(const Json& j) {
 }
 
 Parsed commandIntent(const Json& j) {
-  auto f = field(j, "type", "one of speed, lane, turn, battery, version, ping");
+  auto f = field(j, "type", "one of speed, lane, turn, battery, version, ping, message");
   if (!f) return Unexpected{f.error()};
   const Json& t = **f;
   if (!t.is_string())
@@ -300,8 +385,9 @@ Parsed commandIntent(const Json& j) {
   if (type == "battery") return Action{BatteryIntent{}};
   if (type == "version") return Action{VersionIntent{}};
   if (type == "ping") return Action{PingIntent{}};
+  if (type == "message") return messageIntent(j);
   return Unexpected{"unknown intent type " + t.dump() +
-                    "; expected one of speed, lane, turn, battery, version, ping"};
+                    "; expected one of speed, lane, turn, battery, version, ping, message"};
 }
 
 Parsed connectionIntent(const Json& j) {
@@ -383,6 +469,153 @@ Result<Intent, IntentError> parseIntent(std::string_view host, std::string_view 
 Publication intentError(std::string_view host, const IntentError& error, Millis now) {
   Json j{{"timestamp", now}, {"topic", error.topic}, {"error", error.message}};
   return {hostTopic(host, "S/IntentError"), j.dump(), kStatusQos, false};
+}
+
+// ---- the reading side ----
+
+std::optional<std::string> intentPayload(const anki::Message& command) {
+  if (!isCommand(command)) return std::nullopt;
+  Json j;
+  std::visit(
+      Overload{
+          [&](const anki::SetSpeed& m) {
+            if (m.respect_limit) return;  // no key for it in the seed's intent
+            j = Json{{"type", "speed"}, {"speed", m.speed_mm_s}, {"acceleration", m.accel_mm_s2}};
+          },
+          [&](const anki::ChangeLane& m) {
+            if (m.hop_intent != 0 || m.tag != 0) return;
+            j = Json{{"type", "lane"},
+                     {"offset", mm(m.offset_mm)},
+                     {"horizontalSpeed", m.h_speed_mm_s},
+                     {"horizontalAcceleration", m.h_accel_mm_s2}};
+          },
+          [&](const anki::Turn& m) {
+            j = Json{{"type", "turn"},
+                     {"turnType", static_cast<int>(m.type)},
+                     {"trigger", static_cast<int>(m.trigger)}};
+          },
+          [&](const anki::BatteryRequest&) {
+            j = Json{{"type", "battery"}};
+          },
+          [&](const anki::VersionRequest&) {
+            j = Json{{"type", "version"}};
+          },
+          [&](const anki::PingRequest&) {
+            j = Json{{"type", "ping"}};
+          },
+          [&](const auto&) {},
+      },
+      command);
+  if (j.is_null()) {
+    auto frame = anki::encode(command);
+    j = Json{{"type", "message"}, {"frame", hex(frame.span())}};
+  }
+  return j.dump();
+}
+
+std::optional<TopicParts> splitTopic(std::string_view topic) {
+  auto parts = split(topic);
+  if (parts.size() < 4 || parts[0] != "Anki" || parts[2].empty()) return std::nullopt;
+  TopicParts out;
+  if (parts[1] == "Car")
+    out.kind = TopicParts::Kind::Car;
+  else if (parts[1] == "Host")
+    out.kind = TopicParts::Kind::Host;
+  else
+    return std::nullopt;
+  out.id = std::string(parts[2]);
+  out.rest = std::string(topic.substr(parts[0].size() + parts[1].size() + parts[2].size() + 3));
+  return out;
+}
+
+namespace {
+
+Result<Json, std::string> object(std::string_view payload) {
+  Json j;
+  try {
+    j = Json::parse(payload);
+  } catch (const Json::parse_error& e) {
+    return Unexpected{std::string("payload is not JSON: ") + e.what()};
+  }
+  if (!j.is_object()) return Unexpected{"payload must be a JSON object, not " + typeName(j)};
+  return j;
+}
+
+template <typename T>
+Result<T, std::string> key(const Json& j, const char* name) {
+  auto it = j.find(name);
+  if (it == j.end()) return Unexpected{std::string("missing key \"") + name + "\""};
+  try {
+    return it->get<T>();
+  } catch (const Json::exception&) {
+    return Unexpected{std::string("\"") + name + "\" has the wrong type (" + it->dump() + ")"};
+  }
+}
+
+// An unsigned integer no larger than `max` (nlohmann would wrap -1 into a uint32_t).
+template <typename T>
+Result<T, std::string> unsignedKey(const Json& j, const char* name) {
+  auto it = j.find(name);
+  if (it == j.end()) return Unexpected{std::string("missing key \"") + name + "\""};
+  constexpr auto max = std::numeric_limits<T>::max();
+  if (!it->is_number_unsigned() || it->get<std::uint64_t>() > max)
+    return Unexpected{std::string("\"") + name + "\" must be an integer 0.." + std::to_string(max) +
+                      ", not " + it->dump()};
+  return static_cast<T>(it->get<std::uint64_t>());
+}
+
+}  // namespace
+
+Result<CarInfo, std::string> readInformation(std::string_view car, std::string_view payload) {
+  auto j = object(payload);
+  if (!j) return Unexpected{j.error()};
+  CarInfo info;
+  info.id = std::string(car);
+  auto address = key<std::string>(*j, "address");
+  if (!address) return Unexpected{address.error()};
+  info.address = *address;
+  auto identifier = unsignedKey<std::uint32_t>(*j, "identifier");
+  if (!identifier) return Unexpected{identifier.error()};
+  info.identifier = *identifier;
+  auto model = unsignedKey<std::uint8_t>(*j, "modelId");
+  if (!model) return Unexpected{model.error()};
+  info.model_id = *model;
+  // optional: the product id, and pitwall's name
+  if (auto product = unsignedKey<std::uint16_t>(*j, "productId")) info.product_id = *product;
+  if (auto name = key<std::string>(*j, "name")) info.name = *name;
+  return info;
+}
+
+Result<CarOnline, std::string> readCarStatus(std::string_view payload) {
+  auto j = object(payload);
+  if (!j) return Unexpected{j.error()};
+  CarOnline out;
+  auto online = key<bool>(*j, "online");
+  if (!online) return Unexpected{online.error()};
+  out.online = *online;
+  if (auto c = key<bool>(*j, "charging")) out.charging = *c;
+  if (auto t = key<bool>(*j, "onTrack")) out.onTrack = *t;
+  return out;
+}
+
+Result<bool, std::string> readHostStatus(std::string_view payload) {
+  auto j = object(payload);
+  if (!j) return Unexpected{j.error()};
+  return key<bool>(*j, "value");
+}
+
+Result<std::vector<std::string>, std::string> readHostCars(std::string_view payload) {
+  auto j = object(payload);
+  if (!j) return Unexpected{j.error()};
+  return key<std::vector<std::string>>(*j, "value");
+}
+
+Result<std::vector<std::uint8_t>, std::string> readFrameEvent(std::string_view payload) {
+  auto j = object(payload);
+  if (!j) return Unexpected{j.error()};
+  auto text = key<std::string>(*j, "value");
+  if (!text) return Unexpected{text.error()};
+  return unhex(*text);
 }
 
 }  // namespace pitwall::topics

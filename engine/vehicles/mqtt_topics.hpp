@@ -47,6 +47,7 @@ struct CarInfo {
   std::uint32_t identifier = 0;
   std::uint8_t model_id = 0;
   std::uint16_t product_id = 0xBEEF;
+  std::string name;  // the car's name in pitwall ("groundshock"); pitwall's extra key
 };
 
 // ---- car → broker ----
@@ -57,6 +58,11 @@ struct CarInfo {
 std::vector<Publication> fromMessage(std::string_view car, const anki::Message& message,
                                      std::optional<double> pingRttSeconds, Millis now);
 
+// pitwall's extension: the vehicle's frame itself, Anki/Car/<car>/E/frame (QoS 0, not retained)
+// {"timestamp":…,"value":"<hex>"}. It carries every message whole, so a remote pitwall turns it
+// back into the same car events (docs/mqtt.md); tools of the seed ignore the extra topic.
+Publication frameEvent(std::string_view car, std::span<const std::uint8_t> frame, Millis now);
+
 // Status for a command that was sent to a car: S/Speed/Desired for a set-speed, S/Lane/Desired
 // for a change-lane or set-offset; nothing for other commands.
 std::vector<Publication> commandStatus(std::string_view car, const anki::Message& sent, Millis now);
@@ -64,6 +70,8 @@ std::vector<Publication> commandStatus(std::string_view car, const anki::Message
 // A car joined: S/Information, S/DiscoveryTime and S/CarStatus online (charging and onTrack
 // from `state`).
 std::vector<Publication> carJoined(const CarInfo& info, const CarState& state, Millis now);
+// A car (re)connected: S/CarStatus with online true.
+Publication carOnline(std::string_view car, const CarState& state, Millis now);
 // A car left: S/CarStatus with online false.
 Publication carLeft(std::string_view car, const CarState& state, Millis now);
 
@@ -96,6 +104,9 @@ struct SpeedIntent {
 };
 struct LaneIntent {
   double offset_mm = 0;
+  // pitwall's optional keys horizontalSpeed / horizontalAcceleration (AnkiCar::changeLane's
+  // defaults when absent)
+  std::optional<int> h_speed_mm_s, h_accel_mm_s2;
   bool operator==(const LaneIntent&) const = default;
 };
 struct TurnIntent {
@@ -113,8 +124,15 @@ struct PingIntent {
   bool operator==(const PingIntent&) const = default;
 };
 
+// pitwall's extension {"type":"message","frame":"<hex>"}: any controller→vehicle message as its
+// frame (lights, set-offset, cancel lane change, …), decoded and range-checked like the others.
+struct MessageIntent {
+  anki::Message message;
+  bool operator==(const MessageIntent&) const = default;
+};
+
 using Action = std::variant<ConnectIntent, SpeedIntent, LaneIntent, TurnIntent, BatteryIntent,
-                            VersionIntent, PingIntent>;
+                            VersionIntent, PingIntent, MessageIntent>;
 
 struct Intent {
   Target target;
@@ -137,5 +155,30 @@ Result<Intent, IntentError> parseIntent(std::string_view host, std::string_view 
 // error belongs to one intent; a late subscriber must not see it as current state), payload
 // {"timestamp":…,"topic":…,"error":…}.
 Publication intentError(std::string_view host, const IntentError& error, Millis now);
+
+// ---- the reading side: a remote pitwall's view of the tree ----
+
+// The intent payload that asks a bridge to send `command` (a controller→vehicle message) to a car:
+// the seed's types where one fits (speed, lane, turn, battery, version, ping), else "message".
+// nullopt for a vehicle→controller message.
+std::optional<std::string> intentPayload(const anki::Message& command);
+
+// What a topic of the tree is about: Anki/Car/<car>/<rest> or Anki/Host/<host>/<rest>.
+struct TopicParts {
+  enum class Kind { Car, Host } kind = Kind::Car;
+  std::string id;    // the car or the host
+  std::string rest;  // "S/CarStatus", "E/frame", …
+};
+std::optional<TopicParts> splitTopic(std::string_view topic);
+
+// Payload readers; an error says what is wrong with the payload.
+Result<CarInfo, std::string> readInformation(std::string_view car, std::string_view payload);
+struct CarOnline {
+  bool online = false, charging = false, onTrack = false;
+};
+Result<CarOnline, std::string> readCarStatus(std::string_view payload);
+Result<bool, std::string> readHostStatus(std::string_view payload);
+Result<std::vector<std::string>, std::string> readHostCars(std::string_view payload);
+Result<std::vector<std::uint8_t>, std::string> readFrameEvent(std::string_view payload);
 
 }  // namespace pitwall::topics

@@ -164,7 +164,7 @@ TEST_CASE("mqtt topics: commands sent publish the desired speed and lane") {
 }
 
 TEST_CASE("mqtt topics: a car that joins publishes its information, discovery time and status") {
-  CarInfo info{kCar, "E8:5A:0F:11:22:33", 0x12345678, 9, 0xBEEF};
+  CarInfo info{kCar, "E8:5A:0F:11:22:33", 0x12345678, 9, 0xBEEF, "skull"};
   CarState state;
   state.on_charger = true;
   auto ps = carJoined(info, state, kNow);
@@ -173,7 +173,7 @@ TEST_CASE("mqtt topics: a car that joins publishes its information, discovery ti
       std::vector<Publication>{
           {"Anki/Car/" + kCar + "/S/Information",
            R"({"address":"E8:5A:0F:11:22:33","identifier":305419896,"model":"Skull",)"
-           R"("modelId":9,"productId":48879})",
+           R"("modelId":9,"productId":48879,"name":"skull"})",
            1, true},
           {"Anki/Car/" + kCar + "/S/DiscoveryTime", R"({"timestamp":1700000000123})", 1, true},
           {"Anki/Car/" + kCar + "/S/CarStatus",
@@ -216,8 +216,10 @@ TEST_CASE("mqtt intents: every intent type is parsed with its target") {
         Intent{{Target::Kind::Host, ""}, ConnectIntent{false}});
   CHECK(accepted(carTopic, R"({"type":"speed","speed":600,"acceleration":1000})") ==
         Intent{one, SpeedIntent{600, 1000}});
-  CHECK(accepted(carTopic, R"({"type":"lane","offset":-23})") == Intent{one, LaneIntent{-23}});
-  CHECK(accepted(carTopic, R"({"type":"lane","offset":44.5})") == Intent{one, LaneIntent{44.5}});
+  CHECK(accepted(carTopic, R"({"type":"lane","offset":-23})") ==
+        Intent{one, LaneIntent{-23, {}, {}}});
+  CHECK(accepted(carTopic, R"({"type":"lane","offset":44.5})") ==
+        Intent{one, LaneIntent{44.5, {}, {}}});
   CHECK(accepted(carTopic, R"({"type":"turn","turnType":3,"trigger":0})") ==
         Intent{one, TurnIntent{anki::TurnType::UTurn, anki::TurnTrigger::Immediate}});
   CHECK(accepted(carTopic, R"({"type":"battery"})") == Intent{one, BatteryIntent{}});
@@ -241,16 +243,17 @@ TEST_CASE("mqtt intents: bad JSON is rejected with the parser's message") {
 
 TEST_CASE("mqtt intents: a missing or unknown type is rejected with the accepted types") {
   CHECK(rejected("Anki/Car/all/I", "{}") ==
-        "missing key \"type\" (one of speed, lane, turn, battery, version, ping)");
+        "missing key \"type\" (one of speed, lane, turn, battery, version, ping, message)");
   CHECK(rejected("Anki/Car/all/I", R"({"type":"fly"})") ==
-        "unknown intent type \"fly\"; expected one of speed, lane, turn, battery, version, ping");
+        "unknown intent type \"fly\"; expected one of speed, lane, turn, battery, version, ping, "
+        "message");
   CHECK(rejected("Anki/Car/all/I", R"({"type":7})") ==
         "\"type\" must be a string, not an integer (7)");
 }
 
 TEST_CASE("mqtt intents: a connection intent is only accepted on the host's connection topic") {
   CHECK(rejected("Anki/Host/pit1/I", R"({"connecting":true})") ==
-        "missing key \"type\" (one of speed, lane, turn, battery, version, ping)");
+        "missing key \"type\" (one of speed, lane, turn, battery, version, ping, message)");
   CHECK(rejected("Anki/Host/pit1/I/connection", R"({"type":"ping"})") ==
         "missing key \"connecting\" (true or false)");
 }
@@ -283,7 +286,7 @@ TEST_CASE("mqtt intents: every out-of-range value is rejected with the car model
   CHECK(accepted("Anki/Car/all/I", R"({"type":"speed","speed":1500,"acceleration":25000})") ==
         Intent{{Target::Kind::AllCars, ""}, SpeedIntent{1500, 25000}});
   CHECK(accepted("Anki/Car/all/I", R"({"type":"lane","offset":100})") ==
-        Intent{{Target::Kind::AllCars, ""}, LaneIntent{100}});
+        Intent{{Target::Kind::AllCars, ""}, LaneIntent{100, {}, {}}});
   CHECK(accepted("Anki/Car/all/I", R"({"type":"turn","turnType":4,"trigger":1})") ==
         Intent{{Target::Kind::AllCars, ""},
                TurnIntent{anki::TurnType::UTurnJump, anki::TurnTrigger::Intersection}});
@@ -342,5 +345,158 @@ TEST_CASE("mqtt intents: a rejected intent is answered on the host's IntentError
   REQUIRE_FALSE(bad);
   CHECK(intentError("pit1", bad.error(), kNow).payload ==
         R"({"timestamp":1700000000123,"topic":"Anki/Car/all/I","error":"unknown intent type )"
-        R"(\"\\\"\"; expected one of speed, lane, turn, battery, version, ping"})");
+        R"(\"\\\"\"; expected one of speed, lane, turn, battery, version, ping, message"})");
+}
+
+TEST_CASE("mqtt topics: a vehicle frame is also published whole as pitwall's E/frame event") {
+  std::vector<std::uint8_t> frame{0x03, 0x19, 0x6e, 0x2b};
+  CHECK(frameEvent(kCar, frame, kNow) == ev("frame", "\"03196e2b\""));
+  auto back = readFrameEvent(frameEvent(kCar, frame, kNow).payload);
+  REQUIRE(back);
+  CHECK(*back == frame);
+  CHECK(readFrameEvent(R"({"timestamp":1,"value":"0319x"})").error() ==
+        "odd number of hex digits (5)");
+  CHECK(readFrameEvent(R"({"timestamp":1,"value":"03zz"})").error() == "\"zz\" is not a hex byte");
+  CHECK(readFrameEvent(R"({"timestamp":1})").error() == "missing key \"value\"");
+  CHECK(readFrameEvent("[").error().starts_with("payload is not JSON: "));
+}
+
+TEST_CASE(
+    "mqtt intents: a lane intent takes pitwall's optional horizontal speed and acceleration") {
+  Target one{Target::Kind::Car, kCar};
+  CHECK(
+      accepted(
+          "Anki/Car/" + kCar + "/I",
+          R"({"type":"lane","offset":-23,"horizontalSpeed":400,"horizontalAcceleration":4000})") ==
+      Intent{one, LaneIntent{-23, 400, 4000}});
+  CHECK(rejected("Anki/Car/all/I", R"({"type":"lane","offset":0,"horizontalSpeed":1501})") ==
+        "horizontalSpeed 1501 mm/s is out of range 0..1500 mm/s");
+  CHECK(rejected("Anki/Car/all/I", R"({"type":"lane","offset":0,"horizontalAcceleration":"x"})") ==
+        "\"horizontalAcceleration\" must be an integer, not a string (\"x\")");
+}
+
+TEST_CASE("mqtt intents: a message intent carries any command frame, checked like the others") {
+  Target all{Target::Kind::AllCars, ""};
+  // set-lights 0x44 (anki-overdrive.md): frame 02 1d 44
+  auto lights = accepted("Anki/Car/all/I", R"({"type":"message","frame":"021d44"})");
+  CHECK(lights ==
+        Intent{all,
+               MessageIntent{anki::decode(std::vector<std::uint8_t>{0x02, 0x1d, 0x44}).value()}});
+  CHECK(rejected("Anki/Car/all/I", R"({"type":"message"})") ==
+        "missing key \"frame\" (a string of hex digits)");
+  CHECK(rejected("Anki/Car/all/I", R"({"type":"message","frame":12})") ==
+        "\"frame\" must be a string of hex digits, not an integer (12)");
+  CHECK(rejected("Anki/Car/all/I", R"({"type":"message","frame":"021"})") ==
+        "\"frame\": odd number of hex digits (3)");
+  // a report the car sends (version response) is not a command
+  CHECK(rejected("Anki/Car/all/I", R"({"type":"message","frame":"03196e2b"})") ==
+        "\"frame\" holds version-response, which a car sends; only controller→vehicle messages "
+        "can be sent");
+  // set-speed 2000 mm/s through a frame: the same range check as the speed intent
+  CHECK(rejected("Anki/Car/all/I", R"({"type":"message","frame":"0624d007e80300"})") ==
+        "speed 2000 mm/s is out of range 0..1500 mm/s");
+  // a frame whose size byte disagrees with its length
+  CHECK(rejected("Anki/Car/all/I", R"({"type":"message","frame":"0524d007"})")
+            .starts_with("\"frame\": "));
+}
+
+TEST_CASE("mqtt intents: a remote command becomes the intent that parses back to it") {
+  using anki::Message;
+  std::vector<Message> commands{
+      anki::SetSpeed{600, 1000, false},
+      anki::ChangeLane{400, 4000, -23.5f, 0, 0},
+      anki::Turn{anki::TurnType::UTurn, anki::TurnTrigger::Intersection},
+      anki::BatteryRequest{},
+      anki::VersionRequest{},
+      anki::PingRequest{},
+      anki::SetLights{0x44},
+      anki::SetOffset{12.0f},
+      anki::CancelLaneChange{},
+      anki::SetSpeed{600, 1000, true},  // respect_limit has no key in the seed's speed intent
+  };
+  std::vector<std::string> types{"speed", "lane",    "turn",    "battery", "version",
+                                 "ping",  "message", "message", "message", "message"};
+  for (std::size_t i = 0; i < commands.size(); ++i) {
+    auto payload = intentPayload(commands[i]);
+    REQUIRE(payload);
+    INFO(*payload);
+    CHECK(payload->find("\"type\":\"" + types[i] + "\"") != std::string::npos);
+    auto intent = accepted("Anki/Car/" + kCar + "/I", *payload);
+    // executed as the bridge does: the action must describe the same command
+    std::visit(
+        [&](const auto& a) {
+          using A = std::decay_t<decltype(a)>;
+          if constexpr (std::is_same_v<A, MessageIntent>) {
+            CHECK(a.message == commands[i]);
+          } else if constexpr (std::is_same_v<A, SpeedIntent>) {
+            CHECK(Message{anki::SetSpeed{static_cast<std::int16_t>(a.speed_mm_s),
+                                         static_cast<std::int16_t>(a.accel_mm_s2), false}} ==
+                  commands[i]);
+          } else if constexpr (std::is_same_v<A, LaneIntent>) {
+            CHECK(Message{anki::ChangeLane{static_cast<std::uint16_t>(*a.h_speed_mm_s),
+                                           static_cast<std::uint16_t>(*a.h_accel_mm_s2),
+                                           static_cast<float>(a.offset_mm), 0, 0}} == commands[i]);
+          } else if constexpr (std::is_same_v<A, TurnIntent>) {
+            CHECK(Message{anki::Turn{a.type, a.trigger}} == commands[i]);
+          } else if constexpr (std::is_same_v<A, BatteryIntent>) {
+            CHECK(Message{anki::BatteryRequest{}} == commands[i]);
+          } else if constexpr (std::is_same_v<A, VersionIntent>) {
+            CHECK(Message{anki::VersionRequest{}} == commands[i]);
+          } else if constexpr (std::is_same_v<A, PingIntent>) {
+            CHECK(Message{anki::PingRequest{}} == commands[i]);
+          } else {
+            FAIL("a command became a connection intent");
+          }
+        },
+        intent.action);
+  }
+  CHECK_FALSE(intentPayload(anki::VersionResponse{0x2b6e}));  // a report, not a command
+}
+
+TEST_CASE("mqtt topics: the reading side splits topics and reads status payloads") {
+  auto car = splitTopic("Anki/Car/sim-0000002a/S/Speed/Actual");
+  REQUIRE(car);
+  CHECK(car->kind == TopicParts::Kind::Car);
+  CHECK(car->id == "sim-0000002a");
+  CHECK(car->rest == "S/Speed/Actual");
+  auto host = splitTopic("Anki/Host/pit1/S/Cars");
+  REQUIRE(host);
+  CHECK(host->kind == TopicParts::Kind::Host);
+  CHECK(host->rest == "S/Cars");
+  CHECK_FALSE(splitTopic("Anki/Car/x"));
+  CHECK_FALSE(splitTopic("Anki/Boat/x/S"));
+  CHECK_FALSE(splitTopic("pitwall/sync/1"));
+
+  CarInfo info{kCar, "E8:5A:0F:11:22:33", 0x12345678, 9, 0xBEEF, "skull"};
+  auto joined = carJoined(info, CarState{}, kNow);
+  auto read = readInformation(kCar, joined[0].payload);
+  REQUIRE(read);
+  CHECK(read->name == "skull");
+  CHECK(read->identifier == 0x12345678u);
+  CHECK(read->model_id == 9);
+  CHECK(read->address == "E8:5A:0F:11:22:33");
+  // the seed's payload, without pitwall's name
+  auto seed =
+      readInformation(kCar, R"({"address":"a","identifier":1,"model":"Skull","modelId":9})");
+  REQUIRE(seed);
+  CHECK(seed->name.empty());
+  CHECK(readInformation(kCar, R"({"address":"a","identifier":-1,"modelId":9})").error() ==
+        "\"identifier\" must be an integer 0..4294967295, not -1");
+  CHECK(readInformation(kCar, R"({"address":"a","identifier":1,"modelId":256})").error() ==
+        "\"modelId\" must be an integer 0..255, not 256");
+
+  CarState state;
+  state.on_track = true;
+  auto online = readCarStatus(carOnline(kCar, state, kNow).payload);
+  REQUIRE(online);
+  CHECK(online->online);
+  CHECK(online->onTrack);
+  CHECK_FALSE(readCarStatus(carLeft(kCar, state, kNow).payload)->online);
+  CHECK(readCarStatus("{}").error() == "missing key \"online\"");
+
+  CHECK(*readHostStatus(hostOnline("pit1").payload));
+  CHECK_FALSE(*readHostStatus(hostWill("pit1").payload));
+  std::vector<std::string> cars{"a", "b"};
+  CHECK(*readHostCars(hostCars("pit1", cars, kNow).payload) == cars);
+  CHECK(readHostCars(R"({"value":[1]})").error() == "\"value\" has the wrong type ([1])");
 }

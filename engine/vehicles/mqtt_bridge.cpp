@@ -1,0 +1,281 @@
+#include "engine/vehicles/mqtt_bridge.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "engine/core/log.hpp"
+#include "engine/core/overload.hpp"
+
+namespace pitwall {
+
+namespace {
+constexpr const char* kLog = "mqtt bridge";
+}
+
+MqttBridge::MqttBridge(Loop& loop, Fleet& fleet, MqttClient& client, BridgeOptions options,
+                       CarConnections connections)
+    : loop_(loop),
+      fleet_(fleet),
+      client_(client),
+      options_(std::move(options)),
+      connections_(std::move(connections)),
+      host_(topics::hostId(options_.host)) {
+  const auto& w = client_.options().will;
+  if (!w || w->topic != topics::hostWill(host_).topic)
+    throw std::invalid_argument("the bridge's MQTT client needs MqttBridge::will(\"" + host_ +
+                                "\") as its last will");
+  client_.onConnected = [this] { connected(); };
+  client_.onMessage = [this](std::string_view topic, std::string_view payload, bool retained) {
+    message(topic, payload, retained);
+  };
+  if (!options_.readOnly) {
+    for (const auto& filter : topics::intentSubscriptions(host_)) client_.subscribe(filter, 1);
+    // Which cars the other bridges own, so that their single-car intents are left to them.
+    client_.subscribe("Anki/Host/+/S/Cars", 1);
+    client_.subscribe("Anki/Host/+/S/HostStatus", 1);
+  }
+
+  previousOnCar_ = std::move(fleet_.onCar);
+  fleet_.onCar = [this](AnkiCar& car) {
+    if (previousOnCar_) previousOnCar_(car);
+    joined(car);
+  };
+  previousOnConnection_ = std::move(fleet_.onConnectionChange);
+  fleet_.onConnectionChange = [this](AnkiCar& car, bool up, const std::string& reason) {
+    if (previousOnConnection_) previousOnConnection_(car, up, reason);
+    connectionChanged(car, up);
+  };
+  previousOnFrame_ = std::move(fleet_.onFrame);
+  fleet_.onFrame = [this](AnkiCar& car, AnkiCar::Direction d, std::span<const std::uint8_t> f,
+                          const anki::Message& m) {
+    if (previousOnFrame_) previousOnFrame_(car, d, f, m);
+    frame(car, d, f, m);
+  };
+  // Cars that were connected before the bridge started.
+  for (auto* car : fleet_.cars())
+    if (car->state().connected) joined(*car);
+  emit(topics::hostOnline(host_));
+}
+
+MqttBridge::~MqttBridge() {
+  fleet_.onCar = std::move(previousOnCar_);
+  fleet_.onConnectionChange = std::move(previousOnConnection_);
+  fleet_.onFrame = std::move(previousOnFrame_);
+  client_.onConnected = nullptr;
+  client_.onMessage = nullptr;
+}
+
+MqttWill MqttBridge::will(const std::string& host) {
+  auto p = topics::hostWill(topics::hostId(host));
+  return MqttWill{p.topic, p.payload, p.qos, p.retain};
+}
+
+topics::Millis MqttBridge::now() {
+  using namespace std::chrono;
+  return duration_cast<milliseconds>(system_clock::now().time_since_epoch()).count();
+}
+
+std::string MqttBridge::carIdOf(const AnkiCar& car) const {
+  auto it = ids_.find(&car);
+  return it == ids_.end() ? topics::carId(const_cast<AnkiCar&>(car).link().address()) : it->second;
+}
+
+void MqttBridge::emit(const topics::Publication& p) {
+  if (p.retain) retained_[p.topic] = p;
+  if (client_.publish(p.topic, p.payload, p.qos, p.retain))
+    ++stats_.published;
+  else
+    ++stats_.dropped;
+}
+
+void MqttBridge::emit(const std::vector<topics::Publication>& ps) {
+  for (const auto& p : ps) emit(p);
+}
+
+void MqttBridge::connected() {
+  // HostStatus true first (it replaces the will's false), then the rest of the retained state
+  // as it was last published: the broker may have lost it (a restart without persistence).
+  auto online = topics::hostOnline(host_);
+  retained_[online.topic] = online;
+  auto send = [this](const topics::Publication& p) {
+    if (client_.publish(p.topic, p.payload, p.qos, p.retain)) ++stats_.republished;
+  };
+  send(online);
+  for (const auto& [topic, p] : retained_)
+    if (topic != online.topic) send(p);
+  log::info(kLog, "publishing as host " + host_ + (options_.readOnly ? " (read-only)" : ""));
+}
+
+std::vector<std::string> MqttBridge::ownCars() const {
+  std::vector<std::string> out;
+  for (const auto& [car, id] : ids_) out.push_back(id);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+void MqttBridge::joined(AnkiCar& car) {
+  if (ids_.count(&car)) return;
+  std::string id = topics::carId(car.link().address());
+  ids_[&car] = id;
+  topics::CarInfo info;
+  info.id = id;
+  info.name = car.identity().name;
+  info.address = car.link().address();
+  if (info.address.starts_with("ble:")) info.address = info.address.substr(4);
+  info.identifier = car.identity().identifier;
+  info.model_id = car.identity().model_id;
+  auto t = now();
+  emit(topics::carDiscovered(host_, id, t));
+  emit(topics::carJoined(info, car.state(), t));
+  publishCars();
+}
+
+void MqttBridge::connectionChanged(AnkiCar& car, bool up) {
+  auto it = ids_.find(&car);
+  if (it == ids_.end()) return;  // not joined yet: joined() publishes it
+  emit(up ? topics::carOnline(it->second, car.state(), now())
+          : topics::carLeft(it->second, car.state(), now()));
+  publishCars();
+}
+
+void MqttBridge::publishCars() {
+  std::vector<std::string> cars;
+  for (const auto& [car, id] : ids_)
+    if (car->state().connected) cars.push_back(id);
+  std::sort(cars.begin(), cars.end());
+  if (haveCars_ && cars == lastCars_) return;
+  haveCars_ = true;
+  lastCars_ = cars;
+  emit(topics::hostCars(host_, cars, now()));
+}
+
+void MqttBridge::frame(AnkiCar& car, AnkiCar::Direction d, std::span<const std::uint8_t> bytes,
+                       const anki::Message& m) {
+  auto it = ids_.find(&car);
+  if (it == ids_.end()) return;
+  auto t = now();
+  if (d == AnkiCar::Direction::Tx) return emit(topics::commandStatus(it->second, m, t));
+  emit(topics::frameEvent(it->second, bytes, t));
+  std::optional<double> rtt;
+  if (std::holds_alternative<anki::PingResponse>(m)) rtt = car.lastPingRtt();
+  emit(topics::fromMessage(it->second, m, rtt, t));
+}
+
+bool MqttBridge::ownedElsewhere(const std::string& car) const {
+  for (const auto& [host, cars] : otherCars_)
+    if (host != host_ && otherOnline_.count(host) &&
+        std::find(cars.begin(), cars.end(), car) != cars.end())
+      return true;
+  return false;
+}
+
+void MqttBridge::message(std::string_view topic, std::string_view payload, bool retained) {
+  if (options_.readOnly) return;
+  auto parts = topics::splitTopic(topic);
+  if (parts && parts->kind == topics::TopicParts::Kind::Host && parts->id != host_) {
+    if (parts->rest == "S/Cars") {
+      if (auto cars = topics::readHostCars(payload)) otherCars_[parts->id] = *cars;
+      return;
+    }
+    if (parts->rest == "S/HostStatus") {
+      auto up = topics::readHostStatus(payload);
+      if (up && *up)
+        otherOnline_.insert(parts->id);
+      else
+        otherOnline_.erase(parts->id);
+      return;
+    }
+  }
+  if (parts && parts->kind == topics::TopicParts::Kind::Host && parts->id == host_ &&
+      parts->rest.starts_with("S/"))
+    return;  // our own status, echoed back by the broker
+  std::string t(topic);
+  if (parts && parts->kind == topics::TopicParts::Kind::Car && parts->rest == "I" &&
+      parts->id != "all") {
+    auto own = ownCars();
+    if (!std::binary_search(own.begin(), own.end(), parts->id) && ownedElsewhere(parts->id))
+      return;  // another bridge's car: its bridge answers
+  }
+  if (retained)
+    return reject(t,
+                  "retained intents are not executed (a retained command would run again on "
+                  "every reconnection); publish the intent without the retain flag");
+  auto own = ownCars();
+  auto intent = topics::parseIntent(host_, topic, payload, own);
+  if (!intent) return reject(t, intent.error().message);
+  execute(*intent, t);
+}
+
+void MqttBridge::reject(const std::string& topic, std::string message) {
+  ++stats_.rejected;
+  log::warn(kLog, "intent on " + topic + " rejected: " + message);
+  emit(topics::intentError(host_, topics::IntentError{topic, std::move(message)}, now()));
+  if (onIntentHandled) onIntentHandled(topic, false);
+}
+
+AnkiCar::Sent MqttBridge::apply(AnkiCar& car, const topics::Action& action) {
+  using namespace topics;
+  return std::visit(
+      Overload{
+          [&](const SpeedIntent& a) { return car.setSpeed(a.speed_mm_s, a.accel_mm_s2); },
+          [&](const LaneIntent& a) {
+            return car.changeLane(a.offset_mm, a.h_speed_mm_s.value_or(kDefaultLaneSpeed),
+                                  a.h_accel_mm_s2.value_or(kDefaultLaneAccel));
+          },
+          [&](const TurnIntent& a) { return car.turn(a.type, a.trigger); },
+          [&](const BatteryIntent&) { return car.requestBattery(); },
+          [&](const VersionIntent&) { return car.requestVersion(); },
+          [&](const PingIntent&) { return car.ping(); },
+          [&](const MessageIntent& a) -> AnkiCar::Sent {
+            if (std::holds_alternative<anki::Disconnect>(a.message)) return car.disconnect();
+            if (auto* s = std::get_if<anki::SetSpeed>(&a.message))
+              return car.setSpeed(s->speed_mm_s, s->accel_mm_s2, s->respect_limit);
+            return car.send(a.message);
+          },
+          [&](const ConnectIntent&) -> AnkiCar::Sent { return true; },
+      },
+      action);
+}
+
+void MqttBridge::execute(const topics::Intent& intent, const std::string& topic) {
+  using Kind = topics::Target::Kind;
+  if (auto* c = std::get_if<topics::ConnectIntent>(&intent.action)) {
+    ++stats_.intents;
+    log::info(kLog, c->connecting ? "connection intent: connecting the cars"
+                                  : "connection intent: disconnecting every car");
+    auto& f = c->connecting ? connections_.connectAll : connections_.disconnectAll;
+    if (f) f();
+    if (onIntentHandled) onIntentHandled(topic, true);
+    return;
+  }
+  if (intent.target.kind == Kind::Car) {
+    for (auto& [car, id] : ids_) {
+      if (id != intent.target.car) continue;
+      auto sent = apply(*const_cast<AnkiCar*>(car), intent.action);
+      if (!sent) return reject(topic, sent.error());
+      ++stats_.intents;
+      if (onIntentHandled) onIntentHandled(topic, true);
+      return;
+    }
+    return reject(topic, "unknown car \"" + intent.target.car + "\"");
+  }
+  // Every car of this host: those not connected are skipped (a drop is not the sender's error).
+  for (auto& [car, id] : ids_) {
+    if (!car->state().connected) continue;
+    auto sent = apply(*const_cast<AnkiCar*>(car), intent.action);
+    if (!sent) log::warn(car->label(), "intent on " + topic + ": " + sent.error());
+  }
+  ++stats_.intents;
+  if (onIntentHandled) onIntentHandled(topic, true);
+}
+
+void MqttBridge::goOffline() {
+  auto t = now();
+  for (const auto& [car, id] : ids_) emit(topics::carLeft(id, car->state(), t));
+  lastCars_.clear();
+  haveCars_ = true;
+  emit(topics::hostCars(host_, {}, t));
+  emit(topics::hostWill(host_));
+}
+
+}  // namespace pitwall

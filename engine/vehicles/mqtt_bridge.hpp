@@ -1,0 +1,109 @@
+#pragma once
+// The MQTT bridge (docs/mqtt.md): the cars of a fleet published under the seed's topic tree
+// (docs/mqtt-topics.md), and intents from any MQTT client executed on them.
+//
+//  - Every frame a car sends becomes its events and status (topics::fromMessage) plus pitwall's
+//    E/frame; every command sent becomes S/Speed/Desired or S/Lane/Desired; joins and drops become
+//    S/CarStatus, S/Cars, S/Information, S/DiscoveryTime and E/CarDiscovered.
+//  - Retained status is kept in a cache and republished whole after every (re)connection to the
+//    broker, HostStatus true first; events that happen while the broker is away are dropped, not
+//    queued, so a reconnection brings no flood of stale events.
+//  - Intents are parsed by topics::parseIntent; a rejected one is answered on
+//    Anki/Host/<host>/S/IntentError and nothing is sent to any car. A single-car intent for a car
+//    that another online bridge lists in its S/Cars is left to that bridge, silently.
+//  - read-only: intents are not even subscribed to.
+#include <chrono>
+#include <functional>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "engine/transport/mqtt_client.hpp"
+#include "engine/vehicles/fleet.hpp"
+#include "engine/vehicles/mqtt_topics.hpp"
+
+namespace pitwall {
+
+struct BridgeOptions {
+  std::string host;  // the host id (topics::hostId applied by the bridge)
+  bool readOnly = false;
+};
+
+// How the bridge carries out a connection intent: scan and connect every car, or drop them all.
+struct CarConnections {
+  std::function<void()> connectAll;
+  std::function<void()> disconnectAll;
+};
+
+class MqttBridge {
+ public:
+  // The client must not be connected yet: the bridge sets its will and handlers. The fleet, the
+  // client and the loop outlive the bridge.
+  MqttBridge(Loop& loop, Fleet& fleet, MqttClient& client, BridgeOptions options,
+             CarConnections connections);
+  ~MqttBridge();
+  MqttBridge(const MqttBridge&) = delete;
+  MqttBridge& operator=(const MqttBridge&) = delete;
+
+  // The will a bridge's client must carry (HostStatus false, retained, QoS 1).
+  static MqttWill will(const std::string& host);
+
+  // Before a clean shutdown: every car offline, S/Cars empty, HostStatus false (the will is not
+  // sent on a clean DISCONNECT).
+  void goOffline();
+
+  const std::string& host() const { return host_; }
+  std::string carIdOf(const AnkiCar& car) const;
+
+  struct Stats {
+    std::uint64_t published = 0;    // publications handed to the client
+    std::uint64_t dropped = 0;      // not connected to the broker: dropped, not queued
+    std::uint64_t intents = 0;      // intents executed
+    std::uint64_t rejected = 0;     // intents answered on S/IntentError
+    std::uint64_t republished = 0;  // retained status sent again after a (re)connection
+  };
+  const Stats& stats() const { return stats_; }
+
+  // Called after an intent was handled (executed or rejected), for tests and logs.
+  std::function<void(const std::string& topic, bool executed)> onIntentHandled;
+
+ private:
+  static topics::Millis now();
+  void emit(const topics::Publication& p);
+  void emit(const std::vector<topics::Publication>& ps);
+  void connected();
+  void joined(AnkiCar& car);
+  void connectionChanged(AnkiCar& car, bool up);
+  void publishCars();
+  void frame(AnkiCar& car, AnkiCar::Direction d, std::span<const std::uint8_t> bytes,
+             const anki::Message& m);
+  void message(std::string_view topic, std::string_view payload, bool retained);
+  bool ownedElsewhere(const std::string& car) const;
+  void execute(const topics::Intent& intent, const std::string& topic);
+  AnkiCar::Sent apply(AnkiCar& car, const topics::Action& action);
+  void reject(const std::string& topic, std::string message);
+  std::vector<std::string> ownCars() const;
+
+  Loop& loop_;
+  Fleet& fleet_;
+  MqttClient& client_;
+  BridgeOptions options_;
+  CarConnections connections_;
+  std::string host_;
+  std::map<const AnkiCar*, std::string> ids_;            // cars that joined, by their topic id
+  std::map<std::string, topics::Publication> retained_;  // last retained publication per topic
+  std::vector<std::string> lastCars_;
+  bool haveCars_ = false;
+  // What the other bridges said: their cars, while they are online.
+  std::map<std::string, std::vector<std::string>> otherCars_;
+  std::set<std::string> otherOnline_;
+  Stats stats_;
+  std::function<void(AnkiCar&)> previousOnCar_;
+  std::function<void(AnkiCar&, bool, const std::string&)> previousOnConnection_;
+  std::function<void(AnkiCar&, AnkiCar::Direction, std::span<const std::uint8_t>,
+                     const anki::Message&)>
+      previousOnFrame_;
+};
+
+}  // namespace pitwall

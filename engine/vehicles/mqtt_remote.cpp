@@ -1,0 +1,193 @@
+#include "engine/vehicles/mqtt_remote.hpp"
+
+#include <unistd.h>
+
+#include <random>
+
+#include "engine/core/log.hpp"
+#include "engine/protocol/anki/advertisement.hpp"
+#include "engine/protocol/anki/codec.hpp"
+
+namespace pitwall {
+
+namespace {
+constexpr const char* kLog = "mqtt remote";
+}
+
+// A remote car's link: frames arrive from the broker, commands leave as intents.
+class RemoteLink : public Link {
+ public:
+  RemoteLink(RemoteCars& owner, std::string id) : owner_(owner), id_(std::move(id)) {}
+
+  bool send(std::span<const std::uint8_t> frame) override {
+    return up_ && owner_.sendCommand(id_, frame);
+  }
+  bool connected() const override { return up_; }
+  // A remote car is the other bridge's to drop: AnkiCar::disconnect() has already sent the
+  // disconnect message as an intent, and the car's status follows from its bridge.
+  void disconnect() override {}
+  std::string address() const override { return "mqtt:" + id_; }
+
+  void set(bool up, const std::string& reason) {
+    if (up == up_) return;
+    up_ = up;
+    deliverState(up, reason);
+  }
+  void frame(std::span<const std::uint8_t> bytes) {
+    if (up_) deliverFrame(bytes);
+  }
+
+ private:
+  RemoteCars& owner_;
+  std::string id_;
+  bool up_ = false;
+};
+
+RemoteCars::RemoteCars(Loop& loop, Fleet& fleet, MqttClient& client)
+    : loop_(loop), fleet_(fleet), client_(client) {
+  std::random_device random;
+  syncTopic_ = "pitwall/sync/" + std::to_string(::getpid()) + "-" + std::to_string(random());
+  client_.subscribe("Anki/Host/+/S/#", 1);
+  client_.subscribe("Anki/Car/+/S/#", 1);
+  client_.subscribe("Anki/Car/+/E/frame", 0);
+  client_.subscribe(syncTopic_, 1);
+  client_.onConnected = [this] {
+    brokerUp_ = true;
+    // After the retained state of the subscriptions above (same client, same QoS: in order).
+    client_.publish(syncTopic_, "{}", 1, false);
+  };
+  client_.onDisconnected = [this](const std::string& reason, bool retrying) {
+    brokerUp_ = false;  // the client has logged why
+    for (auto& [id, car] : cars_)
+      if (car.link) car.link->set(false, "MQTT: " + reason);
+    if (onChange) onChange();
+    if (!retrying && failed_) failed_(reason);
+  };
+  client_.onMessage = [this](std::string_view topic, std::string_view payload, bool) {
+    message(topic, payload);
+  };
+}
+
+RemoteCars::~RemoteCars() {
+  client_.onConnected = nullptr;
+  client_.onDisconnected = nullptr;
+  client_.onMessage = nullptr;
+}
+
+void RemoteCars::start(std::function<void()> synced,
+                       std::function<void(const std::string&)> failed) {
+  synced_ = std::move(synced);
+  failed_ = std::move(failed);
+  client_.connect();
+}
+
+std::size_t RemoteCars::onlineCount() const {
+  std::size_t n = 0;
+  for (const auto& [id, car] : cars_) n += car.link && car.link->connected() ? 1 : 0;
+  return n;
+}
+
+bool RemoteCars::hostUp(const std::string& host) const {
+  auto it = hosts_.find(host);
+  return host.empty() || it == hosts_.end() || it->second;
+}
+
+void RemoteCars::message(std::string_view topic, std::string_view payload) {
+  if (topic == syncTopic_) {
+    if (auto done = std::move(synced_)) {
+      synced_ = nullptr;
+      done();
+    }
+    return;
+  }
+  auto parts = topics::splitTopic(topic);
+  if (!parts) return;
+  auto complain = [&](const std::string& why) {
+    log::warn(kLog, "ignored " + std::string(topic) + ": " + why);
+  };
+  if (parts->kind == topics::TopicParts::Kind::Host) {
+    if (parts->rest == "S/HostStatus") {
+      auto up = topics::readHostStatus(payload);
+      if (!up) return complain(up.error());
+      hosts_[parts->id] = *up;
+      for (auto& [id, car] : cars_)
+        if (car.host == parts->id) update(id, car);
+    } else if (parts->rest == "S/Cars") {
+      auto list = topics::readHostCars(payload);
+      if (!list) return complain(list.error());
+      for (const auto& id : *list) {
+        auto& car = cars_[id];
+        car.host = parts->id;
+      }
+    } else if (parts->rest == "S/IntentError") {
+      // Only errors about intents we might have sent: single-car intents to remote cars.
+      for (const auto& [id, car] : cars_)
+        if (car.link && payload.find("\"Anki/Car/" + id + "/I\"") != std::string_view::npos)
+          log::warn(kLog, "host " + parts->id + " refused an intent: " + std::string(payload));
+    }
+    return;
+  }
+  const std::string& id = parts->id;
+  if (parts->rest == "E/frame") {
+    auto it = cars_.find(id);
+    if (it == cars_.end() || !it->second.link) return;
+    auto bytes = topics::readFrameEvent(payload);
+    if (!bytes) return complain(bytes.error());
+    it->second.link->frame(*bytes);
+  } else if (parts->rest == "S/Information") {
+    auto info = topics::readInformation(id, payload);
+    if (!info) return complain(info.error());
+    auto& car = cars_[id];
+    car.info = *info;
+    update(id, car);
+  } else if (parts->rest == "S/CarStatus") {
+    auto status = topics::readCarStatus(payload);
+    if (!status) return complain(status.error());
+    auto& car = cars_[id];
+    car.online = status->online;
+    update(id, car);
+  }
+}
+
+std::string RemoteCars::uniqueName(const topics::CarInfo& info) const {
+  std::vector<std::string> taken;
+  for (const auto* c : fleet_.cars()) taken.push_back(c->identity().name);
+  if (info.name.empty()) return anki::uniqueCarName(info.model_id, taken);
+  std::string name = info.name;
+  for (int n = 2; std::find(taken.begin(), taken.end(), name) != taken.end(); ++n)
+    name = info.name + std::to_string(n);
+  return name;
+}
+
+void RemoteCars::update(const std::string& id, Car& car) {
+  bool up = brokerUp_ && car.online && car.info && hostUp(car.host);
+  if (!car.link) {
+    if (!up) return;
+    auto link = std::make_unique<RemoteLink>(*this, id);
+    car.link = link.get();
+    CarIdentity identity;
+    identity.name = uniqueName(*car.info);
+    identity.model_id = car.info->model_id;
+    identity.identifier = car.info->identifier;
+    auto& added = fleet_.add(std::move(link), std::move(identity));
+    log::info(kLog, added.label() + " is " + id + (car.host.empty() ? "" : " on host " + car.host));
+  }
+  std::string reason = !car.online         ? "its bridge reports it offline"
+                       : !hostUp(car.host) ? "host " + car.host + " is offline"
+                       : !brokerUp_        ? "lost the MQTT broker"
+                                           : "connected through the MQTT broker";
+  bool was = car.link->connected();
+  car.link->set(up, reason);
+  if (was != up && onChange) onChange();
+}
+
+bool RemoteCars::sendCommand(const std::string& car, std::span<const std::uint8_t> frame) {
+  auto message = anki::decode(frame);
+  if (!message) return false;
+  if (std::holds_alternative<anki::SdkMode>(*message)) return true;
+  auto payload = topics::intentPayload(*message);
+  if (!payload) return false;
+  return client_.publish("Anki/Car/" + car + "/I", *payload, 1, false);
+}
+
+}  // namespace pitwall

@@ -1,0 +1,74 @@
+#pragma once
+// Remote cars (docs/mqtt.md "Remote cars"): the cars that bridges on other hosts publish, put in
+// the local fleet as ordinary AnkiCars. Each has a RemoteLink:
+//
+//  - up while its S/CarStatus says online and its host's S/HostStatus (when known) says true;
+//    down, with the reason, when either turns false or this client loses the broker;
+//  - its frames are the bridge's Anki/Car/<car>/E/frame events, fed to AnkiCar::receive, so the
+//    car's state and its Lua events are exactly those of a local car;
+//  - a command becomes an intent on Anki/Car/<car>/I (topics::intentPayload), QoS 1, which the
+//    owning bridge validates again and executes. sdk-mode is the bridge's business (it keeps its
+//    cars in SDK mode) and is accepted without sending anything.
+//
+// start() subscribes, then publishes a marker to a topic of its own: the broker delivers it after
+// every retained message of the earlier subscriptions, so when it comes back the cars online at
+// that moment are all known.
+#include <functional>
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+
+#include "engine/transport/mqtt_client.hpp"
+#include "engine/vehicles/fleet.hpp"
+#include "engine/vehicles/mqtt_topics.hpp"
+
+namespace pitwall {
+
+class RemoteLink;
+
+class RemoteCars {
+ public:
+  // The client must not be connected yet (its handlers are set here). The loop, the fleet and
+  // the client outlive this object.
+  RemoteCars(Loop& loop, Fleet& fleet, MqttClient& client);
+  ~RemoteCars();
+  RemoteCars(const RemoteCars&) = delete;
+  RemoteCars& operator=(const RemoteCars&) = delete;
+
+  // Connects; synced() once the broker has delivered the retained state, or failed(reason) when
+  // the broker refuses this client.
+  void start(std::function<void()> synced, std::function<void(const std::string&)> failed);
+
+  // Remote cars online now.
+  std::size_t onlineCount() const;
+  // Called whenever a remote car goes up or down.
+  std::function<void()> onChange;
+
+  // Used by RemoteLink.
+  bool sendCommand(const std::string& car, std::span<const std::uint8_t> frame);
+
+ private:
+  struct Car {
+    RemoteLink* link = nullptr;  // owned by the fleet once added
+    std::optional<topics::CarInfo> info;
+    bool online = false;
+    std::string host;  // from the hosts' S/Cars; empty while unknown
+  };
+  void message(std::string_view topic, std::string_view payload);
+  void update(const std::string& id, Car& car);
+  bool hostUp(const std::string& host) const;
+  std::string uniqueName(const topics::CarInfo& info) const;
+
+  Loop& loop_;
+  Fleet& fleet_;
+  MqttClient& client_;
+  std::string syncTopic_;
+  std::map<std::string, Car> cars_;
+  std::map<std::string, bool> hosts_;  // HostStatus as last published
+  bool brokerUp_ = false;
+  std::function<void()> synced_;
+  std::function<void(const std::string&)> failed_;
+};
+
+}  // namespace pitwall
