@@ -237,8 +237,13 @@ int Session::connectRemoteCars(const char* command) {
     return 2;
   }
   if (!synced) {
-    std::cerr << "pitwall " << command << ": no answer from the MQTT broker" << where << " in "
-              << source_.mqttTimeout << " s\n";
+    if (mqtt_->state() == MqttClient::State::Connected)
+      std::cerr << "pitwall " << command << ": the MQTT broker" << where
+                << " did not return pitwall's sync message in " << source_.mqttTimeout
+                << " s (does its access control allow pitwall/sync/#?)\n";
+    else
+      std::cerr << "pitwall " << command << ": no connection to the MQTT broker" << where << " in "
+                << source_.mqttTimeout << " s\n";
     return 2;
   }
   if (!enough()) {

@@ -296,6 +296,27 @@ TEST_CASE("ble: shutdown disconnects every car") {
   CHECK(rig.central->attempts()[kCar1] == attempts);
 }
 
+TEST_CASE("ble: reconnect after shutdown connects every car again (the MQTT connection intent)") {
+  Rig rig(cars(2, 2));
+  REQUIRE(rig.start() == std::nullopt);
+  REQUIRE(rig.waitFor([&] { return rig.fleet.connectedCount() == 2; }));
+  bool down = false;
+  rig.central->shutdown([&] { down = true; });
+  REQUIRE(rig.waitFor([&] { return down && rig.fleet.connectedCount() == 0; }));
+  rig.central->reconnect();
+  CHECK(rig.waitFor([&] { return rig.fleet.connectedCount() == 2; }));
+  CHECK(rig.fake.connected(kCar1));
+  CHECK(rig.fake.connected(kCar2));
+  CHECK(rig.fleet.cars().size() == 2);  // the rescan found the same cars: none added twice
+  // a car already connected is not connected again
+  int attempts = rig.central->attempts()[kCar1];
+  rig.central->reconnect();
+  testing::runFor(rig.loop, 500ms);
+  CHECK(rig.central->attempts()[kCar1] == attempts);
+  CHECK(rig.fleet.connectedCount() == 2);
+  CHECK(rig.fleet.cars().size() == 2);
+}
+
 TEST_CASE("ble: bluetoothd restarting: the cars go down, then are found and connected again") {
   testing::PrivateBus bus;
   Loop loop(ClockKind::Real);
