@@ -208,27 +208,36 @@ int Session::connectRemoteCars(const char* command) {
     return 2;
   }
   remote_ = std::make_unique<RemoteCars>(loop_, fleet_, *mqtt_);
-  bool synced = false;
-  std::optional<std::string> failed;
-  auto enough = [&] {
-    return synced && remote_->onlineCount() >= static_cast<std::size_t>(source_.remoteCars);
+  // The callbacks outlive this wait (a late sync, a refusal on a later reconnection): they share
+  // this state and do nothing once the wait is over.
+  struct Start {
+    bool waiting = true, synced = false;
+    std::optional<std::string> failed;
   };
-  remote_->onChange = [&] {
+  auto start = std::make_shared<Start>();
+  auto enough = [this, start] {
+    return start->synced && remote_->onlineCount() >= static_cast<std::size_t>(source_.remoteCars);
+  };
+  remote_->onChange = [this, enough] {
     if (enough()) loop_.stop();
   };
   remote_->start(
-      [&] {
-        synced = true;
-        if (enough()) loop_.stop();
+      [this, start, enough] {
+        start->synced = true;
+        if (start->waiting && enough()) loop_.stop();
       },
-      [&](const std::string& reason) {
-        failed = reason;
+      [this, start](const std::string& reason) {
+        if (!start->waiting) return;
+        start->failed = reason;
         loop_.stop();
       });
   auto timeout = loop_.after(fromSeconds(source_.mqttTimeout), [this] { loop_.stop(); });
   loop_.run();
   loop_.cancel(timeout);
+  start->waiting = false;
   remote_->onChange = nullptr;
+  const bool synced = start->synced;
+  const auto& failed = start->failed;
   if (interrupted_) return 130;
   std::string where = " (" + source_.mqtt.url + ")";
   if (failed) {
