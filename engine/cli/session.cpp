@@ -343,11 +343,20 @@ void Session::finish() {
   loop_.after(kFlush, [this] {
     auto done = [this] {
       if (!mqtt_) return loop_.stop();
+      auto disconnect = [this] {
+        mqtt_->disconnect();
+        loop_.after(kFlush, [this] { loop_.stop(); });
+      };
+      if (!bridge_) return disconnect();
       // A clean goodbye: the bridge says its cars and itself are offline (the broker drops the
-      // will on DISCONNECT), then the client disconnects.
-      if (bridge_) bridge_->goOffline();
-      mqtt_->disconnect();
-      loop_.after(kFlush, [this] { loop_.stop(); });
+      // will on DISCONNECT), then the client disconnects. The goodbye is QoS 1 and DISCONNECT
+      // closes the socket: it goes kFlush later, once the broker's PUBACKs are back, and the
+      // bridge is gone meanwhile so that nothing else is published. (A broker whose PUBACK
+      // meets a closed socket drops the connection with the rest of the goodbye unread and
+      // publishes the will: mosquitto 2.0 logs "disconnected due to out of memory".)
+      bridge_->goOffline();
+      bridge_.reset();
+      loop_.after(kFlush, disconnect);
     };
     if (!central_) return done();
     central_->shutdown(done);

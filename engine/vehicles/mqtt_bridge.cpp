@@ -77,7 +77,13 @@ topics::Millis MqttBridge::now() {
 
 std::string MqttBridge::carIdOf(const AnkiCar& car) const {
   auto it = ids_.find(&car);
-  return it == ids_.end() ? topics::carId(const_cast<AnkiCar&>(car).link().address()) : it->second;
+  if (it != ids_.end()) return it->second;
+  // A simulated car's identifier is the same in every pitwall process (the grid numbers them
+  // from a fixed base): the host id keeps the cars of two simulated bridges apart. A BLE
+  // address is unique as it is.
+  std::string address = const_cast<AnkiCar&>(car).link().address();
+  std::string id = topics::carId(address);
+  return address.starts_with("sim:") ? host_ + "-" + id : id;
 }
 
 void MqttBridge::emit(const topics::Publication& p) {
@@ -103,6 +109,8 @@ void MqttBridge::connected() {
   send(online);
   for (const auto& [topic, p] : retained_)
     if (topic != online.topic) send(p);
+  for (const auto& p : undelivered_) emit(p);
+  undelivered_.clear();
   log::info(kLog, "publishing as host " + host_ + (options_.readOnly ? " (read-only)" : ""));
 }
 
@@ -115,7 +123,7 @@ std::vector<std::string> MqttBridge::ownCars() const {
 
 void MqttBridge::joined(AnkiCar& car) {
   if (ids_.count(&car)) return;
-  std::string id = topics::carId(car.link().address());
+  std::string id = carIdOf(car);
   ids_[&car] = id;
   topics::CarInfo info;
   info.id = id;
@@ -125,7 +133,13 @@ void MqttBridge::joined(AnkiCar& car) {
   info.identifier = car.identity().identifier;
   info.model_id = car.identity().model_id;
   auto t = now();
-  emit(topics::carDiscovered(host_, id, t));
+  // An event, but the one a dashboard needs to learn of a car: one that happens before the first
+  // connection to the broker waits for it (there is one per car at most).
+  auto discovered = topics::carDiscovered(host_, id, t);
+  if (client_.state() == MqttClient::State::Connected)
+    emit(discovered);
+  else
+    undelivered_.push_back(std::move(discovered));
   emit(topics::carJoined(info, car.state(), t));
   publishCars();
 }
@@ -196,10 +210,12 @@ void MqttBridge::message(std::string_view topic, std::string_view payload, bool 
     if (!std::binary_search(own.begin(), own.end(), parts->id) && ownedElsewhere(parts->id))
       return;  // another bridge's car: its bridge answers
   }
+  if (payload.empty()) return;  // how MQTT clears a retained message: nothing to execute
   if (retained)
     return reject(t,
                   "retained intents are not executed (a retained command would run again on "
-                  "every reconnection); publish the intent without the retain flag");
+                  "every reconnection); publish the intent without the retain flag, and clear the "
+                  "stored one with an empty retained message");
   auto own = ownCars();
   auto intent = topics::parseIntent(host_, topic, payload, own);
   if (!intent) return reject(t, intent.error().message);
@@ -230,6 +246,12 @@ AnkiCar::Sent MqttBridge::apply(AnkiCar& car, const topics::Action& action) {
             if (std::holds_alternative<anki::Disconnect>(a.message)) return car.disconnect();
             if (auto* s = std::get_if<anki::SetSpeed>(&a.message))
               return car.setSpeed(s->speed_mm_s, s->accel_mm_s2, s->respect_limit);
+            // Through the commands that keep the car's state in step (a remote car's setOffset
+            // and cancelLaneChange arrive here), not the bare send().
+            if (auto* o = std::get_if<anki::SetOffset>(&a.message))
+              return car.setOffset(o->offset_mm);
+            if (std::holds_alternative<anki::CancelLaneChange>(a.message))
+              return car.cancelLaneChange();
             return car.send(a.message);
           },
           [&](const ConnectIntent&) -> AnkiCar::Sent { return true; },

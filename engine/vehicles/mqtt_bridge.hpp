@@ -54,6 +54,8 @@ class MqttBridge {
   void goOffline();
 
   const std::string& host() const { return host_; }
+  // The car's <car> in the tree: topics::carId of its address; for a simulated car prefixed with
+  // the host id ("pit1-sim-51a00001").
   std::string carIdOf(const AnkiCar& car) const;
 
   struct Stats {
@@ -94,6 +96,7 @@ class MqttBridge {
   std::map<const AnkiCar*, std::string> ids_;            // cars that joined, by their topic id
   std::map<std::string, topics::Publication> retained_;  // last retained publication per topic
   std::vector<std::string> lastCars_;
+  std::vector<topics::Publication> undelivered_;  // CarDiscovered before the first connection
   bool haveCars_ = false;
   // What the other bridges said: their cars, while they are online.
   std::map<std::string, std::vector<std::string>> otherCars_;

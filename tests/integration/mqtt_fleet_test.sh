@@ -1,0 +1,80 @@
+# A fleet across two pitwall processes and one private mosquitto (docs/mqtt.md): host A bridges
+# two simulated cars, host B runs a race with them as remote cars (--cars 0 --remote-cars 2), then
+# a mixed race with one local car besides. The race finishes with results for every car, host A's
+# cars really drove (their own S/Speed/Actual on the tree), and they are stopped after each run.
+source "$(dirname "$0")/mqtt_lib.sh"
+
+count() { grep -cE -- "$2" "$1" 2>/dev/null || true; }
+ALL="$TMP/all.sub"
+RACE="$SRC/tests/integration/mqtt_race.lua"
+
+# wait_last CAR TOPIC VALUE [SECONDS]: until the last CAR/TOPIC message seen has "value":VALUE.
+wait_last() {
+  local deadline=$((SECONDS + ${4:-5}))
+  until [[ "$(last_value "$ALL" "Anki/Car/$1/$2")" == *"\"value\":$3}" ]]; do
+    [ $SECONDS -ge $deadline ] && return 1
+    sleep 0.02
+  done
+}
+
+# after_run NAME: what every run must leave behind: host A's cars stopped, online, no error.
+after_run() {
+  local c
+  for c in "${CARS[@]}"; do
+    wait_last "$c" S/Speed/Desired 0 && echo "ok: $1: $c was stopped at the end (S/Speed/Desired 0)" ||
+      fail "$1: last S/Speed/Desired of $c: $(last_value "$ALL" "Anki/Car/$c/S/Speed/Desired")"
+    wait_last "$c" S/Speed/Actual 0 10 && echo "ok: $1: $c came to a halt (S/Speed/Actual 0)" ||
+      fail "$1: last S/Speed/Actual of $c: $(last_value "$ALL" "Anki/Car/$c/S/Speed/Actual")"
+  done
+  check "$1: no intent of host B was refused" 0 "$(count "$ALL" '^Anki/Host/hostA/S/IntentError ')"
+  kill -0 "$BRIDGE" 2>/dev/null && echo "ok: $1: host A's bridge still runs" || fail "$1: the bridge exited"
+}
+
+broker_config anonymous
+start_broker
+subscribe all 'Anki/#'
+spawn bridge $PITWALL bridge --mqtt "$MQTT_URL" --host-id hostA --cars 2
+BRIDGE=$LAST_PID
+wait_for "$TMP/bridge.err" "bridging 2 cars as host hostA" ||
+  { fail "host A's bridge did not start: $(cat "$TMP/bridge.err")"; finish; }
+wait_for "$ALL" '^Anki/Host/hostA/S/Cars .*"value":\["hostA-sim-[0-9a-f]+","hostA-sim-[0-9a-f]+"\]' 5 ||
+  { fail "no S/Cars from host A"; finish; }
+CARS=($(grep -m1 '^Anki/Host/hostA/S/Cars ' "$ALL" | grep -oE 'hostA-sim-[0-9a-f]+'))
+
+# ---- host B: a race with host A's two cars ----
+LAPS=1 timeout 60 $PITWALL run "$RACE" --cars 0 --mqtt "$MQTT_URL" --remote-cars 2 \
+  >"$TMP/race.out" 2>"$TMP/race.err"
+check "remote race: exit status" 0 "$?"
+out=$(cat "$TMP/race.out")
+contains "remote race: two remote cars" "Race: 2 cars" "$out"
+contains "remote race: the remote cars are named" "2 remote cars through $MQTT_URL" "$(cat "$TMP/race.err")"
+check "remote race: both cars finished the lap" 2 "$(grep -cE '^result [12] .* laps=1 finished=true' <<<"$out")"
+contains "remote race: the results table" "POS  CAR" "$out"
+contains "remote race: a winner" "Winner: " "$out"
+for c in "${CARS[@]}"; do
+  grep -qE "^Anki/Car/$c/S/Speed/Actual .*\"value\":[1-9][0-9]*}" "$ALL" &&
+    echo "ok: remote race: host A's $c drove (S/Speed/Actual > 0)" || fail "remote race: $c never moved"
+  grep -qE "^Anki/Car/$c/E/track_piece_id " "$ALL" &&
+    echo "ok: remote race: $c published its pieces" || fail "remote race: no E/track_piece_id for $c"
+  grep -qE "^Anki/Car/$c/I \{\"type\":\"(speed|message)\"" "$ALL" &&
+    echo "ok: remote race: host B drove $c through intents" || fail "remote race: no intent for $c"
+done
+after_run "remote race"
+
+# ---- host B: a mixed race, one local simulated car and host A's two ----
+moved_before=$(count "$ALL" "^Anki/Car/${CARS[0]}/S/Speed/Actual .*\"value\":[1-9]")
+LAPS=1 timeout 60 $PITWALL run "$RACE" --cars 1 --mqtt "$MQTT_URL" --remote-cars 2 \
+  >"$TMP/mixed.out" 2>"$TMP/mixed.err"
+check "mixed race: exit status" 0 "$?"
+out=$(cat "$TMP/mixed.out")
+contains "mixed race: three cars" "Race: 3 cars" "$out"
+check "mixed race: every car finished the lap" 3 "$(grep -cE '^result [123] .* laps=1 finished=true' <<<"$out")"
+contains "mixed race: a winner" "Winner: " "$out"
+[ "$(count "$ALL" "^Anki/Car/${CARS[0]}/S/Speed/Actual .*\"value\":[1-9]")" -gt "$moved_before" ] &&
+  echo "ok: mixed race: host A's cars drove again" || fail "mixed race: host A's car did not move"
+after_run "mixed race"
+
+kill -TERM "$BRIDGE"
+wait "$BRIDGE"
+check "host A's bridge ends on SIGTERM" 130 "$?"
+finish

@@ -1,0 +1,353 @@
+// RemoteCars against a real mosquitto broker: host A bridges two simulated cars (MqttBridge);
+// host B, on the same real-clock loop, sees them as AnkiCars of its own fleet and drives them
+// through intents.
+#include "engine/vehicles/mqtt_remote.hpp"
+
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "engine/core/log.hpp"
+#include "engine/protocol/anki/codec.hpp"
+#include "engine/sim/grid.hpp"
+#include "engine/sim/track.hpp"
+#include "engine/sim/world.hpp"
+#include "engine/vehicles/mqtt_bridge.hpp"
+#include "tests/support/mosquitto_broker.hpp"
+#include "tests/support/run_until.hpp"
+
+using namespace pitwall;
+using namespace std::chrono_literals;
+using pitwall::testing::MosquittoBroker;
+using pitwall::testing::runUntil;
+
+namespace {
+
+const std::string kHost = "hostA";
+
+// Host A: two simulated cars published by a bridge; every command its cars are sent, recorded.
+struct BridgedHost {
+  Loop& loop;
+  const MosquittoBroker& broker;
+  sim::World world;
+  Fleet fleet;
+  std::vector<std::pair<AnkiCar*, anki::Message>> tx;
+  std::unique_ptr<MqttClient> client;
+  std::unique_ptr<MqttBridge> bridge;
+
+  BridgedHost(Loop& l, const MosquittoBroker& b)
+      : loop(l), broker(b), world(l, *sim::loadLayout("oval"), 11), fleet(l) {
+    for (int i = 0; i < 2; ++i) fleet.addSimulated(world, sim::gridSpec(world.track(), i));
+    fleet.onFrame = [this](AnkiCar& car, AnkiCar::Direction d, std::span<const std::uint8_t>,
+                           const anki::Message& m) {
+      if (d == AnkiCar::Direction::Tx) tx.emplace_back(&car, m);
+    };
+    REQUIRE(runUntil(loop, [&] { return fleet.connectedCount() == 2; }));
+    startBridge();
+  }
+
+  // A fresh client and bridge (the first, or after the previous one went away).
+  void startBridge() {
+    bridge.reset();
+    client.reset();
+    auto options = MqttOptions::fromUrl(broker.url());
+    options.will = MqttBridge::will(kHost);
+    client = std::make_unique<MqttClient>(loop, options);
+    bridge = std::make_unique<MqttBridge>(loop, fleet, *client, BridgeOptions{kHost, false},
+                                          CarConnections{});
+    client->connect();
+    REQUIRE(runUntil(loop, [&] { return client->state() == MqttClient::State::Connected; }));
+  }
+  // The process dies: no DISCONNECT, the broker sends the will.
+  void crash() {
+    bridge.reset();
+    client.reset();
+  }
+
+  AnkiCar& car(int i) { return *fleet.cars().at(i); }
+  sim::SimCar& simCar(int i) { return *world.cars().at(i); }
+  AnkiCar* byName(const std::string& name) {
+    for (auto* c : fleet.cars())
+      if (c->identity().name == name) return c;
+    return nullptr;
+  }
+};
+
+// Host B: remote cars only.
+struct RemoteHost {
+  Fleet fleet;
+  MqttClient client;
+  RemoteCars remote;
+  bool synced = false;
+  std::optional<std::string> failed;
+  std::vector<std::pair<std::string, std::string>> downs;  // car name, reason
+  int changes = 0;
+
+  RemoteHost(Loop& loop, const MosquittoBroker& broker)
+      : fleet(loop), client(loop, MqttOptions::fromUrl(broker.url())), remote(loop, fleet, client) {
+    fleet.onConnectionChange = [this](AnkiCar& car, bool up, const std::string& reason) {
+      if (!up) downs.emplace_back(car.identity().name, reason);
+    };
+    remote.onChange = [this] { ++changes; };
+    remote.start([this] { synced = true; }, [this](const std::string& r) { failed = r; });
+  }
+  AnkiCar& car(int i) { return *fleet.cars().at(i); }
+};
+
+// A and B, with B's two remote cars online.
+struct Pair {
+  MosquittoBroker broker;
+  Loop loop{ClockKind::Real};
+  BridgedHost a{loop, broker};
+  RemoteHost b{loop, broker};
+
+  Pair() {
+    REQUIRE(runUntil(loop, [&] { return b.synced && b.remote.onlineCount() == 2; }));
+    REQUIRE(b.fleet.cars().size() == 2);
+  }
+  // A's car behind B's car i.
+  AnkiCar& aOf(int i) {
+    auto* c = a.byName(b.car(i).identity().name);
+    REQUIRE(c);
+    return *c;
+  }
+  // Sends a command on B's car i; true once A's car behind it has been sent `expected`. (B's
+  // cars also ask for the version and battery whenever they connect: those intents may arrive
+  // in between.)
+  bool reaches(int i, const std::function<AnkiCar::Sent(AnkiCar&)>& command,
+               const anki::Message& expected) {
+    AnkiCar* target = &aOf(i);
+    std::size_t before = a.tx.size();
+    auto sent = command(b.car(i));
+    if (!sent.ok()) FAIL(sent.error());
+    bool arrived = runUntil(loop, [&] {
+      for (std::size_t n = before; n < a.tx.size(); ++n)
+        if (a.tx[n].first == target && a.tx[n].second == expected) return true;
+      return false;
+    });
+    if (!arrived) {
+      std::string seen;
+      for (std::size_t n = before; n < a.tx.size(); ++n)
+        seen += std::string(a.tx[n].first == target ? "" : "(other car) ") +
+                std::string(anki::name(a.tx[n].second)) + " ";
+      INFO("A's cars were sent: ", seen);
+      CHECK_MESSAGE(false, "expected ", anki::name(expected));
+    }
+    return arrived;
+  }
+  // SDK mode stays the bridge's business: A's car was sent it once, when it connected to A.
+  std::size_t sdkModesSent(int i) {
+    std::size_t n = 0;
+    for (const auto& [car, m] : a.tx)
+      n += car == &aOf(i) && std::holds_alternative<anki::SdkMode>(m);
+    return n;
+  }
+  bool allUp() const {
+    return std::all_of(b.fleet.cars().begin(), b.fleet.cars().end(),
+                       [](const AnkiCar* c) { return c->state().connected; });
+  }
+  bool allDown() const {
+    return std::none_of(b.fleet.cars().begin(), b.fleet.cars().end(),
+                        [](const AnkiCar* c) { return c->state().connected; });
+  }
+};
+
+}  // namespace
+
+TEST_CASE("mqtt remote: another host's cars join as connected cars that follow the real ones") {
+  Pair p;
+  std::vector<std::string> aNames, bNames;
+  for (int i = 0; i < 2; ++i) {
+    CAPTURE(i);
+    AnkiCar& remote = p.b.car(i);
+    CHECK(remote.state().connected);
+    bNames.push_back(remote.identity().name);
+    aNames.push_back(p.a.car(i).identity().name);
+    AnkiCar& real = p.aOf(i);
+    CHECK(remote.identity().model_id == real.identity().model_id);
+    CHECK(remote.identity().identifier == real.identity().identifier);
+    CHECK(remote.link().address() == "mqtt:" + p.a.bridge->carIdOf(real));
+  }
+  std::sort(aNames.begin(), aNames.end());
+  std::sort(bNames.begin(), bNames.end());
+  CHECK(aNames == bNames);
+  CHECK(p.b.failed == std::nullopt);
+
+  // B drives its car; A's car drives; A's frames come back as B's car's messages.
+  int positions = 0;
+  p.b.car(0).onMessage = [&](const anki::Message& m) {
+    positions += std::holds_alternative<anki::PositionUpdate>(m) ? 1 : 0;
+  };
+  REQUIRE(p.reaches(
+      0, [](AnkiCar& c) { return c.setSpeed(600, 1000); }, anki::SetSpeed{600, 1000, false}));
+  AnkiCar& real = p.aOf(0);
+  CHECK(real.state().target_speed_mm_s == 600);
+  REQUIRE(runUntil(p.loop, [&] { return positions >= 3 && p.b.car(0).state().speed_mm_s > 0; }));
+  CHECK(p.a.simCar(0).truth().speed_mm_s > 0);
+  REQUIRE(runUntil(p.loop, [&] {
+    return p.b.car(0).state().piece >= 0 && p.b.car(0).state().piece == real.state().piece &&
+           p.b.car(0).state().location == real.state().location;
+  }));
+  CHECK(p.b.car(0).state().frames_in > 0);
+  CHECK(p.b.car(1).state().speed_mm_s == 0);
+}
+
+TEST_CASE("mqtt remote: every command on a remote car reaches the real car as the same message") {
+  Pair p;
+  auto check = [&](const std::function<AnkiCar::Sent(AnkiCar&)>& command,
+                   const anki::Message& expected) { CHECK(p.reaches(0, command, expected)); };
+  check([](AnkiCar& c) { return c.setSpeed(500); }, anki::SetSpeed{500, kDefaultAccel, false});
+  // respect_limit has no key in the seed's speed intent: it travels as a frame
+  check([](AnkiCar& c) { return c.setSpeed(550, 800, true); }, anki::SetSpeed{550, 800, true});
+  check([](AnkiCar& c) { return c.changeLane(23, 250, 2000); },
+        anki::ChangeLane{250, 2000, 23.0f, 0, 0});
+  check([](AnkiCar& c) { return c.changeLane(-23.5); },
+        anki::ChangeLane{kDefaultLaneSpeed, kDefaultLaneAccel, -23.5f, 0, 0});
+  check([](AnkiCar& c) { return c.cancelLaneChange(); }, anki::CancelLaneChange{});
+  check([](AnkiCar& c) { return c.setOffset(-68); }, anki::SetOffset{-68});
+  CHECK(p.aOf(0).state().offset_mm == -68);  // the real car's belief is re-based too
+  check([](AnkiCar& c) { return c.turn(anki::TurnType::UTurn, anki::TurnTrigger::Immediate); },
+        anki::Turn{anki::TurnType::UTurn, anki::TurnTrigger::Immediate});
+  check([](AnkiCar& c) { return c.lights(0x44); }, anki::SetLights{0x44});
+  anki::LightsPattern pattern;
+  pattern.channel_count = 1;
+  pattern.channels[0] = anki::LightChannel{3, 2, 0, 14, 10};
+  check([&](AnkiCar& c) { return c.lightsPattern(pattern); }, pattern);
+
+  check([](AnkiCar& c) { return c.ping(); }, anki::PingRequest{});
+  REQUIRE(runUntil(p.loop, [&] { return p.b.car(0).lastPingRtt().has_value(); }));
+  CHECK(*p.b.car(0).lastPingRtt() > 0);
+
+  check([](AnkiCar& c) { return c.requestBattery(); }, anki::BatteryRequest{});
+  REQUIRE(runUntil(p.loop, [&] { return p.b.car(0).state().battery_mv > 0; }));
+  CHECK(p.b.car(0).state().battery_mv == p.aOf(0).state().battery_mv);
+
+  check([](AnkiCar& c) { return c.requestVersion(); }, anki::VersionRequest{});
+  REQUIRE(runUntil(p.loop, [&] { return p.b.car(0).state().version > 0; }));
+  CHECK(p.b.car(0).state().version == p.aOf(0).state().version);
+
+  // SDK mode is accepted and nothing is sent (B's cars also asked for it when they connected).
+  CHECK(p.b.car(0).sdkMode(true).ok());
+  check([](AnkiCar& c) { return c.stop(); }, anki::SetSpeed{0, kStopAccel, false});
+  CHECK(p.sdkModesSent(0) == 1);
+  CHECK(p.sdkModesSent(1) == 1);
+  // Nothing of the above went to the other car.
+  for (const auto& [car, m] : p.a.tx)
+    if (car == &p.aOf(1))
+      CHECK((std::holds_alternative<anki::SdkMode>(m) ||
+             std::holds_alternative<anki::VersionRequest>(m) ||
+             std::holds_alternative<anki::BatteryRequest>(m)));
+}
+
+TEST_CASE("mqtt remote: the cars of a host that goes offline disconnect, and come back with it") {
+  Pair p;
+  SUBCASE("the bridge goes offline cleanly") {
+    p.a.bridge->goOffline();
+    REQUIRE(runUntil(p.loop, [&] { return p.allDown(); }));
+    REQUIRE(p.b.downs.size() == 2);
+    for (const auto& [name, reason] : p.b.downs) {
+      CAPTURE(name);
+      bool said = reason.find("offline") != std::string::npos;
+      CHECK_MESSAGE(said, reason);
+    }
+    p.a.client->disconnect();
+  }
+  SUBCASE("the bridge's process dies: its will") {
+    p.a.crash();
+    REQUIRE(runUntil(p.loop, [&] { return p.allDown(); }));
+    REQUIRE(p.b.downs.size() == 2);
+    for (const auto& [name, reason] : p.b.downs) {
+      CAPTURE(name);
+      CHECK(reason == "host " + kHost + " is offline");
+    }
+  }
+  CHECK(p.b.remote.onlineCount() == 0);
+  CHECK(p.b.fleet.cars().size() == 2);
+  // Commands to a car that is down are refused here, not sent.
+  CHECK_FALSE(p.b.car(0).setSpeed(300).ok());
+
+  p.a.startBridge();
+  REQUIRE(runUntil(p.loop, [&] { return p.allUp(); }));
+  CHECK(p.b.fleet.cars().size() == 2);  // the same cars, not new ones
+  CHECK(p.b.remote.onlineCount() == 2);
+  CHECK(p.reaches(
+      1, [](AnkiCar& c) { return c.setSpeed(300); }, anki::SetSpeed{300, kDefaultAccel, false}));
+}
+
+TEST_CASE("mqtt remote: losing the broker disconnects the remote cars until it is back") {
+  Pair p;
+  int changes = p.b.changes;
+  p.broker.stop();
+  REQUIRE(runUntil(p.loop, [&] { return p.allDown(); }));
+  CHECK(p.b.changes > changes);
+  REQUIRE(p.b.downs.size() == 2);
+  // Why depends on what reaches B first: its own loss of the broker, or A's will, which
+  // mosquitto publishes as it shuts down.
+  for (const auto& [name, reason] : p.b.downs) {
+    CAPTURE(reason);
+    CHECK((reason.starts_with("MQTT: ") || reason == "host " + kHost + " is offline"));
+  }
+  CHECK(p.b.failed == std::nullopt);  // a lost broker is retried, not a failure
+  p.broker.start();
+  REQUIRE(runUntil(
+      p.loop, [&] { return p.allUp(); }, 4s));
+  CHECK(p.b.fleet.cars().size() == 2);
+  CHECK(p.reaches(
+      0, [](AnkiCar& c) { return c.setSpeed(400); }, anki::SetSpeed{400, kDefaultAccel, false}));
+  REQUIRE(runUntil(p.loop, [&] { return p.b.car(0).state().speed_mm_s > 0; }));
+}
+
+TEST_CASE("mqtt remote: malformed status and frames on the tree are ignored with a warning") {
+  Pair p;
+  std::vector<std::string> warnings;
+  log::setSink([&](log::Level level, std::string_view line) {
+    if (level == log::Level::Warn) warnings.emplace_back(line);
+  });
+  struct Restore {
+    ~Restore() { log::setSink(nullptr); }
+  } restore;
+
+  MqttClient vandal(p.loop, MqttOptions::fromUrl(p.broker.url()));
+  bool connected = false;
+  vandal.onConnected = [&] { connected = true; };
+  vandal.connect();
+  REQUIRE(runUntil(p.loop, [&] { return connected; }));
+  std::string id = p.a.bridge->carIdOf(p.aOf(0));
+  std::string car = "Anki/Car/" + id;
+  std::uint64_t malformed = p.b.car(0).state().malformed;
+
+  REQUIRE(vandal.publish(car + "/S/CarStatus", "not json", 1));
+  REQUIRE(vandal.publish(car + "/E/frame", R"({"timestamp":1,"value":"zz"})", 0));
+  REQUIRE(vandal.publish(car + "/S/Information", "[]", 1));
+  REQUIRE(vandal.publish("Anki/Car/stranger/S/Information", "{}", 1));
+  REQUIRE(vandal.publish("Anki/Host/" + kHost + "/S/HostStatus", "yes", 1));
+  REQUIRE(vandal.publish("Anki/Host/" + kHost + "/S/Cars", R"({"value":5})", 1));
+  // well-formed hex, but no vehicle message: the car itself reports it as malformed
+  REQUIRE(vandal.publish(car + "/E/frame", R"({"timestamp":1,"value":"05ff"})", 0));
+  auto ignored = [&](const std::string& topic) {
+    return std::any_of(warnings.begin(), warnings.end(), [&](const std::string& w) {
+      return w.find("ignored " + topic) != std::string::npos;
+    });
+  };
+  REQUIRE(runUntil(p.loop, [&] {
+    return ignored(car + "/S/CarStatus") && ignored(car + "/E/frame") &&
+           ignored(car + "/S/Information") && ignored("Anki/Car/stranger/S/Information") &&
+           ignored("Anki/Host/" + kHost + "/S/HostStatus") &&
+           ignored("Anki/Host/" + kHost + "/S/Cars") &&
+           p.b.car(0).state().malformed == malformed + 1;
+  }));
+
+  // Nothing broke: the same two cars, online, driven as before.
+  CHECK(p.b.fleet.cars().size() == 2);
+  CHECK(p.allUp());
+  CHECK(p.b.remote.onlineCount() == 2);
+  CHECK(p.reaches(
+      0, [](AnkiCar& c) { return c.setSpeed(450); }, anki::SetSpeed{450, kDefaultAccel, false}));
+  REQUIRE(runUntil(p.loop, [&] { return p.b.car(0).state().speed_mm_s > 0; }));
+}
