@@ -347,16 +347,15 @@ void Session::finish() {
         mqtt_->disconnect();
         loop_.after(kFlush, [this] { loop_.stop(); });
       };
-      if (!bridge_) return disconnect();
+      if (!bridge_) return mqtt_->whenDelivered(disconnect);
       // A clean goodbye: the bridge says its cars and itself are offline (the broker drops the
-      // will on DISCONNECT), then the client disconnects. The goodbye is QoS 1 and DISCONNECT
-      // closes the socket: it goes kFlush later, once the broker's PUBACKs are back, and the
-      // bridge is gone meanwhile so that nothing else is published. (A broker whose PUBACK
-      // meets a closed socket drops the connection with the rest of the goodbye unread and
-      // publishes the will: mosquitto 2.0 logs "disconnected due to out of memory".)
+      // will on DISCONNECT), and is gone so that nothing else is published; DISCONNECT follows
+      // once the broker has acknowledged the goodbye (QoS 1). A broker whose PUBACK meets a
+      // closed socket drops the rest of the goodbye and publishes the will (mosquitto 2.0 logs
+      // "disconnected due to out of memory").
       bridge_->goOffline();
       bridge_.reset();
-      loop_.after(kFlush, disconnect);
+      mqtt_->whenDelivered(disconnect);
     };
     if (!central_) return done();
     central_->shutdown(done);

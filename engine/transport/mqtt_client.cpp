@@ -143,6 +143,7 @@ MqttClient::MqttClient(Loop& loop, MqttOptions options)
   mosquitto_disconnect_callback_set(mosq_, &MqttClient::handleDisconnect);
   mosquitto_message_callback_set(mosq_, &MqttClient::handleMessage);
   mosquitto_log_callback_set(mosq_, &MqttClient::handleLog);
+  mosquitto_publish_callback_set(mosq_, &MqttClient::handlePublish);
   auto check = [&](int rc, const char* what) {
     if (rc == MOSQ_ERR_SUCCESS) return;
     std::string message = std::string("MQTT: ") + what + ": " + mosquitto_strerror(rc);
@@ -170,6 +171,7 @@ MqttClient::~MqttClient() {
   *alive_ = false;
   for (auto* t : {&miscTimer_, &retryTimer_, &attemptTimer_})
     if (*t) loop_.cancel(*t);
+  for (auto& w : deliveryWaiters_) loop_.cancel(w->timer);
   detachSocket();
   mosquitto_destroy(mosq_);  // closes the socket without DISCONNECT
 }
@@ -338,6 +340,8 @@ void MqttClient::report(const std::string& reason, bool retrying) {
 void MqttClient::lost(const std::string& reason) {
   if (attemptTimer_) loop_.cancel(attemptTimer_), attemptTimer_ = 0;
   state_ = State::WaitingToReconnect;
+  unacknowledged_.clear();
+  settleDeliveries();
   report(reason, true);
   std::weak_ptr<bool> alive = alive_;
   if (retryTimer_) loop_.cancel(retryTimer_);
@@ -369,8 +373,10 @@ bool MqttClient::publish(std::string_view topic, std::string_view payload, int q
                                 std::to_string(payload.size()) + " bytes is too large");
   if (state_ != State::Connected) return false;
   std::string t(topic);
-  int rc = mosquitto_publish(mosq_, nullptr, t.c_str(), static_cast<int>(payload.size()),
+  int mid = 0;
+  int rc = mosquitto_publish(mosq_, &mid, t.c_str(), static_cast<int>(payload.size()),
                              payload.data(), qos, retain);
+  if (rc == MOSQ_ERR_SUCCESS && qos > 0) unacknowledged_.insert(mid);
   service();
   return rc == MOSQ_ERR_SUCCESS;
 }
@@ -419,6 +425,8 @@ void MqttClient::handleDisconnect(mosquitto*, void* self, int rc) {
   // others); the descriptor is released, never closed by Asio, and on one thread the number
   // cannot be reused in between.
   c.detachSocket();
+  c.unacknowledged_.clear();  // a clean session: they will never be acknowledged now
+  c.settleDeliveries();
   if (c.state_ == State::Disconnected) {
     c.report("disconnected from the MQTT broker at " + c.where() + " on request", false);
     return;
@@ -428,6 +436,41 @@ void MqttClient::handleDisconnect(mosquitto*, void* self, int rc) {
   c.lost((c.wasConnected_ ? "lost the connection to the MQTT broker at "
                           : "cannot connect to the MQTT broker at ") +
          c.where() + ": " + why);
+}
+
+void MqttClient::handlePublish(mosquitto*, void* self, int mid) {
+  auto& c = *static_cast<MqttClient*>(self);
+  c.unacknowledged_.erase(mid);
+  c.settleDeliveries();
+}
+
+void MqttClient::whenDelivered(std::function<void()> done, Duration limit) {
+  auto waiter = std::make_shared<DeliveryWaiter>();
+  waiter->done = std::move(done);
+  std::weak_ptr<bool> alive = alive_;
+  waiter->timer = loop_.after(limit, [this, alive, w = std::weak_ptr<DeliveryWaiter>(waiter)] {
+    auto waiter = w.lock();
+    if (alive.expired() || !waiter) return;
+    waiter->timer = 0;
+    std::erase(deliveryWaiters_, waiter);
+    if (waiter->done) waiter->done();
+  });
+  deliveryWaiters_.push_back(std::move(waiter));
+  // Called from the loop, never from inside the caller's own call.
+  loop_.post([this, alive] {
+    if (!alive.expired()) settleDeliveries();
+  });
+}
+
+void MqttClient::settleDeliveries() {
+  if ((!unacknowledged_.empty() && state_ == State::Connected) || deliveryWaiters_.empty()) return;
+  auto waiters = std::move(deliveryWaiters_);
+  deliveryWaiters_.clear();
+  for (auto& w : waiters) {
+    loop_.cancel(w->timer);
+    w->timer = 0;
+    if (w->done) w->done();
+  }
 }
 
 void MqttClient::handleMessage(mosquitto*, void* self, const mosquitto_message* m) {

@@ -12,8 +12,10 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "engine/core/loop.hpp"
 #include "engine/core/result.hpp"
@@ -79,6 +81,12 @@ class MqttClient {
   // Throws std::invalid_argument for a bad topic or QoS. Returns false (nothing queued) when not
   // connected.
   bool publish(std::string_view topic, std::string_view payload, int qos = 0, bool retain = false);
+  // Calls done() on the loop once every QoS 1/2 message published so far on this connection is
+  // acknowledged by the broker, the connection is gone (they never will be), or `limit` passed.
+  // A clean goodbye publishes, waits for this, then disconnect()s: a broker whose PUBACK meets
+  // a closed socket drops the rest of what was sent.
+  void whenDelivered(std::function<void()> done, Duration limit = std::chrono::seconds(2));
+
   // Remembered and (re)sent on every connection. Throws std::invalid_argument for a bad pattern.
   void subscribe(std::string_view pattern, int qos = 0);
 
@@ -90,6 +98,8 @@ class MqttClient {
   static void handleDisconnect(mosquitto*, void* self, int rc);
   static void handleMessage(mosquitto*, void* self, const mosquitto_message* message);
   static void handleLog(mosquitto*, void* self, int level, const char* text);
+  static void handlePublish(mosquitto*, void* self, int mid);
+  void settleDeliveries();  // calls the delivery waiters when nothing is unacknowledged
 
   void startAttempt(bool first);
   void attachSocket();
@@ -118,6 +128,12 @@ class MqttClient {
   Duration backoff_ = std::chrono::milliseconds(500);
   std::string lastReported_, lastLogError_;
   std::map<std::string, int> subscriptions_;
+  std::set<int> unacknowledged_;  // message ids of QoS 1/2 publications awaiting the broker
+  struct DeliveryWaiter {
+    std::function<void()> done;
+    Loop::TimerId timer = 0;
+  };
+  std::vector<std::shared_ptr<DeliveryWaiter>> deliveryWaiters_;
   Loop::TimerId attemptTimer_ = 0;
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };

@@ -192,6 +192,38 @@ TEST_CASE("mqtt: a retained message reaches a subscriber that comes later") {
   CHECK(probe.messages.front().retained);
 }
 
+TEST_CASE("mqtt: whenDelivered waits for the broker's acknowledgements of QoS 1 messages") {
+  MosquittoBroker broker;
+  Loop loop(ClockKind::Real);
+  MqttClient publisher(loop, optionsFor(broker, "publisher"));
+  Probe pub(publisher);
+  // not connected: nothing can be waited for, done comes at once (on the loop)
+  bool early = false;
+  publisher.whenDelivered([&] { early = true; });
+  CHECK_FALSE(early);
+  REQUIRE(runUntil(loop, [&] { return early; }));
+
+  publisher.connect();
+  REQUIRE(runUntil(loop, [&] { return pub.connects == 1; }));
+  constexpr int kCount = 200;
+  for (int i = 0; i < kCount; ++i)
+    REQUIRE(publisher.publish("pitwall/test/r" + std::to_string(i), std::to_string(i), 1, true));
+  bool delivered = false;
+  publisher.whenDelivered([&] {
+    delivered = true;
+    publisher.disconnect();  // at once: everything acknowledged is the broker's
+  });
+  CHECK_FALSE(delivered);  // 200 PUBACKs cannot have come back inside publish()
+  REQUIRE(runUntil(loop, [&] { return delivered && !pub.drops.empty(); }));
+
+  MqttClient late(loop, optionsFor(broker, "late"));
+  Probe probe(late);
+  late.subscribe("pitwall/test/#", 1);
+  late.connect();
+  CHECK(runUntil(loop, [&] { return probe.messages.size() == kCount; }));
+  CHECK(probe.has("pitwall/test/r199", "199"));
+}
+
 TEST_CASE("mqtt: the broker publishes the last will of a client killed without disconnecting") {
   MosquittoBroker broker;
   // The client under test lives in a child process that is SIGKILLed: a real crash, the socket
