@@ -1,5 +1,9 @@
 #include "engine/transport/mqtt_client.hpp"
 
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <sys/socket.h>
+
 #include <mosquitto.h>
 #include <poll.h>
 #include <unistd.h>
@@ -150,6 +154,10 @@ MqttClient::MqttClient(Loop& loop, MqttOptions options)
     mosquitto_destroy(mosq_);
     throw std::invalid_argument(message);
   };
+  // Nagle's algorithm holds a small packet while an earlier one is unacknowledged, and the peer
+  // delays its ACK (Linux: 40 ms): a burst of publications would wait that long
+  // (docs/performance.md "MQTT bridge"). Bursts are coalesced with Batch instead.
+  check(mosquitto_int_option(mosq_, MOSQ_OPT_TCP_NODELAY, 1), "cannot set TCP_NODELAY");
   if (!o.username.empty())
     check(mosquitto_username_pw_set(mosq_, o.username.c_str(),
                                     o.password.empty() ? nullptr : o.password.c_str()),
@@ -436,6 +444,23 @@ void MqttClient::handleDisconnect(mosquitto*, void* self, int rc) {
   c.lost((c.wasConnected_ ? "lost the connection to the MQTT broker at "
                           : "cannot connect to the MQTT broker at ") +
          c.where() + ": " + why);
+}
+
+MqttClient::Batch::Batch(MqttClient& client) : client_(client) {
+  if (client_.batchDepth_++ > 0 || client_.state_ != State::Connected) return;
+  int fd = mosquitto_socket(client_.mosq_);
+  int one = 1;
+  if (fd >= 0 && ::setsockopt(fd, IPPROTO_TCP, TCP_CORK, &one, sizeof one) == 0) corked_ = fd;
+}
+
+MqttClient::Batch::~Batch() {
+  --client_.batchDepth_;
+  if (corked_ < 0) return;
+  // Uncorking sends what was held at once; the socket may have changed meanwhile (a loss): then
+  // the held bytes went with the old one.
+  int zero = 0;
+  if (mosquitto_socket(client_.mosq_) == corked_)
+    ::setsockopt(corked_, IPPROTO_TCP, TCP_CORK, &zero, sizeof zero);
 }
 
 void MqttClient::handlePublish(mosquitto*, void* self, int mid) {

@@ -103,6 +103,7 @@ void MqttBridge::connected() {
   // as it was last published: the broker may have lost it (a restart without persistence).
   auto online = topics::hostOnline(host_);
   retained_[online.topic] = online;
+  MqttClient::Batch batch(client_);
   auto send = [this](const topics::Publication& p) {
     if (client_.publish(p.topic, p.payload, p.qos, p.retain)) ++stats_.republished;
   };
@@ -168,6 +169,7 @@ void MqttBridge::frame(AnkiCar& car, AnkiCar::Direction d, std::span<const std::
   auto it = ids_.find(&car);
   if (it == ids_.end()) return;
   auto t = now();
+  MqttClient::Batch batch(client_);  // one frame's publications, sent together
   if (d == AnkiCar::Direction::Tx) return emit(topics::commandStatus(it->second, m, t));
   emit(topics::frameEvent(it->second, bytes, t));
   std::optional<double> rtt;

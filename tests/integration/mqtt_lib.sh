@@ -41,6 +41,7 @@ broker_config() {
   {
     echo "listener $MQTT_PORT 127.0.0.1"
     echo "persistence false"
+    echo "set_tcp_nodelay true"  # as docs/mqtt.md recommends
     echo "user root"  # a container runs as root: stay root, keep reading the temp dir
     # the default types, and every SUBSCRIBE ("CLIENT-ID QOS FILTER"), for the tests to read
     printf 'log_type %s\n' error warning notice information subscribe

@@ -75,7 +75,7 @@ MosquittoBroker::MosquittoBroker(BrokerOptions options) : options_(std::move(opt
   std::ofstream conf(dir_ + "/mosquitto.conf");
   conf << "listener " << port_ << " 127.0.0.1\n"
        << "persistence false\n"
-       << "log_dest stderr\n"
+       << (options_.tcpNoDelay ? "set_tcp_nodelay true\n" : "") << "log_dest stderr\n"
        << "log_type error\nlog_type warning\nlog_type notice\n"
        << "user root\n";  // run as root (a container): stay root, keep reading the temp dir
   if (!options_.username.empty()) {

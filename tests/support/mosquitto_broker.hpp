@@ -13,6 +13,8 @@ struct BrokerOptions {
   std::string username, password;
   // TLS listener with these PEM files (a test makes them; see mqtt_client_test.cpp)
   std::string certFile, keyFile, caFile;
+  // set_tcp_nodelay, as docs/mqtt.md recommends for a broker (the benchmark compares)
+  bool tcpNoDelay = true;
 };
 
 class MosquittoBroker {
