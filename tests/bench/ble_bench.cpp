@@ -27,7 +27,6 @@
 #include <benchmark/benchmark.h>
 #include <sys/socket.h>
 #include <unistd.h>
-#include <lua.hpp>
 
 #include <algorithm>
 #include <boost/asio/defer.hpp>
@@ -49,6 +48,7 @@
 #include "engine/vehicles/ble_central.hpp"
 #include "engine/vehicles/fleet.hpp"
 #include "tests/bench/frames.hpp"
+#include "tests/bench/latency.hpp"
 #include "tests/fake_bluez/fake_bluez.hpp"
 #include "tests/support/private_bus.hpp"
 #include "tests/support/run_until.hpp"
@@ -58,101 +58,13 @@ namespace {
 using namespace pitwall;
 using bench::positionFrame;
 using namespace std::chrono_literals;
-using Clock = std::chrono::steady_clock;
 
 constexpr const char* kAddress = "E0:00:00:00:00:01";
 constexpr std::size_t kLocationByte = 2;  // [size][id][location][piece]…
 constexpr int kWarmup = 300;              // samples per path, not recorded
 
-struct Stats {
-  double p50 = 0, p99 = 0, mean = 0, min = 0, max = 0;
-};
-
-Stats summarize(std::vector<double> v) {
-  Stats s;
-  if (v.empty()) return s;
-  std::sort(v.begin(), v.end());
-  auto rank = [&](double q) {  // nearest rank
-    std::size_t k = static_cast<std::size_t>(q * static_cast<double>(v.size()) + 0.999999);
-    return v[std::min(v.size(), std::max<std::size_t>(k, 1)) - 1];
-  };
-  s.p50 = rank(0.50);
-  s.p99 = rank(0.99);
-  double sum = 0;
-  for (double x : v) sum += x;
-  s.mean = sum / static_cast<double>(v.size());
-  s.min = v.front();
-  s.max = v.back();
-  return s;
-}
-
-// Takes turns among the paths, one sample in flight at a time.
-struct Sampler {
-  struct Path {
-    std::string name;
-    std::function<void(std::uint8_t location)> send;
-    std::vector<double> us;
-  };
-  Loop& loop;
-  std::vector<Path> paths;
-  long next = 0, total = 0;
-  std::size_t current = 0;
-  int expected = -1;
-  Clock::time_point t0;
-  long strays = 0;  // arrivals that were not the sample in flight
-  bool timedOut = false;
-
-  explicit Sampler(Loop& l) : loop(l) {}
-
-  void add(std::string name, std::function<void(std::uint8_t)> send) {
-    paths.push_back({std::move(name), std::move(send), {}});
-  }
-
-  // Every receiver calls this with the location id it got.
-  void arrived(long location) {
-    auto t1 = Clock::now();
-    if (location != expected) {
-      ++strays;
-      return;
-    }
-    expected = -1;
-    if (next > static_cast<long>(paths.size()) * kWarmup)
-      paths[current].us.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
-    if (next == total) return loop.stop();
-    // defer, not Loop::post: a continuation goes to this thread's private queue, where a post
-    // from inside a handler would interrupt the reactor (an epoll_ctl and one more epoll_wait)
-    // and put that harness cost on whichever sample comes next.
-    boost::asio::defer(loop.io(), [this] { fire(); });
-  }
-
-  void fire() {
-    current = static_cast<std::size_t>(next % static_cast<long>(paths.size()));
-    auto location = static_cast<std::uint8_t>(next & 0xff);
-    ++next;
-    expected = location;
-    t0 = Clock::now();
-    paths[current].send(location);
-  }
-
-  // Runs kWarmup + samples per path; false when a sample got lost (no answer within 60 s).
-  bool run(int samples) {
-    total = static_cast<long>(paths.size()) * (kWarmup + samples);
-    auto watchdog = loop.after(60s, [this] {
-      timedOut = true;
-      loop.stop();
-    });
-    loop.post([this] { fire(); });
-    loop.run();
-    loop.cancel(watchdog);
-    return !timedOut;
-  }
-};
-
-int luaMark(lua_State* L) {
-  auto* sampler = static_cast<Sampler*>(lua_touserdata(L, lua_upvalueindex(1)));
-  sampler->arrived(static_cast<long>(luaL_checkinteger(L, 1)));
-  return 0;
-}
+using Sampler = bench::Sampler;
+using Stats = bench::LatencyStats;
 
 // One car behind the fake BlueZ, connected by the Central, its onPosition handler calling mark().
 struct Rig {
@@ -164,7 +76,7 @@ struct Rig {
   std::unique_ptr<ble::Central> central;
   std::unique_ptr<ScriptHost> host;
   AnkiCar* car = nullptr;
-  Sampler sampler{loop};
+  Sampler sampler{loop, kWarmup, {60s}};  // no answer within 60 s: a sample got lost
   anki::Frame frame = positionFrame();
   std::string error;
 
@@ -198,13 +110,7 @@ struct Rig {
     testing::runFor(loop, 200ms);  // SDK mode and the car's answers
 
     host = std::make_unique<ScriptHost>(loop, fleet, nullptr, HostOptions{});
-    lua_State* L = host->state();
-    lua_pushlightuserdata(L, &sampler);
-    lua_pushcclosure(L, luaMark, 1);
-    lua_setglobal(L, "mark");
-    auto started = host->startString(
-        "pitwall.cars()[1].onPosition = function(car, ev) mark(ev.location) end", "ble_bench");
-    if (!started) error = started.error();
+    error = bench::startMarking(*host, sampler, "ble_bench");
     testing::runFor(loop, 10ms);  // the main chunk runs as a task
   }
 
@@ -247,16 +153,9 @@ std::unique_ptr<Rig> makeRig(benchmark::State& state, bool acquire) {
 }
 
 void report(benchmark::State& state, const Sampler& s, const std::vector<std::string>& bare) {
+  std::vector<Stats> all = s.report(state);
   std::map<std::string, Stats> st;
-  for (const auto& p : s.paths) {
-    Stats x = summarize(p.us);
-    st[p.name] = x;
-    state.counters[p.name + "50"] = x.p50;
-    state.counters[p.name + "99"] = x.p99;
-    state.counters[p.name + "Avg"] = x.mean;
-    state.counters[p.name + "Min"] = x.min;
-    state.counters[p.name + "Max"] = x.max;
-  }
+  for (std::size_t i = 0; i < all.size(); ++i) st[s.paths[i].name] = all[i];
   const Stats& eng = st["eng"];
   const char* names[][2] = {{"add50", "add99"}, {"addF50", "addF99"}};
   for (std::size_t i = 0; i < bare.size() && i < 2; ++i) {
@@ -264,7 +163,6 @@ void report(benchmark::State& state, const Sampler& s, const std::vector<std::st
     state.counters[names[i][0]] = 100.0 * (eng.p50 - b.p50) / b.p50;
     state.counters[names[i][1]] = 100.0 * (eng.p99 - b.p99) / b.p99;
   }
-  state.counters["strays"] = static_cast<double>(s.strays);
   state.SetIterationTime(eng.p50 * 1e-6);
 }
 
