@@ -11,6 +11,7 @@
 #include "bindings/car_proxy.hpp"
 #include "bindings/lua_support.hpp"
 #include "bindings/script_host.hpp"
+#include "engine/core/hex.hpp"
 #include "engine/core/log.hpp"
 #include "engine/protocol/anki/message_json.hpp"
 
@@ -184,15 +185,9 @@ void CarBinding::hookEvents(Proxy& p) {
     std::string what = e.message();
     log::warn(p.car->label(), "malformed frame ignored: " + what);
     if (!begin(p, CarEvent::Malformed)) return;
-    std::string hex;
-    for (auto b : bytes) {
-      char h[4];
-      std::snprintf(h, sizeof h, hex.empty() ? "%02x" : " %02x", b);
-      hex += h;
-    }
     EventTable t(L_);
     t.string(kError, what);
-    t.string(kHex, hex);
+    t.string(kHex, toHex(bytes));
     finish(p, CarEvent::Malformed);
   };
 }

@@ -8,6 +8,7 @@
 #include <iostream>
 
 #include "engine/cli/commands.hpp"
+#include "engine/core/hex.hpp"
 #include "engine/core/log.hpp"
 #include "engine/protocol/alphabot/ble_codec.hpp"
 #include "engine/protocol/alphabot/command_text.hpp"
@@ -21,16 +22,6 @@ namespace pitwall::cli {
 namespace {
 
 constexpr const char* kComponent = "sim-robot alphabot";
-
-std::string hexBytes(const std::vector<std::uint8_t>& bytes) {
-  std::string out;
-  char buf[4];
-  for (auto b : bytes) {
-    std::snprintf(buf, sizeof buf, "%02x", b);
-    out += (out.empty() ? "" : " ") + std::string(buf);
-  }
-  return out;
-}
 
 // "127.0.0.1:4000", "[::1]:4000", "localhost:0" → host and port.
 bool splitListen(const std::string& text, std::string& host, std::uint16_t& port,
@@ -88,7 +79,7 @@ int encodeAlphabot(const std::vector<std::string>& words) {
     std::cerr << "pitwall encode: " << request.error() << "\n";
     return 2;
   }
-  std::cout << hexBytes(alphabot::wlan::encode(*request)) << "\n";
+  std::cout << toHex(alphabot::wlan::encode(*request)) << "\n";
   return 0;
 }
 

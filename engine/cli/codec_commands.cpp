@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include "engine/cli/commands.hpp"
+#include "engine/core/hex.hpp"
 #include "engine/protocol/anki/codec.hpp"
 #include "engine/protocol/anki/command_text.hpp"
 #include "engine/protocol/anki/message_json.hpp"
@@ -33,12 +34,7 @@ Result<std::vector<std::uint8_t>, std::string> parseHex(const std::vector<std::s
   }
   if (digits.empty())
     return Unexpected{std::string("no bytes given; write them as hex, e.g. \"01 17\"")};
-  if (digits.size() % 2)
-    return Unexpected{"odd number of hex digits (" + std::to_string(digits.size()) + ")"};
-  std::vector<std::uint8_t> bytes;
-  for (std::size_t i = 0; i < digits.size(); i += 2)
-    bytes.push_back(static_cast<std::uint8_t>(std::stoi(digits.substr(i, 2), nullptr, 16)));
-  return bytes;
+  return fromHex(digits);  // only digits are left: the error can only be an odd count
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "engine/cli/commands.hpp"
+#include "engine/core/hex.hpp"
 #include "engine/core/log.hpp"
 #include "engine/core/loop.hpp"
 #include "engine/protocol/mindroad/codec.hpp"

@@ -5,6 +5,7 @@
 
 #include <sdbus-c++/sdbus-c++.h>
 
+#include "engine/core/hex.hpp"
 #include "engine/core/log.hpp"
 #include "engine/transport/bluez_api.hpp"
 
@@ -52,17 +53,6 @@ bool isNoObject(const sdbus::Error& e) {
          e.getName() == "org.freedesktop.DBus.Error.UnknownMethod" ||
          e.getName() == "org.freedesktop.DBus.Error.UnknownInterface" ||
          e.getName() == "org.freedesktop.DBus.Error.InvalidArgs";
-}
-
-std::string hex(std::span<const std::uint8_t> bytes) {
-  static const char digits[] = "0123456789abcdef";
-  std::string out;
-  for (std::uint8_t b : bytes) {
-    if (!out.empty()) out += ' ';
-    out += digits[b >> 4];
-    out += digits[b & 15];
-  }
-  return out;
 }
 
 std::string errorText(const sdbus::Error& e) {
@@ -184,7 +174,7 @@ struct BlePeripheral::State {
           if (auto it = options.find("device"); it != options.end())
             device = it->second.get<sdbus::ObjectPath>();
           if (peer.empty()) peer = device;
-          log::debug(kComponent, "write " + hex(bytes));
+          log::debug(kComponent, "write " + toHex(bytes));
           up(device);  // a central may write before it subscribes
           if (self.onWrite) self.onWrite(bytes);
         });
@@ -450,10 +440,10 @@ void BlePeripheral::stop(std::function<void()> done) {
 bool BlePeripheral::notify(std::span<const std::uint8_t> value) {
   State& s = *state_;
   if (!s.notifying) {
-    log::debug(kComponent, "not subscribed: dropped " + hex(value));
+    log::debug(kComponent, "not subscribed: dropped " + toHex(value));
     return false;
   }
-  log::debug(kComponent, "notify " + hex(value));
+  log::debug(kComponent, "notify " + toHex(value));
   s.value.assign(value.begin(), value.end());
   // BlueZ turns a PropertiesChanged on Value into a notification to every subscribed central
   // (gatt-api "StartNotify"); the signal carries the value, so back-to-back frames all go out.

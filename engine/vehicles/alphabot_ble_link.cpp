@@ -6,9 +6,9 @@
 #include <cctype>
 #include <sstream>
 
+#include "engine/core/hex.hpp"
 #include "engine/core/log.hpp"
 #include "engine/core/overload.hpp"
-#include "engine/vehicles/recorder.hpp"  // toHex
 
 namespace pitwall::alphabot {
 

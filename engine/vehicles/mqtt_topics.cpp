@@ -8,6 +8,7 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
+#include "engine/core/hex.hpp"
 #include "engine/core/overload.hpp"
 #include "engine/protocol/anki/advertisement.hpp"
 #include "engine/protocol/anki/codec.hpp"
@@ -71,38 +72,6 @@ std::string safe(std::string_view s, bool lower) {
     auto u = static_cast<unsigned char>(c);
     if (lower) u = static_cast<unsigned char>(std::tolower(u));
     out += (std::isalnum(u) || c == '.' || c == '_' || c == '-') ? static_cast<char>(u) : '_';
-  }
-  return out;
-}
-
-std::string hex(std::span<const std::uint8_t> bytes) {
-  static constexpr char kDigits[] = "0123456789abcdef";
-  std::string out;
-  out.reserve(bytes.size() * 2);
-  for (auto b : bytes) {
-    out += kDigits[b >> 4];
-    out += kDigits[b & 0xf];
-  }
-  return out;
-}
-
-// "0624e803" → bytes; an error names the problem.
-Result<std::vector<std::uint8_t>, std::string> unhex(std::string_view text) {
-  if (text.size() % 2)
-    return Unexpected{"odd number of hex digits (" + std::to_string(text.size()) + ")"};
-  std::vector<std::uint8_t> out;
-  out.reserve(text.size() / 2);
-  auto digit = [](char c) -> int {
-    if (c >= '0' && c <= '9') return c - '0';
-    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
-    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
-    return -1;
-  };
-  for (std::size_t i = 0; i < text.size(); i += 2) {
-    int hi = digit(text[i]), lo = digit(text[i + 1]);
-    if (hi < 0 || lo < 0)
-      return Unexpected{"\"" + std::string(text.substr(i, 2)) + "\" is not a hex byte"};
-    out.push_back(static_cast<std::uint8_t>(hi * 16 + lo));
   }
   return out;
 }
@@ -205,7 +174,7 @@ std::vector<Publication> fromMessage(std::string_view car, const anki::Message& 
 }
 
 Publication frameEvent(std::string_view car, std::span<const std::uint8_t> frame, Millis now) {
-  return event(car, "frame", hex(frame), now);
+  return event(car, "frame", toHex(frame, ""), now);
 }
 
 std::vector<Publication> commandStatus(std::string_view car, const anki::Message& sent,
@@ -351,7 +320,7 @@ Parsed messageIntent(const Json& j) {
   if (!v.is_string())
     return Unexpected{"\"frame\" must be a string of hex digits, not " + typeName(v) + " (" +
                       v.dump() + ")"};
-  auto bytes = unhex(v.get_ref<const std::string&>());
+  auto bytes = fromHex(v.get_ref<const std::string&>());
   if (!bytes) return Unexpected{"\"frame\": " + bytes.error()};
   auto message = anki::decode(*bytes);
   if (!message) return Unexpected{"\"frame\": " + message.error().message()};
@@ -508,7 +477,7 @@ std::optional<std::string> intentPayload(const anki::Message& command) {
       command);
   if (j.is_null()) {
     auto frame = anki::encode(command);
-    j = Json{{"type", "message"}, {"frame", hex(frame.span())}};
+    j = Json{{"type", "message"}, {"frame", toHex(frame.span(), "")}};
   }
   return j.dump();
 }
@@ -615,7 +584,7 @@ Result<std::vector<std::uint8_t>, std::string> readFrameEvent(std::string_view p
   if (!j) return Unexpected{j.error()};
   auto text = key<std::string>(*j, "value");
   if (!text) return Unexpected{text.error()};
-  return unhex(*text);
+  return fromHex(*text);
 }
 
 }  // namespace pitwall::topics

@@ -5,21 +5,10 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "engine/core/hex.hpp"
 #include "engine/protocol/anki/message_json.hpp"
 
 namespace pitwall {
-
-std::string toHex(std::span<const std::uint8_t> bytes) {
-  static constexpr char kDigits[] = "0123456789abcdef";
-  std::string out;
-  out.reserve(bytes.size() * 3);
-  for (std::size_t i = 0; i < bytes.size(); ++i) {
-    if (i) out += ' ';
-    out += kDigits[bytes[i] >> 4];
-    out += kDigits[bytes[i] & 0x0f];
-  }
-  return out;
-}
 
 Recorder::Recorder(const std::string& path) : out_(path, std::ios::out | std::ios::trunc) {
   if (!out_)

@@ -11,8 +11,6 @@
 
 namespace pitwall {
 
-std::string toHex(std::span<const std::uint8_t> bytes);  // "06 24 e8 03"
-
 class Recorder {
  public:
   // Throws std::runtime_error naming the file when it cannot be opened.

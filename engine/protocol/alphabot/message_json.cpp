@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <string>
 
+#include "engine/core/hex.hpp"
 #include "engine/core/overload.hpp"
 #include "engine/protocol/alphabot/toggles.hpp"
 #include "engine/protocol/alphabot/wlan_codec.hpp"
@@ -15,11 +16,7 @@ using nlohmann::json;
 json header(std::string_view name, std::uint8_t id) {
   json j;
   j["name"] = name;
-  if (id != 0) {
-    char buf[8];
-    std::snprintf(buf, sizeof buf, "0x%02x", id);
-    j["packet"] = buf;
-  }
+  if (id != 0) j["packet"] = hexByte(id);
   return j;
 }
 

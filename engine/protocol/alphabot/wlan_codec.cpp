@@ -1,4 +1,5 @@
 #include "engine/protocol/alphabot/wlan_codec.hpp"
+#include "engine/core/hex.hpp"
 #include "engine/core/overload.hpp"
 
 #include <cstdio>
@@ -100,12 +101,6 @@ std::optional<std::size_t> packetLength(std::span<const std::uint8_t> bytes) {
   return 2 + 4 * static_cast<std::size_t>(bytes[1]);
 }
 
-std::string hex2(std::uint8_t b) {
-  char buf[8];
-  std::snprintf(buf, sizeof buf, "0x%02x", b);
-  return buf;
-}
-
 Packet decodeKnown(std::span<const std::uint8_t> bytes, Options options) {
   Reader r{options, bytes};
   switch (bytes[0]) {
@@ -205,12 +200,12 @@ Packet decodeKnown(std::span<const std::uint8_t> bytes, Options options) {
 
 std::string DecodeError::message() const {
   std::string n(nameOfId(id));
-  std::string what = "packet " + hex2(id) + (n.empty() ? "" : " (" + n + ")");
+  std::string what = "packet " + hexByte(id) + (n.empty() ? "" : " (" + n + ")");
   switch (kind) {
     case Kind::Empty:
       return "empty packet: no id byte";
     case Kind::UnknownId:
-      return "unknown packet id " + hex2(id) + " (known: requests 0x01..0x0c and 0xc0, " +
+      return "unknown packet id " + hexByte(id) + " (known: requests 0x01..0x0c and 0xc0, " +
              "responses 0x81..0x86): " + std::to_string(received) + " byte(s) not decoded";
     case Kind::WrongDirection:
       return what + " travels the other way (" +

@@ -16,6 +16,7 @@
 #include <type_traits>
 #include <utility>
 
+#include "engine/core/hex.hpp"
 #include "engine/protocol/anki/message_fields.hpp"
 
 namespace pitwall::anki {
@@ -229,18 +230,13 @@ Decoded fail(DecodeError::Kind kind, std::uint8_t id, std::size_t expected, std:
   return Unexpected{DecodeError{kind, id, expected, received}};
 }
 
-std::string hexId(std::uint8_t id) {
-  static constexpr char kDigits[] = "0123456789abcdef";
-  return {'0', 'x', kDigits[id >> 4], kDigits[id & 0x0f]};
-}
-
 std::string bytes(std::size_t n) {
   return std::to_string(n) + (n == 1 ? " byte" : " bytes");
 }
 
 std::string idText(std::uint8_t id) {
   const auto& e = kById[id];
-  return "message " + hexId(id) +
+  return "message " + hexByte(id) +
          (e.read ? " (" + std::string(e.layout.name) + ")" : std::string());
 }
 

@@ -9,17 +9,13 @@
 #include <string>
 #include <type_traits>
 
+#include "engine/core/hex.hpp"
 #include "engine/protocol/anki/message_fields.hpp"
 
 namespace pitwall::anki {
 namespace {
 
 using nlohmann::json;
-
-std::string hexByte(std::uint8_t b) {
-  static constexpr char kDigits[] = "0123456789abcdef";
-  return {kDigits[b >> 4], kDigits[b & 0x0f]};
-}
 
 // ---- one field's value ----
 
@@ -110,12 +106,7 @@ json value(const T& record) {
 
 // The whole frame as space-separated hex bytes: "03 99 01 02".
 void addFields(json& j, const Unknown& m) {
-  std::string raw;
-  for (const auto b : m.raw.span()) {
-    if (!raw.empty()) raw += ' ';
-    raw += hexByte(b);
-  }
-  j["raw"] = std::move(raw);
+  j["raw"] = toHex(m.raw.span());
 }
 
 }  // namespace
@@ -123,7 +114,7 @@ void addFields(json& j, const Unknown& m) {
 json toJson(const Message& message) {
   json j = json::object();
   j["name"] = name(message);
-  j["id"] = "0x" + hexByte(messageId(message));
+  j["id"] = hexByte(messageId(message));
   std::visit([&](const auto& m) { addFields(j, m); }, message);
   return j;
 }

@@ -3,6 +3,8 @@
 
 #include <type_traits>
 
+#include "engine/core/hex.hpp"
+
 namespace pitwall::mindroad {
 
 namespace {
@@ -21,11 +23,6 @@ std::string idText(std::uint8_t id) {
   if (id <= id::kLastUsed)
     return "instruction " + std::to_string(id) + " (" + std::string(kNames[id]) + ")";
   return "instruction " + std::to_string(id);
-}
-
-std::string hexByte(int b) {
-  static constexpr char kDigits[] = "0123456789abcdef";
-  return std::string("0x") + kDigits[(b >> 4) & 15] + kDigits[b & 15];
 }
 
 DecodeError error(DecodeError::Kind kind, std::uint8_t id, std::size_t expected = 0,

@@ -5,15 +5,9 @@
 
 #include <type_traits>
 
+#include "engine/core/hex.hpp"
+
 namespace pitwall::mindroad {
-namespace {
-
-std::string hexByte(std::uint8_t b) {
-  static constexpr char kDigits[] = "0123456789abcdef";
-  return std::string("0x") + kDigits[b >> 4] + kDigits[b & 15];
-}
-
-}  // namespace
 
 nlohmann::json toJson(const Instruction& instruction) {
   nlohmann::json j;
