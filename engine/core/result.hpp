@@ -7,8 +7,11 @@
 
 namespace pitwall {
 
+// The constructor (not an aggregate) so that `Unexpected(e)` also compiles with clang 14, which
+// lacks C++20's parenthesized aggregate initialization.
 template <class E>
 struct Unexpected {
+  Unexpected(E e) : error(std::move(e)) {}
   E error;
 };
 template <class E>
