@@ -1,5 +1,6 @@
 #pragma once
 // The `pitwall` subcommands (docs/cli.md). Each returns the process exit status.
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -14,6 +15,9 @@ struct MqttSettings {
   std::string passwordFile;  // --mqtt-password-file; else $PITWALL_MQTT_PASSWORD when set
   std::string caFile;        // --mqtt-ca: the CA of the broker's certificate (mqtts://)
   std::string clientId;      // --mqtt-client-id; empty: a random one
+  // --mqtt-max-payload: a larger payload from the broker is refused unread (docs/mqtt.md
+  // "Hostile input"); topics::kDefaultMaxPayload
+  std::size_t maxPayload = 64 * 1024;
 };
 
 // Where the cars of a run or a REPL come from: the simulator's starting grid, or real cars over

@@ -50,6 +50,11 @@ CLI::Option* addMqtt(CLI::App* cmd, pitwall::cli::MqttSettings& mqtt, double& ti
       ->needs(url);
   cmd->add_option("--mqtt-client-id", mqtt.clientId, "MQTT client id (default: a random one)")
       ->needs(url);
+  cmd->add_option("--mqtt-max-payload", mqtt.maxPayload,
+                  "Refuse a payload from the broker larger than this many bytes, unread "
+                  "(default 65536)")
+      ->check(CLI::Range(std::size_t{1}, std::size_t{256} * 1024 * 1024))
+      ->needs(url);
   cmd->add_option("--mqtt-timeout", timeout,
                   "Seconds to wait for the broker (and --remote-cars) at start (default 5)")
       ->check(CLI::PositiveNumber)

@@ -160,7 +160,9 @@ int Session::startBridge(const MqttSettings& settings, const std::string& hostId
   try {
     mqtt_ = std::make_unique<MqttClient>(loop_, std::move(*options));
     bridge_ = std::make_unique<MqttBridge>(
-        loop_, fleet_, *mqtt_, pitwall::BridgeOptions{host, readOnly}, std::move(connections));
+        loop_, fleet_, *mqtt_,
+        pitwall::BridgeOptions{host, readOnly, topics::PayloadLimits{settings.maxPayload}},
+        std::move(connections));
   } catch (const std::invalid_argument& e) {
     std::cerr << "pitwall " << command << ": " << e.what() << "\n";
     return 2;
@@ -207,7 +209,8 @@ int Session::connectRemoteCars(const char* command) {
     std::cerr << "pitwall " << command << ": " << e.what() << "\n";
     return 2;
   }
-  remote_ = std::make_unique<RemoteCars>(loop_, fleet_, *mqtt_);
+  remote_ = std::make_unique<RemoteCars>(loop_, fleet_, *mqtt_,
+                                         topics::PayloadLimits{source_.mqtt.maxPayload});
   // The callbacks outlive this wait (a late sync, a refusal on a later reconnection): they share
   // this state and do nothing once the wait is over.
   struct Start {

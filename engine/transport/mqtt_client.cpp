@@ -501,10 +501,20 @@ void MqttClient::settleDeliveries() {
 void MqttClient::handleMessage(mosquitto*, void* self, const mosquitto_message* m) {
   auto& c = *static_cast<MqttClient*>(self);
   if (!c.onMessage) return;
-  c.onMessage(m->topic,
-              std::string_view(static_cast<const char*>(m->payload),
-                               static_cast<std::size_t>(std::max(m->payloadlen, 0))),
-              m->retain);
+  std::string_view payload(static_cast<const char*>(m->payload),
+                           static_cast<std::size_t>(std::max(m->payloadlen, 0)));
+  // An exception must not unwind through libmosquitto's C frames. The handlers catch what a
+  // message makes them throw (docs/mqtt.md "Hostile input"); this is the last resort.
+  try {
+    c.onMessage(m->topic, payload, m->retain);
+  } catch (const std::exception& e) {
+    log::warn("mqtt", "dropped a message on " + std::string(m->topic).substr(0, 200) + " (" +
+                          std::to_string(payload.size()) + " bytes): its handler threw " +
+                          std::string(e.what()).substr(0, 200));
+  } catch (...) {
+    log::warn("mqtt", "dropped a message on " + std::string(m->topic).substr(0, 200) + " (" +
+                          std::to_string(payload.size()) + " bytes): its handler threw");
+  }
 }
 
 void MqttClient::handleLog(mosquitto*, void* self, int level, const char* text) {

@@ -1,6 +1,7 @@
 #include "engine/vehicles/mqtt_bridge.hpp"
 
 #include <algorithm>
+#include <sstream>
 #include <stdexcept>
 
 #include "engine/core/log.hpp"
@@ -10,7 +11,15 @@ namespace pitwall {
 
 namespace {
 constexpr const char* kLog = "mqtt bridge";
+// The bucket of the host's connection intents (car ids never hold a space).
+const std::string kConnection = "connection intents";
+
+std::string perSecond(const RateLimit& r) {
+  std::ostringstream out;
+  out << r.perSecond << " a second, " << r.burst << " at once";
+  return out.str();
 }
+}  // namespace
 
 MqttBridge::MqttBridge(Loop& loop, Fleet& fleet, MqttClient& client, BridgeOptions options,
                        CarConnections connections)
@@ -58,6 +67,8 @@ MqttBridge::MqttBridge(Loop& loop, Fleet& fleet, MqttClient& client, BridgeOptio
 }
 
 MqttBridge::~MqttBridge() {
+  for (auto& [key, s] : dropped_) loop_.cancel(s.timer);
+  loop_.cancel(unanswered_.timer);
   fleet_.onCar = std::move(previousOnCar_);
   fleet_.onConnectionChange = std::move(previousOnConnection_);
   fleet_.onFrame = std::move(previousOnFrame_);
@@ -185,16 +196,34 @@ bool MqttBridge::ownedElsewhere(const std::string& car) const {
   return false;
 }
 
+// The last resort: whatever a message from the broker makes throw (a parser, a serialiser, a
+// command) is logged and the message dropped; the bridge and its cars carry on.
 void MqttBridge::message(std::string_view topic, std::string_view payload, bool retained) {
+  try {
+    handle(topic, payload, retained);
+  } catch (const std::exception& e) {
+    ++stats_.faults;
+    log::warn(kLog, "dropped the message on " + topics::quote(topic) + " (" +
+                        std::to_string(payload.size()) +
+                        " bytes): " + topics::quote(e.what(), 300));
+  } catch (...) {
+    ++stats_.faults;
+    log::warn(kLog, "dropped the message on " + topics::quote(topic) + " (" +
+                        std::to_string(payload.size()) + " bytes): an unknown exception");
+  }
+}
+
+void MqttBridge::handle(std::string_view topic, std::string_view payload, bool retained) {
   if (options_.readOnly) return;
   auto parts = topics::splitTopic(topic);
   if (parts && parts->kind == topics::TopicParts::Kind::Host && parts->id != host_) {
     if (parts->rest == "S/Cars") {
-      if (auto cars = topics::readHostCars(payload)) otherCars_[parts->id] = *cars;
+      if (auto cars = topics::readHostCars(payload, options_.payload))
+        otherCars_[parts->id] = *cars;
       return;
     }
     if (parts->rest == "S/HostStatus") {
-      auto up = topics::readHostStatus(payload);
+      auto up = topics::readHostStatus(payload, options_.payload);
       if (up && *up)
         otherOnline_.insert(parts->id);
       else
@@ -219,16 +248,68 @@ void MqttBridge::message(std::string_view topic, std::string_view payload, bool 
                   "every reconnection); publish the intent without the retain flag, and clear the "
                   "stored one with an empty retained message");
   auto own = ownCars();
-  auto intent = topics::parseIntent(host_, topic, payload, own);
+  auto intent = topics::parseIntent(host_, topic, payload, own, options_.payload);
   if (!intent) return reject(t, intent.error().message);
   execute(*intent, t);
 }
 
 void MqttBridge::reject(const std::string& topic, std::string message) {
   ++stats_.rejected;
-  log::warn(kLog, "intent on " + topic + " rejected: " + message);
-  emit(topics::intentError(host_, topics::IntentError{topic, std::move(message)}, now()));
+  if (errorBucket_.take(options_.errors, loop_.now())) {
+    log::warn(kLog, "intent on " + topics::quote(topic) + " rejected: " + message);
+    emit(topics::intentError(host_, topics::IntentError{topic, std::move(message)}, now()));
+  } else {
+    // A flood of bad intents: one answer each would be a flood of errors (and of log lines).
+    ++stats_.unanswered;
+    ++unanswered_.count;
+    unanswered_.topic = topic;
+    unanswered_.last = std::move(message);
+    summarise(unanswered_, [this](Summary& s) {
+      std::string why = std::to_string(s.count) + " more intent" +
+                        (s.count == 1 ? " was" : "s were") +
+                        " rejected without an answer each (S/IntentError answers at most " +
+                        perSecond(options_.errors) + "); the last: " + s.last;
+      log::warn(kLog, why);
+      emit(topics::intentError(host_, topics::IntentError{s.topic, why}, now()));
+    });
+  }
   if (onIntentHandled) onIntentHandled(topic, false);
+}
+
+bool MqttBridge::admit(const std::string& key, const std::string& topic) {
+  if (intentBuckets_[key].take(options_.intents, loop_.now())) return true;
+  ++stats_.throttled;
+  auto& s = dropped_[key];
+  ++s.count;
+  s.topic = topic;
+  summarise(s, [this, key](Summary& s) {
+    std::string what = key == kConnection ? key : "car " + key;
+    std::string why = std::to_string(s.count) + " intent" + (s.count == 1 ? "" : "s") + " for " +
+                      what + (s.count == 1 ? " was" : " were") +
+                      " dropped: more than the car's link can take (at most " +
+                      perSecond(options_.intents) + "); send fewer, e.g. only when a value changes";
+    log::warn(kLog, why);
+    emit(topics::intentError(host_, topics::IntentError{s.topic, why}, now()));
+  });
+  return false;
+}
+
+// The first of a quiet spell is reported at once; whatever follows within a second waits for
+// one report at the end of that second.
+void MqttBridge::summarise(Summary& s, std::function<void(Summary&)> report) {
+  if (s.timer) return;  // a report is due already and will count this one too
+  auto fire = [this, &s, report = std::move(report)] {
+    s.timer = 0;
+    s.reported = true;
+    s.lastReport = loop_.now();
+    report(s);
+    s.count = 0;
+  };
+  auto due = s.lastReport + std::chrono::seconds(1);
+  if (!s.reported || due <= loop_.now())
+    fire();
+  else
+    s.timer = loop_.at(due, std::move(fire));
 }
 
 AnkiCar::Sent MqttBridge::apply(AnkiCar& car, const topics::Action& action) {
@@ -264,6 +345,10 @@ AnkiCar::Sent MqttBridge::apply(AnkiCar& car, const topics::Action& action) {
 void MqttBridge::execute(const topics::Intent& intent, const std::string& topic) {
   using Kind = topics::Target::Kind;
   if (auto* c = std::get_if<topics::ConnectIntent>(&intent.action)) {
+    if (!admit(kConnection, topic)) {
+      if (onIntentHandled) onIntentHandled(topic, false);
+      return;
+    }
     ++stats_.intents;
     log::info(kLog, c->connecting ? "connection intent: connecting the cars"
                                   : "connection intent: disconnecting every car");
@@ -275,6 +360,10 @@ void MqttBridge::execute(const topics::Intent& intent, const std::string& topic)
   if (intent.target.kind == Kind::Car) {
     for (auto& [car, id] : ids_) {
       if (id != intent.target.car) continue;
+      if (!admit(id, topic)) {
+        if (onIntentHandled) onIntentHandled(topic, false);
+        return;
+      }
       auto sent = apply(*const_cast<AnkiCar*>(car), intent.action);
       if (!sent) return reject(topic, sent.error());
       ++stats_.intents;
@@ -285,7 +374,7 @@ void MqttBridge::execute(const topics::Intent& intent, const std::string& topic)
   }
   // Every car of this host: those not connected are skipped (a drop is not the sender's error).
   for (auto& [car, id] : ids_) {
-    if (!car->state().connected) continue;
+    if (!car->state().connected || !admit(id, topic)) continue;
     auto sent = apply(*const_cast<AnkiCar*>(car), intent.action);
     if (!sent) log::warn(car->label(), "intent on " + topic + ": " + sent.error());
   }

@@ -12,6 +12,12 @@
 //    Anki/Host/<host>/S/IntentError and nothing is sent to any car. A single-car intent for a car
 //    that another online bridge lists in its S/Cars is left to that bridge, silently.
 //  - read-only: intents are not even subscribed to.
+//  - Hostile input is contained (docs/mqtt.md "Hostile input"): an intent beyond
+//    BridgeOptions::payload is refused before it is parsed; each car takes at most
+//    BridgeOptions::intents (a token bucket), the rest is dropped and summed up on S/IntentError
+//    at most once a second per car; S/IntentError itself carries at most BridgeOptions::errors,
+//    the rest summed up once a second; an exception from any message is caught, logged, and the
+//    message dropped.
 #include <chrono>
 #include <functional>
 #include <map>
@@ -21,6 +27,7 @@
 
 #include "engine/transport/mqtt_client.hpp"
 #include "engine/vehicles/fleet.hpp"
+#include "engine/vehicles/mqtt_throttle.hpp"
 #include "engine/vehicles/mqtt_topics.hpp"
 
 namespace pitwall {
@@ -28,6 +35,11 @@ namespace pitwall {
 struct BridgeOptions {
   std::string host;  // the host id (topics::hostId applied by the bridge)
   bool readOnly = false;
+  topics::PayloadLimits payload{};  // an intent larger or deeper is refused before it is parsed
+  // Intents per car (and connection intents per host): a BLE link takes about 20–50 commands a
+  // second, so 50 a second, 20 at once; the rest are dropped, not queued.
+  RateLimit intents{50, 20};
+  RateLimit errors{10, 20};  // S/IntentError answers, one per rejected intent
 };
 
 // How the bridge carries out a connection intent: scan and connect every car, or drop them all.
@@ -62,7 +74,10 @@ class MqttBridge {
     std::uint64_t published = 0;    // publications handed to the client
     std::uint64_t dropped = 0;      // not connected to the broker: dropped, not queued
     std::uint64_t intents = 0;      // intents executed
-    std::uint64_t rejected = 0;     // intents answered on S/IntentError
+    std::uint64_t rejected = 0;     // intents refused (answered on S/IntentError, or summed up)
+    std::uint64_t throttled = 0;    // intents for a car beyond BridgeOptions::intents: dropped
+    std::uint64_t unanswered = 0;   // refusals beyond BridgeOptions::errors: only summed up
+    std::uint64_t faults = 0;       // messages that threw: logged and dropped
     std::uint64_t republished = 0;  // retained status sent again after a (re)connection
   };
   const Stats& stats() const { return stats_; }
@@ -81,10 +96,23 @@ class MqttBridge {
   void frame(AnkiCar& car, AnkiCar::Direction d, std::span<const std::uint8_t> bytes,
              const anki::Message& m);
   void message(std::string_view topic, std::string_view payload, bool retained);
+  void handle(std::string_view topic, std::string_view payload, bool retained);
   bool ownedElsewhere(const std::string& car) const;
   void execute(const topics::Intent& intent, const std::string& topic);
   AnkiCar::Sent apply(AnkiCar& car, const topics::Action& action);
   void reject(const std::string& topic, std::string message);
+  // One token of `key`'s bucket (a car id, or kConnection); false, counted and later summed up
+  // on S/IntentError, when there is none.
+  bool admit(const std::string& key, const std::string& topic);
+  // What was held back (intents dropped, errors not published), summed up at most once a second.
+  struct Summary {
+    std::uint64_t count = 0;
+    std::string topic, last;  // the last one's topic and error
+    TimePoint lastReport{};
+    bool reported = false;
+    Loop::TimerId timer = 0;
+  };
+  void summarise(Summary& s, std::function<void(Summary&)> report);
   std::vector<std::string> ownCars() const;
 
   Loop& loop_;
@@ -101,6 +129,10 @@ class MqttBridge {
   // What the other bridges said: their cars, while they are online.
   std::map<std::string, std::vector<std::string>> otherCars_;
   std::set<std::string> otherOnline_;
+  std::map<std::string, TokenBucket> intentBuckets_;  // by car id, and kConnection
+  std::map<std::string, Summary> dropped_;            // the same keys
+  TokenBucket errorBucket_;
+  Summary unanswered_;
   Stats stats_;
   std::function<void(AnkiCar&)> previousOnCar_;
   std::function<void(AnkiCar&, bool, const std::string&)> previousOnConnection_;

@@ -12,7 +12,8 @@ namespace pitwall {
 
 namespace {
 constexpr const char* kLog = "mqtt remote";
-}
+constexpr RateLimit kWarnings{10, 20};
+}  // namespace
 
 // A remote car's link: frames arrive from the broker, commands leave as intents.
 class RemoteLink : public Link {
@@ -43,8 +44,8 @@ class RemoteLink : public Link {
   bool up_ = false;
 };
 
-RemoteCars::RemoteCars(Loop& loop, Fleet& fleet, MqttClient& client)
-    : loop_(loop), fleet_(fleet), client_(client) {
+RemoteCars::RemoteCars(Loop& loop, Fleet& fleet, MqttClient& client, topics::PayloadLimits limits)
+    : loop_(loop), fleet_(fleet), client_(client), limits_(limits) {
   std::random_device random;
   syncTopic_ = "pitwall/sync/" + std::to_string(::getpid()) + "-" + std::to_string(random());
   client_.subscribe("Anki/Host/+/S/#", 1);
@@ -92,7 +93,33 @@ bool RemoteCars::hostUp(const std::string& host) const {
   return host.empty() || it == hosts_.end() || it->second;
 }
 
+void RemoteCars::warn(const std::string& line) {
+  if (!warnings_.take(kWarnings, loop_.now())) {
+    ++unlogged_;
+    return;
+  }
+  std::string more;
+  if (unlogged_)
+    more = " (" + std::to_string(unlogged_) + " more warning" + (unlogged_ == 1 ? "" : "s") +
+           " not logged before this one: more than 10 a second)";
+  unlogged_ = 0;
+  log::warn(kLog, line + more);
+}
+
+// The last resort: whatever a publication makes throw is logged and the publication dropped.
 void RemoteCars::message(std::string_view topic, std::string_view payload) {
+  try {
+    handle(topic, payload);
+  } catch (const std::exception& e) {
+    warn("dropped the message on " + topics::quote(topic) + " (" + std::to_string(payload.size()) +
+         " bytes): " + topics::quote(e.what(), 300));
+  } catch (...) {
+    warn("dropped the message on " + topics::quote(topic) + " (" + std::to_string(payload.size()) +
+         " bytes): an unknown exception");
+  }
+}
+
+void RemoteCars::handle(std::string_view topic, std::string_view payload) {
   if (topic == syncTopic_) {
     if (auto done = std::move(synced_)) {
       synced_ = nullptr;
@@ -103,17 +130,17 @@ void RemoteCars::message(std::string_view topic, std::string_view payload) {
   auto parts = topics::splitTopic(topic);
   if (!parts) return;
   auto complain = [&](const std::string& why) {
-    log::warn(kLog, "ignored " + std::string(topic) + ": " + why);
+    warn("ignored " + topics::quote(topic) + ": " + why);
   };
   if (parts->kind == topics::TopicParts::Kind::Host) {
     if (parts->rest == "S/HostStatus") {
-      auto up = topics::readHostStatus(payload);
+      auto up = topics::readHostStatus(payload, limits_);
       if (!up) return complain(up.error());
       hosts_[parts->id] = *up;
       for (auto& [id, car] : cars_)
         if (car.host == parts->id) update(id, car);
     } else if (parts->rest == "S/Cars") {
-      auto list = topics::readHostCars(payload);
+      auto list = topics::readHostCars(payload, limits_);
       if (!list) return complain(list.error());
       for (const auto& id : *list) {
         auto& car = cars_[id];
@@ -123,7 +150,8 @@ void RemoteCars::message(std::string_view topic, std::string_view payload) {
       // Only errors about intents we might have sent: single-car intents to remote cars.
       for (const auto& [id, car] : cars_)
         if (car.link && payload.find("\"Anki/Car/" + id + "/I\"") != std::string_view::npos)
-          log::warn(kLog, "host " + parts->id + " refused an intent: " + std::string(payload));
+          warn("host " + topics::quote(parts->id) +
+               " refused an intent: " + topics::quote(payload, topics::kMaxIntentError));
     }
     return;
   }
@@ -131,17 +159,17 @@ void RemoteCars::message(std::string_view topic, std::string_view payload) {
   if (parts->rest == "E/frame") {
     auto it = cars_.find(id);
     if (it == cars_.end() || !it->second.link) return;
-    auto bytes = topics::readFrameEvent(payload);
+    auto bytes = topics::readFrameEvent(payload, limits_);
     if (!bytes) return complain(bytes.error());
     it->second.link->frame(*bytes);
   } else if (parts->rest == "S/Information") {
-    auto info = topics::readInformation(id, payload);
+    auto info = topics::readInformation(id, payload, limits_);
     if (!info) return complain(info.error());
     auto& car = cars_[id];
     car.info = *info;
     update(id, car);
   } else if (parts->rest == "S/CarStatus") {
-    auto status = topics::readCarStatus(payload);
+    auto status = topics::readCarStatus(payload, limits_);
     if (!status) return complain(status.error());
     auto& car = cars_[id];
     car.online = status->online;

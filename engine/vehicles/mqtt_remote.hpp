@@ -10,6 +10,10 @@
 //    owning bridge validates again and executes. sdk-mode is the bridge's business (it keeps its
 //    cars in SDK mode) and is accepted without sending anything.
 //
+// Hostile publications on the tree (docs/mqtt.md "Hostile input") are ignored with a warning:
+// a payload beyond the limits is refused before it is parsed, an exception from any message is
+// caught, and the warnings themselves are limited (10 a second, 20 at once; the rest counted).
+//
 // start() subscribes, then publishes a marker to a topic of its own: the broker delivers it after
 // every retained message of the earlier subscriptions, so when it comes back the cars online at
 // that moment are all known.
@@ -21,6 +25,7 @@
 
 #include "engine/transport/mqtt_client.hpp"
 #include "engine/vehicles/fleet.hpp"
+#include "engine/vehicles/mqtt_throttle.hpp"
 #include "engine/vehicles/mqtt_topics.hpp"
 
 namespace pitwall {
@@ -31,7 +36,7 @@ class RemoteCars {
  public:
   // The client must not be connected yet (its handlers are set here). The loop, the fleet and
   // the client outlive this object.
-  RemoteCars(Loop& loop, Fleet& fleet, MqttClient& client);
+  RemoteCars(Loop& loop, Fleet& fleet, MqttClient& client, topics::PayloadLimits limits = {});
   ~RemoteCars();
   RemoteCars(const RemoteCars&) = delete;
   RemoteCars& operator=(const RemoteCars&) = delete;
@@ -56,6 +61,8 @@ class RemoteCars {
     std::string host;  // from the hosts' S/Cars; empty while unknown
   };
   void message(std::string_view topic, std::string_view payload);
+  void handle(std::string_view topic, std::string_view payload);
+  void warn(const std::string& line);  // rate-limited: a flood of junk is not a flood of logs
   void update(const std::string& id, Car& car);
   bool hostUp(const std::string& host) const;
   std::string uniqueName(const topics::CarInfo& info) const;
@@ -63,6 +70,9 @@ class RemoteCars {
   Loop& loop_;
   Fleet& fleet_;
   MqttClient& client_;
+  topics::PayloadLimits limits_;
+  TokenBucket warnings_;
+  std::uint64_t unlogged_ = 0;  // warnings beyond the limit since the last one logged
   std::string syncTopic_;
   std::map<std::string, Car> cars_;
   std::map<std::string, bool> hosts_;  // HostStatus as last published

@@ -8,6 +8,8 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
+#include <mosquitto.h>
+
 #include "engine/core/hex.hpp"
 #include "engine/core/overload.hpp"
 #include "engine/protocol/anki/advertisement.hpp"
@@ -80,7 +82,99 @@ bool isCommand(const anki::Message& m) {
   return m.index() <= variantIndex<anki::SdkMode>();
 }
 
+// At most `n` bytes of a sentence of ours, cut between two UTF-8 characters, then "…".
+std::string clip(std::string_view s, std::size_t n) {
+  if (s.size() <= n) return std::string(s);
+  while (n > 0 && (static_cast<unsigned char>(s[n]) & 0xC0) == 0x80) --n;
+  return std::string(s.substr(0, n)) + "…";
+}
+
+// A value received, as an error message shows it: its JSON, cut and escaped (a string value of
+// 60 KB stays a short sentence).
+std::string excerpt(const Json& v) {
+  return quote(v.dump());
+}
+
+// Thrown by the parser callback at the depth limit: the parse stops there.
+struct TooDeep {};
+
+// nlohmann's message for a parse error quotes the token it read ("last read: '…'", "number
+// overflow parsing '…'"): that token is the sender's text, of any length and any bytes (a string
+// with invalid UTF-8 in it), so it is cut to its last 80 bytes and escaped like every quote.
+std::string describe(const Json::exception& e) {
+  std::string_view what = e.what();
+  auto open = what.find('\'');
+  auto close = what.rfind("'; expected ");
+  if (close == std::string_view::npos || close <= open) close = what.rfind('\'');
+  if (open == std::string_view::npos || close <= open) return quote(what, 400);
+  std::string_view token = what.substr(open + 1, close - open - 1);
+  std::string tail =
+      token.size() > 80 ? "…" + quote(token.substr(token.size() - 80)) : quote(token);
+  return quote(what.substr(0, open + 1), 400) + tail + quote(what.substr(close), 400);
+}
+
+// The one way a payload from the broker becomes JSON: size first, then a parse that stops at the
+// depth limit; every exception of the parser becomes an error sentence.
+Result<Json, std::string> parse(std::string_view payload, const PayloadLimits& limits) {
+  if (payload.size() > limits.maxBytes)
+    return Unexpected{"payload is " + std::to_string(payload.size()) + " bytes, more than " +
+                      std::to_string(limits.maxBytes) + " (it begins " + quote(payload) +
+                      "); send a smaller payload, or raise the limit with --mqtt-max-payload"};
+  Json::parser_callback_t depth = [&](int level, Json::parse_event_t event, Json&) {
+    // `level` counts the containers around this one
+    if ((event == Json::parse_event_t::object_start || event == Json::parse_event_t::array_start) &&
+        level >= limits.maxDepth)
+      throw TooDeep{};
+    return true;
+  };
+  try {
+    return Json::parse(payload, depth);
+  } catch (const TooDeep&) {
+    return Unexpected{"payload nests objects and arrays more than " +
+                      std::to_string(limits.maxDepth) + " deep (it begins " + quote(payload) +
+                      "); send flatter JSON"};
+  } catch (const Json::out_of_range& e) {
+    // 406: a number beyond a double (1e400) would otherwise be infinity
+    return Unexpected{"payload holds a number beyond the range of a double: " + describe(e) +
+                      "; send numbers within ±1.7e308 (and within the ranges of the intent)"};
+  } catch (const Json::parse_error& e) {
+    return Unexpected{"payload is not JSON: " + describe(e)};
+  } catch (const Json::exception& e) {
+    return Unexpected{"payload cannot be read: " + describe(e)};
+  }
+}
+
 }  // namespace
+
+std::string quote(std::string_view text, std::size_t maxBytes) {
+  std::string out;
+  std::size_t i = 0;
+  for (; i < text.size() && i < maxBytes;) {
+    auto b = static_cast<unsigned char>(text[i]);
+    std::size_t n = b < 0x80             ? 1
+                    : (b & 0xE0) == 0xC0 ? 2
+                    : (b & 0xF0) == 0xE0 ? 3
+                    : (b & 0xF8) == 0xF0 ? 4
+                                         : 0;
+    if (n == 1 && b >= 0x20 && b < 0x7f) {
+      out += static_cast<char>(b);
+      ++i;
+      continue;
+    }
+    // libmosquitto's check of one character: well formed (no overlong form, no surrogate) and
+    // printable (MQTT's rules refuse control characters and non-characters)
+    if (n > 1 && i + n <= text.size() && i + n <= maxBytes &&
+        mosquitto_validate_utf8(text.data() + i, static_cast<int>(n)) == MOSQ_ERR_SUCCESS) {
+      out.append(text.substr(i, n));
+      i += n;
+      continue;
+    }
+    out += "\\x" + toHex(std::span<const std::uint8_t>(&b, 1), "");
+    ++i;
+  }
+  if (i < text.size()) out += "…";
+  return out;
+}
 
 std::string carId(std::string_view address) {
   std::string id;
@@ -268,7 +362,7 @@ Result<int, std::string> integer(const Json& j, const char* key, int lo, int hi,
   const Json& v = **f;
   if (!v.is_number_integer())
     return Unexpected{std::string("\"") + key + "\" must be an integer, not " + typeName(v) + " (" +
-                      v.dump() + ")"};
+                      excerpt(v) + ")"};
   double d = v.get<double>();
   std::string u = unit.empty() ? "" : " " + std::string(unit);
   if (d < lo || d > hi)
@@ -292,7 +386,7 @@ Parsed laneIntent(const Json& j) {
   if (!f) return Unexpected{f.error()};
   const Json& v = **f;
   if (!v.is_number())
-    return Unexpected{"\"offset\" must be a number, not " + typeName(v) + " (" + v.dump() + ")"};
+    return Unexpected{"\"offset\" must be a number, not " + typeName(v) + " (" + excerpt(v) + ")"};
   double d = v.get<double>();
   if (!(d >= L::kOffsetMin && d <= L::kOffsetMax))
     return Unexpected{"offset " + v.dump() + " mm is out of range " +
@@ -319,9 +413,9 @@ Parsed messageIntent(const Json& j) {
   const Json& v = **f;
   if (!v.is_string())
     return Unexpected{"\"frame\" must be a string of hex digits, not " + typeName(v) + " (" +
-                      v.dump() + ")"};
+                      excerpt(v) + ")"};
   auto bytes = fromHex(v.get_ref<const std::string&>());
-  if (!bytes) return Unexpected{"\"frame\": " + bytes.error()};
+  if (!bytes) return Unexpected{"\"frame\": " + quote(bytes.error())};
   auto message = anki::decode(*bytes);
   if (!message) return Unexpected{"\"frame\": " + message.error().message()};
   if (!isCommand(*message))
@@ -346,7 +440,7 @@ Parsed commandIntent(const Json& j) {
   if (!f) return Unexpected{f.error()};
   const Json& t = **f;
   if (!t.is_string())
-    return Unexpected{"\"type\" must be a string, not " + typeName(t) + " (" + t.dump() + ")"};
+    return Unexpected{"\"type\" must be a string, not " + typeName(t) + " (" + excerpt(t) + ")"};
   const auto& type = t.get_ref<const std::string&>();
   if (type == "speed") return speedIntent(j);
   if (type == "lane") return laneIntent(j);
@@ -355,7 +449,7 @@ Parsed commandIntent(const Json& j) {
   if (type == "version") return Action{VersionIntent{}};
   if (type == "ping") return Action{PingIntent{}};
   if (type == "message") return messageIntent(j);
-  return Unexpected{"unknown intent type " + t.dump() +
+  return Unexpected{"unknown intent type " + excerpt(t) +
                     "; expected one of speed, lane, turn, battery, version, ping, message"};
 }
 
@@ -364,8 +458,8 @@ Parsed connectionIntent(const Json& j) {
   if (!f) return Unexpected{f.error()};
   const Json& v = **f;
   if (!v.is_boolean())
-    return Unexpected{"\"connecting\" must be true or false, not " + typeName(v) + " (" + v.dump() +
-                      ")"};
+    return Unexpected{"\"connecting\" must be true or false, not " + typeName(v) + " (" +
+                      excerpt(v) + ")"};
   return Action{ConnectIntent{v.get<bool>()}};
 }
 
@@ -383,7 +477,8 @@ std::vector<std::string_view> split(std::string_view s) {
 
 Result<Intent, IntentError> parseIntent(std::string_view host, std::string_view topic,
                                         std::string_view payload,
-                                        std::span<const std::string> knownCars) {
+                                        std::span<const std::string> knownCars,
+                                        const PayloadLimits& limits) {
   auto fail = [&](std::string message) {
     return Unexpected{IntentError{std::string(topic), std::move(message)}};
   };
@@ -393,7 +488,7 @@ Result<Intent, IntentError> parseIntent(std::string_view host, std::string_view 
   bool connection = false;
   if (parts.size() >= 3 && parts[0] == "Anki" && parts[1] == "Host" && parts[2] != host &&
       (parts.size() == 4 || parts.size() == 5) && parts[3] == "I") {
-    return fail("intent addressed to host \"" + std::string(parts[2]) + "\", this host is \"" +
+    return fail("intent addressed to host \"" + quote(parts[2]) + "\", this host is \"" +
                 std::string(host) + "\"");
   }
   if (parts.size() == 5 && parts[0] == "Anki" && parts[1] == "Host" && parts[2] == host &&
@@ -411,7 +506,7 @@ Result<Intent, IntentError> parseIntent(std::string_view host, std::string_view 
       if (std::find(knownCars.begin(), knownCars.end(), target.car) == knownCars.end()) {
         std::string known;
         for (const auto& c : knownCars) known += (known.empty() ? "" : ", ") + c;
-        return fail("unknown car \"" + target.car +
+        return fail("unknown car \"" + quote(target.car) +
                     "\"; known cars: " + (known.empty() ? "none" : known) + " (or \"all\")");
       }
     }
@@ -421,23 +516,29 @@ Result<Intent, IntentError> parseIntent(std::string_view host, std::string_view 
                 "/I, Anki/Car/all/I or Anki/Car/<car>/I");
   }
 
-  Json j;
-  try {
-    j = Json::parse(payload);
-  } catch (const Json::parse_error& e) {
-    return fail(std::string("payload is not JSON: ") + e.what());
-  }
-  if (!j.is_object())
-    return fail("payload must be a JSON object, not " + typeName(j) + " (" + j.dump() + ")");
+  auto j = parse(payload, limits);
+  if (!j) return fail(j.error());
+  if (!j->is_object())
+    return fail("payload must be a JSON object, not " + typeName(*j) + " (" + excerpt(*j) + ")");
 
-  Parsed action = connection ? connectionIntent(j) : commandIntent(j);
+  Parsed action = connection ? connectionIntent(*j) : commandIntent(*j);
   if (!action) return fail(action.error());
   return Intent{std::move(target), std::move(*action)};
 }
 
 Publication intentError(std::string_view host, const IntentError& error, Millis now) {
-  Json j{{"timestamp", now}, {"topic", error.topic}, {"error", error.message}};
-  return {hostTopic(host, "S/IntentError"), j.dump(), kStatusQos, false};
+  // The topic and the sentence both come from the sender one way or another. They are cut until
+  // the whole fits kMaxIntentError; the second cut fits whatever they hold (JSON escapes at most
+  // sextuple a byte: \u001f). replace() turns any invalid UTF-8 left into U+FFFD, not a throw.
+  std::string payload;
+  for (auto [topicBytes, errorBytes] : {std::pair<std::size_t, std::size_t>{200, 800}, {32, 100}}) {
+    Json j{{"timestamp", now},
+           {"topic", quote(error.topic, topicBytes)},
+           {"error", clip(error.message, errorBytes)}};
+    payload = j.dump(-1, ' ', false, Json::error_handler_t::replace);
+    if (payload.size() <= kMaxIntentError) break;
+  }
+  return {hostTopic(host, "S/IntentError"), std::move(payload), kStatusQos, false};
 }
 
 // ---- the reading side ----
@@ -499,14 +600,10 @@ std::optional<TopicParts> splitTopic(std::string_view topic) {
 
 namespace {
 
-Result<Json, std::string> object(std::string_view payload) {
-  Json j;
-  try {
-    j = Json::parse(payload);
-  } catch (const Json::parse_error& e) {
-    return Unexpected{std::string("payload is not JSON: ") + e.what()};
-  }
-  if (!j.is_object()) return Unexpected{"payload must be a JSON object, not " + typeName(j)};
+Result<Json, std::string> object(std::string_view payload, const PayloadLimits& limits) {
+  auto j = parse(payload, limits);
+  if (!j) return j;
+  if (!j->is_object()) return Unexpected{"payload must be a JSON object, not " + typeName(*j)};
   return j;
 }
 
@@ -517,7 +614,7 @@ Result<T, std::string> key(const Json& j, const char* name) {
   try {
     return it->get<T>();
   } catch (const Json::exception&) {
-    return Unexpected{std::string("\"") + name + "\" has the wrong type (" + it->dump() + ")"};
+    return Unexpected{std::string("\"") + name + "\" has the wrong type (" + excerpt(*it) + ")"};
   }
 }
 
@@ -529,14 +626,15 @@ Result<T, std::string> unsignedKey(const Json& j, const char* name) {
   constexpr auto max = std::numeric_limits<T>::max();
   if (!it->is_number_unsigned() || it->get<std::uint64_t>() > max)
     return Unexpected{std::string("\"") + name + "\" must be an integer 0.." + std::to_string(max) +
-                      ", not " + it->dump()};
+                      ", not " + excerpt(*it)};
   return static_cast<T>(it->get<std::uint64_t>());
 }
 
 }  // namespace
 
-Result<CarInfo, std::string> readInformation(std::string_view car, std::string_view payload) {
-  auto j = object(payload);
+Result<CarInfo, std::string> readInformation(std::string_view car, std::string_view payload,
+                                             const PayloadLimits& limits) {
+  auto j = object(payload, limits);
   if (!j) return Unexpected{j.error()};
   CarInfo info;
   info.id = std::string(car);
@@ -555,8 +653,9 @@ Result<CarInfo, std::string> readInformation(std::string_view car, std::string_v
   return info;
 }
 
-Result<CarOnline, std::string> readCarStatus(std::string_view payload) {
-  auto j = object(payload);
+Result<CarOnline, std::string> readCarStatus(std::string_view payload,
+                                             const PayloadLimits& limits) {
+  auto j = object(payload, limits);
   if (!j) return Unexpected{j.error()};
   CarOnline out;
   auto online = key<bool>(*j, "online");
@@ -567,24 +666,28 @@ Result<CarOnline, std::string> readCarStatus(std::string_view payload) {
   return out;
 }
 
-Result<bool, std::string> readHostStatus(std::string_view payload) {
-  auto j = object(payload);
+Result<bool, std::string> readHostStatus(std::string_view payload, const PayloadLimits& limits) {
+  auto j = object(payload, limits);
   if (!j) return Unexpected{j.error()};
   return key<bool>(*j, "value");
 }
 
-Result<std::vector<std::string>, std::string> readHostCars(std::string_view payload) {
-  auto j = object(payload);
+Result<std::vector<std::string>, std::string> readHostCars(std::string_view payload,
+                                                           const PayloadLimits& limits) {
+  auto j = object(payload, limits);
   if (!j) return Unexpected{j.error()};
   return key<std::vector<std::string>>(*j, "value");
 }
 
-Result<std::vector<std::uint8_t>, std::string> readFrameEvent(std::string_view payload) {
-  auto j = object(payload);
+Result<std::vector<std::uint8_t>, std::string> readFrameEvent(std::string_view payload,
+                                                              const PayloadLimits& limits) {
+  auto j = object(payload, limits);
   if (!j) return Unexpected{j.error()};
   auto text = key<std::string>(*j, "value");
   if (!text) return Unexpected{text.error()};
-  return fromHex(*text);
+  auto bytes = fromHex(*text);
+  if (!bytes) return Unexpected{quote(bytes.error())};  // a pair may cut a character in two
+  return bytes;
 }
 
 }  // namespace pitwall::topics

@@ -4,6 +4,7 @@
 // intent → a typed Intent or an error that says what is wrong. No sockets and no cars are touched
 // here; the bridge publishes the results and executes valid intents. docs/mqtt-topics.md is the
 // user-facing description of the same tree.
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -17,6 +18,24 @@
 #include "engine/vehicles/anki_car.hpp"
 
 namespace pitwall::topics {
+
+// ---- hostile input (docs/mqtt.md "Hostile input") ----
+
+// What a payload from the broker may be. Anyone who can publish on the broker can send anything:
+// a larger payload is refused before it is parsed, a deeper one as soon as the parser reaches
+// the limit, so a hostile publication costs little and cannot exhaust the stack.
+inline constexpr std::size_t kDefaultMaxPayload = 64 * 1024;  // bytes; --mqtt-max-payload
+inline constexpr int kMaxDepth = 64;  // nested objects and arrays; pitwall's own payloads use 1
+struct PayloadLimits {
+  std::size_t maxBytes = kDefaultMaxPayload;
+  int maxDepth = kMaxDepth;
+};
+
+// How an error message shows text it received (a payload, a topic level, a value): at most
+// `maxBytes` of it (then "…"), with every byte that is not part of a printable
+// UTF-8 character (control characters, invalid UTF-8) as \xNN. The result is valid UTF-8 of at
+// most 4 × maxBytes + 3 bytes.
+std::string quote(std::string_view text, std::size_t maxBytes = 80);
 
 struct Publication {
   std::string topic;
@@ -146,14 +165,19 @@ struct IntentError {
 };
 
 // Parses an intent received on `topic`. `knownCars` are the car ids a single-car intent may
-// name. Values are checked against engine/protocol/anki/limits.hpp.
+// name. Values are checked against engine/protocol/anki/limits.hpp. A payload beyond `limits`,
+// invalid UTF-8, or a number beyond a double is an error like any other; the error quotes at
+// most 80 bytes of what was received (quote()).
 Result<Intent, IntentError> parseIntent(std::string_view host, std::string_view topic,
                                         std::string_view payload,
-                                        std::span<const std::string> knownCars);
+                                        std::span<const std::string> knownCars,
+                                        const PayloadLimits& limits = {});
 
 // The answer to a rejected intent: Anki/Host/<host>/S/IntentError, QoS 1, not retained (an
 // error belongs to one intent; a late subscriber must not see it as current state), payload
-// {"timestamp":…,"topic":…,"error":…}.
+// {"timestamp":…,"topic":…,"error":…}. Whatever the error holds, the payload is valid JSON of
+// at most kMaxIntentError bytes (a longer topic or sentence is cut, marked "…").
+inline constexpr std::size_t kMaxIntentError = 1024;
 Publication intentError(std::string_view host, const IntentError& error, Millis now);
 
 // ---- the reading side: a remote pitwall's view of the tree ----
@@ -171,14 +195,20 @@ struct TopicParts {
 };
 std::optional<TopicParts> splitTopic(std::string_view topic);
 
-// Payload readers; an error says what is wrong with the payload.
-Result<CarInfo, std::string> readInformation(std::string_view car, std::string_view payload);
+// Payload readers; an error says what is wrong with the payload (quoting at most 80 bytes of it,
+// escaped). A payload beyond `limits` is refused before it is parsed.
+Result<CarInfo, std::string> readInformation(std::string_view car, std::string_view payload,
+                                             const PayloadLimits& limits = {});
 struct CarOnline {
   bool online = false, charging = false, onTrack = false;
 };
-Result<CarOnline, std::string> readCarStatus(std::string_view payload);
-Result<bool, std::string> readHostStatus(std::string_view payload);
-Result<std::vector<std::string>, std::string> readHostCars(std::string_view payload);
-Result<std::vector<std::uint8_t>, std::string> readFrameEvent(std::string_view payload);
+Result<CarOnline, std::string> readCarStatus(std::string_view payload,
+                                             const PayloadLimits& limits = {});
+Result<bool, std::string> readHostStatus(std::string_view payload,
+                                         const PayloadLimits& limits = {});
+Result<std::vector<std::string>, std::string> readHostCars(std::string_view payload,
+                                                           const PayloadLimits& limits = {});
+Result<std::vector<std::uint8_t>, std::string> readFrameEvent(std::string_view payload,
+                                                              const PayloadLimits& limits = {});
 
 }  // namespace pitwall::topics
