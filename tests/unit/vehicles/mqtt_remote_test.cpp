@@ -13,12 +13,14 @@
 #include <string>
 #include <vector>
 
+#include "engine/core/hex.hpp"
 #include "engine/core/log.hpp"
 #include "engine/protocol/anki/codec.hpp"
 #include "engine/sim/grid.hpp"
 #include "engine/sim/track.hpp"
 #include "engine/sim/world.hpp"
 #include "engine/vehicles/mqtt_bridge.hpp"
+#include "tests/support/hostile_payloads.hpp"
 #include "tests/support/mosquitto_broker.hpp"
 #include "tests/support/run_until.hpp"
 
@@ -59,8 +61,9 @@ struct BridgedHost {
     auto options = MqttOptions::fromUrl(broker.url());
     options.will = MqttBridge::will(kHost);
     client = std::make_unique<MqttClient>(loop, options);
-    bridge = std::make_unique<MqttBridge>(loop, fleet, *client, BridgeOptions{kHost, false},
-                                          CarConnections{});
+    BridgeOptions bridgeOptions;
+    bridgeOptions.host = kHost;
+    bridge = std::make_unique<MqttBridge>(loop, fleet, *client, bridgeOptions, CarConnections{});
     client->connect();
     REQUIRE(runUntil(loop, [&] { return client->state() == MqttClient::State::Connected; }));
   }
@@ -357,4 +360,78 @@ TEST_CASE("mqtt remote: malformed status and frames on the tree are ignored with
   CHECK(p.reaches(
       0, [](AnkiCar& c) { return c.setSpeed(450); }, anki::SetSpeed{450, kDefaultAccel, false}));
   REQUIRE(runUntil(p.loop, [&] { return p.b.car(0).state().speed_mm_s > 0; }));
+}
+
+TEST_CASE(
+    "mqtt remote: hostile publications on every topic it reads are ignored, the cars follow") {
+  Pair p;
+  std::vector<std::string> warnings;
+  log::setSink([&](log::Level level, std::string_view line) {
+    if (level == log::Level::Warn) warnings.emplace_back(line);
+  });
+  struct Restore {
+    ~Restore() { log::setSink(nullptr); }
+  } restore;
+
+  MqttClient vandal(p.loop, MqttOptions::fromUrl(p.broker.url()));
+  bool connected = false;
+  vandal.onConnected = [&] { connected = true; };
+  vandal.connect();
+  REQUIRE(runUntil(p.loop, [&] { return connected; }));
+  const std::string car = "Anki/Car/" + p.a.bridge->carIdOf(p.aOf(0));
+  const std::string host = "Anki/Host/" + kHost;
+  const std::vector<std::string> read = {car + "/S/CarStatus",
+                                         car + "/S/Information",
+                                         car + "/E/frame",
+                                         "Anki/Car/stranger/S/Information",
+                                         "Anki/Car/stranger/S/CarStatus",
+                                         host + "/S/HostStatus",
+                                         host + "/S/Cars",
+                                         host + "/S/IntentError",
+                                         "Anki/Host/other/S/Cars"};
+  // The reader is alive and a valid frame still updates the car: a battery report of its own.
+  int millivolts = 3000;
+  auto follows = [&] {
+    ++millivolts;
+    auto frame = anki::encode(anki::BatteryResponse{static_cast<std::uint16_t>(millivolts)});
+    // E/frame is QoS 0: the broker may drop one behind a queue of large QoS 1 messages, so it is
+    // sent again until it arrives
+    for (int attempt = 0; attempt < 10; ++attempt) {
+      REQUIRE(vandal.publish(car + "/E/frame",
+                             R"({"timestamp":1,"value":")" + toHex(frame.span(), "") + R"("})", 0));
+      if (runUntil(
+              p.loop, [&] { return p.b.car(0).state().battery_mv == millivolts; }, 500ms))
+        return true;
+    }
+    return false;
+  };
+
+  auto payloads = pitwall::testing::hostilePayloads();
+  payloads.push_back({"empty", "", ""});
+  payloads.push_back({"64 KB", pitwall::testing::paddedSpeedIntent(64 * 1024), ""});
+  payloads.push_back({"64 deep", pitwall::testing::deepSpeedIntent(64), ""});
+  // a valid hex frame of 32 KB: no vehicle message, the car counts it as malformed
+  payloads.push_back({"a 32 KB frame", R"({"value":")" + std::string(64000, 'f') + R"("})", ""});
+  auto start = p.loop.now();
+  for (const auto& bad : payloads) {
+    CAPTURE(bad.name);
+    for (const auto& topic : read) REQUIRE(vandal.publish(topic, bad.payload, 1));
+    CHECK(follows());
+  }
+  double seconds = toSeconds(p.loop.now() - start);
+  CAPTURE(seconds);
+
+  // Warnings name what was wrong in short lines, and a flood of junk is not a flood of them.
+  CHECK(!warnings.empty());
+  for (const auto& w : warnings) CHECK(w.size() < 1500);
+  CHECK(warnings.size() <= 20 + 10 * seconds + 5);  // (+ the car's own about the 32 KB frame)
+  CHECK(std::any_of(warnings.begin(), warnings.end(), [](const std::string& w) {
+    return w.find("not logged before this one") != std::string::npos;
+  }));
+
+  // Nothing broke: the same two cars, online, driven as before.
+  CHECK(p.b.fleet.cars().size() == 2);
+  CHECK(p.allUp());
+  CHECK(p.reaches(
+      0, [](AnkiCar& c) { return c.setSpeed(450); }, anki::SetSpeed{450, kDefaultAccel, false}));
 }

@@ -2,6 +2,10 @@
 
 #include <doctest/doctest.h>
 
+#include <nlohmann/json.hpp>
+
+#include "tests/support/hostile_payloads.hpp"
+
 using namespace pitwall;
 using namespace pitwall::topics;
 
@@ -499,4 +503,91 @@ TEST_CASE("mqtt topics: the reading side splits topics and reads status payloads
   std::vector<std::string> cars{"a", "b"};
   CHECK(*readHostCars(hostCars("pit1", cars, kNow).payload) == cars);
   CHECK(readHostCars(R"({"value":[1]})").error() == "\"value\" has the wrong type ([1])");
+}
+
+TEST_CASE("mqtt topics: quote() shows at most so many bytes, printable, invalid bytes as \\xNN") {
+  CHECK(quote("speed") == "speed");
+  CHECK(quote("é ✓ 🏁") == "é ✓ 🏁");
+  CHECK(quote("a\xff"
+              "b\n\x01") == "a\\xffb\\x0a\\x01");
+  CHECK(quote("\xc3\x28") == "\\xc3(");               // a lead byte without its continuation
+  CHECK(quote("\xed\xa0\x80") == "\\xed\\xa0\\x80");  // a UTF-16 surrogate
+  CHECK(quote("\xc0\xaf") == "\\xc0\\xaf");           // an overlong '/'
+  CHECK(quote(std::string(100, 'x')) == std::string(80, 'x') + "…");
+  CHECK(quote("abcdé", 5) == "abcd\\xc3…");  // a character cut by the limit
+  CHECK(quote(std::string(5, '\0'), 3) == "\\x00\\x00\\x00…");
+}
+
+TEST_CASE("mqtt intents: a hostile payload is an error that quotes at most 80 bytes, escaped") {
+  for (const auto& bad : pitwall::testing::hostilePayloads()) {
+    CAPTURE(bad.name);
+    auto e = rejected("Anki/Car/all/I", bad.payload);
+    CAPTURE(e);
+    CHECK(e.find(bad.error) != std::string::npos);
+    CHECK(e.size() < 600);
+    // the answer is valid JSON within its bound, whatever the payload held
+    auto answer = intentError("pit1", IntentError{"Anki/Car/all/I", e}, kNow).payload;
+    CHECK(answer.size() <= kMaxIntentError);
+    CHECK(nlohmann::json::parse(answer)["error"] == e);
+  }
+  CHECK(rejected("Anki/Car/all/I", "5e999") ==
+        "payload holds a number beyond the range of a double: [json.exception.out_of_range.406] "
+        "number overflow parsing '5e999'; send numbers within ±1.7e308 (and within the ranges of "
+        "the intent)");
+  CHECK(rejected("Anki/Car/all/I", "{\"type\":\"fly\xff\"}")
+            .ends_with("ill-formed UTF-8 byte; last read: '\"fly\\xff'"));
+  // The token nlohmann quotes is cut to its last 80 bytes.
+  auto longToken = rejected("Anki/Car/all/I", "{\"type\":\"" + std::string(60000, 'a') + "\x01");
+  // (nlohmann shows a control character as <U+0001> itself)
+  CHECK(longToken.find("last read: '…" + std::string(72, 'a') + "<U+0001>'") != std::string::npos);
+  CHECK(rejected("Anki/Car/all/I", std::string(70000, ' ')) ==
+        "payload is 70000 bytes, more than 65536 (it begins " + std::string(80, ' ') +
+            "…); send a smaller payload, or raise the limit with --mqtt-max-payload");
+  CHECK(rejected("Anki/Car/all/I", pitwall::testing::nested(65, "")) ==
+        "payload nests objects and arrays more than 64 deep (it begins " + std::string(65, '[') +
+            std::string(15, ']') + "…); send flatter JSON");
+  // up to the limits: accepted
+  CHECK(accepted("Anki/Car/all/I", pitwall::testing::deepSpeedIntent(64)).action ==
+        Action{SpeedIntent{600, 1000}});
+  CHECK(accepted("Anki/Car/all/I", pitwall::testing::paddedSpeedIntent(64 * 1024)).action ==
+        Action{SpeedIntent{600, 1000}});
+  // and the limits are the caller's
+  CHECK(parseIntent("pit1", "Anki/Car/all/I", pitwall::testing::paddedSpeedIntent(2000), kCars,
+                    PayloadLimits{1999, 64})
+            .error()
+            .message.starts_with("payload is 2000 bytes, more than 1999"));
+  CHECK(parseIntent("pit1", "Anki/Car/all/I", pitwall::testing::deepSpeedIntent(3), kCars,
+                    PayloadLimits{kDefaultMaxPayload, 2})
+            .error()
+            .message.starts_with("payload nests objects and arrays more than 2 deep"));
+}
+
+TEST_CASE("mqtt intents: an error about a hostile topic quotes it short and escaped") {
+  std::string car(5000, 'c');
+  auto e = rejected("Anki/Car/" + car + "/I", R"({"type":"ping"})");
+  CHECK(e.starts_with("unknown car \"" + std::string(80, 'c') + "…\"; known cars: "));
+  auto answer =
+      intentError("pit1", IntentError{std::string(60000, '\xff'), std::string(60000, '"')}, kNow);
+  CHECK(answer.payload.size() <= kMaxIntentError);
+  CHECK_NOTHROW(nlohmann::json::parse(answer.payload));
+}
+
+TEST_CASE("mqtt topics: the readers refuse hostile payloads with an error, never an exception") {
+  for (const auto& bad : pitwall::testing::hostilePayloads()) {
+    CAPTURE(bad.name);
+    CHECK_FALSE(readInformation(kCar, bad.payload));
+    CHECK_FALSE(readCarStatus(bad.payload));
+    CHECK_FALSE(readHostStatus(bad.payload));
+    CHECK_FALSE(readHostCars(bad.payload));
+    auto frame = readFrameEvent(bad.payload);
+    REQUIRE_FALSE(frame);
+    CHECK(frame.error().size() < 600);
+  }
+  // a pair that cuts a character in two is shown escaped
+  CHECK(readFrameEvent("{\"value\":\"0\xc3\xa9"
+                       "f\"}")
+            .error() == "\"0\\xc3\" is not a hex byte");
+  CHECK(readCarStatus(pitwall::testing::nested(3, ""), PayloadLimits{100, 2})
+            .error()
+            .starts_with("payload nests objects and arrays more than 2 deep"));
 }
