@@ -20,6 +20,7 @@ std::string seconds(Duration d) {
 GattClient::GattClient(Bluez& bluez, std::string devicePath, std::string address,
                        LinkTimeouts timeouts)
     : bluez_(bluez),
+      loop_(bluez.loop()),
       devicePath_(std::move(devicePath)),
       address_(std::move(address)),
       timeouts_(timeouts),
@@ -27,7 +28,7 @@ GattClient::GattClient(Bluez& bluez, std::string devicePath, std::string address
 
 GattClient::~GattClient() {
   *alive_ = false;
-  bluez_.loop().cancel(stepTimer_);
+  loop_.cancel(stepTimer_);
 }
 
 void GattClient::armStepTimer(Duration timeout, std::string what) {

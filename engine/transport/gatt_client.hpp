@@ -87,6 +87,10 @@ class GattClient {
   void disconnectQuietly();  // Device1.Disconnect, nobody waiting for the answer
 
   Bluez& bluez_;
+  // The loop itself, not through bluez_: a link may outlive the Bluez (the fleet that holds the
+  // links is destroyed after the Central that owns the Bluez), and its destructor still cancels
+  // the step timer (found by the ASan unit run, docs/testing.md).
+  Loop& loop_;
   std::string devicePath_, address_;
   LinkTimeouts timeouts_;
   Step step_ = Step::Idle;

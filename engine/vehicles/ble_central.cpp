@@ -64,8 +64,11 @@ void scanForCars(Bluez& bluez, const std::vector<const Adapter*>& adapters, Dura
                        [&](const std::string& w) { return state->seen.count(w) > 0; });
   };
 
-  state->finish = [&bluez, state, done] {
-    if (state->finished) return;
+  // A weak reference: the state owns `finish`, so a strong one would keep the state alive
+  // forever (found by LeakSanitizer, docs/testing.md). Whoever calls finish holds the state.
+  state->finish = [&bluez, weak = std::weak_ptr<State>(state), done] {
+    auto state = weak.lock();
+    if (!state || state->finished) return;
     state->finished = true;
     bluez.loop().cancel(state->timer);
     bluez.onDevice = state->previous;
