@@ -39,15 +39,23 @@ void Loop::post(Callback fn) {
 }
 
 bool Loop::fireDue() {
-  bool fired = false;
-  TimePoint t = now();
+  // One bounded batch: the timers due when it began (not those a callback schedules for "now"
+  // again), and at most kBatchTimers of them or kBatchTime of real time. Between batches the
+  // loop polls signals and sockets, so timer work that never ends (a periodic callback slower
+  // than its period) slows itself and never Ctrl-C (docs/safety.md).
+  constexpr int kBatchTimers = 256;
+  constexpr auto kBatchTime = std::chrono::milliseconds(20);
+  const TimePoint t = now();
+  const auto began = std::chrono::steady_clock::now();
+  int count = 0;
   while (!stopped_ && !timers_.empty() && timers_.begin()->first.when <= t) {
     auto node = timers_.extract(timers_.begin());
     keys_.erase(node.mapped().first);
-    fired = true;
     node.mapped().second();
+    if (++count >= kBatchTimers) break;
+    if (kind_ == ClockKind::Real && std::chrono::steady_clock::now() - began >= kBatchTime) break;
   }
-  return fired;
+  return count > 0;
 }
 
 void Loop::stop() {

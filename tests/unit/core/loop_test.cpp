@@ -2,6 +2,7 @@
 
 #include <doctest/doctest.h>
 
+#include <functional>
 #include <vector>
 
 using namespace pitwall;
@@ -69,4 +70,46 @@ TEST_CASE("a real loop fires a timer after its delay and stops") {
   });
   loop.run();
   CHECK(firedAt >= 0.020);
+}
+
+// Timer work that never catches up (docs/safety.md): signals, sockets and posted work still get
+// their turn between bounded batches. The hog gives up after 200 rounds so that a loop without
+// the bound fails the check instead of hanging.
+TEST_CASE("a timer that is always overdue does not starve posted work (real clock)") {
+  Loop loop(ClockKind::Real);
+  int hogRounds = 0, roundsBeforePost = -1;
+  std::function<void(TimePoint)> hog = [&](TimePoint due) {
+    auto until = std::chrono::steady_clock::now() + 5ms;
+    while (std::chrono::steady_clock::now() < until) {
+    }
+    if (++hogRounds < 200) loop.at(due + 1ms, [&hog, due] { hog(due + 1ms); });
+  };
+  loop.at(0ms, [&hog] { hog(0ms); });
+  loop.after(1ms, [&] {
+    loop.post([&] {
+      roundsBeforePost = hogRounds;
+      loop.stop();
+    });
+  });
+  loop.run();
+  CHECK(roundsBeforePost >= 0);
+  CHECK(roundsBeforePost < 20);
+}
+
+TEST_CASE("a timer that reschedules itself for now does not starve posted work (virtual)") {
+  Loop loop(ClockKind::Virtual);
+  int rounds = 0, roundsBeforePost = -1;
+  std::function<void()> again = [&] {
+    if (++rounds < 100000) loop.after(0ms, again);
+  };
+  loop.after(0ms, again);
+  loop.post([&] {
+    loop.post([&] {
+      roundsBeforePost = rounds;
+      loop.stop();
+    });
+  });
+  loop.run();
+  CHECK(roundsBeforePost >= 0);
+  CHECK(roundsBeforePost < 1000);
 }
