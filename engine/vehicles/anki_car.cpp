@@ -37,6 +37,9 @@ std::string AnkiCar::label() const {
 
 AnkiCar::Sent AnkiCar::send(const Message& message) {
   if (auto problem = limits::validate(message)) return Unexpected{*problem};
+  if (halted_ && !std::holds_alternative<Disconnect>(message))
+    return Unexpected{label() + " was stopped for the end of the run and takes no more commands; " +
+                      std::string(name(message)) + " was not sent"};
   if (!link_.connected())
     return Unexpected{label() + " is not connected; " + std::string(name(message)) +
                       " was not sent"};
@@ -61,6 +64,13 @@ AnkiCar::Sent AnkiCar::setSpeed(int speed, int accel, bool respect_limit) {
 
 AnkiCar::Sent AnkiCar::stop() {
   return setSpeed(0, kStopAccel);
+}
+
+AnkiCar::Sent AnkiCar::halt() {
+  if (halted_) return true;
+  auto sent = link_.connected() ? stop() : Sent{true};
+  halted_ = true;
+  return sent;
 }
 
 AnkiCar::Sent AnkiCar::changeLane(double offset, int h_speed, int h_accel) {

@@ -81,6 +81,10 @@ class AnkiCar {
   Sent disconnect();
   // Any controller→vehicle message, validated (the CLI and bridges use this).
   Sent send(const anki::Message& message);
+  // The end of the run (docs/safety.md): a stop, when connected, and from then on no command
+  // but a disconnect is sent, whoever asks (a script, the REPL, an MQTT intent). Final.
+  Sent halt();
+  bool halted() const { return halted_; }
 
   // Events. Handlers are called on the loop; the message has already updated state().
   std::function<void(const anki::Message&)> onMessage;
@@ -103,6 +107,7 @@ class AnkiCar {
   Link& link_;
   CarIdentity identity_;
   CarState state_;
+  bool halted_ = false;
   std::optional<double> pingSentAt_;
   std::optional<double> lastPingRtt_;
 };

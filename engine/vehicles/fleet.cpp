@@ -69,4 +69,9 @@ void Fleet::stopAll() {
       if (auto sent = car->stop(); !sent) log::warn(car->label(), sent.error());
 }
 
+void Fleet::haltAll() {
+  for (auto* car : cars_)
+    if (auto sent = car->halt(); !sent) log::warn(car->label(), sent.error());
+}
+
 }  // namespace pitwall

@@ -38,6 +38,8 @@ class Fleet {
 
   // Sends speed 0 to every connected car (shutdown, end of run, script death).
   void stopAll();
+  // The end of the run: every car gets its stop and takes no command after it (AnkiCar::halt).
+  void haltAll();
 
  private:
   struct Entry;

@@ -139,3 +139,35 @@ TEST_CASE_FIXTURE(Fixture,
   link.setConnected(false);
   CHECK_FALSE(car.state().lane_change_target_mm);  // nor one that lost its link
 }
+
+TEST_CASE_FIXTURE(Fixture, "halt sends the stop and then refuses every command but a disconnect") {
+  link.setConnected(true);
+  REQUIRE(car.setSpeed(800));
+  REQUIRE(car.halt());
+  Message last = link.lastSent();
+  auto* stop = std::get_if<SetSpeed>(&last);
+  REQUIRE(stop);
+  CHECK(stop->speed_mm_s == 0);
+  auto sent = link.sent.size();
+  auto refused = car.setSpeed(800);
+  REQUIRE_FALSE(refused);
+  CHECK(refused.error() ==
+        "car 1 (skull) was stopped for the end of the run and takes no more commands; set-speed "
+        "was not sent");
+  CHECK_FALSE(car.changeLane(23));
+  CHECK_FALSE(car.send(SetLights{0x44}));
+  CHECK_FALSE(car.stop());
+  CHECK(link.sent.size() == sent);
+  CHECK(car.halt());  // again: nothing more is sent
+  CHECK(link.sent.size() == sent);
+  CHECK(car.disconnect());
+  CHECK(std::holds_alternative<Disconnect>(link.lastSent()));
+}
+
+TEST_CASE_FIXTURE(Fixture, "a car halted while disconnected obeys nothing once it is back") {
+  REQUIRE(car.halt());
+  link.setConnected(true);
+  auto sent = link.sent.size();
+  CHECK_FALSE(car.setSpeed(500));
+  CHECK(link.sent.size() == sent);
+}
