@@ -3,7 +3,12 @@
 //   {"t":1.234567,"car":1,"dir":"tx","hex":"06 24 58 02 e8 03 00","msg":{"name":"set-speed",…}}
 // Times are engine-clock seconds with microsecond resolution, so a virtual-time run with the
 // same seed writes the same bytes.
-#include <fstream>
+//
+// The record is never lost (docs/safety.md): lines reach the file at least every 50 ms of real
+// time while frames come (and the session flushes every 50 ms in real time when none come), at
+// every way out of a run, and from a crash signal (SIGSEGV, SIGABRT, …) through write(2) of
+// whole lines only. A killed run loses at most its last 100 ms.
+#include <chrono>
 #include <span>
 #include <string>
 
@@ -15,13 +20,25 @@ class Recorder {
  public:
   // Throws std::runtime_error naming the file when it cannot be opened.
   explicit Recorder(const std::string& path);
+  ~Recorder();  // flushes
+  Recorder(const Recorder&) = delete;
+  Recorder& operator=(const Recorder&) = delete;
+
   void write(double t, int car, bool tx, std::span<const std::uint8_t> frame,
              const anki::Message& message);
+  // Everything written so far reaches the file.
+  void flush();
   std::size_t lines() const { return lines_; }
 
  private:
-  std::ofstream out_;
+  static constexpr std::size_t kCapacity = std::size_t{1} << 18;
+  int fd_ = -1;
+  std::string path_;
+  char* buffer_;          // kCapacity bytes, never reallocated (a crash handler reads it)
+  std::size_t used_ = 0;  // whole lines only
   std::size_t lines_ = 0;
+  std::chrono::steady_clock::time_point lastFlush_;
+  bool failed_ = false;
 };
 
 }  // namespace pitwall
