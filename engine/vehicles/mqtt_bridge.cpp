@@ -342,8 +342,20 @@ AnkiCar::Sent MqttBridge::apply(AnkiCar& car, const topics::Action& action) {
       action);
 }
 
+namespace {
+// A stop (speed 0) is never throttled: the rate limit must not stand between a car and its stop
+// (docs/safety.md). A flood of stops costs the car nothing it would not do anyway.
+bool isStop(const topics::Action& action) {
+  if (auto* s = std::get_if<topics::SpeedIntent>(&action)) return s->speed_mm_s == 0;
+  if (auto* m = std::get_if<topics::MessageIntent>(&action))
+    if (auto* s = std::get_if<anki::SetSpeed>(&m->message)) return s->speed_mm_s == 0;
+  return false;
+}
+}  // namespace
+
 void MqttBridge::execute(const topics::Intent& intent, const std::string& topic) {
   using Kind = topics::Target::Kind;
+  const bool stop = isStop(intent.action);
   if (auto* c = std::get_if<topics::ConnectIntent>(&intent.action)) {
     if (!admit(kConnection, topic)) {
       if (onIntentHandled) onIntentHandled(topic, false);
@@ -360,7 +372,7 @@ void MqttBridge::execute(const topics::Intent& intent, const std::string& topic)
   if (intent.target.kind == Kind::Car) {
     for (auto& [car, id] : ids_) {
       if (id != intent.target.car) continue;
-      if (!admit(id, topic)) {
+      if (!stop && !admit(id, topic)) {
         if (onIntentHandled) onIntentHandled(topic, false);
         return;
       }
@@ -374,7 +386,7 @@ void MqttBridge::execute(const topics::Intent& intent, const std::string& topic)
   }
   // Every car of this host: those not connected are skipped (a drop is not the sender's error).
   for (auto& [car, id] : ids_) {
-    if (!car->state().connected || !admit(id, topic)) continue;
+    if (!car->state().connected || (!stop && !admit(id, topic))) continue;
     auto sent = apply(*const_cast<AnkiCar*>(car), intent.action);
     if (!sent) log::warn(car->label(), "intent on " + topic + ": " + sent.error());
   }

@@ -800,6 +800,27 @@ TEST_CASE("mqtt bridge: a flood of intents to a car is cut to its rate, with one
   REQUIRE(runUntil(loop, [&] { return h.sent<anki::SetSpeed>(0).back().speed_mm_s == 1499; }));
 }
 
+TEST_CASE("mqtt bridge: a stop is never throttled, however full the flood before it") {
+  MosquittoBroker broker;
+  Loop loop(ClockKind::Real);
+  Observer o(loop, broker);
+  REQUIRE(runUntil(loop, [&] { return o.connects == 1; }));
+  Host h(loop, broker);
+  waitForCars(loop, o, h);
+  const std::string one = h.carTopic(0, "I");
+  constexpr int kFlood = 300;
+  for (int i = 0; i < kFlood; ++i)
+    o.send(one, R"({"type":"speed","speed":800,"acceleration":1000})");
+  o.send(one, R"({"type":"speed","speed":0,"acceleration":12500})");
+  const auto& stats = h.bridge->stats();
+  REQUIRE(runUntil(
+      loop, [&] { return stats.intents + stats.throttled == kFlood + 1; }, 20s));
+  CHECK(stats.throttled > 0);  // the bucket was empty when the stop came
+  auto speeds = h.sent<anki::SetSpeed>(0);
+  REQUIRE_FALSE(speeds.empty());
+  CHECK(speeds.back().speed_mm_s == 0);
+}
+
 TEST_CASE("mqtt bridge: a flood of bad intents gets a bounded number of answers") {
   MosquittoBroker broker;
   Loop loop(ClockKind::Real);
