@@ -3,6 +3,7 @@
 #include <pthread.h>
 #include <signal.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <mutex>
@@ -12,7 +13,7 @@ namespace pitwall::interrupt {
 
 namespace {
 
-enum Reason : int { kNone = 0, kUser = 1, kBudget = 2 };
+enum Reason : int { kNone = 0, kUser = 1, kBudget = 2, kMessage = 3 };
 
 // All of this is written on the loop's thread; the watchdog only reads. The signal handler runs
 // on the loop's thread too (the watchdog sends it there), so it sees the loop's own writes.
@@ -25,6 +26,7 @@ std::atomic<int> g_reason{kNone};            // why the current call is being in
 std::atomic<std::uint64_t> g_reasonCall{0};  // … and which call that is
 std::atomic<long long> g_budgetMs{100};
 std::atomic<pthread_t> g_loopThread{};
+char g_message[256] = {};  // abortRunning's message; written on the loop's thread only
 static_assert(std::atomic<lua_State*>::is_always_lock_free);
 static_assert(std::atomic<std::uint64_t>::is_always_lock_free);
 static_assert(std::atomic<pthread_t>::is_always_lock_free);
@@ -39,6 +41,7 @@ void hook(lua_State* L, lua_Debug*) {
   // The hook stays set: code that catches this error with pcall is interrupted again at its
   // next instruction, until the engine's call returns.
   if (reason == kUser) luaL_error(L, "interrupted");
+  if (reason == kMessage) luaL_error(L, "%s", g_message);
   luaL_error(L,
              "still running after %d ms: interrupted (a callback must return quickly; run long "
              "work in a task with pitwall.spawn and pitwall.sleep, or raise --budget)",
@@ -232,6 +235,18 @@ bool requestFromSignal() {
   if (!L || g_depth.load(std::memory_order_relaxed) == 0) return false;
   arm(L, kUser);
   return true;
+}
+
+void abortRunning(const std::string& message) {
+  std::size_t n = std::min(message.size(), sizeof g_message - 1);
+  message.copy(g_message, n);
+  g_message[n] = '\0';
+  lua_State* L = g_running.load(std::memory_order_relaxed);
+  if (L && g_depth.load(std::memory_order_relaxed) > 0) arm(L, kMessage);
+}
+
+bool inCall() {
+  return g_depth.load(std::memory_order_relaxed) > 0;
 }
 
 bool inConsole() {

@@ -11,6 +11,7 @@
 #include <lua.hpp>
 
 #include <chrono>
+#include <string>
 
 namespace pitwall::interrupt {
 
@@ -56,6 +57,13 @@ void watchThisThread();
 // For a SIGINT handler (async-signal-safe): interrupts the Lua code running now with the error
 // "interrupted". Returns false when no Lua code is running (the caller then cancels the line).
 bool requestFromSignal();
+
+// Ends the Lua code running now with `message` (copied), the way the budget does: pcall cannot
+// swallow it, until the engine's call returns. For the memory cap (sandbox.cpp).
+void abortRunning(const std::string& message);
+
+// True while the engine is inside a call into Lua (any kind).
+bool inCall();
 
 // True while a chunk typed at the REPL runs (the outermost call into Lua is Kind::Console):
 // commands that need the operator's confirmation ask for it then.

@@ -153,7 +153,7 @@ std::unique_ptr<ScriptHost> Reloader::makeWorld(bool detached) {
 void Reloader::hookStop(ScriptHost& host) {
   host.onStopRequested = [this, &host] {
     if (&host != current_.get()) return;  // on trial: reload() acts on it once it took over
-    if (keepRunning_ && host.mainFailed()) {
+    if (keepRunning_ && host.mainFailed() && !host.exitStatus()) {
       fleet_.stopAll();
       log::warn("pitwall",
                 "the script stopped with an error; its cars are stopped. Save a fix and it "
@@ -267,7 +267,13 @@ void Reloader::watchFile(const std::string& path) {
     log::warn("reload", "not watching " + path + ": " + added.error());
 }
 
+void Reloader::shutDown() {
+  shutDown_ = true;  // no version after this one (the watch itself lives on, idle)
+  current_->shutDown();
+}
+
 void Reloader::changed(const std::vector<std::string>& paths) {
+  if (shutDown_) return;
   std::string names;
   for (const auto& p : paths)
     names += (names.empty() ? "" : ", ") + std::filesystem::path(p).filename().string();

@@ -42,6 +42,10 @@ class Reloader {
   // stopped and the run waits for a fix (--watch, --repl).
   void keepRunningOnError(bool keep) { keepRunning_ = keep; }
 
+  // The run is ending (docs/safety.md): the current version shuts down (ScriptHost::shutDown)
+  // and no save starts another.
+  void shutDown();
+
   // pitwall.stop(), or the script died and nothing keeps the run going.
   std::function<void()> onStopRequested;
   // A new version took over (the REPL evaluates in host() from now on).
@@ -69,6 +73,7 @@ class Reloader {
   std::unique_ptr<FileWatch> watch_;
   std::vector<std::string> watched_;
   bool keepRunning_ = false;
+  bool shutDown_ = false;
   Stats stats_;
 };
 

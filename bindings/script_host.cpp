@@ -93,6 +93,19 @@ int consoleFileFlush(lua_State* L) {
   return 1;
 }
 
+// os.exit([code]): the run ends through the engine's stop path (the cars get their stop, the
+// record is flushed) with this exit status; the code running now is ended like an interrupt.
+int scriptExit(lua_State* L) {
+  int status = EXIT_SUCCESS;
+  if (lua_isboolean(L, 1))
+    status = lua_toboolean(L, 1) ? EXIT_SUCCESS : EXIT_FAILURE;
+  else if (!lua_isnoneornil(L, 1))
+    status = static_cast<int>(luaL_checkinteger(L, 1) & 0xff);
+  ScriptHost::from(L).requestExit(status);
+  interrupt::abortRunning("os.exit: the run is ending");
+  return 0;
+}
+
 std::string scriptsDir() {
   if (const char* env = std::getenv("PITWALL_SCRIPTS")) return env;
   return PITWALL_SCRIPTS_DIR;
@@ -101,7 +114,7 @@ std::string scriptsDir() {
 
 ScriptHost::ScriptHost(Loop& loop, Fleet& fleet, SimSession* sim, HostOptions options)
     : loop_(loop), fleet_(fleet), sim_(sim), options_(std::move(options)) {
-  L_ = luaL_newstate();
+  L_ = sandbox::newState(memory_);
   if (!L_) throw std::runtime_error("cannot create a Lua state (out of memory)");
   interrupt::watchThisThread();
   *static_cast<ScriptHost**>(lua_getextraspace(L_)) = this;
@@ -130,6 +143,7 @@ void ScriptHost::detach() {
 }
 
 void ScriptHost::carJoined(AnkiCar& car) {
+  if (shutDown_) return;
   cars_->bind(car);
   lua_State* L = L_;
   int top = lua_gettop(L);
@@ -159,6 +173,11 @@ ScriptHost& ScriptHost::from(lua_State* L) {
 void ScriptHost::openLibraries() {
   lua_State* L = L_;
   luaL_openlibs(L);
+  sandbox::restrict(L);
+  lua_getglobal(L, "os");
+  lua_pushcfunction(L, scriptExit);
+  lua_setfield(L, -2, "exit");
+  lua_pop(L, 1);
   interrupt::openCoroutineTracking(L);
   trackRequire();
   lua_pushcfunction(L, consolePrint);
@@ -241,6 +260,10 @@ int ScriptHost::searchAndRecord(lua_State* L) {
 
 bool ScriptHost::call(int nargs, int nresults, const char* what, const AnkiCar* car) {
   lua_State* L = L_;
+  if (shutDown_) {
+    lua_pop(L, nargs + 1);
+    return false;
+  }
   int base = lua_gettop(L) - nargs;  // the function's slot
   lua_pushcfunction(L, lua::traceback);
   lua_insert(L, base);
@@ -275,10 +298,16 @@ bool ScriptHost::protectedCall(int nargs, int nresults, std::string& error, bool
   if (status == LUA_OK) return true;
   error = lua_tostring(L, -1) ? lua_tostring(L, -1) : "(error without a message)";
   lua_pop(L, 1);
+  if (memory_.exceeded) error = sandbox::memoryMessage(memory_);
+  checkMemory();
   return false;
 }
 
 bool ScriptHost::callAboveHandler(int nargs, const char* what, const AnkiCar* car) {
+  if (shutDown_) {
+    lua_pop(L_, nargs + 2);
+    return false;
+  }
   int status;
   {
     interrupt::Scope scope(L_, interrupt::Kind::Callback);
@@ -296,13 +325,27 @@ bool ScriptHost::finishCall(int status, const char* what, const AnkiCar* car) {
   if (status == LUA_OK) return true;
   std::string message = lua_tostring(L_, -1) ? lua_tostring(L_, -1) : "(error without a message)";
   lua_pop(L_, 1);
+  if (memory_.exceeded) {
+    checkMemory();
+    return false;
+  }
   std::string where = what;
   if (car) where += " of " + car->label();
   reportError(where, message);
   return false;
 }
 
+void ScriptHost::checkMemory() {
+  if (!memory_.exceeded || memoryReported_) return;
+  memoryReported_ = true;
+  std::string text = "error: " + sandbox::memoryMessage(memory_);
+  if (options_.test_mode && !failure_) failure_ = text;
+  log::error("script", text);
+  requestExit(EXIT_FAILURE);
+}
+
 void ScriptHost::reportError(const std::string& where, const std::string& message) {
+  if (exitStatus_) return;  // os.exit or the memory limit: the run is ending, and said why
   ++errors_;
   lua_State* L = L_;
   std::string text = "error in " + where + ": " + message;
@@ -329,6 +372,29 @@ void ScriptHost::reportError(const std::string& where, const std::string& messag
     return;
   }
   log::error("script", text);
+}
+
+void ScriptHost::requestExit(int status) {
+  if (!exitStatus_) exitStatus_ = status;
+  if (!stopRequested_) return requestStop();
+  // pitwall.stop() came first: the stop path is under way, and takes the exit status from here
+}
+
+void ScriptHost::shutDown() {
+  if (shutDown_) return;
+  shutDown_ = true;
+  // The handlers stay hooked until the world closes (this may run inside one of them); call()
+  // turns every call into Lua away from now on.
+  for (auto& [co, task] : tasks_)
+    if (task.wake) {
+      loop_.cancel(*task.wake);
+      task.wake.reset();
+    }
+  for (auto& [handle, timer] : timers_) {
+    loop_.cancel(timer.id);
+    luaL_unref(L_, LUA_REGISTRYINDEX, timer.fnRef);
+  }
+  timers_.clear();
 }
 
 void ScriptHost::requestStop() {
@@ -392,6 +458,10 @@ Result<bool, std::string> ScriptHost::startString(const std::string& code,
 }
 
 void ScriptHost::spawn(lua_State* L, const std::string& name, bool main) {
+  if (shutDown_) {
+    lua_pop(L, 1);
+    return;
+  }
   lua_State* co = lua_newthread(L);
   int ref = luaL_ref(L, LUA_REGISTRYINDEX);  // pops the thread, keeps it alive
   lua_xmove(L, co, 1);                       // the function
@@ -402,7 +472,7 @@ void ScriptHost::spawn(lua_State* L, const std::string& name, bool main) {
 
 void ScriptHost::sleepCurrent(lua_State* co, Duration delay) {
   auto it = tasks_.find(co);
-  if (it == tasks_.end()) return;
+  if (it == tasks_.end() || shutDown_) return;
   it->second.wake = loop_.after(delay, [this, co] {
     auto t = tasks_.find(co);
     if (t == tasks_.end()) return;
@@ -412,7 +482,7 @@ void ScriptHost::sleepCurrent(lua_State* co, Duration delay) {
 }
 
 void ScriptHost::resume(lua_State* co, int nargs) {
-  if (!tasks_.count(co)) return;
+  if (shutDown_ || !tasks_.count(co)) return;
   int nres = 0;
   int status;
   {
@@ -423,10 +493,14 @@ void ScriptHost::resume(lua_State* co, int nargs) {
   if (status == LUA_YIELD) {
     lua_pop(co, nres);
     if (tasks_.at(co).wake) return;  // asleep: its timer resumes it
+    if (shutDown_) return;           // the run ended while it ran: it stays asleep for good
     // A bare coroutine.yield() has nobody to wake it: end the task with a clear error.
     error =
         "the task yielded without pitwall.sleep or pitwall.waitUntil; nothing would ever "
         "resume it";
+  } else if (status != LUA_OK && memory_.exceeded) {
+    checkMemory();
+    error = sandbox::memoryMessage(memory_);
   } else if (status != LUA_OK) {
     const char* msg = lua_tostring(co, -1);
     luaL_traceback(L_, co, msg ? msg : "(error without a message)", 0);
@@ -463,6 +537,10 @@ void ScriptHost::endTask(lua_State* co, const std::string& error) {
 
 int ScriptHost::addTimer(lua_State* L, Duration first, std::optional<Duration> period) {
   int handle = nextTimer_++;
+  if (shutDown_) {  // the run is ending: a timer that never fires
+    lua_pop(L, 1);
+    return handle;
+  }
   Timer t;
   t.fnRef = luaL_ref(L, LUA_REGISTRYINDEX);
   t.period = period;
@@ -488,11 +566,27 @@ void ScriptHost::fireTimer(int handle) {
   int fnRef = t.fnRef;
   bool repeating = t.period.has_value();
   if (repeating) {
-    // Scheduled before the call, so the callback may cancel it; due times do not drift.
+    // Scheduled before the call, so the callback may cancel it; due times do not drift. A timer
+    // that is behind (its callback is slower than its period, or the loop was busy) skips the
+    // ticks it missed instead of queueing them: the next tick is the next one in phase after
+    // now, so a hog slows itself, never the engine (docs/lua-api.md).
+    auto skipMissed = [this](Timer& timer) {
+      if (const TimePoint now = loop_.now(); timer.due <= now)
+        timer.due += (((now - timer.due) / *timer.period) + 1) * *timer.period;
+    };
     t.due += *t.period;
-    t.id = loop_.at(t.due, [this, handle] { fireTimer(handle); });
+    skipMissed(t);
+    const Loop::TimerId id = t.id = loop_.at(t.due, [this, handle] { fireTimer(handle); });
     lua_rawgeti(L_, LUA_REGISTRYINDEX, fnRef);
     call(0, 0, "pitwall.every callback");
+    // A callback slower than its period: its next tick is the first after it returned, so the
+    // timers that came due while it ran go first.
+    auto again = timers_.find(handle);
+    if (again != timers_.end() && again->second.id == id && again->second.due <= loop_.now()) {
+      loop_.cancel(id);
+      skipMissed(again->second);
+      again->second.id = loop_.at(again->second.due, [this, handle] { fireTimer(handle); });
+    }
   } else {
     timers_.erase(it);
     lua_rawgeti(L_, LUA_REGISTRYINDEX, fnRef);

@@ -13,6 +13,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "bindings/sandbox.hpp"
 #include "engine/core/loop.hpp"
 #include "engine/core/result.hpp"
 #include "engine/sim/world.hpp"
@@ -108,6 +109,17 @@ class ScriptHost {
   std::function<void()> onStopRequested;
   void requestStop();
   bool stopRequested() const { return stopRequested_; }
+  // os.exit(code) from the script or the REPL: the run ends through the stop path with this exit
+  // status. Also set (to 1) when the script reached its memory limit.
+  void requestExit(int status);
+  const std::optional<int>& exitStatus() const { return exitStatus_; }
+
+  // The run is ending (docs/safety.md): nothing of this world runs again — no timer, task, event
+  // handler or callback — except a chunk typed at the REPL. Final.
+  void shutDown();
+  bool isShutDown() const { return shutDown_; }
+  // The memory this world's allocations hold now, and its cap (sandbox.hpp).
+  const sandbox::Memory& memory() const { return memory_; }
   // In test mode: the first failure (error in a task or callback, failed expectation).
   const std::optional<std::string>& failure() const { return failure_; }
   int errorCount() const { return errors_; }
@@ -137,10 +149,13 @@ class ScriptHost {
   void fireTimer(int handle);
   Result<bool, std::string> startLoaded(int status);
 
+  void checkMemory();
+
   Loop& loop_;
   Fleet& fleet_;
   SimSession* sim_;
   HostOptions options_;
+  sandbox::Memory memory_;  // before L_: the state's allocator counts in it until lua_close
   lua_State* L_ = nullptr;
   std::unique_ptr<CarBinding> cars_;
   std::unordered_map<lua_State*, Task> tasks_;
@@ -150,6 +165,9 @@ class ScriptHost {
   std::unordered_map<int, Timer> timers_;
   int nextTimer_ = 1;
   bool stopRequested_ = false;
+  bool shutDown_ = false;
+  bool memoryReported_ = false;
+  std::optional<int> exitStatus_;
   bool inOnError_ = false;
   std::optional<std::string> failure_;
   int errors_ = 0;

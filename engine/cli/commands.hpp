@@ -31,6 +31,7 @@ struct CarSource {
   std::vector<std::string> adapters;      // --adapter hciN (repeatable); empty: every adapter
   double scanTimeout = 5;                 // seconds to look for cars before the script starts
   double budget = 0.1;  // --budget SECONDS a callback may run before it is interrupted; 0: off
+  int luaMemory = 512;  // --lua-memory MB a script's Lua world may hold; 0: no limit
   // --mqtt: the cars bridged by other hosts join as remote cars (docs/mqtt.md)
   MqttSettings mqtt;
   int remoteCars = 0;  // --remote-cars N: wait (up to --mqtt-timeout) until N are online
@@ -60,6 +61,7 @@ struct TestOptions {
   std::uint64_t seed = 1;
   double timeout = 600;  // seconds of virtual time per scenario
   double budget = 0.1;   // seconds a callback may run (real time) before it is interrupted
+  int luaMemory = 512;   // MB a scenario's Lua world may hold; 0: no limit
 };
 int test(const TestOptions& options);
 

@@ -32,6 +32,9 @@ CLI::Option* addCarSource(CLI::App* cmd, pitwall::cli::CarSource& source, const 
   cmd->add_option("--budget", source.budget,
                   "Seconds a callback may run before it is interrupted (default 0.1; 0: no limit)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--lua-memory", source.luaMemory,
+                  "MB of memory the script's Lua world may hold (default 512; 0: no limit)")
+      ->check(CLI::Range(0, 1 << 20));
   return ble;
 }
 
@@ -174,6 +177,10 @@ int main(int argc, char** argv) {
       ->add_option("--budget", test.budget,
                    "Seconds a callback may run before it is interrupted (default 0.1; 0: no limit)")
       ->check(CLI::NonNegativeNumber);
+  testCmd
+      ->add_option("--lua-memory", test.luaMemory,
+                   "MB of memory a scenario's Lua world may hold (default 512; 0: no limit)")
+      ->check(CLI::Range(0, 1 << 20));
 
   std::string protocol;
   std::vector<std::string> words;

@@ -203,6 +203,8 @@ void Repl::line(const std::string& text) {
 }
 
 void Repl::oneLine(const std::string& text) {
+  // os.exit, pitwall.stop(): the run is ending; what is typed from now on is not run.
+  if (world_().isShutDown()) return;
   if (pending_.empty()) {
     std::string_view typed = trim(text);
     if (typed.empty()) return;
@@ -240,6 +242,7 @@ void Repl::run(ScriptHost& host, int top) {
   std::string error;
   if (!host.callInteractive(0, LUA_MULTRET, error)) {
     lua_settop(L, top);
+    if (host.exitStatus()) return;  // os.exit: the run is ending, and that is no failure
     return fail(error);
   }
   int count = lua_gettop(L) - top;

@@ -8,7 +8,7 @@ enum class Load { Ok, Incomplete, Invalid };
 
 // Loads `code`; on success the function is pushed, otherwise the error goes to `error`.
 Load load(lua_State* L, const std::string& code, std::string& error) {
-  int status = luaL_loadbuffer(L, code.data(), code.size(), kChunkName);
+  int status = luaL_loadbufferx(L, code.data(), code.size(), kChunkName, "t");  // text only
   if (status == LUA_OK) return Load::Ok;
   size_t len = 0;
   const char* msg = lua_tolstring(L, -1, &len);

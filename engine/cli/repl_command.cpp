@@ -46,8 +46,7 @@ int repl(const ReplOptions& options) {
   if (prompt.interactive()) prompt.print(banner(options, session.fleet().cars().size()));
   prompt.start();
   loop.run();  // ends through Session::finish: :quit, Ctrl-D, end of input, SIGTERM, pitwall.stop()
-  if (session.interrupted()) return 130;
-  return !prompt.interactive() && prompt.failures() > 0 ? 1 : 0;
+  return session.exitStatus(!prompt.interactive() && prompt.failures() > 0 ? 1 : 0);
 }
 
 }  // namespace pitwall::cli

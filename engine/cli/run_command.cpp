@@ -89,8 +89,7 @@ int run(const RunOptions& options) {
   }
   loop.run();  // ends through Session::finish, which every way out of a run calls
   repl.reset();
-  if (session.interrupted()) return 130;
-  return session.host().mainFailed() ? 1 : 0;
+  return session.exitStatus(session.host().mainFailed() ? 1 : 0);
 }
 
 }  // namespace pitwall::cli

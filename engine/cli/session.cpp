@@ -9,6 +9,7 @@
 #include <iostream>
 
 #include "bindings/interrupt.hpp"
+#include "bindings/sandbox.hpp"
 #include "engine/core/log.hpp"
 #include "engine/protocol/anki/advertisement.hpp"
 #include "engine/sim/grid.hpp"
@@ -32,10 +33,8 @@ Session::Session(ble::CentralOptions options) : loop_(ClockKind::Real), fleet_(l
 }
 
 Session::~Session() {
-  if (signals_) {
-    boost::system::error_code ignored;
-    signals_->cancel(ignored);
-  }
+  signals_.reset();
+  if (recorder_) recorder_->flush();
   scripts_.reset();
   bridge_.reset();
   remote_.reset();
@@ -69,18 +68,27 @@ std::unique_ptr<Session> Session::open(const CarSource& source, bool fast, const
   session->source_ = source;
   session->catchSignals();
   interrupt::setBudget(std::chrono::milliseconds(std::llround(source.budget * 1000)));
+  sandbox::setMemoryLimit(static_cast<std::size_t>(source.luaMemory) << 20);
   return session;
 }
 
-void Session::catchSignals() {
-  signals_ = std::make_unique<boost::asio::signal_set>(loop_.io(), SIGINT, SIGTERM);
-  awaitSignal();
+namespace {
+// In the signal handler: the Lua code running now is interrupted, so that a busy callback does
+// not hold the stop up (with or without the callback budget).
+void interruptLua() {
+  interrupt::requestFromSignal();
 }
+}  // namespace
 
-void Session::awaitSignal() {
-  signals_->async_wait([this](const boost::system::error_code& ec, int sig) {
-    if (ec) return;
-    if (interrupted_) {  // a second one: leave now
+void Session::catchSignals() {
+  StopSignals::setAsyncHook(interruptLua);
+  signals_ = std::make_unique<StopSignals>(loop_);
+  signals_->onSignal = [this](int sig, int count) {
+    if (count >= 2) {  // a second one: leave now, the stops sent all the same
+      log::warn("pitwall", "leaving now");
+      if (scripts_) scripts_->shutDown();
+      fleet_.haltAll();
+      if (recorder_) recorder_->flush();
       loop_.stop();
       return;
     }
@@ -88,13 +96,17 @@ void Session::awaitSignal() {
     log::warn("pitwall",
               std::string(sig == SIGINT ? "interrupted" : "terminated") + ": stopping the cars");
     finish();
-    awaitSignal();
-  });
+  };
 }
 
 void Session::releaseSigint() {
-  boost::system::error_code ignored;
-  if (signals_) signals_->remove(SIGINT, ignored);
+  if (signals_) signals_->releaseSigint();
+}
+
+int Session::exitStatus(int otherwise) {
+  if (scripts_ && host().exitStatus()) return *host().exitStatus();
+  if (interrupted_) return 130;
+  return otherwise;
 }
 
 namespace {
@@ -297,10 +309,23 @@ int Session::connectLocalCars(const char* command) {
 
 void Session::record(const std::string& path) {
   recorder_ = std::make_unique<Recorder>(path);
+  flushRecordPeriodically();
   fleet_.onFrame = [this](AnkiCar& car, AnkiCar::Direction d, std::span<const std::uint8_t> f,
                           const anki::Message& m) {
     recorder_->write(loop_.seconds(), car.identity().number, d == AnkiCar::Direction::Tx, f, m);
   };
+}
+
+// A killed run loses at most the last 100 ms of its record: in real time the record reaches
+// the file every 50 ms even when no frame comes (Recorder::write flushes as frames come, which
+// covers virtual time, where a timer here would keep the loop from ever running dry).
+void Session::flushRecordPeriodically() {
+  if (loop_.clockKind() != ClockKind::Real || finishing_) return;
+  loop_.after(std::chrono::milliseconds(50), [this] {
+    if (!recorder_) return;
+    recorder_->flush();
+    flushRecordPeriodically();
+  });
 }
 
 bool Session::addGridCars(int count) {
@@ -342,7 +367,11 @@ void Session::startHost(HostOptions options) {
 void Session::finish() {
   if (finishing_) return;
   finishing_ = true;
-  fleet_.stopAll();
+  // First the script: from here nothing of it runs, so nothing it does can follow the stop.
+  if (scripts_) scripts_->shutDown();
+  // Then every car's stop, the last command it takes (AnkiCar::halt).
+  fleet_.haltAll();
+  if (recorder_) recorder_->flush();
   loop_.after(kFlush, [this] {
     auto done = [this] {
       if (!mqtt_) return loop_.stop();

@@ -1,13 +1,13 @@
 #pragma once
 // One run, as `pitwall run` and `pitwall test` set it up: the loop, the cars (simulated in a
 // world, or real ones over Bluetooth LE) and the Lua host, destroyed in the right order.
-#include <boost/asio/signal_set.hpp>
 #include <memory>
 #include <string>
 
 #include "bindings/reloader.hpp"
 #include "engine/cli/commands.hpp"
 #include "engine/core/loop.hpp"
+#include "engine/core/stop_signals.hpp"
 #include "engine/transport/mqtt_client.hpp"
 #include "engine/vehicles/ble_central.hpp"
 #include "engine/vehicles/fleet.hpp"
@@ -26,9 +26,9 @@ class Session {
   ~Session();
 
   // The session `pitwall COMMAND` asks for with `source` (the simulator in real time, or in
-  // virtual time when `fast`; or BLE), catching SIGINT and SIGTERM: the first stops the cars
-  // and ends the run with status 130, a second leaves at once. nullptr after printing
-  // "pitwall COMMAND: why" (exit status 2).
+  // virtual time when `fast`; or BLE), catching SIGINT and SIGTERM: the first interrupts the Lua
+  // code running, stops the cars and ends the run with status 130; a second leaves at once (the
+  // stops are sent all the same). nullptr after printing "pitwall COMMAND: why" (exit status 2).
   static std::unique_ptr<Session> open(const CarSource& source, bool fast, const char* command);
   // Puts the cars of the source on the run (the grid, or the real cars found, then with --mqtt the
   // remote cars). 0, or the exit status after printing why not: 1 (simulated cars did not
@@ -55,9 +55,14 @@ class Session {
   // Finds and connects the real cars (runs the loop until every car had a first attempt).
   std::optional<std::string> connectRealCars();
   void startHost(HostOptions options);
-  // Stops every car, lets the stop frames reach them, disconnects real cars, then ends
-  // loop().run().
+  // The one stop path (docs/safety.md): the script is shut down first (nothing of it runs or
+  // commands again), then every car gets its stop as its last command, the record is flushed,
+  // the stop frames are given time to reach the cars, real cars are disconnected, and
+  // loop().run() ends. Every way out of a run comes here.
   void finish();
+  // The exit status a run ends with: os.exit's or the memory limit's when the script asked for
+  // one, else 130 after a signal, else `otherwise`.
+  int exitStatus(int otherwise);
 
  private:
   Loop loop_;  // first made, last destroyed: everything below schedules on it
@@ -74,9 +79,9 @@ class Session {
   int connectRemoteCars(const char* command);
   bool finishing_ = false;
   void catchSignals();
-  void awaitSignal();
+  void flushRecordPeriodically();
   CarSource source_;
-  std::unique_ptr<boost::asio::signal_set> signals_;
+  std::unique_ptr<StopSignals> signals_;
   bool interrupted_ = false;
 };
 

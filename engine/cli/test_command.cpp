@@ -6,6 +6,7 @@
 #include <iostream>
 
 #include "bindings/interrupt.hpp"
+#include "bindings/sandbox.hpp"
 #include "engine/cli/commands.hpp"
 #include "engine/cli/session.hpp"
 #include "engine/core/log.hpp"
@@ -92,6 +93,7 @@ int test(const TestOptions& options) {
     return 2;
   }
   interrupt::setBudget(std::chrono::milliseconds(std::lround(options.budget * 1000)));
+  sandbox::setMemoryLimit(static_cast<std::size_t>(options.luaMemory) << 20);
   int passed = 0, failed = 0;
   for (const auto& file : *files) {
     auto begin = std::chrono::steady_clock::now();

@@ -1,7 +1,8 @@
 # A fleet across two pitwall processes and one private mosquitto (docs/mqtt.md): host A bridges
 # two simulated cars, host B runs a race with them as remote cars (--cars 0 --remote-cars 2), then
 # a mixed race with one local car besides. The race finishes with results for every car, host A's
-# cars really drove (their own S/Speed/Actual on the tree), and they are stopped after each run.
+# cars really drove (their own S/Speed/Actual on the tree), and they are stopped after each run,
+# also after a script that never stops commanding.
 source "$(dirname "$0")/mqtt_lib.sh"
 
 count() { grep -cE -- "$2" "$1" 2>/dev/null || true; }
@@ -17,17 +18,27 @@ wait_last() {
   done
 }
 
-# after_run NAME: what every run must leave behind: host A's cars stopped, online, no error.
-after_run() {
+# cars_stopped NAME: the last speed host A's cars were given is 0, and the bridge still runs.
+cars_stopped() {
   local c
   for c in "${CARS[@]}"; do
     wait_last "$c" S/Speed/Desired 0 && echo "ok: $1: $c was stopped at the end (S/Speed/Desired 0)" ||
       fail "$1: last S/Speed/Desired of $c: $(last_value "$ALL" "Anki/Car/$c/S/Speed/Desired")"
+  done
+  kill -0 "$BRIDGE" 2>/dev/null && echo "ok: $1: host A's bridge still runs" || fail "$1: the bridge exited"
+}
+
+# after_run NAME: what every polite run must leave behind: host A's cars stopped and standing
+# (the simulated car reports its actual speed when it is commanded: the race's own stop and the
+# end of the run's stop find it standing), no error.
+after_run() {
+  local c
+  cars_stopped "$1"
+  for c in "${CARS[@]}"; do
     wait_last "$c" S/Speed/Actual 0 10 && echo "ok: $1: $c came to a halt (S/Speed/Actual 0)" ||
       fail "$1: last S/Speed/Actual of $c: $(last_value "$ALL" "Anki/Car/$c/S/Speed/Actual")"
   done
   check "$1: no intent of host B was refused" 0 "$(count "$ALL" '^Anki/Host/hostA/S/IntentError ')"
-  kill -0 "$BRIDGE" 2>/dev/null && echo "ok: $1: host A's bridge still runs" || fail "$1: the bridge exited"
 }
 
 broker_config anonymous
@@ -73,6 +84,13 @@ contains "mixed race: a winner" "Winner: " "$out"
 [ "$(count "$ALL" "^Anki/Car/${CARS[0]}/S/Speed/Actual .*\"value\":[1-9]")" -gt "$moved_before" ] &&
   echo "ok: mixed race: host A's cars drove again" || fail "mixed race: host A's car did not move"
 after_run "mixed race"
+
+# ---- host B: a script that never stops commanding (tests/integration/nagging.lua), ended by
+# --duration: the stop is the last speed host A's cars get, however many intents were in flight.
+MODE=none timeout 60 $PITWALL run "$SRC/tests/integration/nagging.lua" --cars 0 --mqtt "$MQTT_URL" \
+  --remote-cars 2 --duration 2 >"$TMP/nag.out" 2>"$TMP/nag.err"
+check "nagging script: exit status" 0 "$?"
+cars_stopped "nagging script"
 
 kill -TERM "$BRIDGE"
 wait "$BRIDGE"

@@ -1,0 +1,241 @@
+#include "bindings/sandbox.hpp"
+
+#include <atomic>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+
+#include "bindings/interrupt.hpp"
+
+namespace pitwall::sandbox {
+
+namespace {
+
+std::atomic<std::size_t> g_limit{std::size_t{512} << 20};
+
+// Once the cap is reached, the engine still needs a little memory to report the error and end
+// the run (error messages, tracebacks): allocations up to this much above the cap are served.
+constexpr std::size_t kHeadroom = std::size_t{4} << 20;
+
+constexpr const char* kBinaryRefused =
+    "precompiled (binary) chunks are refused: pitwall runs Lua source only, as Lua does not "
+    "verify bytecode (docs/safety.md)";
+
+void* allocate(void* ud, void* ptr, std::size_t osize, std::size_t nsize) {
+  auto* m = static_cast<Memory*>(ud);
+  const std::size_t old = ptr ? osize : 0;  // without ptr, osize says what kind of object
+  if (nsize == 0) {
+    std::free(ptr);
+    m->used -= old;
+    return nullptr;
+  }
+  // Only a call from the engine into Lua is refused memory: there a refusal is a Lua error the
+  // engine catches. Outside one (the engine pushing an event's values) it would be a panic.
+  if (nsize > old && m->limit != 0 && interrupt::inCall()) {
+    const std::size_t cap = m->exceeded ? m->limit + kHeadroom : m->limit;
+    if (m->used + (nsize - old) > cap) {
+      if (!m->exceeded && ptr == m->refusedPtr && osize == m->refusedOld &&
+          nsize == m->refusedNew) {
+        // The retry after Lua's emergency collection: the script does hold that much.
+        m->exceeded = true;
+        interrupt::abortRunning(memoryMessage(*m));
+      }
+      m->refusedPtr = ptr;
+      m->refusedOld = osize;
+      m->refusedNew = nsize;
+      return nullptr;
+    }
+  }
+  void* p = std::realloc(ptr, nsize);
+  if (p) m->used = m->used - old + nsize;
+  return p;
+}
+
+int panic(lua_State* L) {
+  const char* msg = lua_tostring(L, -1);
+  std::fprintf(stderr, "pitwall: unprotected error in the Lua world: %s\n",
+               msg ? msg : "(error object is not a string)");
+  return 0;  // Lua aborts
+}
+
+bool isBinary(const char* s, std::size_t n) {
+  return n > 0 && s[0] == LUA_SIGNATURE[0];
+}
+
+// load(chunk [, chunkname [, mode [, env]]]): text only.
+int loadText(lua_State* L) {
+  int n = lua_gettop(L);
+  if (lua_type(L, 1) == LUA_TSTRING) {
+    std::size_t len = 0;
+    const char* s = lua_tolstring(L, 1, &len);
+    if (isBinary(s, len)) {
+      luaL_pushfail(L);
+      lua_pushfstring(L, "load: %s", kBinaryRefused);
+      return 2;
+    }
+  }
+  // The original load, with mode "t" (a reader function's binary chunk is refused by Lua).
+  lua_pushvalue(L, lua_upvalueindex(1));
+  lua_pushvalue(L, 1);
+  if (n >= 2)
+    lua_pushvalue(L, 2);
+  else
+    lua_pushnil(L);
+  lua_pushliteral(L, "t");
+  int args = 3;
+  if (n >= 4) {
+    lua_pushvalue(L, 4);
+    ++args;
+  }
+  lua_call(L, args, LUA_MULTRET);
+  return lua_gettop(L) - n;
+}
+
+// loadfile([filename [, mode [, env]]]): text only.
+int loadfileText(lua_State* L) {
+  const char* fname = luaL_optstring(L, 1, nullptr);
+  int env = !lua_isnone(L, 3) ? 3 : 0;
+  int status = luaL_loadfilex(L, fname, "t");
+  if (status == LUA_OK) {
+    if (env != 0) {
+      lua_pushvalue(L, env);
+      if (!lua_setupvalue(L, -2, 1)) lua_pop(L, 1);
+    }
+    return 1;
+  }
+  luaL_pushfail(L);
+  lua_insert(L, -2);
+  return 2;
+}
+
+int dofileText(lua_State* L) {
+  const char* fname = luaL_optstring(L, 1, nullptr);
+  lua_settop(L, 1);
+  if (luaL_loadfilex(L, fname, "t") != LUA_OK) return lua_error(L);
+  lua_call(L, 0, LUA_MULTRET);
+  return lua_gettop(L) - 1;
+}
+
+// require's searcher for Lua files, text only (Lua's own loads binary files too).
+int searchLuaText(lua_State* L) {
+  const char* name = luaL_checkstring(L, 1);
+  lua_getfield(L, lua_upvalueindex(1), "searchpath");
+  lua_pushstring(L, name);
+  lua_getfield(L, lua_upvalueindex(1), "path");
+  if (!lua_isstring(L, -1)) luaL_error(L, "'package.path' must be a string");
+  lua_call(L, 2, 2);
+  if (lua_isnil(L, -2)) return 1;  // the "no file …" lines
+  lua_pop(L, 1);
+  const char* filename = lua_tostring(L, -1);
+  if (luaL_loadfilex(L, filename, "t") != LUA_OK)
+    return luaL_error(L, "error loading module '%s' from file '%s':\n\t%s", name, filename,
+                      lua_tostring(L, -1));
+  lua_pushstring(L, filename);
+  return 2;
+}
+
+int refused(lua_State* L) {
+  return luaL_error(L, "%s is not available to scripts: %s", lua_tostring(L, lua_upvalueindex(1)),
+                    lua_tostring(L, lua_upvalueindex(2)));
+}
+
+void refuse(lua_State* L, const char* library, const char* name, const char* why) {
+  lua_getglobal(L, library);
+  if (!lua_istable(L, -1)) {
+    lua_pop(L, 1);
+    return;
+  }
+  lua_pushfstring(L, "%s.%s", library, name);
+  lua_pushstring(L, why);
+  lua_pushcclosure(L, refused, 2);
+  lua_setfield(L, -2, name);
+  lua_pop(L, 1);
+}
+
+// io.lines(filename, …) reads a file; io.lines() would read the terminal.
+int linesOfFile(lua_State* L) {
+  if (lua_isnoneornil(L, 1))
+    return luaL_error(L,
+                      "io.lines() without a file name would read the terminal and block the "
+                      "engine; give a file name");
+  lua_pushvalue(L, lua_upvalueindex(1));
+  lua_insert(L, 1);
+  lua_call(L, lua_gettop(L) - 1, LUA_MULTRET);
+  return lua_gettop(L);
+}
+
+}  // namespace
+
+void setMemoryLimit(std::size_t bytes) {
+  g_limit.store(bytes, std::memory_order_relaxed);
+}
+
+std::size_t memoryLimit() {
+  return g_limit.load(std::memory_order_relaxed);
+}
+
+std::string memoryMessage(const Memory& memory) {
+  return "script memory limit of " + std::to_string(memory.limit >> 20) +
+         " MB reached (the script keeps too much: drop what it no longer needs, or raise the "
+         "limit with --lua-memory MB)";
+}
+
+lua_State* newState(Memory& memory) {
+  memory.limit = memoryLimit();
+  lua_State* L = lua_newstate(allocate, &memory);
+  if (L) lua_atpanic(L, panic);
+  return L;
+}
+
+void restrict(lua_State* L) {
+  lua_getglobal(L, "load");
+  lua_pushcclosure(L, loadText, 1);
+  lua_setglobal(L, "load");
+  lua_pushcfunction(L, loadfileText);
+  lua_setglobal(L, "loadfile");
+  lua_pushcfunction(L, dofileText);
+  lua_setglobal(L, "dofile");
+
+  lua_getglobal(L, "package");
+  lua_getfield(L, -1, "searchers");
+  lua_pushvalue(L, -2);
+  lua_pushcclosure(L, searchLuaText, 1);
+  lua_rawseti(L, -2, 2);
+  lua_pop(L, 2);
+
+  // The debug library keeps what reads.
+  lua_getglobal(L, "debug");
+  if (lua_istable(L, -1)) {
+    static const char* const kept[] = {"traceback",  "getinfo",   "getlocal",    "getmetatable",
+                                       "getupvalue", "upvalueid", "getuservalue"};
+    lua_createtable(L, 0, 7);
+    for (const char* name : kept) {
+      lua_getfield(L, -2, name);
+      lua_setfield(L, -2, name);
+    }
+    lua_setglobal(L, "debug");
+  }
+  lua_pop(L, 1);
+  // debug is also reachable as package.loaded.debug
+  lua_getglobal(L, "package");
+  lua_getfield(L, -1, "loaded");
+  lua_getglobal(L, "debug");
+  lua_setfield(L, -2, "debug");
+  lua_pop(L, 2);
+
+  constexpr const char* kBlocks =
+      "it would block the engine's one loop (and with it Ctrl-C and the cars' stop); run "
+      "other programs outside the script";
+  refuse(L, "io", "read", "it reads the terminal and would block the engine; use io.open(file)");
+  refuse(L, "io", "popen", kBlocks);
+  refuse(L, "os", "execute", kBlocks);
+  lua_getglobal(L, "io");
+  if (lua_istable(L, -1)) {
+    lua_getfield(L, -1, "lines");
+    lua_pushcclosure(L, linesOfFile, 1);
+    lua_setfield(L, -2, "lines");
+  }
+  lua_pop(L, 1);
+}
+
+}  // namespace pitwall::sandbox

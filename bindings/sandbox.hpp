@@ -1,0 +1,48 @@
+#pragma once
+// What a script may touch, and how much memory its Lua world may take (docs/safety.md).
+//
+// Redis's function_lua.c is the model: the engine decides what the world holds, and a script
+// cannot reach past it to crash or wedge the engine.
+// - Code is loaded as text only: load, loadfile, dofile and require refuse precompiled chunks
+//   (Lua does not verify bytecode: patched bytecode crashes the process).
+// - The debug library keeps only what reads (traceback, getinfo, getlocal, getmetatable,
+//   getupvalue, upvalueid, getuservalue): debug.sethook would disarm the callback budget,
+//   debug.debug reads the terminal, the setters and the registry reach into the engine's
+//   references.
+// - Nothing may block the loop: io.read, io.lines() on stdin, io.popen and os.execute are gone.
+//   Files (io.open) stay: scripts write results.
+// - os.exit ends the run through the engine's stop path (ScriptHost), with its exit status.
+// - Each world's allocations are counted against a cap (default 512 MB): a script that reaches it
+//   gets the error "script memory limit of N MB reached", which pcall cannot swallow, and the run
+//   ends through the stop path.
+#include <lua.hpp>
+
+#include <cstddef>
+#include <string>
+
+namespace pitwall::sandbox {
+
+// The memory of one Lua world. `limit` 0: no cap.
+struct Memory {
+  std::size_t used = 0;
+  std::size_t limit = 0;
+  bool exceeded = false;  // the cap was reached (Lua's emergency collection did not help)
+  // The last request refused: Lua retries a refused allocation once after a full collection, and
+  // only that retry failing too means the script really holds that much.
+  const void* refusedPtr = nullptr;
+  std::size_t refusedOld = 0, refusedNew = 0;
+};
+
+// The cap for worlds made from now on (--lua-memory MB); 0 turns it off.
+void setMemoryLimit(std::size_t bytes);
+std::size_t memoryLimit();
+// "script memory limit of 512 MB reached (…what to do…)"
+std::string memoryMessage(const Memory& memory);
+
+// A new Lua state whose allocations are counted in `memory` (which must outlive it).
+lua_State* newState(Memory& memory);
+
+// After luaL_openlibs: the restrictions above (os.exit is the host's, see ScriptHost).
+void restrict(lua_State* L);
+
+}  // namespace pitwall::sandbox

@@ -1,0 +1,92 @@
+#include "engine/core/stop_signals.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+#include <boost/asio/read.hpp>
+
+namespace pitwall {
+
+namespace {
+
+std::atomic<int> g_writeFd{-1};
+std::atomic<int> g_count{0};  // signals received
+std::atomic<int> g_acted{0};  // signals the loop has acted on
+std::atomic<StopSignals::AsyncHook> g_hook{nullptr};
+static_assert(std::atomic<int>::is_always_lock_free);
+
+void onStopSignal(int sig) {
+  int saved = errno;
+  int count = g_count.fetch_add(1, std::memory_order_relaxed) + 1;
+  if (auto hook = g_hook.load(std::memory_order_relaxed)) hook();
+  if (count >= 3 && g_acted.load(std::memory_order_relaxed) < 2) {
+    static const char kMsg[] = "\npitwall: the loop did not answer two signals: leaving now\n";
+    ssize_t ignored = ::write(STDERR_FILENO, kMsg, sizeof kMsg - 1);
+    (void)ignored;
+    ::_exit(130);
+  }
+  int fd = g_writeFd.load(std::memory_order_relaxed);
+  if (fd >= 0) {
+    char byte = static_cast<char>(sig);
+    ssize_t written = ::write(fd, &byte, 1);  // a full pipe already says it
+    (void)written;
+  }
+  errno = saved;
+}
+
+}  // namespace
+
+StopSignals::StopSignals(Loop& loop) : pipe_(loop.io()) {
+  int fds[2];
+  if (::pipe2(fds, O_CLOEXEC | O_NONBLOCK) != 0)
+    throw std::runtime_error(std::string("cannot make the signal pipe: ") + std::strerror(errno));
+  pipe_.assign(fds[0]);
+  writeFd_ = fds[1];
+  g_count.store(0, std::memory_order_relaxed);
+  g_acted.store(0, std::memory_order_relaxed);
+  g_writeFd.store(writeFd_, std::memory_order_relaxed);
+  struct sigaction sa {};
+  sa.sa_handler = onStopSignal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESTART;
+  ::sigaction(SIGINT, &sa, &oldInt_);
+  ::sigaction(SIGTERM, &sa, &oldTerm_);
+  await();
+}
+
+StopSignals::~StopSignals() {
+  if (!sigintReleased_) ::sigaction(SIGINT, &oldInt_, nullptr);
+  ::sigaction(SIGTERM, &oldTerm_, nullptr);
+  g_writeFd.store(-1, std::memory_order_relaxed);
+  boost::system::error_code ignored;
+  pipe_.close(ignored);
+  ::close(writeFd_);
+}
+
+void StopSignals::setAsyncHook(AsyncHook hook) {
+  g_hook.store(hook, std::memory_order_relaxed);
+}
+
+void StopSignals::releaseSigint() {
+  sigintReleased_ = true;
+}
+
+void StopSignals::await() {
+  pipe_.async_read_some(boost::asio::buffer(&byte_, 1),
+                        [this](const boost::system::error_code& ec, std::size_t n) {
+                          if (ec || n == 0) return;
+                          int sig = static_cast<unsigned char>(byte_);
+                          await();
+                          if (sig == SIGINT && sigintReleased_) return;
+                          int count = g_acted.fetch_add(1, std::memory_order_relaxed) + 1;
+                          if (onSignal) onSignal(sig, count);
+                        });
+}
+
+}  // namespace pitwall

@@ -1,0 +1,40 @@
+#pragma once
+// SIGINT and SIGTERM for a run (docs/safety.md). The handler does only async-signal-safe work:
+// it counts the signal, calls an async-signal-safe hook (the bindings interrupt the Lua code
+// running now, so a busy callback cannot hold Ctrl-C up), and wakes the loop through a pipe; the
+// loop then calls onSignal. A third signal that the loop has not acted on ends the process at
+// once (_exit 130): the last word when the loop itself is wedged.
+#include <boost/asio/posix/stream_descriptor.hpp>
+#include <csignal>
+#include <functional>
+
+#include "engine/core/loop.hpp"
+
+namespace pitwall {
+
+class StopSignals {
+ public:
+  using AsyncHook = void (*)();
+  explicit StopSignals(Loop& loop);
+  ~StopSignals();  // the previous handlers come back
+  StopSignals(const StopSignals&) = delete;
+  StopSignals& operator=(const StopSignals&) = delete;
+
+  // On the loop: `count` is how many SIGINT/SIGTERM arrived so far (1 for the first).
+  std::function<void(int sig, int count)> onSignal;
+  // Called inside the handler, on every signal; must be async-signal-safe.
+  static void setAsyncHook(AsyncHook hook);
+  // SIGINT is someone else's from now on (the REPL's own handler); SIGTERM stays.
+  void releaseSigint();
+
+ private:
+  void await();
+  boost::asio::posix::stream_descriptor pipe_;
+  int writeFd_ = -1;
+  struct sigaction oldInt_ {
+  }, oldTerm_{};
+  bool sigintReleased_ = false;
+  char byte_ = 0;
+};
+
+}  // namespace pitwall

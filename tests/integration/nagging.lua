@@ -1,0 +1,39 @@
+-- The adversary of the stop tests (stop_test.sh, ble_stop_test.sh, mqtt_fleet_test.sh): a script
+-- that never stops commanding. Every 20 ms, from a timer, from a timer it schedules, and on every
+-- position event, it sets every car's speed again. MODE picks how the run ends after 1 s, and
+-- the script commands again right after asking for the end:
+--   none    (the default) never: --duration, a signal or the test ends it
+--   stop    pitwall.stop(), then commands from the same task (in pcall) and from a new task
+--   error   the main chunk dies
+--   exit    os.exit(3) inside pcall, then a command
+--   memory  an allocation loop behind pcall (run it with --lua-memory and --budget 0)
+local mode = os.getenv("MODE") or "none"
+local cars = pitwall.cars()
+local function command()
+  for _, car in ipairs(cars) do car:setSpeed(800) end
+end
+pitwall.every(0.02, command)
+pitwall.every(0.02, function() pitwall.after(0, command) end)
+for _, car in ipairs(cars) do
+  car.onPosition = function() car:setSpeed(800) end
+end
+command()
+print("driving")
+io.stdout:flush()
+pitwall.sleep(1)
+if mode == "stop" then
+  pitwall.stop()
+  local ok, err = pcall(command)
+  print("after stop:", ok, err)
+  pitwall.spawn(function() while true do command(); pitwall.sleep(0.01) end end)
+elseif mode == "error" then
+  error("the strategy crashed")
+elseif mode == "exit" then
+  pcall(os.exit, 3)
+  command()
+elseif mode == "memory" then
+  local keep = {}
+  while true do
+    pcall(function() keep[#keep + 1] = string.rep("x", 1 << 20) .. #keep end)
+  end
+end

@@ -1,0 +1,152 @@
+// The script's side of the stop path and of the sandbox (docs/safety.md): a world that was shut
+// down runs nothing again, os.exit asks for the end of the run, and the memory cap ends a script
+// that keeps allocating, even behind pcall.
+#include <doctest/doctest.h>
+
+#include "bindings/interrupt.hpp"
+#include "bindings/sandbox.hpp"
+#include "bindings/script_host.hpp"
+#include "engine/core/log.hpp"
+
+using namespace pitwall;
+using namespace std::chrono_literals;
+
+namespace {
+
+struct World {
+  Loop loop{ClockKind::Virtual};
+  Fleet fleet{loop};
+  std::unique_ptr<ScriptHost> host;
+  std::vector<std::string> logged;
+  int stops = 0;
+
+  explicit World(std::size_t memoryLimit = sandbox::memoryLimit()) {
+    setenv("PITWALL_SCRIPTS", PITWALL_SOURCE_DIR "/scripts", 1);
+    std::size_t saved = sandbox::memoryLimit();
+    sandbox::setMemoryLimit(memoryLimit);
+    host = std::make_unique<ScriptHost>(loop, fleet, nullptr, HostOptions{});
+    sandbox::setMemoryLimit(saved);
+    host->onStopRequested = [this] { ++stops; };
+    log::setSink([this](log::Level, std::string_view line) { logged.emplace_back(line); });
+  }
+  ~World() { log::setSink(nullptr); }
+
+  lua_Integer global(const char* name) {
+    lua_getglobal(host->state(), name);
+    lua_Integer v = lua_tointeger(host->state(), -1);
+    lua_pop(host->state(), 1);
+    return v;
+  }
+  bool logContains(const std::string& text) const {
+    for (const auto& l : logged)
+      if (l.find(text) != std::string::npos) return true;
+    return false;
+  }
+};
+
+}  // namespace
+
+TEST_CASE("a world that was shut down runs no timer, task or callback again") {
+  World w;
+  REQUIRE(w.host->startString(R"(
+    ticks, after, woke = 0, 0, 0
+    pitwall.every(0.1, function() ticks = ticks + 1 end)
+    pitwall.after(1, function() after = after + 1 end)
+    pitwall.spawn(function() pitwall.sleep(0.5) woke = woke + 1 end)
+    function late() pitwall.after(0, function() after = after + 100 end) end
+  )",
+                              "world"));
+  w.loop.after(250ms, [&] {
+    w.host->shutDown();
+    w.loop.after(5s, [&] { w.loop.stop(); });
+  });
+  w.loop.run();
+  CHECK(w.global("ticks") == 2);
+  CHECK(w.global("after") == 0);
+  CHECK(w.global("woke") == 0);
+  CHECK(w.host->isShutDown());
+
+  // The engine's calls into it are turned away with the stack left as it was.
+  lua_State* L = w.host->state();
+  int top = lua_gettop(L);
+  lua_getglobal(L, "late");
+  lua_pushinteger(L, 1);
+  CHECK_FALSE(w.host->call(1, 0, "test callback"));
+  CHECK(lua_gettop(L) == top);
+  // A REPL chunk still runs (the operator may look), but what it schedules never fires.
+  lua_getglobal(L, "late");
+  std::string error;
+  CHECK(w.host->callInteractive(0, 0, error));
+  w.loop.after(1s, [&] { w.loop.stop(); });
+  w.loop.run();
+  CHECK(w.global("after") == 0);
+}
+
+TEST_CASE("os.exit asks for the end of the run with its status, even inside pcall") {
+  World w;
+  REQUIRE(w.host->startString(R"(
+    pitwall.spawn(function()
+      pitwall.sleep(1)
+      pcall(os.exit, 7)
+      reached = 1
+    end)
+  )",
+                              "exit"));
+  w.loop.after(10s, [&] { w.loop.stop(); });
+  w.loop.run();
+  REQUIRE(w.host->exitStatus());
+  CHECK(*w.host->exitStatus() == 7);
+  CHECK(w.stops == 1);
+  CHECK(w.global("reached") == 0);   // the code after it did not run
+  CHECK(w.host->errorCount() == 0);  // and nothing was reported as an error
+}
+
+TEST_CASE("os.exit's status: none and true are 0, false is 1") {
+  for (auto [code, status] : {std::pair{"os.exit()", 0}, std::pair{"os.exit(true)", 0},
+                              std::pair{"os.exit(false)", 1}, std::pair{"os.exit(300)", 44}}) {
+    World w;
+    REQUIRE(w.host->startString(code, "exit"));
+    REQUIRE(w.host->exitStatus());
+    CHECK(*w.host->exitStatus() == status);
+  }
+}
+
+TEST_CASE("an allocation loop behind pcall reaches the memory cap and the run ends") {
+  interrupt::setBudget(0ms);  // only the cap may end it
+  World w(std::size_t{16} << 20);
+  auto started = w.host->startString(R"(
+    local keep = {}
+    while true do
+      pcall(function() keep[#keep + 1] = string.rep("x", 1 << 20) .. #keep end)
+    end
+  )",
+                                     "hog");
+  interrupt::setBudget(100ms);
+  REQUIRE(started);
+  REQUIRE(w.host->exitStatus());
+  CHECK(*w.host->exitStatus() == 1);
+  CHECK(w.stops == 1);
+  CHECK(w.host->memory().exceeded);
+  CHECK(w.host->memory().used <= (std::size_t{16} << 20) + (std::size_t{4} << 20));
+  CHECK(w.logContains("script memory limit of 16 MB reached"));
+}
+
+TEST_CASE("memory under the cap is served, and what is freed counts no more") {
+  interrupt::setBudget(0ms);  // twenty full collections take their time under load
+  World w(std::size_t{16} << 20);
+  auto started = w.host->startString(R"(
+    for round = 1, 20 do
+      local t = {}
+      for i = 1, 8 do t[i] = string.rep("y", 1 << 20) .. i end
+      t = nil
+      collectgarbage()
+    end
+    done = 1
+  )",
+                                     "churn");
+  interrupt::setBudget(100ms);
+  REQUIRE(started);
+  CHECK(w.global("done") == 1);
+  CHECK_FALSE(w.host->memory().exceeded);
+  CHECK_FALSE(w.host->exitStatus());
+}
