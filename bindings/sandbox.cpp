@@ -16,6 +16,7 @@ std::atomic<std::size_t> g_limit{std::size_t{512} << 20};
 // Once the cap is reached, the engine still needs a little memory to report the error and end
 // the run (error messages, tracebacks): allocations up to this much above the cap are served.
 constexpr std::size_t kHeadroom = std::size_t{4} << 20;
+constexpr int kRefusals = 16;
 
 constexpr const char* kBinaryRefused =
     "precompiled (binary) chunks are refused: pitwall runs Lua source only, as Lua does not "
@@ -34,9 +35,10 @@ void* allocate(void* ud, void* ptr, std::size_t osize, std::size_t nsize) {
   if (nsize > old && m->limit != 0 && interrupt::inCall()) {
     const std::size_t cap = m->exceeded ? m->limit + kHeadroom : m->limit;
     if (m->used + (nsize - old) > cap) {
-      if (!m->exceeded && ptr == m->refusedPtr && osize == m->refusedOld &&
-          nsize == m->refusedNew) {
-        // The retry after Lua's emergency collection: the script does hold that much.
+      // The retry after Lua's emergency collection: the script does hold that much. (Lua skips
+      // the collection while one runs: many refusals in a row say the same.)
+      const bool retry = ptr == m->refusedPtr && osize == m->refusedOld && nsize == m->refusedNew;
+      if (!m->exceeded && (retry || ++m->refusals >= kRefusals)) {
         m->exceeded = true;
         interrupt::abortRunning(memoryMessage(*m));
       }

@@ -31,6 +31,7 @@ struct Memory {
   // only that retry failing too means the script really holds that much.
   const void* refusedPtr = nullptr;
   std::size_t refusedOld = 0, refusedNew = 0;
+  int refusals = 0;
 };
 
 // The cap for worlds made from now on (--lua-memory MB); 0 turns it off.
