@@ -98,6 +98,7 @@ std::string MqttBridge::carIdOf(const AnkiCar& car) const {
 }
 
 void MqttBridge::emit(const topics::Publication& p) {
+  if (offline_) return;  // a car's frame after the goodbye would contradict it
   if (p.retain) retained_[p.topic] = p;
   if (client_.publish(p.topic, p.payload, p.qos, p.retain))
     ++stats_.published;
@@ -110,6 +111,7 @@ void MqttBridge::emit(const std::vector<topics::Publication>& ps) {
 }
 
 void MqttBridge::connected() {
+  if (offline_) return;  // a reconnection after the goodbye says nothing
   // HostStatus true first (it replaces the will's false), then the rest of the retained state
   // as it was last published: the broker may have lost it (a restart without persistence).
   auto online = topics::hostOnline(host_);
@@ -214,7 +216,7 @@ void MqttBridge::message(std::string_view topic, std::string_view payload, bool 
 }
 
 void MqttBridge::handle(std::string_view topic, std::string_view payload, bool retained) {
-  if (options_.readOnly) return;
+  if (options_.readOnly || offline_) return;
   auto parts = topics::splitTopic(topic);
   if (parts && parts->kind == topics::TopicParts::Kind::Host && parts->id != host_) {
     if (parts->rest == "S/Cars") {
@@ -401,6 +403,7 @@ void MqttBridge::goOffline() {
   haveCars_ = true;
   emit(topics::hostCars(host_, {}, t));
   emit(topics::hostWill(host_));
+  offline_ = true;
 }
 
 }  // namespace pitwall

@@ -62,7 +62,7 @@ class MqttBridge {
   static MqttWill will(const std::string& host);
 
   // Before a clean shutdown: every car offline, S/Cars empty, HostStatus false (the will is not
-  // sent on a clean DISCONNECT).
+  // sent on a clean DISCONNECT). The last word: nothing is published or executed after it.
   void goOffline();
 
   const std::string& host() const { return host_; }
@@ -126,6 +126,7 @@ class MqttBridge {
   std::vector<std::string> lastCars_;
   std::vector<topics::Publication> undelivered_;  // CarDiscovered before the first connection
   bool haveCars_ = false;
+  bool offline_ = false;  // goOffline() said the last word
   // What the other bridges said: their cars, while they are online.
   std::map<std::string, std::vector<std::string>> otherCars_;
   std::set<std::string> otherOnline_;

@@ -675,7 +675,25 @@ TEST_CASE("mqtt bridge: goOffline() publishes every car offline, no cars, and Ho
   CHECK(o.json(kCars)["value"].empty());
   CHECK(o.json(h.carTopic(0, "S/CarStatus"))["online"] == false);
   CHECK(o.json(h.carTopic(1, "S/CarStatus"))["online"] == false);
-  h.client->disconnect();  // clean: no will, the status above stays
+  // The goodbye is the last word: a car's frame after it (a battery answer, a late status) is not
+  // published over it, and an intent is not executed.
+  const std::string intent = h.carTopic(1, "I");
+  auto bridgeSaid = [&] {
+    std::size_t n = 0;
+    for (const auto& m : o.messages) n += m.topic.starts_with("Anki/") && m.topic != intent;
+    return n;
+  };
+  const auto published = bridgeSaid();
+  const auto commands = h.tx.size();
+  const auto framesIn = h.car(0).state().frames_in;
+  REQUIRE(h.car(0).requestBattery());
+  o.send(intent, R"({"type":"speed","speed":500,"acceleration":1000})");
+  REQUIRE(runUntil(loop, [&] { return h.car(0).state().frames_in > framesIn; }));
+  REQUIRE(o.roundTrip(loop));
+  REQUIRE(o.roundTrip(loop));
+  CHECK(bridgeSaid() == published);
+  CHECK(h.tx.size() == commands + 1);  // only the battery request made above
+  h.client->disconnect();              // clean: no will, the status above stays
   Observer late(loop, broker);
   REQUIRE(runUntil(loop, [&] { return late.connects == 1; }));
   REQUIRE(late.roundTrip(loop));
