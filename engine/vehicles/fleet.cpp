@@ -23,6 +23,7 @@ AnkiCar& Fleet::add(std::unique_ptr<Link> link, CarIdentity identity) {
   entry->car = std::make_unique<AnkiCar>(loop_, *entry->link, std::move(identity));
   Entry* e = entry.get();
   AnkiCar& car = *e->car;
+  if (halted_) (void)car.halt();  // a car that joins after the end of the run obeys nothing
   car.onConnection = [this, e](bool up, const std::string& reason) {
     if (up && !e->joined) {
       e->joined = true;
@@ -70,6 +71,7 @@ void Fleet::stopAll() {
 }
 
 void Fleet::haltAll() {
+  halted_ = true;
   for (auto* car : cars_)
     if (auto sent = car->halt(); !sent) log::warn(car->label(), sent.error());
 }

@@ -38,12 +38,14 @@ class Fleet {
 
   // Sends speed 0 to every connected car (shutdown, end of run, script death).
   void stopAll();
-  // The end of the run: every car gets its stop and takes no command after it (AnkiCar::halt).
+  // The end of the run: every car gets its stop and takes no command after it (AnkiCar::halt);
+  // so does a car added after it.
   void haltAll();
 
  private:
   struct Entry;
   Loop& loop_;
+  bool halted_ = false;
   std::vector<std::unique_ptr<Entry>> entries_;
   std::vector<AnkiCar*> cars_;
 };

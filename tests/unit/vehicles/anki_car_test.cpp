@@ -2,6 +2,7 @@
 
 #include <doctest/doctest.h>
 
+#include "engine/vehicles/fleet.hpp"
 #include "tests/unit/capture_link.hpp"
 
 using namespace pitwall;
@@ -170,4 +171,20 @@ TEST_CASE_FIXTURE(Fixture, "a car halted while disconnected obeys nothing once i
   auto sent = link.sent.size();
   CHECK_FALSE(car.setSpeed(500));
   CHECK(link.sent.size() == sent);
+}
+
+TEST_CASE("a car that joins the fleet after haltAll is halted too") {
+  Loop loop{ClockKind::Virtual};
+  Fleet fleet(loop);
+  auto first = std::make_unique<CaptureLink>();
+  first->up = true;
+  fleet.add(std::move(first), CarIdentity{0, "first", 9, 1});
+  fleet.haltAll();
+  auto late = std::make_unique<CaptureLink>();
+  CaptureLink& lateLink = *late;
+  AnkiCar& car = fleet.add(std::move(late), CarIdentity{0, "late", 9, 2});
+  lateLink.setConnected(true);
+  CHECK(car.halted());
+  CHECK_FALSE(car.setSpeed(600));
+  CHECK(lateLink.sent.empty());
 }
