@@ -50,6 +50,12 @@ void hook(lua_State* L, lua_Debug*) {
 
 constexpr int kHookMask = LUA_MASKCALL | LUA_MASKRET | LUA_MASKLINE | LUA_MASKCOUNT;
 
+// The call running now is being interrupted.
+bool armedNow() {
+  return g_reason.load(std::memory_order_relaxed) != kNone &&
+         g_reasonCall.load(std::memory_order_relaxed) == g_call.load(std::memory_order_relaxed);
+}
+
 void arm(lua_State* L, int reason) {
   g_reasonCall.store(g_call.load(std::memory_order_relaxed), std::memory_order_relaxed);
   g_reason.store(reason, std::memory_order_relaxed);
@@ -115,6 +121,39 @@ void startWatchdog() {
     std::thread(watch).detach();
     pthread_sigmask(SIG_SETMASK, &old, nullptr);
   });
+}
+
+// xpcall whose message handler is not run for an interrupt's error. Lua runs a message handler
+// where the error was raised; for an error raised by the interrupt's hook that is inside the hook,
+// where Lua turns hooks off, so a handler that loops could never be interrupted again. An
+// interrupt's error reaches the xpcall as it is; every other error goes through the handler.
+int guardedHandler(lua_State* L) {
+  if (armedNow()) return 1;
+  lua_pushvalue(L, lua_upvalueindex(1));
+  lua_insert(L, 1);
+  lua_call(L, lua_gettop(L) - 1, 1);
+  return 1;
+}
+
+int afterXpcall(lua_State* L, int status, lua_KContext) {
+  if (status != LUA_OK && status != LUA_YIELD) {
+    lua_pushboolean(L, 0);
+    lua_pushvalue(L, -2);
+    return 2;
+  }
+  return lua_gettop(L) - 2;  // `true` and the function's results
+}
+
+int guardedXpcall(lua_State* L) {
+  const int n = lua_gettop(L);
+  luaL_checktype(L, 2, LUA_TFUNCTION);
+  lua_pushboolean(L, 1);  // the first result when the call succeeds
+  lua_pushvalue(L, 1);    // the function
+  lua_rotate(L, 3, 2);    // both below the arguments
+  lua_pushvalue(L, 2);
+  lua_pushcclosure(L, guardedHandler, 1);
+  lua_replace(L, 2);  // the handler, guarded
+  return afterXpcall(L, lua_pcallk(L, n - 2, LUA_MULTRET, 2, 0, afterXpcall), 0);
 }
 
 // coroutine.resume and coroutine.wrap that say which thread runs.
@@ -213,6 +252,9 @@ Running::Running(lua_State* co) : previous_(g_running.load(std::memory_order_rel
 
 Running::~Running() {
   g_running.store(previous_, std::memory_order_relaxed);
+  // Interrupted inside the coroutine: the thread that resumed it is interrupted too, so a pcall
+  // around the resume cannot catch the interrupt and carry on.
+  if (previous_ && armedNow()) lua_sethook(previous_, hook, kHookMask, 1);
 }
 
 void setBudget(std::chrono::milliseconds budget) {
@@ -265,6 +307,8 @@ void openCoroutineTracking(lua_State* L) {
   lua_pushcfunction(L, trackedWrap);
   lua_setfield(L, -2, "wrap");
   lua_pop(L, 1);
+  lua_pushcfunction(L, guardedXpcall);
+  lua_setglobal(L, "xpcall");
 }
 
 }  // namespace pitwall::interrupt

@@ -70,7 +70,9 @@ bool inCall();
 bool inConsole();
 
 // Replaces coroutine.resume and coroutine.wrap in L with versions that tell the interrupter
-// which thread runs (so a runaway loop inside a script's own coroutine is caught too).
+// which thread runs (so a runaway loop inside a script's own coroutine is caught too), and
+// xpcall with one whose message handler never runs for an interrupt's error (Lua would run it
+// with hooks off, where a loop in it could not be interrupted).
 void openCoroutineTracking(lua_State* L);
 
 }  // namespace pitwall::interrupt

@@ -84,6 +84,9 @@ int after(lua_State* L) {
 
 int every(lua_State* L) {
   Duration d = checkDelay(L, 1, "pitwall.every period", false);
+  if (d < std::chrono::milliseconds(1))
+    throw LuaError("pitwall.every period must be at least 0.001 seconds, got " +
+                   lua::show(lua_tonumber(L, 1)));
   lua::checkFunction(L, 2, "pitwall.every callback");
   lua_settop(L, 2);
   return pushTimer(L, ScriptHost::from(L).addTimer(L, d, d));

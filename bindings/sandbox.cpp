@@ -64,50 +64,67 @@ bool isBinary(const char* s, std::size_t n) {
   return n > 0 && s[0] == LUA_SIGNATURE[0];
 }
 
-// load(chunk [, chunkname [, mode [, env]]]): text only.
+// A loaded chunk gets `env` (the argument at envIdx, 0: none) as its first upvalue, as load and
+// loadfile do; a failure is `fail, message`.
+int loaded(lua_State* L, int status, int envIdx) {
+  if (status != LUA_OK) {
+    luaL_pushfail(L);
+    lua_insert(L, -2);
+    return 2;
+  }
+  if (envIdx != 0) {
+    lua_pushvalue(L, envIdx);
+    if (!lua_setupvalue(L, -2, 1)) lua_pop(L, 1);
+  }
+  return 1;
+}
+
+constexpr int kPieceSlot = 5;  // where load keeps the reader function's last piece alive
+
+// A reader function's pieces, one call each, until it returns nil or "".
+const char* nextPiece(lua_State* L, void*, std::size_t* size) {
+  luaL_checkstack(L, 2, "too many nested functions");
+  lua_pushvalue(L, 1);
+  lua_call(L, 0, 1);
+  if (lua_isnil(L, -1)) {
+    lua_pop(L, 1);
+    *size = 0;
+    return nullptr;
+  }
+  if (!lua_isstring(L, -1)) luaL_error(L, "reader function must return a string");
+  lua_replace(L, kPieceSlot);
+  return lua_tolstring(L, kPieceSlot, size);
+}
+
+// load(chunk [, chunkname [, mode [, env]]]), text only whatever the mode says. Written here
+// rather than wrapping Lua's own, so that no reference to that one is left for a script to find.
 int loadText(lua_State* L) {
-  int n = lua_gettop(L);
-  if (lua_type(L, 1) == LUA_TSTRING) {
-    std::size_t len = 0;
-    const char* s = lua_tolstring(L, 1, &len);
-    if (isBinary(s, len)) {
+  std::size_t len = 0;
+  const char* text = lua_tolstring(L, 1, &len);
+  luaL_optstring(L, 3, "bt");
+  const int envIdx = lua_isnone(L, 4) ? 0 : 4;
+  int status;
+  if (text) {
+    if (isBinary(text, len)) {
       luaL_pushfail(L);
       lua_pushfstring(L, "load: %s", kBinaryRefused);
       return 2;
     }
+    const char* name = luaL_optstring(L, 2, text);
+    status = luaL_loadbufferx(L, text, len, name, "t");
+  } else {
+    const char* name = luaL_optstring(L, 2, "=(load)");
+    luaL_checktype(L, 1, LUA_TFUNCTION);
+    lua_settop(L, kPieceSlot);
+    status = lua_load(L, nextPiece, nullptr, name, "t");
   }
-  // The original load, with mode "t" (a reader function's binary chunk is refused by Lua).
-  lua_pushvalue(L, lua_upvalueindex(1));
-  lua_pushvalue(L, 1);
-  if (n >= 2)
-    lua_pushvalue(L, 2);
-  else
-    lua_pushnil(L);
-  lua_pushliteral(L, "t");
-  int args = 3;
-  if (n >= 4) {
-    lua_pushvalue(L, 4);
-    ++args;
-  }
-  lua_call(L, args, LUA_MULTRET);
-  return lua_gettop(L) - n;
+  return loaded(L, status, envIdx);
 }
 
 // loadfile([filename [, mode [, env]]]): text only.
 int loadfileText(lua_State* L) {
   const char* fname = luaL_optstring(L, 1, nullptr);
-  int env = !lua_isnone(L, 3) ? 3 : 0;
-  int status = luaL_loadfilex(L, fname, "t");
-  if (status == LUA_OK) {
-    if (env != 0) {
-      lua_pushvalue(L, env);
-      if (!lua_setupvalue(L, -2, 1)) lua_pop(L, 1);
-    }
-    return 1;
-  }
-  luaL_pushfail(L);
-  lua_insert(L, -2);
-  return 2;
+  return loaded(L, luaL_loadfilex(L, fname, "t"), lua_isnone(L, 3) ? 0 : 3);
 }
 
 int dofileText(lua_State* L) {
@@ -154,6 +171,24 @@ void refuse(lua_State* L, const char* library, const char* name, const char* why
   lua_pop(L, 1);
 }
 
+// setmetatable(t, mt) without finalizers: a __gc runs where Lua turns debug hooks off (nothing
+// interrupts it: not the budget, not Ctrl-C) and when the world closes (past the memory cap).
+int setmetatableNoGc(lua_State* L) {
+  if (lua_type(L, 2) == LUA_TTABLE) {
+    lua_pushliteral(L, "__gc");
+    if (lua_rawget(L, 2) != LUA_TNIL)
+      return luaL_error(L,
+                        "setmetatable: a __gc finalizer is refused: it would run where nothing can "
+                        "interrupt it; close resources with a to-be-closed variable (local x "
+                        "<close>) or in pitwall.onUnload");
+    lua_pop(L, 1);
+  }
+  lua_pushvalue(L, lua_upvalueindex(1));
+  lua_insert(L, 1);
+  lua_call(L, lua_gettop(L) - 1, 1);
+  return 1;
+}
+
 // io.lines(filename, …) reads a file; io.lines() would read the terminal.
 int linesOfFile(lua_State* L) {
   if (lua_isnoneornil(L, 1))
@@ -190,9 +225,11 @@ lua_State* newState(Memory& memory) {
 }
 
 void restrict(lua_State* L) {
-  lua_getglobal(L, "load");
-  lua_pushcclosure(L, loadText, 1);
+  lua_pushcfunction(L, loadText);
   lua_setglobal(L, "load");
+  lua_getglobal(L, "setmetatable");
+  lua_pushcclosure(L, setmetatableNoGc, 1);
+  lua_setglobal(L, "setmetatable");
   lua_pushcfunction(L, loadfileText);
   lua_setglobal(L, "loadfile");
   lua_pushcfunction(L, dofileText);
@@ -208,9 +245,10 @@ void restrict(lua_State* L) {
   // The debug library keeps what reads.
   lua_getglobal(L, "debug");
   if (lua_istable(L, -1)) {
-    static const char* const kept[] = {"traceback",  "getinfo",   "getlocal",    "getmetatable",
-                                       "getupvalue", "upvalueid", "getuservalue"};
-    lua_createtable(L, 0, 7);
+    // getupvalue and getlocal would reach into the engine's C functions and their stacks.
+    static const char* const kept[] = {"traceback", "getinfo", "getmetatable", "getuservalue",
+                                       "upvalueid"};
+    lua_createtable(L, 0, 5);
     for (const char* name : kept) {
       lua_getfield(L, -2, name);
       lua_setfield(L, -2, name);
@@ -229,6 +267,14 @@ void restrict(lua_State* L) {
       "it would block the engine's one loop (and with it Ctrl-C and the cars' stop); run "
       "other programs outside the script";
   refuse(L, "io", "read", "it reads the terminal and would block the engine; use io.open(file)");
+  refuse(L, "io", "input", "it reads the terminal and would block the engine; use io.open(file)");
+  refuse(L, "package", "loadlib",
+         "it calls any function of any library; a C module loads with require, through "
+         "package.cpath");
+  lua_getglobal(L, "io");
+  lua_pushnil(L);
+  lua_setfield(L, -2, "stdin");  // reading the terminal would block the engine
+  lua_pop(L, 1);
   refuse(L, "io", "popen", kBlocks);
   refuse(L, "os", "execute", kBlocks);
   lua_getglobal(L, "io");

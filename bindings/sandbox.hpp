@@ -5,12 +5,15 @@
 // cannot reach past it to crash or wedge the engine.
 // - Code is loaded as text only: load, loadfile, dofile and require refuse precompiled chunks
 //   (Lua does not verify bytecode: patched bytecode crashes the process).
-// - The debug library keeps only what reads (traceback, getinfo, getlocal, getmetatable,
-//   getupvalue, upvalueid, getuservalue): debug.sethook would disarm the callback budget,
-//   debug.debug reads the terminal, the setters and the registry reach into the engine's
-//   references.
-// - Nothing may block the loop: io.read, io.lines() on stdin, io.popen and os.execute are gone.
-//   Files (io.open) stay: scripts write results.
+// - The debug library keeps only what reads and reaches nothing of the engine (traceback,
+//   getinfo, getmetatable, getuservalue, upvalueid): debug.sethook would disarm the callback
+//   budget, debug.debug reads the terminal, the setters and the registry reach into the engine's
+//   references, getupvalue/getlocal into its C functions. load is written anew, not wrapped.
+// - No __gc finalizers (setmetatable refuses them): Lua runs them with hooks off, where nothing
+//   interrupts them, and again when the world closes.
+// - Nothing may block the loop: io.read, io.input, io.stdin, io.lines() on stdin, io.popen and
+//   os.execute are gone; so is package.loadlib (any function of any library). Files (io.open)
+//   stay: scripts write results.
 // - os.exit ends the run through the engine's stop path (ScriptHost), with its exit status.
 // - Each world's allocations are counted against a cap (default 512 MB): a script that reaches it
 //   gets the error "script memory limit of N MB reached", which pcall cannot swallow, and the run

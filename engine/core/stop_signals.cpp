@@ -54,7 +54,9 @@ StopSignals::StopSignals(Loop& loop) : pipe_(loop.io()) {
   struct sigaction sa {};
   sa.sa_handler = onStopSignal;
   sigemptyset(&sa.sa_mask);
-  sa.sa_flags = SA_RESTART;
+  // No SA_RESTART: a script blocked in a read (a FIFO, the terminal) gets EINTR and returns to the
+  // loop, which then acts on the signal; the engine's own I/O is asynchronous and retries.
+  sa.sa_flags = 0;
   ::sigaction(SIGINT, &sa, &oldInt_);
   ::sigaction(SIGTERM, &sa, &oldTerm_);
   await();

@@ -60,3 +60,43 @@ local lines = {}
 for line in io.lines(out) do lines[#lines + 1] = line end
 os.remove(out)
 expect.eq(#lines, 2, "io.lines(file) reads a file")
+
+-- Nothing reaches past the sandbox: no upvalue or stack slot of the engine's C functions (where the
+-- unrestricted functions would be), no library's exports, no finalizer.
+expect.eq(debug.getupvalue, nil, "debug.getupvalue is not there")
+expect.eq(debug.getlocal, nil, "debug.getlocal is not there")
+-- Inside a reader function, the C function on the stack is the sandbox's own load: Lua's, which
+-- takes binary chunks, is nowhere to be found.
+local cFrames = {}
+load(function()
+  for level = 1, 10 do
+    local info = debug.getinfo(level, "fS")
+    if info and info.what == "C" then cFrames[#cFrames + 1] = info.func end
+  end
+  return nil
+end)
+expect.eq(#cFrames, 1, "one C function under the reader")
+expect.eq(cFrames[1], load, "and it is the sandbox's load")
+expect.fails(function() package.loadlib("libc.so.6", "abort") end, "package.loadlib is not available")
+expect.fails(function() setmetatable({}, { __gc = function() end }) end, "__gc finalizer is refused")
+expect.eq(getmetatable(setmetatable({}, { __index = { x = 1 } })).__index.x, 1, "other metatables work")
+expect.eq(io.stdin, nil, "io.stdin is not there")
+expect.fails(function() io.input() end, "io.input is not available")
+
+-- xpcall: handlers and yields work as in Lua
+local ok, msg = xpcall(error, function(m) return "handled: " .. m end, "x")
+expect.falsy(ok)
+expect.eq(msg, "handled: x")
+local r = table.pack(xpcall(function(a, b) return a + b, "two" end, debug.traceback, 2, 3))
+expect.eq(r.n, 3)
+expect.eq(r[2], 5)
+local slept
+pitwall.spawn(function()
+  slept = table.pack(xpcall(function() pitwall.sleep(0.5) return "woke" end, debug.traceback))
+end)
+pitwall.sleep(1)
+expect.eq(slept and slept[2], "woke", "a task may sleep inside xpcall")
+
+-- A timer period the clock cannot tell from zero is refused.
+expect.fails(function() pitwall.every(1e-12, function() end) end, "at least 0.001 seconds")
+pitwall.cancel(pitwall.every(0.001, function() end))

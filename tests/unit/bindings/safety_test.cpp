@@ -150,3 +150,33 @@ TEST_CASE("memory under the cap is served, and what is freed counts no more") {
   CHECK_FALSE(w.host->memory().exceeded);
   CHECK_FALSE(w.host->exitStatus());
 }
+
+TEST_CASE("os.exit inside a coroutine is not caught by a pcall around the coroutine") {
+  World w;
+  REQUIRE(w.host->startString(R"(
+    local co = coroutine.wrap(function() os.exit(4) end)
+    print(pcall(co))
+    reached = 1
+  )",
+                              "exit"));
+  REQUIRE(w.host->exitStatus());
+  CHECK(*w.host->exitStatus() == 4);
+  CHECK(w.global("reached") == 0);
+}
+
+TEST_CASE("a message handler that never returns is interrupted with the call") {
+  World w;
+  lua_State* L = w.host->state();
+  REQUIRE(luaL_dostring(L, R"(
+    function handlerSpins() return xpcall(error, function() while true do end end, "x") end
+    function bodyAndHandlerSpin()
+      return xpcall(function() while true do end end, function(m) while true do end end)
+    end
+  )") == LUA_OK);
+  for (const char* name : {"handlerSpins", "bodyAndHandlerSpin"}) {
+    CAPTURE(name);
+    lua_getglobal(L, name);
+    CHECK_FALSE(w.host->call(0, 0, "test callback"));
+    CHECK(w.logContains("still running after 100 ms: interrupted"));
+  }
+}
