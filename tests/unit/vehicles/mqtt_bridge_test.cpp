@@ -203,16 +203,25 @@ void waitForCars(Loop& loop, Observer& o, Host& h) {
   CHECK(o.json(kCars)["value"].get<std::vector<std::string>>() == sorted({h.id(0), h.id(1)}));
 }
 
+// The usual set-up: a private broker, an observer subscribed to the whole tree, and a bridge of
+// two simulated cars that the observer has seen published.
+struct Bridged {
+  MosquittoBroker broker;
+  Loop loop{ClockKind::Real};
+  Observer o{loop, broker};
+  bool observing = runUntil(loop, [this] { return o.connects == 1; });
+  Host h{loop, broker};
+  Bridged() {
+    REQUIRE(observing);
+    waitForCars(loop, o, h);
+  }
+};
+
 }  // namespace
 
-TEST_CASE("mqtt bridge: a speed intent drives the simulated cars and their events are published") {
-  MosquittoBroker broker;
-  Loop loop(ClockKind::Real);
-  Observer o(loop, broker);
-  REQUIRE(runUntil(loop, [&] { return o.connects == 1; }));
-  Host h(loop, broker);
-  waitForCars(loop, o, h);
-
+TEST_CASE_FIXTURE(
+    Bridged,
+    "mqtt bridge: a speed intent drives the simulated cars and their events are published") {
   o.send(kHostIntent, R"({"type":"speed","speed":600,"acceleration":1000})");
   auto seen = [&](int i) {
     for (const char* rest : {"E/speed", "E/track_piece_id", "E/frame", "S/Speed/Actual"})
@@ -240,13 +249,8 @@ TEST_CASE("mqtt bridge: a speed intent drives the simulated cars and their event
   CHECK_FALSE(o.has(kIntentError));
 }
 
-TEST_CASE("mqtt bridge: a late subscriber gets the retained status and no stale events") {
-  MosquittoBroker broker;
-  Loop loop(ClockKind::Real);
-  Observer o(loop, broker);
-  REQUIRE(runUntil(loop, [&] { return o.connects == 1; }));
-  Host h(loop, broker);
-  waitForCars(loop, o, h);
+TEST_CASE_FIXTURE(Bridged,
+                  "mqtt bridge: a late subscriber gets the retained status and no stale events") {
   // Events happen (and would be in the broker's store if they were retained); then the cars stop.
   REQUIRE(h.car(0).setSpeed(500).ok());
   REQUIRE(runUntil(loop, [&] { return o.has(h.carTopic(0, "E/speed")); }));
@@ -290,13 +294,8 @@ TEST_CASE("mqtt bridge: a late subscriber gets the retained status and no stale 
   }
 }
 
-TEST_CASE("mqtt bridge: every intent type is executed on one car, on all cars and on the host") {
-  MosquittoBroker broker;
-  Loop loop(ClockKind::Real);
-  Observer o(loop, broker);
-  REQUIRE(runUntil(loop, [&] { return o.connects == 1; }));
-  Host h(loop, broker);
-  waitForCars(loop, o, h);
+TEST_CASE_FIXTURE(
+    Bridged, "mqtt bridge: every intent type is executed on one car, on all cars and on the host") {
   const std::string one = h.carTopic(0, "I");
 
   SUBCASE("speed") {
@@ -405,13 +404,8 @@ TEST_CASE("mqtt bridge: every intent type is executed on one car, on all cars an
   CHECK(h.bridge->stats().rejected == 0);
 }
 
-TEST_CASE("mqtt bridge: a malformed intent is answered on S/IntentError and sends nothing") {
-  MosquittoBroker broker;
-  Loop loop(ClockKind::Real);
-  Observer o(loop, broker);
-  REQUIRE(runUntil(loop, [&] { return o.connects == 1; }));
-  Host h(loop, broker);
-  waitForCars(loop, o, h);
+TEST_CASE_FIXTURE(
+    Bridged, "mqtt bridge: a malformed intent is answered on S/IntentError and sends nothing") {
   std::size_t framesBefore = h.tx.size();
   std::uint64_t out0 = h.car(0).state().frames_out, out1 = h.car(1).state().frames_out;
   const std::string one = h.carTopic(0, "I");
@@ -502,13 +496,8 @@ TEST_CASE("mqtt bridge: a retained intent is rejected, not executed, when the br
   CHECK(h.bridge->stats().rejected == 1);
 }
 
-TEST_CASE("mqtt bridge: a single-car intent for a car another online host owns is left to it") {
-  MosquittoBroker broker;
-  Loop loop(ClockKind::Real);
-  Observer o(loop, broker);
-  REQUIRE(runUntil(loop, [&] { return o.connects == 1; }));
-  Host h(loop, broker);
-  waitForCars(loop, o, h);
+TEST_CASE_FIXTURE(
+    Bridged, "mqtt bridge: a single-car intent for a car another online host owns is left to it") {
   const std::string speed = R"({"type":"speed","speed":600,"acceleration":1000})";
   std::size_t framesBefore = h.tx.size();
 
@@ -662,13 +651,9 @@ TEST_CASE("mqtt bridge: the broker publishes HostStatus false when a bridge's pr
   CHECK(late.json(kHostStatus) == Json{{"value", false}});
 }
 
-TEST_CASE("mqtt bridge: goOffline() publishes every car offline, no cars, and HostStatus false") {
-  MosquittoBroker broker;
-  Loop loop(ClockKind::Real);
-  Observer o(loop, broker);
-  REQUIRE(runUntil(loop, [&] { return o.connects == 1; }));
-  Host h(loop, broker);
-  waitForCars(loop, o, h);
+TEST_CASE_FIXTURE(
+    Bridged,
+    "mqtt bridge: goOffline() publishes every car offline, no cars, and HostStatus false") {
   h.bridge->goOffline();
   REQUIRE(runUntil(loop, [&] { return o.json(kHostStatus) == Json{{"value", false}}; }));
   REQUIRE(o.roundTrip(loop));
@@ -818,13 +803,8 @@ TEST_CASE("mqtt bridge: a flood of intents to a car is cut to its rate, with one
   REQUIRE(runUntil(loop, [&] { return h.sent<anki::SetSpeed>(0).back().speed_mm_s == 1499; }));
 }
 
-TEST_CASE("mqtt bridge: a stop is never throttled, however full the flood before it") {
-  MosquittoBroker broker;
-  Loop loop(ClockKind::Real);
-  Observer o(loop, broker);
-  REQUIRE(runUntil(loop, [&] { return o.connects == 1; }));
-  Host h(loop, broker);
-  waitForCars(loop, o, h);
+TEST_CASE_FIXTURE(Bridged,
+                  "mqtt bridge: a stop is never throttled, however full the flood before it") {
   const std::string one = h.carTopic(0, "I");
   constexpr int kFlood = 300;
   for (int i = 0; i < kFlood; ++i)
