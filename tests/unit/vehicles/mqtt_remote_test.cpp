@@ -313,21 +313,28 @@ TEST_CASE("mqtt remote: losing the broker disconnects the remote cars until it i
   REQUIRE(runUntil(p.loop, [&] { return p.b.car(0).state().speed_mm_s > 0; }));
 }
 
+// A client that publishes what it likes on the tree, and the warnings logged meanwhile.
+struct Vandal {
+  std::vector<std::string> warnings;
+  MqttClient client;
+  explicit Vandal(Pair& p) : client(p.loop, MqttOptions::fromUrl(p.broker.url())) {
+    log::setSink([this](log::Level level, std::string_view line) {
+      if (level == log::Level::Warn) warnings.emplace_back(line);
+    });
+    bool connected = false;
+    client.onConnected = [&connected] { connected = true; };
+    client.connect();
+    REQUIRE(runUntil(p.loop, [&] { return connected; }));
+    client.onConnected = nullptr;
+  }
+  ~Vandal() { log::setSink(nullptr); }
+};
+
 TEST_CASE("mqtt remote: malformed status and frames on the tree are ignored with a warning") {
   Pair p;
-  std::vector<std::string> warnings;
-  log::setSink([&](log::Level level, std::string_view line) {
-    if (level == log::Level::Warn) warnings.emplace_back(line);
-  });
-  struct Restore {
-    ~Restore() { log::setSink(nullptr); }
-  } restore;
-
-  MqttClient vandal(p.loop, MqttOptions::fromUrl(p.broker.url()));
-  bool connected = false;
-  vandal.onConnected = [&] { connected = true; };
-  vandal.connect();
-  REQUIRE(runUntil(p.loop, [&] { return connected; }));
+  Vandal v(p);
+  MqttClient& vandal = v.client;
+  const std::vector<std::string>& warnings = v.warnings;
   std::string id = p.a.bridge->carIdOf(p.aOf(0));
   std::string car = "Anki/Car/" + id;
   std::uint64_t malformed = p.b.car(0).state().malformed;
@@ -365,19 +372,9 @@ TEST_CASE("mqtt remote: malformed status and frames on the tree are ignored with
 TEST_CASE(
     "mqtt remote: hostile publications on every topic it reads are ignored, the cars follow") {
   Pair p;
-  std::vector<std::string> warnings;
-  log::setSink([&](log::Level level, std::string_view line) {
-    if (level == log::Level::Warn) warnings.emplace_back(line);
-  });
-  struct Restore {
-    ~Restore() { log::setSink(nullptr); }
-  } restore;
-
-  MqttClient vandal(p.loop, MqttOptions::fromUrl(p.broker.url()));
-  bool connected = false;
-  vandal.onConnected = [&] { connected = true; };
-  vandal.connect();
-  REQUIRE(runUntil(p.loop, [&] { return connected; }));
+  Vandal v(p);
+  MqttClient& vandal = v.client;
+  const std::vector<std::string>& warnings = v.warnings;
   const std::string car = "Anki/Car/" + p.a.bridge->carIdOf(p.aOf(0));
   const std::string host = "Anki/Host/" + kHost;
   const std::vector<std::string> read = {car + "/S/CarStatus",
