@@ -18,10 +18,18 @@ wait_last() {
   done
 }
 
-# cars_stopped NAME: the last speed host A's cars were given is 0, and the bridge still runs.
+# cars_stopped NAME [FROM]: the last speed host A's cars were given is 0, and the bridge still
+# runs. With FROM (a line of $ALL), the run's own 800 mm/s from that line on came before that 0.
 cars_stopped() {
   local c
   for c in "${CARS[@]}"; do
+    if [ -n "${2:-}" ]; then
+      local deadline=$((SECONDS + 10))
+      until tail -n +"$2" "$ALL" | grep -qE "^Anki/Car/$c/S/Speed/Desired .*\"value\":800}"; do
+        [ $SECONDS -ge $deadline ] && { fail "$1: $c never got the script's 800 mm/s"; break; }
+        sleep 0.02
+      done
+    fi
     wait_last "$c" S/Speed/Desired 0 && echo "ok: $1: $c was stopped at the end (S/Speed/Desired 0)" ||
       fail "$1: last S/Speed/Desired of $c: $(last_value "$ALL" "Anki/Car/$c/S/Speed/Desired")"
   done
@@ -86,11 +94,34 @@ contains "mixed race: a winner" "Winner: " "$out"
 after_run "mixed race"
 
 # ---- host B: a script that never stops commanding (tests/integration/nagging.lua), ended by
-# --duration: the stop is the last speed host A's cars get, however many intents were in flight.
-MODE=none timeout 60 $PITWALL run "$SRC/tests/integration/nagging.lua" --cars 0 --mqtt "$MQTT_URL" \
-  --remote-cars 2 --duration 2 >"$TMP/nag.out" 2>"$TMP/nag.err"
-check "nagging script: exit status" 0 "$?"
-cars_stopped "nagging script"
+# --duration, os.exit, a dying main chunk and Ctrl-C: the stop is the last speed host A's cars
+# get, however many intents were in flight.
+while read -r mode status options; do
+  from=$(wc -l <"$ALL")
+  MODE=$mode timeout 60 $PITWALL run "$SRC/tests/integration/nagging.lua" --cars 0 \
+    --mqtt "$MQTT_URL" --remote-cars 2 $options </dev/null >"$TMP/nag.out" 2>"$TMP/nag.err"
+  check "nagging script ($mode): exit status" "$status" "$?"
+  cars_stopped "nagging script ($mode)" "$from"
+done <<'MODES'
+none 0 --duration 2
+exit 3
+error 1
+MODES
+rm -f "$TMP/nag.fifo"
+from=$(wc -l <"$ALL")
+mkfifo "$TMP/nag.fifo"
+MODE=none $PITWALL run "$SRC/tests/integration/nagging.lua" --cars 0 --mqtt "$MQTT_URL" \
+  --remote-cars 2 </dev/null >"$TMP/nag.fifo" 2>"$TMP/nag.err" &
+NAG=$!
+exec 4<"$TMP/nag.fifo"
+read -r -t 20 -u 4 line
+check "nagging script (Ctrl-C): driving" "driving" "$line"
+kill -INT $NAG
+cat <&4 >/dev/null 2>&1 &
+wait $NAG
+check "nagging script (Ctrl-C): exit status" 130 "$?"
+exec 4<&-
+cars_stopped "nagging script (Ctrl-C)" "$from"
 
 kill -TERM "$BRIDGE"
 wait "$BRIDGE"
