@@ -9,6 +9,9 @@
 
 namespace pitwall {
 
+// Other hosts remembered from their S/Cars and S/HostStatus: more than any real tree holds.
+constexpr std::size_t kMaxOtherHosts = 1024;
+
 namespace {
 constexpr const char* kLog = "mqtt bridge";
 // The bucket of the host's connection intents (car ids never hold a space).
@@ -220,13 +223,15 @@ void MqttBridge::handle(std::string_view topic, std::string_view payload, bool r
   auto parts = topics::splitTopic(topic);
   if (parts && parts->kind == topics::TopicParts::Kind::Host && parts->id != host_) {
     if (parts->rest == "S/Cars") {
-      if (auto cars = topics::readHostCars(payload, options_.payload))
+      // At most kMaxOtherHosts remembered: ids a hostile publisher invents do not grow it.
+      if (auto cars = topics::readHostCars(payload, options_.payload);
+          cars && (otherCars_.count(parts->id) || otherCars_.size() < kMaxOtherHosts))
         otherCars_[parts->id] = *cars;
       return;
     }
     if (parts->rest == "S/HostStatus") {
       auto up = topics::readHostStatus(payload, options_.payload);
-      if (up && *up)
+      if (up && *up && otherOnline_.size() < kMaxOtherHosts)
         otherOnline_.insert(parts->id);
       else
         otherOnline_.erase(parts->id);

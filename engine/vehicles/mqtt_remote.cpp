@@ -93,6 +93,29 @@ bool RemoteCars::hostUp(const std::string& host) const {
   return host.empty() || it == hosts_.end() || it->second;
 }
 
+namespace {
+// Bounds against a publisher that invents ids: more than any real tree holds.
+constexpr std::size_t kMaxTracked = 1024;    // car ids and host ids remembered
+constexpr std::size_t kMaxRemoteCars = 256;  // remote cars in the fleet
+constexpr std::size_t kMaxName = 64;         // bytes of a remote car's name
+}  // namespace
+
+RemoteCars::Car* RemoteCars::track(const std::string& id, std::string_view topic) {
+  if (auto it = cars_.find(id); it != cars_.end()) return &it->second;
+  if (cars_.size() >= kMaxTracked) {
+    warn("ignored " + topics::quote(topic) + ": the tree names more than " +
+         std::to_string(kMaxTracked) + " cars; no more are followed");
+    return nullptr;
+  }
+  return &cars_[id];
+}
+
+std::size_t RemoteCars::linkedCount() const {
+  std::size_t n = 0;
+  for (const auto& [id, car] : cars_) n += car.link != nullptr;
+  return n;
+}
+
 void RemoteCars::warn(const std::string& line) {
   if (!warnings_.take(kWarnings, loop_.now())) {
     ++unlogged_;
@@ -136,16 +159,17 @@ void RemoteCars::handle(std::string_view topic, std::string_view payload) {
     if (parts->rest == "S/HostStatus") {
       auto up = topics::readHostStatus(payload, limits_);
       if (!up) return complain(up.error());
+      if (!hosts_.count(parts->id) && hosts_.size() >= kMaxTracked)
+        return complain("the tree names more than " + std::to_string(kMaxTracked) +
+                        " hosts; no more are followed");
       hosts_[parts->id] = *up;
       for (auto& [id, car] : cars_)
         if (car.host == parts->id) update(id, car);
     } else if (parts->rest == "S/Cars") {
       auto list = topics::readHostCars(payload, limits_);
       if (!list) return complain(list.error());
-      for (const auto& id : *list) {
-        auto& car = cars_[id];
-        car.host = parts->id;
-      }
+      for (const auto& id : *list)
+        if (Car* car = track(id, topic)) car->host = parts->id;
     } else if (parts->rest == "S/IntentError") {
       // Only errors about intents we might have sent: single-car intents to remote cars.
       for (const auto& [id, car] : cars_)
@@ -165,15 +189,17 @@ void RemoteCars::handle(std::string_view topic, std::string_view payload) {
   } else if (parts->rest == "S/Information") {
     auto info = topics::readInformation(id, payload, limits_);
     if (!info) return complain(info.error());
-    auto& car = cars_[id];
-    car.info = *info;
-    update(id, car);
+    Car* car = track(id, topic);
+    if (!car) return;
+    car->info = *info;
+    update(id, *car);
   } else if (parts->rest == "S/CarStatus") {
     auto status = topics::readCarStatus(payload, limits_);
     if (!status) return complain(status.error());
-    auto& car = cars_[id];
-    car.online = status->online;
-    update(id, car);
+    Car* car = track(id, topic);
+    if (!car) return;
+    car->online = status->online;
+    update(id, *car);
   }
 }
 
@@ -181,9 +207,12 @@ std::string RemoteCars::uniqueName(const topics::CarInfo& info) const {
   std::vector<std::string> taken;
   for (const auto* c : fleet_.cars()) taken.push_back(c->identity().name);
   if (info.name.empty()) return anki::uniqueCarName(info.model_id, taken);
-  std::string name = info.name;
+  std::size_t cut = std::min(info.name.size(), kMaxName);
+  while (cut > 0 && cut < info.name.size() && (info.name[cut] & 0xC0) == 0x80) --cut;  // UTF-8
+  std::string name = info.name.substr(0, cut);
+  const std::string base = name;
   for (int n = 2; std::find(taken.begin(), taken.end(), name) != taken.end(); ++n)
-    name = info.name + std::to_string(n);
+    name = base + std::to_string(n);
   return name;
 }
 
@@ -191,6 +220,9 @@ void RemoteCars::update(const std::string& id, Car& car) {
   bool up = brokerUp_ && car.online && car.info && hostUp(car.host);
   if (!car.link) {
     if (!up) return;
+    if (linkedCount() >= kMaxRemoteCars)
+      return warn("remote car " + topics::quote(id) + " not taken: already " +
+                  std::to_string(kMaxRemoteCars) + " remote cars");
     auto link = std::make_unique<RemoteLink>(*this, id);
     car.link = link.get();
     CarIdentity identity;

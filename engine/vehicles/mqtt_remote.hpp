@@ -66,6 +66,10 @@ class RemoteCars {
   void update(const std::string& id, Car& car);
   bool hostUp(const std::string& host) const;
   std::string uniqueName(const topics::CarInfo& info) const;
+  // The entry of car `id`, made when there is room (kMaxTracked); nullptr, with a warning, when
+  // the tree names more cars than any fleet has (a hostile publisher inventing ids).
+  Car* track(const std::string& id, std::string_view topic);
+  std::size_t linkedCount() const;
 
   Loop& loop_;
   Fleet& fleet_;

@@ -432,3 +432,21 @@ TEST_CASE(
   CHECK(p.reaches(
       0, [](AnkiCar& c) { return c.setSpeed(450); }, anki::SetSpeed{450, kDefaultAccel, false}));
 }
+
+TEST_CASE("mqtt remote: ids a publisher invents are followed only up to a bound") {
+  Pair p;
+  Vandal v(p);
+  std::string ids;
+  for (int i = 0; i < 2000; ++i)
+    ids += std::string(ids.empty() ? "" : ",") + "\"fake" + std::to_string(i) + "\"";
+  REQUIRE(v.client.publish("Anki/Host/evil/S/Cars", R"({"timestamp":1,"value":[)" + ids + "]}", 1));
+  REQUIRE(runUntil(p.loop, [&] {
+    for (const auto& w : v.warnings)
+      if (w.find("the tree names more than 1024 cars; no more are followed") != std::string::npos)
+        return true;
+    return false;
+  }));
+  // and the real cars still follow
+  CHECK(p.reaches(
+      0, [](AnkiCar& c) { return c.setSpeed(420); }, anki::SetSpeed{420, kDefaultAccel, false}));
+}
