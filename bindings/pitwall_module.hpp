@@ -3,8 +3,13 @@
 // simulator is the transport (sim_binding.cpp).
 namespace pitwall {
 class ScriptHost;
+}  // namespace pitwall
+struct lua_State;
+namespace pitwall {
 void openPitwallModule(ScriptHost& host);
 void openSimModule(ScriptHost& host);  // leaves nothing on the stack; sets pitwall.sim
+// sim.script and sim.reload (script_under_test.cpp) on the pitwall.sim table on top of the stack.
+void openScriptUnderTest(lua_State* L);
 // pitwall.mindroad{…} and pitwall.alphabot{…}: the seed robots (docs/robots.md). Each leaves
 // nothing on the stack and sets its function in the `pitwall` table.
 void openMindroadModule(ScriptHost& host);

@@ -15,8 +15,10 @@ namespace {
 // table on `to`'s stack keyed by the source table's address), so sharing and cycles survive.
 class Copier {
  public:
-  Copier(lua_State* from, lua_State* to, std::vector<std::string>& dropped)
-      : from_(from), to_(to), dropped_(dropped) {}
+  // quiet: what cannot cross is left out without being named (the library's own state, whose
+  // functions and metatables stay behind by design: the new version brings its own).
+  Copier(lua_State* from, lua_State* to, std::vector<std::string>& dropped, bool quiet = false)
+      : from_(from), to_(to), dropped_(dropped), quiet_(quiet) {}
 
   // Copies the value at `from` index idx onto `to`'s stack; false (nothing pushed) when it
   // cannot be copied.
@@ -52,7 +54,7 @@ class Copier {
       default:
         break;
     }
-    dropped_.push_back(path + " (a " + luaL_typename(from_, idx) + ")");
+    if (!quiet_) dropped_.push_back(path + " (a " + luaL_typename(from_, idx) + ")");
     return false;
   }
 
@@ -76,11 +78,11 @@ class Copier {
     lua_rawsetp(to_, memo_, key);
     if (lua_getmetatable(from_, idx)) {
       lua_pop(from_, 1);
-      dropped_.push_back(path + "'s metatable");
+      if (!quiet_) dropped_.push_back(path + "'s metatable");
     }
     lua_pushnil(from_);
     while (lua_next(from_, idx)) {  // raw traversal: no __pairs, no __index
-      std::string keyPath = path + keyText(-2);
+      std::string keyPath = quiet_ ? path : path + keyText(-2);
       if (copy(-2, keyPath + " (as a key)", depth + 1)) {
         if (copy(-1, keyPath, depth + 1))
           lua_rawset(to_, -3);
@@ -112,6 +114,7 @@ class Copier {
   lua_State* from_;
   lua_State* to_;
   std::vector<std::string>& dropped_;
+  bool quiet_;
   int memo_ = 0;
 };
 
@@ -126,6 +129,23 @@ void copyPersist(ScriptHost& from, ScriptHost& to, std::vector<std::string>& dro
   lua_getglobal(F, "pitwall");
   bool copied = lua_istable(F, -1) && lua_getfield(F, -1, "persist") == LUA_TTABLE &&
                 copier.copy(-1, "pitwall.persist", 0);
+  if (!copied) lua_newtable(T);
+  copier.closeMemo();
+  lua_settop(F, fromTop);
+}
+
+void copyCarried(ScriptHost& from, ScriptHost& to) {
+  lua_State* F = from.state();
+  lua_State* T = to.state();
+  int fromTop = lua_gettop(F);
+  std::vector<std::string> dropped;
+  Copier copier(F, T, dropped, true);
+  copier.openMemo();
+  lua_getglobal(F, "pitwall");
+  bool copied = false;
+  if (lua_istable(F, -1) && lua_getfield(F, -1, "_saveCarried") == LUA_TFUNCTION &&
+      from.call(0, 1, "pitwall (carrying the library's state into the new version)"))
+    copied = lua_istable(F, -1) && copier.copy(-1, "carried", 0);
   if (!copied) lua_newtable(T);
   copier.closeMemo();
   lua_settop(F, fromTop);
@@ -170,7 +190,28 @@ Result<bool, std::string> Reloader::start(const std::string& script) {
   return current_->startFile(script);
 }
 
+Result<bool, std::string> Reloader::startSource(const Source& source) {
+  script_ = source.name;
+  if (auto loaded = current_->loadString(source.code, source.name); !loaded) return loaded;
+  return current_->startLoadedFile(ScriptHost::StartMode::Run);
+}
+
 Result<bool, std::string> Reloader::reload(const std::vector<std::string>& changed) {
+  return reloadFrom(changed, nullptr);
+}
+
+Result<bool, std::string> Reloader::reloadSource(const Source& source) {
+  script_ = source.name;
+  return reloadFrom({source.name}, &source);
+}
+
+Result<bool, std::string> Reloader::reloadFile(const std::string& path) {
+  script_ = path;
+  return reloadFrom({path}, nullptr);
+}
+
+Result<bool, std::string> Reloader::reloadFrom(const std::vector<std::string>& changed,
+                                               const Source* source) {
   auto began = std::chrono::steady_clock::now();
   auto refuse = [this](std::string error) -> Result<bool, std::string> {
     ++stats_.failures;
@@ -182,7 +223,8 @@ Result<bool, std::string> Reloader::reload(const std::vector<std::string>& chang
   // 1. It must compile before the running version hears of it. The chunk stays on the new
   // world's stack until step 4 runs it.
   lua_State* N = next->state();
-  if (auto loaded = next->loadFile(script_); !loaded) return refuse(loaded.error());
+  auto loaded = source ? next->loadString(source->code, source->name) : next->loadFile(script_);
+  if (!loaded) return refuse(loaded.error());
 
   // 2. The running version's last word: pitwall.onUnload(persist).
   ScriptHost& old = *current_;
@@ -206,6 +248,12 @@ Result<bool, std::string> Reloader::reload(const std::vector<std::string>& chang
   lua_pop(N, 1);
   for (const auto& d : dropped)
     log::warn("reload", d + " cannot cross into the new version; left out");
+  // 3b. What the library carries over (a race in progress, docs/hot-reload.md "Races").
+  copyCarried(old, *next);
+  lua_getglobal(N, "pitwall");
+  lua_insert(N, -2);
+  lua_setfield(N, -2, "_carried");
+  lua_pop(N, 1);
 
   // 4. The new version starts, up to its first sleep; then its pitwall.onReload(persist, info).
   if (auto started = next->startLoadedFile(ScriptHost::StartMode::Trial); !started)

@@ -34,6 +34,15 @@ class Reloader {
   // Loads the script again as a new version (docs/hot-reload.md has the order of events). On
   // failure the running version carries on untouched and the error says why.
   Result<bool, std::string> reload(const std::vector<std::string>& changed = {});
+  // A scenario's script under test (pitwall.sim.script, sim.reload): the script is source text
+  // named `name`, or from now on the file `path`.
+  struct Source {
+    std::string code;
+    std::string name;
+  };
+  Result<bool, std::string> startSource(const Source& source);
+  Result<bool, std::string> reloadSource(const Source& source);
+  Result<bool, std::string> reloadFile(const std::string& path);
   // Reloads whenever one of the script's files is saved: the script and every module it loaded
   // from disk with require. Failures are logged; the running version carries on.
   Result<bool, std::string> watch(Duration debounce = std::chrono::milliseconds(100));
@@ -63,6 +72,8 @@ class Reloader {
   void hookStop(ScriptHost& host);
   void watchFile(const std::string& path);
   void changed(const std::vector<std::string>& paths);
+  Result<bool, std::string> reloadFrom(const std::vector<std::string>& changed,
+                                       const Source* source);
 
   Loop& loop_;
   Fleet& fleet_;
@@ -83,5 +94,9 @@ class Reloader {
 // cannot cross into another Lua world: it is left out and named in `dropped`
 // ("pitwall.persist.onLap (a function)").
 void copyPersist(ScriptHost& from, ScriptHost& to, std::vector<std::string>& dropped);
+// The library's own state (a race in progress): pitwall._saveCarried() of `from`, copied the same
+// way onto `to`'s stack, but quietly: its functions and metatables stay behind by design (the
+// new version's modules bring their own and take the data up again).
+void copyCarried(ScriptHost& from, ScriptHost& to);
 
 }  // namespace pitwall

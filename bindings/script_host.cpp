@@ -395,6 +395,15 @@ void ScriptHost::shutDown() {
     luaL_unref(L_, LUA_REGISTRYINDEX, timer.fnRef);
   }
   timers_.clear();
+  auto hooks = std::move(atShutDown_);
+  for (auto& fn : hooks) fn();
+}
+
+void ScriptHost::atShutDown(std::function<void()> fn) {
+  if (shutDown_)
+    fn();
+  else
+    atShutDown_.push_back(std::move(fn));
 }
 
 void ScriptHost::requestStop() {
@@ -449,6 +458,16 @@ Result<bool, std::string> ScriptHost::startLoadedFile(StartMode mode) {
 Result<bool, std::string> ScriptHost::startFile(const std::string& path, StartMode mode) {
   if (auto loaded = loadFile(path); !loaded) return loaded;
   return startLoadedFile(mode);
+}
+
+Result<bool, std::string> ScriptHost::loadString(const std::string& code,
+                                                 const std::string& chunkname) {
+  if (luaL_loadbufferx(L_, code.data(), code.size(), ("@" + chunkname).c_str(), "t") != LUA_OK) {
+    std::string err = lua_tostring(L_, -1) ? lua_tostring(L_, -1) : "cannot load the script";
+    lua_pop(L_, 1);
+    return Unexpected{err};
+  }
+  return true;
 }
 
 Result<bool, std::string> ScriptHost::startString(const std::string& code,

@@ -63,6 +63,8 @@ class ScriptHost {
   // compiles before it tells the running version anything), then start that chunk.
   Result<bool, std::string> loadFile(const std::string& path);
   Result<bool, std::string> startLoadedFile(StartMode mode);
+  // loadFile for a chunk of text named `chunkname` (a scenario's script under test).
+  Result<bool, std::string> loadString(const std::string& code, const std::string& chunkname);
   // Same for a chunk of text (tests, benchmarks).
   Result<bool, std::string> startString(const std::string& code, const std::string& chunkname);
   bool mainFinished() const { return mainFinished_; }
@@ -118,6 +120,9 @@ class ScriptHost {
   // handler or callback — except a chunk typed at the REPL. Final.
   void shutDown();
   bool isShutDown() const { return shutDown_; }
+  // Runs `fn` when this world shuts down (what it started that must end with it), or at once
+  // when it already has.
+  void atShutDown(std::function<void()> fn);
   // The memory this world's allocations hold now, and its cap (sandbox.hpp).
   const sandbox::Memory& memory() const { return memory_; }
   // In test mode: the first failure (error in a task or callback, failed expectation).
@@ -176,6 +181,7 @@ class ScriptHost {
   bool trial_ = false;
   std::optional<std::string> trialError_;
   std::vector<std::string> loadedFiles_;
+  std::vector<std::function<void()>> atShutDown_;
 };
 
 }  // namespace pitwall

@@ -188,6 +188,8 @@ int truth(lua_State* L) {
   lua::setBoolean(L, "connected", t.connected);
   lua::setInteger(L, "battery", t.battery_mv);
   lua::setInteger(L, "collisions", t.collisions);
+  lua::setInteger(L, "speedCommands", t.speed_commands);
+  lua::setInteger(L, "stopCommands", t.stop_commands);
   return 1;
 }
 
@@ -258,6 +260,7 @@ void openSimModule(ScriptHost& host) {
                                        {nullptr, nullptr}};
   lua_getglobal(L, "pitwall");
   luaL_newlib(L, functions);
+  openScriptUnderTest(L);
   lua_setfield(L, -2, "sim");
   lua_pop(L, 1);
 }

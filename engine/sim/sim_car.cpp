@@ -131,6 +131,8 @@ void Car::receive(std::span<const std::uint8_t> frame) {
           [&](const anki::Disconnect&) { drop(true); },
           [&](const anki::SetSpeed& m) {
             if (!sdk) return;
+            ++speed_commands_;
+            if (m.speed_mm_s <= 0) ++stop_commands_;
             target_ = std::clamp<double>(m.speed_mm_s, 0, kMaxSpeed);
             accel_ = m.accel_mm_s2 > 0 ? m.accel_mm_s2 : kMaxAccel;
             emit(anki::SpeedUpdate{static_cast<std::int16_t>(target_), m.accel_mm_s2,
@@ -344,6 +346,8 @@ Truth Car::truth() const {
   t.connected = static_cast<bool>(sink_);
   t.battery_mv = clampU16(battery_mv_);
   t.collisions = collisions_;
+  t.speed_commands = speed_commands_;
+  t.stop_commands = stop_commands_;
   return t;
 }
 

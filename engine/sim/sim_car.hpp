@@ -109,6 +109,7 @@ class Car final : public SimCar {
   bool on_track_ = true, delocalized_ = false, sdk_ = false, low_battery_ = false;
   double battery_mv_ = 0;
   int laps_ = 0, collisions_ = 0;
+  int speed_commands_ = 0, stop_commands_ = 0;  // Truth::speed_commands, stop_commands
   double wheel_left_mm_ = 0, wheel_right_mm_ = 0;
 
   FrameSink sink_;

@@ -28,8 +28,8 @@ struct CarSpec {
 };
 
 struct Noise {
-  double drop = 0;          // probability that a vehicle→controller frame is lost
-  double late = 0;          // probability that one is delayed
+  double drop = 0;  // probability that a vehicle→controller frame is lost
+  double late = 0;  // probability that one is delayed
   Duration late_by{std::chrono::milliseconds(150)};  // upper bound of that delay
 };
 
@@ -42,13 +42,15 @@ struct Truth {
   double offset_mm = 0;
   double speed_mm_s = 0;
   double target_speed_mm_s = 0;
-  int laps = 0;                  // finish lines crossed (34 → 33) while on track
+  int laps = 0;  // finish lines crossed (34 → 33) while on track
   bool on_track = true;
   bool delocalized = false;
   bool sdk_mode = false;
   bool connected = false;
   std::uint16_t battery_mv = 0;
   int collisions = 0;
+  int speed_commands = 0;  // set-speed frames received in SDK mode
+  int stop_commands = 0;   // those of them that asked for 0 mm/s
 };
 
 class SimCar {

@@ -90,6 +90,37 @@ function pitwall.listen(car, event, fn)
   return setmetatable({ car = car, event = event, entry = entry }, Subscription)
 end
 
+-- What the library carries into the next version of the script (docs/hot-reload.md "A race
+-- survives a reload"). A module registers a function that returns its state; at a reload the
+-- engine calls pitwall._saveCarried() in the running version and copies the result into the new
+-- one as pitwall._carried — plain data and cars; functions and metatables stay behind, and the
+-- module of the new version takes the data up again. (pitwall.persist is the script's own.)
+local carriers = {}
+pitwall._carried = {}
+
+--- Registers `save`, which returns module `name`'s state for the next version.
+function pitwall._carry(name, save)
+  carriers[name] = save
+end
+
+--- The carried state of module `name` from the version before, or nil (first version).
+function pitwall._takeCarried(name)
+  return pitwall._carried[name]
+end
+
+function pitwall._saveCarried()
+  local out = {}
+  for name, save in pairs(carriers) do
+    local ok, state = xpcall(save, debug.traceback)
+    if ok then
+      out[name] = state
+    else
+      pitwall._reportError("carrying " .. name .. " into the new version", state)
+    end
+  end
+  return out
+end
+
 --- A shallow copy of a table: event tables are reused, so keep a copy to store one.
 function pitwall.copy(t)
   local c = {}

@@ -79,11 +79,29 @@ function laps.timer(car, map, options)
   }, Timer)
   for k, i in ipairs(sectors) do self.sectorAt[i] = k end
   self:reset()
-  self.unsubscribe = loc:subscribe {
+  self:_follow()
+  return self
+end
+
+function Timer:_follow()
+  self.unsubscribe = self.localization:subscribe {
     enter = function(_, i, from, t) self:_enter(i, from, t) end,
     lost = function() self.clean = false end,
   }
-  return self
+end
+
+--- Takes up a timer carried from an earlier version of the script (docs/hot-reload.md): its
+--- laps, times and the lap under way as they were, timing on. `options.onLap`,
+--- `options.onBestLap`: its handlers in this version (handlers are not carried). The map must
+--- have been taken up (track._adopt). Returns the timer.
+function laps._adopt(data, options)
+  if getmetatable(data) == Timer then return data end
+  options = options or {}
+  setmetatable(data, Timer)
+  data.localization = localize._adopt(data.localization)
+  data.onLap, data.onBestLap = options.onLap, options.onBestLap
+  data:_follow()
+  return data
 end
 
 --- Forgets every lap: the next finish crossing starts lap 1 (e.g. at a race start).

@@ -267,6 +267,28 @@ function Tracker:_onSpeed(ev)
   self.accel = ev.accel > 0 and ev.accel or MAX_ACCEL
 end
 
+-- The tracker's listeners on its car's events.
+local function listenTo(self)
+  local car = self.car
+  self.subs = {
+    pitwall.listen(car, "onPosition", function(_, ev) self:_onPosition(ev) end),
+    pitwall.listen(car, "onTransition", function(_, ev) self:_onTransition(ev) end),
+    pitwall.listen(car, "onSpeed", function(_, ev) self:_onSpeed(ev) end),
+    pitwall.listen(car, "onDelocalized", function(_, ev)
+      self:_lose(ev.time, "delocalized")
+      self:_rebase(ev.time, 0)
+    end),
+    pitwall.listen(car, "onStatus", function(_, ev)
+      if not ev.onTrack then self:_lose(ev.time, "off the track") end
+    end),
+    -- Where a car goes while nobody hears from it is unknown.
+    pitwall.listen(car, "onDisconnect", function(_, ev)
+      self:_lose(ev.time, "disconnected")
+      self:_rebase(ev.time, 0)
+    end),
+  }
+end
+
 --- Follows `car` on `map` (a map from pitwall.track) and returns its tracker; the same car and
 --- map give the same tracker. options.horizon: how many seconds past the last event the
 --- position is extrapolated (default 3; at 300 mm/s two lost frames leave a gap over 1 s).
@@ -284,29 +306,27 @@ function localize.follow(car, map, options)
     carry = 0, modelTime = now, modelSpeed = 0, sinceEntry = 0, entrySeen = false,
     horizon = options and options.horizon or 3, watchers = {},
   }, Tracker)
-  local ok, err = pcall(function()
-    self.subs = {
-      pitwall.listen(car, "onPosition", function(_, ev) self:_onPosition(ev) end),
-      pitwall.listen(car, "onTransition", function(_, ev) self:_onTransition(ev) end),
-      pitwall.listen(car, "onSpeed", function(_, ev) self:_onSpeed(ev) end),
-      pitwall.listen(car, "onDelocalized", function(_, ev)
-        self:_lose(ev.time, "delocalized")
-        self:_rebase(ev.time, 0)
-      end),
-      pitwall.listen(car, "onStatus", function(_, ev)
-        if not ev.onTrack then self:_lose(ev.time, "off the track") end
-      end),
-      -- Where a car goes while nobody hears from it is unknown.
-      pitwall.listen(car, "onDisconnect", function(_, ev)
-        self:_lose(ev.time, "disconnected")
-        self:_rebase(ev.time, 0)
-      end),
-    }
-  end)
+  local ok, err = pcall(listenTo, self)
   if not ok then error("localize.follow: " .. tostring(err), 2) end
   followed[car] = byMap or {}
   followed[car][map] = self
   return self
+end
+
+--- Takes up a tracker carried from an earlier version of the script (docs/hot-reload.md): its
+--- state as it was, following the car again in this version. Its watchers are not carried: who
+--- subscribed (a lap timer, a race) subscribes again. The map must have been taken up
+--- (track._adopt). Returns the tracker.
+function localize._adopt(data)
+  if getmetatable(data) == Tracker then return data end
+  local byMap = followed[data.car]
+  if byMap and byMap[data.map] then return byMap[data.map] end
+  setmetatable(data, Tracker)
+  data.watchers = {}
+  listenTo(data)
+  followed[data.car] = byMap or {}
+  followed[data.car][data.map] = data
+  return data
 end
 
 --- Stops following: the tracker's listeners are cancelled.

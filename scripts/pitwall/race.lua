@@ -48,8 +48,28 @@ local Race = {}
 Race.__index = Race
 
 -- car → the kind of its last event ("position", "transition"): whether car.piece is still
--- where it is (kept for the whole run, from a car's first session on)
+-- where it is (kept for the whole run, from a car's first session on, across reloads)
 local lastKind = setmetatable({}, { __mode = "k" })
+local listening = setmetatable({}, { __mode = "k" }) -- cars whose kinds this version follows
+
+-- The sessions this version ran, in order; the last map a session raced on. A reload carries
+-- them into the new version (docs/hot-reload.md "A race survives a reload"): there the k-th
+-- session the script runs takes up the k-th one carried — a finished one returns at once with
+-- its results, one under way goes on where it was.
+local sessions = {}
+local lastMap
+local carried = pitwall._takeCarried("race") or { sessions = {} }
+if carried.lastKind then
+  for car, kind in pairs(carried.lastKind) do lastKind[car] = kind end
+end
+if carried.map then lastMap = track._adopt(carried.map) end
+
+pitwall._carry("race", function()
+  local out, kinds = {}, {}
+  for k, session in ipairs(sessions) do out[k] = session:_carry() end
+  for car, kind in pairs(lastKind) do kinds[car] = kind end
+  return { sessions = out, lastKind = kinds, map = lastMap }
+end)
 
 local MODES = { practice = "Free practice", qualifying = "Qualifying", laps = "Race",
   timed = "Timed race" }
@@ -126,6 +146,10 @@ function Race:_map()
   local o = self.options
   if o.map then return o.map end
   if pitwall.sim and not o.scan then return track.fromSim() end
+  if lastMap and lastMap.source == "scan" then
+    pitwall.log("info", "race: the track map of the session before is used (no new scan lap)")
+    return lastMap
+  end
   local scanOptions = type(o.scan) == "table" and o.scan or {}
   pitwall.log("info", "race: scan lap with " .. tostring(self.cars[1]))
   return track.scan(self.cars[1], scanOptions)
@@ -141,10 +165,36 @@ function Race:_progress(e, now)
   return base + d / L, d
 end
 
--- Drives cars that are known to be elsewhere to the grid (piece 34) and stops them there.
+local LANES = { -68, -23, 23, 68 }
+
+-- Why a car did not reach the grid, for the error.
+function Race:_gridProblem(e)
+  local car, loc, n = e.car, e.loc, #self.map.pieces
+  if not car.connected then return "it is not connected" end
+  if not loc.localized then
+    return "its place on the map is not known (no position updates: is it on the track?)"
+  end
+  local where = string.format("on piece %d of %d (id %d) in lane %s at %d mm/s", loc.index, n,
+    self.map.pieces[loc.index].id, tostring(loc.lane), math.floor((car.speed or 0) + 0.5))
+  local me = loc:distance()
+  for _, o in ipairs(self.order) do
+    local d = o ~= e and o.loc.localized and o.loc:distance()
+    if d and me and o.loc.lane == loc.lane then
+      local gap = (d - me) % self.map:lapLength(0)
+      if gap < 400 then
+        return string.format("%s, %.0f mm behind %s in the same lane", where, gap, tostring(o.car))
+      end
+    end
+  end
+  return where .. ((car.speed or 0) == 0 and ", standing still" or "")
+end
+
+-- Drives cars that are known to be elsewhere to the grid (piece 34) and stops them there. Cars
+-- are given lanes of their own (those already on the grid keep theirs; the others take the
+-- free lane nearest to theirs), so two cars in one lane do not end up one behind the other.
 function Race:_toGrid()
   local n = #self.map.pieces
-  local moving = {}
+  local moving, taken = {}, {}
   for _, e in ipairs(self.order) do
     local piece = e.loc.index and self.map.pieces[e.loc.index].id or e.car.piece
     -- a transition after its last position update: it has left that piece (a scan lap ends so,
@@ -152,14 +202,38 @@ function Race:_toGrid()
     if not e.loc.index and self.lastKind[e.car] == "transition" then piece = 0 end
     if piece and piece ~= 34 and e.car.connected then
       moving[#moving + 1] = e
-      e.car:setSpeed(self.options.gridSpeed or 500, 1000)
+    else
+      taken[localize.nearestLane(e.car.offset or 0)] = e
     end
   end
   if #moving == 0 then return end
   pitwall.log("info", string.format("race: %d car(s) to the grid", #moving))
+  -- A car's lane is known once it reports a position on the way (one that was put somewhere
+  -- by hand has not reported where): then it is given the free lane nearest to its own.
+  local began = pitwall.now()
+  local function assign(e)
+    local here = localize.nearestLane(e.car.offset or 0)
+    local lane
+    for _, l in ipairs(LANES) do
+      if not taken[l] and (not lane or math.abs(l - here) < math.abs(lane - here)) then lane = l end
+    end
+    lane = lane or here -- more cars than lanes: this one queues in its lane
+    taken[lane], e.gridLane = e, lane
+    if lane ~= here then
+      pitwall.log("info", string.format("race: %s moves to lane %d for the grid", tostring(e.car),
+        lane))
+      e.car:changeLane(lane)
+    end
+  end
+  for _, e in ipairs(moving) do
+    e.gridLane = nil
+    e.car:setSpeed(self.options.gridSpeed or 500, 1000)
+  end
+  local timeout = self.options.gridTimeout or 90
   local ok = pitwall.waitUntil(function()
     local all = true
     for _, e in ipairs(moving) do
+      if not e.gridLane and (e.car.lastPositionTime or -math.huge) > began then assign(e) end
       if e.loc.localized and e.loc.index == n then
         if e.car.targetSpeed ~= 0 then e.car:stop() end
       else
@@ -167,8 +241,20 @@ function Race:_toGrid()
       end
     end
     return all
-  end, self.options.gridTimeout or 90, 0.005)
-  if not ok then error("race: the cars did not reach the grid (piece 34) in time", 0) end
+  end, timeout, 0.005)
+  if not ok then
+    local why = {}
+    for _, e in ipairs(moving) do
+      if not (e.loc.localized and e.loc.index == n) then
+        why[#why + 1] = tostring(e.car) .. ": " .. self:_gridProblem(e)
+        if e.car.connected then pcall(e.car.stop, e.car) end
+      end
+    end
+    error(string.format("race: %d car(s) did not reach the grid (piece 34) in %g s — %s. The "
+      .. "cars are stopped: check that each is on the track and can drive (a car blocked in its "
+      .. "lane: put it in a lane of its own), or raise gridTimeout", #why, timeout,
+      table.concat(why, "; ")), 0)
+  end
   pitwall.sleep(1) -- settled: a car still rolling at the first light would be a false start
 end
 
@@ -178,16 +264,15 @@ function Race:_lights()
   local o = self.options
   local count, interval, hold = o.lights or 5, o.lightInterval or 1, o.hold or 0.5
   self.state = "lights"
-  local moved = {}
   local subs = {}
   for _, e in ipairs(self.order) do
     -- a car that moves reports it; one that is only told to (targetSpeed) is caught as well
-    subs[#subs + 1] = pitwall.listen(e.car, "onTransition", function() moved[e] = true end)
-    subs[#subs + 1] = pitwall.listen(e.car, "onPosition", function() moved[e] = true end)
+    subs[#subs + 1] = pitwall.listen(e.car, "onTransition", function() e.moved = true end)
+    subs[#subs + 1] = pitwall.listen(e.car, "onPosition", function() e.moved = true end)
   end
   local function check()
     for _, e in ipairs(self.order) do
-      if not e.falseStart and (moved[e] or (e.car.targetSpeed or 0) > 0) then
+      if not e.falseStart and (e.moved or (e.car.targetSpeed or 0) > 0) then
         e.falseStart = true
         pitwall.log("warn", string.format("race: false start by %s: held %g s after green",
           tostring(e.car), self.penalty))
@@ -197,14 +282,21 @@ function Race:_lights()
     end
     return false
   end
-  for k = 1, count do
+  local function wait(k, spent)
+    pitwall.waitUntil(check, math.max(0, (k < count and interval or hold) - spent), 0.005)
+  end
+  -- A version that took the session up during the lights waits out the light that was on.
+  local from = self.light or 0
+  if from > 0 then wait(from, pitwall.now() - self.lightAt) end
+  for k = from + 1, count do
+    self.light, self.lightAt = k, pitwall.now()
     pitwall.log("debug", string.format("race: light %d of %d", k, count))
     self:_emit("onLights", k, self)
     if self.board then
       self.board.title = self.title .. "   " .. string.rep("●", k) .. string.rep("○", count - k)
       self.board:show(self:_rows())
     end
-    pitwall.waitUntil(check, k < count and interval or hold, 0.005)
+    wait(k, 0)
   end
   for _, s in ipairs(subs) do s:cancel() end
   pitwall.log("debug", "race: green")
@@ -423,33 +515,23 @@ function Race:abort()
   self.done = true
 end
 
---- Runs the session to its end inside a task; returns the session.
-function Race:run()
-  if not coroutine.isyieldable() then
-    error("race: a session drives and waits: run it inside a task (the main chunk or "
-      .. "pitwall.spawn), not in a handler", 2)
-  end
-  local o = self.options
-  self.lastKind = lastKind
-  for _, car in ipairs(self.cars) do
-    if not lastKind[car] then
-      lastKind[car] = "none"
-      pitwall.listen(car, "onPosition", function() lastKind[car] = "position" end)
-      pitwall.listen(car, "onTransition", function() lastKind[car] = "transition" end)
-    end
-  end
-  self.map = self:_map()
-  self.penalty = o.falseStartPenalty or 5
-  local field = {}
-  local grid = self:_gridOrder()
-  for slot, car in ipairs(grid) do
-    local loc = localize.follow(car, self.map)
-    field[#field + 1] = { car = car, loc = loc }
-    local e = { car = car, loc = loc, gridSlot = slot, passes = {}, started = false }
+-- The entries: one per car, in grid order, each followed on the map.
+function Race:_entries()
+  for slot, car in ipairs(self:_gridOrder()) do
+    local e = { car = car, loc = localize.follow(car, self.map), gridSlot = slot, passes = {},
+      started = false }
     self.entries[car] = e
     self.order[slot] = e
   end
-  local driverSpec = o.drivers
+end
+
+-- The driver of every car from this version's options, and its context. A car that is racing
+-- already (a reload took the session up) gets its new driver through takeover, handed what the
+-- driver before it handed over; a driver without takeover is started as at the green light.
+function Race:_drivers()
+  local field = {}
+  for _, e in ipairs(self.order) do field[#field + 1] = { car = e.car, loc = e.loc } end
+  local driverSpec = self.options.drivers
   for i, car in ipairs(self.cars) do
     local e = self.entries[car]
     local spec = driverSpec
@@ -458,11 +540,31 @@ function Race:run()
     end
     e.driver = makeDriver(spec, car, i)
     e.ctx = drivers.context(car, self.map, field, { period = self.period })
+    local h = e.handover
+    e.handover = nil
+    if h and e.started and not e.finished and self.phase == "racing" then
+      if e.driver.takeover then
+        local fine, err = xpcall(e.driver.takeover, debug.traceback, e.driver, car, e.ctx, h.state,
+          h.name)
+        if not fine then report("takeover of driver " .. tostring(e.driver.name or "?") .. " of "
+          .. tostring(car), err) end
+      else
+        drivers.call(e.driver, "start", car, e.ctx)
+      end
+    end
   end
-  if self.mode ~= "practice" then self:_toGrid() end
+end
+
+-- Lap timers (from the grid on) and what the director follows of each car.
+function Race:_timing(adopted)
   local n = #self.map.pieces
   for _, e in ipairs(self.order) do
-    e.timer = laps.timer(e.car, self.map, { onLap = function(_, lap) self:_onLap(e, lap) end })
+    local onLap = function(_, lap) self:_onLap(e, lap) end
+    if adopted and e.timer then
+      e.timer = laps._adopt(e.timer, { onLap = onLap })
+    else
+      e.timer = laps.timer(e.car, self.map, { onLap = onLap })
+    end
     e.unsubscribe = e.loc:subscribe {
       enter = function(_, i, _, t)
         local key = (e.timer.start and e.timer.count or -1) * n + i
@@ -474,10 +576,8 @@ function Race:run()
         end
       end,
     }
-  end
-  -- A car put back on the track (a status "on track" after it left) stands still: it is sent
-  -- its last commanded speed again, so that its driver resumes.
-  for _, e in ipairs(self.order) do
+    -- A car put back on the track (a status "on track" after it left) stands still: it is sent
+    -- its last commanded speed again, so that its driver resumes.
     e.statusSub = pitwall.listen(e.car, "onStatus", function(car, ev)
       if not ev.onTrack then e.offTrack = true
       elseif e.offTrack then
@@ -488,44 +588,185 @@ function Race:run()
       end
     end)
   end
-  if o.board ~= false then
-    self.board = Board.new {
-      title = self.title,
-      columns = {
-        { key = "position", title = "POS", align = "right" },
-        { key = "car", title = "CAR" },
-        { key = "lap", title = "LAP", align = "right" },
-        { key = "lastLap", title = "LAST", align = "right", format = Board.time },
-        { key = "bestLap", title = "BEST", align = "right", format = Board.time },
-        { key = "gap", title = "GAP", align = "right",
-          format = function(v, row) return Board.gap(v, row.lapsBehind) end },
-      },
-    }
+end
+
+function Race:_board(drawn)
+  if self.options.board == false then return end
+  self.board = Board.new {
+    title = self.title,
+    columns = {
+      { key = "position", title = "POS", align = "right" },
+      { key = "car", title = "CAR" },
+      { key = "lap", title = "LAP", align = "right" },
+      { key = "lastLap", title = "LAST", align = "right", format = Board.time },
+      { key = "bestLap", title = "BEST", align = "right", format = Board.time },
+      { key = "gap", title = "GAP", align = "right",
+        format = function(v, row) return Board.gap(v, row.lapsBehind) end },
+    },
+  }
+  self.board.drawn = drawn or 0 -- a new version redraws over the drawing of the one before
+end
+
+-- What the next version takes up (pitwall._carry above): the session's data, each entry's data
+-- and what its driver hands over; not the options, drivers, handlers or board, which the next
+-- version brings.
+local SKIP = { options = true, board = true, lastKind = true }
+local SKIP_ENTRY = { driver = true, ctx = true, unsubscribe = true, statusSub = true }
+function Race:_carry()
+  local c = {}
+  for k, v in pairs(self) do
+    if not SKIP[k] then c[k] = v end
   end
-  if self.mode ~= "practice" and o.lights ~= 0 then self:_lights() end
-  self.state = "racing"
-  self.green = pitwall.now()
+  c.drawn = self.board and self.board.drawn or 0
+  local copies = {}
   for _, e in ipairs(self.order) do
-    e.releaseAt = self.green + (e.falseStart and self.penalty or 0)
+    local ce = {}
+    for k, v in pairs(e) do
+      if not SKIP_ENTRY[k] then ce[k] = v end
+    end
+    local d = e.driver
+    if d then
+      local state
+      if d.handover and e.started and not e.finished then
+        local fine, result = xpcall(d.handover, debug.traceback, d)
+        if fine then state = result
+        else report("handover of driver " .. tostring(d.name or "?") .. " of " .. tostring(e.car),
+          result) end
+      end
+      ce.handover = { name = d.name, state = state }
+    end
+    copies[e] = ce
   end
-  self.ticks = 0
-  self:_tick()
-  local ticker = pitwall.every(self.period, function()
-    if self.done then return end
-    local ok, err = xpcall(self._tick, debug.traceback, self)
-    if not ok then report("race director", err) end
-  end)
-  pitwall.waitUntil(function() return self.done end, nil, self.period)
-  ticker:cancel()
-  self.state = "done"
-  self:_standings(pitwall.now())
-  -- Every car brought to a stop.
-  for _, e in ipairs(self.order) do
-    if e.started and not e.finished then drivers.call(e.driver, "finish", e.car, e.ctx) end
-    if e.car.connected then pcall(e.car.stop, e.car) end
+  c.entries, c.order = {}, {}
+  for k, e in ipairs(self.order) do
+    local ce = copies[e]
+    if ce.limitedBy then ce.limitedBy = copies[ce.limitedBy] end
+    c.order[k], c.entries[e.car] = ce, ce
+  end
+  return c
+end
+
+-- Takes up session `c` carried from the version before: its state as it was, this version's
+-- options where they may change mid-session (drivers, title, board, period, …); the mode and
+-- the cars cannot, the number of laps (or minutes) can.
+function Race:_takeUp(c)
+  local o = self.options
+  if c.mode ~= self.mode then
+    pitwall.log("warn", string.format("race: this version asks for a %s, but a %s is under way: "
+      .. "a session cannot change its kind; it goes on as a %s", MODES[self.mode]:lower(),
+      MODES[c.mode]:lower(), MODES[c.mode]:lower()))
+  end
+  local newMode, newLaps, newSeconds = self.mode, self.laps, self.seconds
+  for k, v in pairs(c) do
+    if k ~= "title" and k ~= "period" then self[k] = v end
+  end
+  self.drawn = nil
+  if c.map then self.map = track._adopt(c.map) end
+  if o.cars and #o.cars ~= #c.cars then
+    pitwall.log("warn", string.format("race: this version names %d car(s), the session under way "
+      .. "has %d: the cars cannot change mid-session; it goes on with its own", #o.cars, #c.cars))
+  end
+  if self.phase == "done" then return end
+  if newMode == c.mode then
+    if self.mode == "laps" and newLaps and newLaps ~= c.laps then
+      local done = 0
+      for _, e in ipairs(self.order) do done = math.max(done, e.timer and e.timer.count or 0) end
+      if self.leaderFinished then
+        pitwall.log("warn", string.format("race: laps = %d: the race is already over (%d laps); "
+          .. "it stays so", newLaps, c.laps))
+      else
+        self.laps = math.max(newLaps, done + 1)
+        pitwall.log("info", string.format("race: %d laps instead of %d%s", self.laps, c.laps,
+          self.laps ~= newLaps and string.format(" (the leader has done %d already)", done) or ""))
+      end
+    elseif newSeconds and c.seconds and newSeconds ~= c.seconds and not self.timeUp
+      and not self.leaderFinished then
+      self.seconds = newSeconds
+      pitwall.log("info", string.format("race: %s instead of %s", Board.time(newSeconds),
+        Board.time(c.seconds)))
+    end
+  end
+  return c.drawn
+end
+
+--- Runs the session to its end inside a task; returns the session. A session that a reload of
+--- the script interrupted is taken up where it was by the same call in the new version.
+function Race:run()
+  if not coroutine.isyieldable() then
+    error("race: a session drives and waits: run it inside a task (the main chunk or "
+      .. "pitwall.spawn), not in a handler", 2)
+  end
+  local o = self.options
+  self.lastKind = lastKind
+  local index = #sessions + 1
+  sessions[index] = self
+  local c = carried.sessions[index]
+  carried.sessions[index] = nil
+  for _, car in ipairs(self.cars) do
+    if not listening[car] then
+      listening[car] = true
+      lastKind[car] = lastKind[car] or "none"
+      pitwall.listen(car, "onPosition", function() lastKind[car] = "position" end)
+      pitwall.listen(car, "onTransition", function() lastKind[car] = "transition" end)
+    end
+  end
+  local drawn
+  if c then
+    drawn = self:_takeUp(c)
+    if self.phase == "done" then return self end
+    pitwall.log("info", string.format("race: %s taken up by the new version (%s)", self.title,
+      self.phase))
+  end
+  self.phase = self.phase or "new"
+  self.penalty = o.falseStartPenalty or self.penalty or 5
+  if self.phase == "new" then
+    self.map = self:_map()
+    lastMap = self.map
+    self:_entries()
+    self.phase = "grid"
+  else
+    for _, e in ipairs(self.order) do e.loc = localize._adopt(e.loc) end
+  end
+  self:_drivers()
+  if self.phase == "grid" then
+    if self.mode ~= "practice" then self:_toGrid() end
+    self:_timing(false)
+    self.phase = "lights"
+  else
+    self:_timing(true)
+  end
+  self:_board(drawn)
+  if self.phase == "lights" then
+    if self.mode ~= "practice" and o.lights ~= 0 then self:_lights() end
+    self.state = "racing"
+    self.green = pitwall.now()
+    for _, e in ipairs(self.order) do
+      e.releaseAt = self.green + (e.falseStart and self.penalty or 0)
+    end
+    self.ticks = 0
+    self.phase = "racing"
+    self:_tick()
+  end
+  if self.phase == "racing" then
+    local ticker = pitwall.every(self.period, function()
+      if self.done then return end
+      local ok, err = xpcall(self._tick, debug.traceback, self)
+      if not ok then report("race director", err) end
+    end)
+    pitwall.waitUntil(function() return self.done end, nil, self.period)
+    ticker:cancel()
+    self.state = "done"
+    self.phase = "ending"
+    self:_standings(pitwall.now())
+    -- Every car brought to a stop.
+    for _, e in ipairs(self.order) do
+      if e.started and not e.finished then drivers.call(e.driver, "finish", e.car, e.ctx) end
+      if e.car.connected then pcall(e.car.stop, e.car) end
+    end
   end
   pitwall.sleep(0.5) -- (car.speed is the last reported one: a stopped car reports nothing)
   for _, e in ipairs(self.order) do e.unsubscribe(); e.timer:cancel(); e.statusSub:cancel() end
+  self.phase = "done"
   if self.board then
     self.board.title = self.title .. "   results"
     self.board:final(self:_rows())

@@ -207,6 +207,40 @@ local function findLap(segs)
   return nil
 end
 
+-- Scans under way, for the next version of the script (a reload during a scan lap goes on with
+-- it instead of starting another).
+local scanning = {}
+local carriedScans -- the scans an earlier version had under way, taken up one by one
+
+pitwall._carry("track", function()
+  local out = {}
+  for st in pairs(scanning) do out[#out + 1] = st end
+  return { scans = out }
+end)
+
+local function takeScan(car)
+  if carriedScans == nil then
+    local c = pitwall._takeCarried("track")
+    carriedScans = c and c.scans or {}
+  end
+  for k, st in ipairs(carriedScans) do
+    if st.car == car then
+      table.remove(carriedScans, k)
+      return st
+    end
+  end
+  return nil
+end
+
+--- Takes up a map carried from an earlier version of the script (its methods stay behind, so
+--- they are given back here). Returns the map.
+function track._adopt(map)
+  if getmetatable(map) == Map then return map end
+  setmetatable(map, Map)
+  for _, p in ipairs(map.pieces) do setmetatable(p, Piece) end
+  return map
+end
+
 --- Drives `car` one lap in a fixed lane and returns the map (inside a task only).
 --- options: speed (mm/s, default 350), offset (mm: change to this lane first; default: stay),
 --- timeout (s, default 120), stop (default true: stop the car once the map is complete, just
@@ -230,24 +264,30 @@ function track.scan(car, options)
     error("track.scan: " .. tostring(car) .. " is not connected", 2)
   end
 
-  local segs, cur = {}, nil
-  local lastTime, lastSpeed = pitwall.now(), car.speed or 0
-  local reversed, delocalized = false, false
+  -- The scan's state is one table, so that a reload of the script takes it up where it was
+  -- (pitwall._carry below): the new version's track.scan of the same car goes on with it.
+  local now = pitwall.now()
+  local st = takeScan(car) or { car = car, speed = speed, phase = "start", segs = {}, cur = nil,
+    lastTime = now, lastSpeed = car.speed or 0, reversed = false, delocalized = false,
+    uturns = 0, deadline = now + timeout }
+  speed = st.speed
+  scanning[st] = true
   local function reckon(t)
-    if cur then cur.reckoned = cur.reckoned + lastSpeed * (t - lastTime) end
-    lastTime = t
+    if st.cur then st.cur.reckoned = st.cur.reckoned + st.lastSpeed * (t - st.lastTime) end
+    st.lastTime = t
   end
   local subs = {
     pitwall.listen(car, "onPosition", function(_, ev)
       reckon(ev.time)
-      lastSpeed = ev.speed
-      reversed = ev.reverse
-      if reversed then
+      st.lastSpeed = ev.speed
+      st.reversed = ev.reverse
+      if st.reversed then
         -- Driving backwards the pieces come the other way round: nothing of it is kept.
-        segs, cur = {}, nil
+        st.segs, st.cur = {}, nil
         return
       end
-      cur = cur or newSegment(ev.time, false)
+      local cur = st.cur or newSegment(ev.time, false)
+      st.cur = cur
       if not cur.ids[ev.piece] then
         cur.ids[ev.piece] = true
         cur.idCount = cur.idCount + 1
@@ -255,57 +295,63 @@ function track.scan(car, options)
     end),
     pitwall.listen(car, "onTransition", function(_, ev)
       reckon(ev.time)
-      if reversed then return end
+      if st.reversed then return end
+      local cur = st.cur
       if cur then
         cur.left, cur.right, cur.offset = ev.leftWheel, ev.rightWheel, ev.offset
         cur.problem = segmentProblem(cur)
-        segs[#segs + 1] = cur
+        st.segs[#st.segs + 1] = cur
       end
-      cur = newSegment(ev.time, true)
+      st.cur = newSegment(ev.time, true)
     end),
-    pitwall.listen(car, "onDelocalized", function() delocalized = true end),
+    pitwall.listen(car, "onDelocalized", function() st.delocalized = true end),
   }
   local function cancel()
     for _, s in ipairs(subs) do s:cancel() end
+    scanning[st] = nil
   end
 
   local ok, result = pcall(function()
-    local deadline = pitwall.now() + timeout
     local function waitFor(cond, what)
-      local left = deadline - pitwall.now()
+      local left = st.deadline - pitwall.now()
       if left <= 0 or not pitwall.waitUntil(cond, left) then
         error(string.format("track.scan: %s within %g s with %s (%d pieces crossed); give a longer "
           .. "timeout, or check that the car drives and the layout has the start pieces 34 and 33",
-          what, timeout, tostring(car), #segs), 0)
+          what, timeout, tostring(car), #st.segs), 0)
       end
     end
-    car:setSpeed(speed, 1000)
-    if options.offset then
-      waitFor(function() return (car.speed or 0) > 0 end, "the car did not start moving")
-      car:changeLane(options.offset)
-      -- Its offset update may be lost: the offsets in position updates tell as well.
-      waitFor(function()
-        return not car.laneChanging or math.abs((car.offset or 0) - options.offset) < 2
-      end, "the lane change did not finish")
-      segs, cur = {}, nil -- what was seen while changing lanes does not count
+    if st.phase == "start" then
+      car:setSpeed(speed, 1000)
+      if options.offset then
+        waitFor(function() return (car.speed or 0) > 0 end, "the car did not start moving")
+        car:changeLane(options.offset)
+        -- Its offset update may be lost: the offsets in position updates tell as well.
+        waitFor(function()
+          return not car.laneChanging or math.abs((car.offset or 0) - options.offset) < 2
+        end, "the lane change did not finish")
+        st.segs, st.cur = {}, nil -- what was seen while changing lanes does not count
+      end
+      st.phase = "lap"
+    else
+      pitwall.log("info", string.format("track.scan: %s goes on with the scan an earlier version "
+        .. "began (%d pieces crossed)", tostring(car), #st.segs))
     end
     local ids, run
-    local uturns, turnedAt = 0, nil
     waitFor(function()
-      if delocalized then
+      if st.delocalized then
         error("track.scan: " .. tostring(car) .. " left the track during the scan; put it back "
           .. "and scan again, slower", 0)
       end
-      if reversed and (not turnedAt or pitwall.now() - turnedAt > 1) then
+      if st.reversed and (not st.turnedAt or pitwall.now() - st.turnedAt > 1) then
         -- It drives reversed: turn it round (once more if that did not take within 1 s).
-        uturns = uturns + 1
-        if uturns > 3 then
+        st.uturns = st.uturns + 1
+        if st.uturns > 3 then
           error("track.scan: " .. tostring(car) .. " keeps driving reversed after 3 U-turns", 0)
         end
         car:uturn()
-        turnedAt = pitwall.now()
+        st.turnedAt = pitwall.now()
       end
-      ids, run = findLap(segs)
+      ids, run = findLap(st.segs)
       return ids ~= nil
     end, "no complete clean lap from finish line to finish line")
 

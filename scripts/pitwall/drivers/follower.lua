@@ -82,6 +82,17 @@ function Follower:target(car, ctx)
   return v, braking
 end
 
+-- A reload swaps the driver (docs/racing.md "Drivers across a reload"): what it follows is
+-- handed to its successor.
+function Follower:handover()
+  return { lastLead = self.lastLead, held = self.held }
+end
+
+function Follower:takeover(car, ctx, state, from)
+  if from ~= "follower" or type(state) ~= "table" then return end
+  self.lastLead, self.held = state.lastLead, state.held
+end
+
 function Follower:update(car, ctx)
   local v, braking = self:target(car, ctx)
   local last = car.targetSpeed or 0

@@ -39,6 +39,21 @@ function Keeper:finish(car, ctx)
   if self.inner.finish then self.inner:finish(car, ctx) end
 end
 
+-- A reload swaps the driver (docs/racing.md "Drivers across a reload").
+function Keeper:handover()
+  return { asked = self.asked, inner = self.inner.handover and self.inner:handover() or nil,
+    innerName = self.inner.name }
+end
+
+function Keeper:takeover(car, ctx, state, from)
+  if from == "lanekeeper" and type(state) == "table" then
+    self.asked = state.asked
+    if self.inner.takeover then self.inner:takeover(car, ctx, state.inner, state.innerName) end
+  elseif self.inner.takeover then
+    self.inner:takeover(car, ctx, state, from)
+  end
+end
+
 function Keeper:update(car, ctx)
   self.inner:update(car, ctx)
   if not drivers.moving(car) or car.offset == nil then return end -- lane changes need motion

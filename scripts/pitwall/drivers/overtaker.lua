@@ -61,6 +61,19 @@ end
 
 function Overtaker:start(car, ctx) self.state = "home" end
 
+-- A reload swaps the driver (docs/racing.md "Drivers across a reload"): a pass under way goes
+-- on, and the count of passes with it.
+function Overtaker:handover()
+  return { state = self.state, passing = self.passing, passes = self.passes,
+    follow = self.follow:handover() }
+end
+
+function Overtaker:takeover(car, ctx, state, from)
+  if from ~= "overtaker" or type(state) ~= "table" then return end
+  self.state, self.passing, self.passes = state.state or "home", state.passing, state.passes or 0
+  self.follow:takeover(car, ctx, state.follow, "follower")
+end
+
 -- Seconds it will spend in the passing lane to pass `lead` at `speed`, lane changes included.
 -- Speeds are along lanes: the gain along the centre line is taken as a lap's average (in a
 -- curve the outer lane gains less, or loses).
