@@ -67,6 +67,11 @@ if carried.map then lastMap = track._adopt(carried.map) end
 pitwall._carry("race", function()
   local out, kinds = {}, {}
   for k, session in ipairs(sessions) do out[k] = session:_carry() end
+  -- sessions this version did not take up (not yet, or a version without the race) go on to the
+  -- next: a save that briefly empties the script does not lose the race
+  for k, c in pairs(carried.sessions) do
+    if out[k] == nil then out[k] = c end
+  end
   for car, kind in pairs(lastKind) do kinds[car] = kind end
   return { sessions = out, lastKind = kinds, map = lastMap }
 end)
@@ -714,8 +719,10 @@ function Race:run()
   if c then
     drawn = self:_takeUp(c)
     if self.phase == "done" then return self end
+    local phases = { new = "the map", grid = "to the grid", lights = "the lights",
+      racing = "racing", ending = "stopping the cars" }
     pitwall.log("info", string.format("race: %s taken up by the new version (%s)", self.title,
-      self.phase))
+      phases[self.phase] or self.phase))
   end
   self.phase = self.phase or "new"
   self.penalty = o.falseStartPenalty or self.penalty or 5

@@ -215,6 +215,11 @@ local carriedScans -- the scans an earlier version had under way, taken up one b
 pitwall._carry("track", function()
   local out = {}
   for st in pairs(scanning) do out[#out + 1] = st end
+  if carriedScans == nil then -- this version never scanned: the scans carried to it go on
+    local c = pitwall._takeCarried("track")
+    carriedScans = c and c.scans or {}
+  end
+  for _, st in ipairs(carriedScans) do out[#out + 1] = st end
   return { scans = out }
 end)
 
