@@ -314,3 +314,34 @@ TEST_CASE("pitwall.stop() in a new version's first run ends the run once it took
   REQUIRE_FALSE(f.scripts->reload());
   CHECK(stops == 1);
 }
+
+TEST_CASE("the library's carried state crosses quietly; a failing carrier is reported") {
+  ReloadFixture f;
+  // A module's state with methods, a metatable, a shared table and a car in it: the data
+  // crosses, the functions and metatables stay behind without a warning.
+  auto script =
+      f.write("race.lua",
+              "local Thing = {__index = {}}\n"
+              "local shared = {n = 7}\n"
+              "local state = setmetatable({a = shared, b = shared, car = pitwall.cars()[2],\n"
+              "  fn = function() end, list = {1, 2.5, 'x'}}, Thing)\n"
+              "pitwall._carry('thing', function() return state end)\n"
+              "pitwall._carry('broken', function() error('cannot save') end)\n"
+              "carried = pitwall._takeCarried('thing')\n");
+  REQUIRE(f.scripts->start(script));
+  CHECK(f.text("tostring(carried)") == "nil");  // a first version finds nothing
+  f.logged.clear();
+  REQUIRE(f.scripts->reload());
+  CHECK(f.number("carried.a.n") == 7);
+  CHECK(f.text("tostring(carried.a == carried.b)") == "true");
+  CHECK(f.text("tostring(carried.car == pitwall.cars()[2])") == "true");
+  CHECK(f.text("tostring(carried.fn)") == "nil");
+  CHECK(f.text("tostring(getmetatable(carried))") == "nil");
+  CHECK(f.text("carried.list[3] .. math.type(carried.list[1])") == "xinteger");
+  std::string log;
+  for (const auto& l : f.logged) log += l + "\n";
+  CHECK(log.find("cannot cross") == std::string::npos);
+  CHECK(log.find("carrying broken into the new version") != std::string::npos);
+  CHECK(log.find("cannot save") != std::string::npos);
+  CHECK(f.scripts->stats().reloads == 1);  // a carrier's error does not refuse the version
+}
