@@ -595,7 +595,9 @@ function Race:_timing(adopted)
   end
 end
 
-function Race:_board(drawn)
+-- (A new version draws its board anew, below the reload's log lines: drawing over the last
+-- version's board would overwrite them.)
+function Race:_board()
   if self.options.board == false then return end
   self.board = Board.new {
     title = self.title,
@@ -609,7 +611,6 @@ function Race:_board(drawn)
         format = function(v, row) return Board.gap(v, row.lapsBehind) end },
     },
   }
-  self.board.drawn = drawn or 0 -- a new version redraws over the drawing of the one before
 end
 
 -- What the next version takes up (pitwall._carry above): the session's data, each entry's data
@@ -622,7 +623,6 @@ function Race:_carry()
   for k, v in pairs(self) do
     if not SKIP[k] then c[k] = v end
   end
-  c.drawn = self.board and self.board.drawn or 0
   local copies = {}
   for _, e in ipairs(self.order) do
     local ce = {}
@@ -665,7 +665,6 @@ function Race:_takeUp(c)
   for k, v in pairs(c) do
     if k ~= "title" and k ~= "period" then self[k] = v end
   end
-  self.drawn = nil
   if c.map then self.map = track._adopt(c.map) end
   if o.cars and #o.cars ~= #c.cars then
     pitwall.log("warn", string.format("race: this version names %d car(s), the session under way "
@@ -691,7 +690,6 @@ function Race:_takeUp(c)
         Board.time(c.seconds)))
     end
   end
-  return c.drawn
 end
 
 --- Runs the session to its end inside a task; returns the session. A session that a reload of
@@ -715,9 +713,8 @@ function Race:run()
       pitwall.listen(car, "onTransition", function() lastKind[car] = "transition" end)
     end
   end
-  local drawn
   if c then
-    drawn = self:_takeUp(c)
+    self:_takeUp(c)
     if self.phase == "done" then return self end
     local phases = { new = "the map", grid = "to the grid", lights = "the lights",
       racing = "racing", ending = "stopping the cars" }
@@ -742,7 +739,7 @@ function Race:run()
   else
     self:_timing(true)
   end
-  self:_board(drawn)
+  self:_board()
   if self.phase == "lights" then
     if self.mode ~= "practice" and o.lights ~= 0 then self:_lights() end
     self.state = "racing"
