@@ -110,6 +110,11 @@ end
 
 function pitwall._saveCarried()
   local out = {}
+  -- what this version did not take up (a version that never loaded the module: a save that
+  -- briefly emptied the script) goes on to the next as it came
+  for name, state in pairs(pitwall._carried) do
+    if not carriers[name] then out[name] = state end
+  end
   for name, save in pairs(carriers) do
     local ok, state = xpcall(save, debug.traceback)
     if ok then
