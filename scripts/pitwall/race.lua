@@ -665,6 +665,7 @@ function Race:_takeUp(c)
   for k, v in pairs(c) do
     if k ~= "title" and k ~= "period" then self[k] = v end
   end
+  if newMode ~= c.mode and not o.title then self.title = c.title end
   if c.map then self.map = track._adopt(c.map) end
   if o.cars and #o.cars ~= #c.cars then
     pitwall.log("warn", string.format("race: this version names %d car(s), the session under way "
