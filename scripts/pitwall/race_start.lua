@@ -1,0 +1,145 @@
+-- The start of a session for pitwall.race (docs/racing.md "What a session does", steps 2 and 3):
+-- the cars to the grid, each in a lane of its own, then the start lights with false starts.
+-- These are methods of a session; race.lua takes them in.
+local localize = require "pitwall.localize"
+
+local Start = {}
+
+local LANES = { -68, -23, 23, 68 }
+
+-- Why a car did not reach the grid, for the error.
+function Start:_gridProblem(e)
+  local car, loc, n = e.car, e.loc, #self.map.pieces
+  if not car.connected then return "it is not connected" end
+  if not loc.localized then
+    return "its place on the map is not known (no position updates: is it on the track?)"
+  end
+  local where = string.format("on piece %d of %d (id %d) in lane %s at %d mm/s", loc.index, n,
+    self.map.pieces[loc.index].id, tostring(loc.lane), math.floor((car.speed or 0) + 0.5))
+  local me = loc:distance()
+  for _, o in ipairs(self.order) do
+    local d = o ~= e and o.loc.localized and o.loc:distance()
+    if d and me and o.loc.lane == loc.lane then
+      local gap = (d - me) % self.map:lapLength(0)
+      if gap < 400 then
+        return string.format("%s, %.0f mm behind %s in the same lane", where, gap, tostring(o.car))
+      end
+    end
+  end
+  return where .. ((car.speed or 0) == 0 and ", standing still" or "")
+end
+
+-- Drives cars that are known to be elsewhere to the grid (piece 34) and stops them there. Cars
+-- are given lanes of their own (those already on the grid keep theirs; the others take the
+-- free lane nearest to theirs), so two cars in one lane do not end up one behind the other.
+function Start:_toGrid()
+  local n = #self.map.pieces
+  local moving, taken = {}, {}
+  for _, e in ipairs(self.order) do
+    local piece = e.loc.index and self.map.pieces[e.loc.index].id or e.car.piece
+    -- a transition after its last position update: it has left that piece (a scan lap ends so,
+    -- just past the line)
+    if not e.loc.index and self.lastKind[e.car] == "transition" then piece = 0 end
+    if piece and piece ~= 34 and e.car.connected then
+      moving[#moving + 1] = e
+    else
+      taken[localize.nearestLane(e.car.offset or 0)] = e
+    end
+  end
+  if #moving == 0 then return end
+  pitwall.log("info", string.format("race: %d car(s) to the grid", #moving))
+  -- A car's lane is known once it reports a position on the way (one that was put somewhere
+  -- by hand has not reported where): then it is given the free lane nearest to its own.
+  local began = pitwall.now()
+  local function assign(e)
+    local here = localize.nearestLane(e.car.offset or 0)
+    local lane
+    for _, l in ipairs(LANES) do
+      if not taken[l] and (not lane or math.abs(l - here) < math.abs(lane - here)) then lane = l end
+    end
+    lane = lane or here -- more cars than lanes: this one queues in its lane
+    taken[lane], e.gridLane = e, lane
+    if lane ~= here then
+      pitwall.log("info", string.format("race: %s moves to lane %d for the grid", tostring(e.car),
+        lane))
+      e.car:changeLane(lane)
+    end
+  end
+  for _, e in ipairs(moving) do
+    e.gridLane = nil
+    e.car:setSpeed(self.options.gridSpeed or 500, 1000)
+  end
+  local timeout = self.options.gridTimeout or 90
+  local ok = pitwall.waitUntil(function()
+    local all = true
+    for _, e in ipairs(moving) do
+      if not e.gridLane and (e.car.lastPositionTime or -math.huge) > began then assign(e) end
+      if e.loc.localized and e.loc.index == n then
+        if e.car.targetSpeed ~= 0 then e.car:stop() end
+      else
+        all = false
+      end
+    end
+    return all
+  end, timeout, 0.005)
+  if not ok then
+    local why = {}
+    for _, e in ipairs(moving) do
+      if not (e.loc.localized and e.loc.index == n) then
+        why[#why + 1] = tostring(e.car) .. ": " .. self:_gridProblem(e)
+        if e.car.connected then pcall(e.car.stop, e.car) end
+      end
+    end
+    error(string.format("race: %d car(s) did not reach the grid (piece 34) in %g s — %s. The "
+      .. "cars are stopped: check that each is on the track and can drive (a car blocked in its "
+      .. "lane: put it in a lane of its own), or raise gridTimeout", #why, timeout,
+      table.concat(why, "; ")), 0)
+  end
+  pitwall.sleep(1) -- settled: a car still rolling at the first light would be a false start
+end
+
+-- Lights: `lights` (5) one a second, then out after `hold` s: green. A car that moves meanwhile
+-- has jumped the start.
+function Start:_lights()
+  local o = self.options
+  local count, interval, hold = o.lights or 5, o.lightInterval or 1, o.hold or 0.5
+  self.state = "lights"
+  local subs = {}
+  for _, e in ipairs(self.order) do
+    -- a car that moves reports it; one that is only told to (targetSpeed) is caught as well
+    subs[#subs + 1] = pitwall.listen(e.car, "onTransition", function() e.moved = true end)
+    subs[#subs + 1] = pitwall.listen(e.car, "onPosition", function() e.moved = true end)
+  end
+  local function check()
+    for _, e in ipairs(self.order) do
+      if not e.falseStart and (e.moved or (e.car.targetSpeed or 0) > 0) then
+        e.falseStart = true
+        pitwall.log("warn", string.format("race: false start by %s: held %g s after green",
+          tostring(e.car), self.penalty))
+        if e.car.connected then pcall(e.car.stop, e.car) end
+        self:_emit("onFalseStart", e.car, self)
+      end
+    end
+    return false
+  end
+  local function wait(k, spent)
+    pitwall.waitUntil(check, math.max(0, (k < count and interval or hold) - spent), 0.005)
+  end
+  -- A version that took the session up during the lights waits out the light that was on.
+  local from = self.light or 0
+  if from > 0 then wait(from, pitwall.now() - self.lightAt) end
+  for k = from + 1, count do
+    self.light, self.lightAt = k, pitwall.now()
+    pitwall.log("debug", string.format("race: light %d of %d", k, count))
+    self:_emit("onLights", k, self)
+    if self.board then
+      self.board.title = self.title .. "   " .. string.rep("●", k) .. string.rep("○", count - k)
+      self.board:show(self:_rows())
+    end
+    wait(k, 0)
+  end
+  for _, s in ipairs(subs) do s:cancel() end
+  pitwall.log("debug", "race: green")
+end
+
+return Start
