@@ -14,9 +14,12 @@ namespace fs = std::filesystem;
 
 namespace {
 // What a save looks like from the folder: the file written and closed, a file renamed onto its
-// name, created, or (a backup-and-rewrite editor) moved away and deleted before the new one.
+// name, created, written, or (a backup-and-rewrite editor) moved away and deleted before the new
+// one is written.
 constexpr std::uint32_t kMask =
-    IN_CLOSE_WRITE | IN_MOVED_TO | IN_CREATE | IN_DELETE | IN_MOVED_FROM | IN_ATTRIB;
+    IN_CLOSE_WRITE | IN_MOVED_TO | IN_CREATE | IN_MODIFY | IN_DELETE | IN_MOVED_FROM | IN_ATTRIB;
+// A complete save: the content is all there, whichever way the editor saved.
+constexpr std::uint32_t kSaved = IN_CLOSE_WRITE | IN_MOVED_TO;
 }  // namespace
 
 FileWatch::FileWatch(Loop& loop, Duration debounce)
@@ -69,9 +72,10 @@ void FileWatch::waitForEvents() {
 
 void FileWatch::readEvents() {
   alignas(inotify_event) char buf[4096];
+  bool saved = false;
   for (;;) {
     ssize_t n = ::read(fd_.native_handle(), buf, sizeof buf);
-    if (n <= 0) return;  // EAGAIN: all read
+    if (n <= 0) break;  // EAGAIN: all read
     for (char* p = buf; p < buf + n;) {
       auto* e = reinterpret_cast<inotify_event*>(p);
       p += sizeof(inotify_event) + e->len;
@@ -79,30 +83,62 @@ void FileWatch::readEvents() {
       auto folder = folders_.find(e->wd);
       if (folder == folders_.end()) continue;
       std::string name = e->name;
-      if (names_[folder->second].count(name)) changed((fs::path(folder->second) / name).string());
+      if (names_[folder->second].count(name))
+        saved |= changed((fs::path(folder->second) / name).string(), e->mask);
     }
+  }
+  // The leading edge of a burst: reported on the next turn of the loop, with everything this
+  // read brought. Within a burst, saves wait for the end of the window.
+  if (saved && !inBurst_ && !reportPosted_) {
+    reportPosted_ = true;
+    std::weak_ptr<bool> alive = alive_;
+    loop_.post([this, alive] {
+      if (!alive.expired()) reportAtOnce();
+    });
   }
 }
 
-void FileWatch::changed(const std::string& path) {
+bool FileWatch::changed(const std::string& path, std::uint32_t mask) {
+  // An editor that sets the file's mode after its save: nothing new about the content just
+  // reported, and not worth a second reload.
+  if (inBurst_ && (mask & kMask) == IN_ATTRIB) return false;
   pending_.insert(path);
+  armQuiet();
+  return (mask & kSaved) != 0;
+}
+
+void FileWatch::armQuiet() {
   loop_.cancel(quiet_);
   std::weak_ptr<bool> alive = alive_;
   quiet_ = loop_.after(debounce_, [this, alive] {
     if (alive.expired()) return;
     quiet_ = 0;
-    // A file that is gone right now is in the middle of a save: report it when it is back.
-    std::vector<std::string> ready;
-    for (auto it = pending_.begin(); it != pending_.end();) {
-      if (fs::exists(*it)) {
-        ready.push_back(*it);
-        it = pending_.erase(it);
-      } else {
-        ++it;
-      }
-    }
-    if (!ready.empty() && onChange) onChange(ready);
+    inBurst_ = false;  // the files have been quiet for a whole window: the burst is over
+    auto ready = takeReady();
+    if (!ready.empty() && onChange) onChange(ready);  // last: it may end this watch
   });
+}
+
+void FileWatch::reportAtOnce() {
+  reportPosted_ = false;
+  auto ready = takeReady();
+  if (ready.empty()) return;
+  inBurst_ = true;  // what follows within the window is one more report, at its end
+  armQuiet();
+  if (onChange) onChange(ready);  // last: it may end this watch
+}
+
+std::vector<std::string> FileWatch::takeReady() {
+  std::vector<std::string> ready;
+  for (auto it = pending_.begin(); it != pending_.end();) {
+    if (fs::exists(*it)) {
+      ready.push_back(*it);
+      it = pending_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  return ready;
 }
 
 }  // namespace pitwall
