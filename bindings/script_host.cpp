@@ -371,7 +371,7 @@ void ScriptHost::reportError(const std::string& where, const std::string& messag
     requestStop();
     return;
   }
-  log::error("script", text);
+  if (flood_.admit(where, message)) log::error("script", text);
 }
 
 void ScriptHost::requestExit(int status) {
@@ -383,6 +383,7 @@ void ScriptHost::requestExit(int status) {
 void ScriptHost::shutDown() {
   if (shutDown_) return;
   shutDown_ = true;
+  flood_.flush();  // counts of errors not yet logged: none is lost
   // The handlers stay hooked until the world closes (this may run inside one of them); call()
   // turns every call into Lua away from now on.
   for (auto& [co, task] : tasks_)

@@ -3,7 +3,8 @@
 // engine clock, and the one protected-call path every call into Lua goes through.
 //
 // Errors: an error in a callback is reported with a traceback (or handed to pitwall.onError) and
-// the run carries on; in test mode it fails the scenario instead.
+// the run carries on; in test mode it fails the scenario instead. In the log, a place that keeps
+// failing prints one traceback, then a count line a second (engine/core/error_flood.hpp).
 #include <lua.hpp>
 
 #include <functional>
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include "bindings/sandbox.hpp"
+#include "engine/core/error_flood.hpp"
 #include "engine/core/loop.hpp"
 #include "engine/core/result.hpp"
 #include "engine/sim/world.hpp"
@@ -94,7 +96,8 @@ class ScriptHost {
   // The files this world loaded from disk: the script and every module found by require.
   const std::vector<std::string>& loadedFiles() const { return loadedFiles_; }
   std::function<void(const std::string& path)> onFileLoaded;
-  // Reports a script error: to pitwall.onError if set, else the log; in test mode, a failure.
+  // Reports a script error: to pitwall.onError if set, else the log (a flood from one `where`:
+  // the first in full, then a count a second); in test mode, a failure.
   void reportError(const std::string& where, const std::string& message);
 
   // A task: a coroutine resumed on the loop. The function is on top of L's stack (L: the
@@ -176,6 +179,7 @@ class ScriptHost {
   bool inOnError_ = false;
   std::optional<std::string> failure_;
   int errors_ = 0;
+  ErrorFlood flood_{loop_, "script"};  // errors to the log: one traceback per place, then counts
   bool attached_ = false;
   std::function<void(AnkiCar&)> previousOnCar_;
   bool trial_ = false;
