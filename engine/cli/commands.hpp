@@ -47,8 +47,13 @@ struct RunOptions : CarSource {
   bool repl = false;               // --repl: open the REPL in the script's Lua world
   bool watch = false;              // --watch: reload the script when one of its files is saved
   std::string history;             // --history FILE for the REPL; empty: the default
+  // --fast-cap S: with --fast and no --duration, the simulated seconds after which a script that
+  // has not ended the run is stopped and the run ends with kExitCapped; none: the default cap
+  std::optional<double> fastCap;
 };
 int run(const RunOptions& options);
+// The exit status of a --fast run that its safety cap ended (docs/cli.md).
+constexpr int kExitCapped = 124;  // as timeout(1) does
 
 // pitwall repl: a Lua prompt with the cars bound, on the simulator (real time) or --ble.
 struct ReplOptions : CarSource {

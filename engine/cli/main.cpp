@@ -93,9 +93,17 @@ int main(int argc, char** argv) {
   runCmd->add_option("script", run.script, "The Lua script to run")->required();
   auto* fastFlag =
       runCmd->add_flag("--fast", run.fast, "Virtual time: the run goes as fast as the machine can");
+  auto* durationOption = runCmd
+                             ->add_option("--duration", run.duration,
+                                          "End the run after this many seconds of engine time")
+                             ->check(CLI::PositiveNumber);
   runCmd
-      ->add_option("--duration", run.duration, "End the run after this many seconds of engine time")
-      ->check(CLI::PositiveNumber);
+      ->add_option("--fast-cap", run.fastCap,
+                   "With --fast and no --duration: stop a script that has not ended the run after "
+                   "this many simulated seconds, exit status 124 (default 86400)")
+      ->check(CLI::PositiveNumber)
+      ->needs(fastFlag)
+      ->excludes(durationOption);
   runCmd->add_option("--record", run.record, "Write every frame in and out as JSON lines to FILE");
   runCmd->add_option("--results", run.results,
                      "Where the race library writes the results: FILE.json or FILE.csv");

@@ -1,5 +1,6 @@
 // pitwall run SCRIPT: a script driving simulated cars (real or virtual time), or real cars over
 // Bluetooth LE with --ble.
+#include <cstdio>
 #include <iostream>
 
 #include "bindings/results.hpp"
@@ -10,9 +11,22 @@
 
 namespace pitwall::cli {
 
-// A --fast run with no --duration and a script that never calls pitwall.stop() would spin
-// forever at full speed; it ends after this much simulated time instead.
-constexpr double kFastDefaultDuration = 3600;
+// A --fast run with no --duration whose script never ends the run (a script that drives and
+// never calls pitwall.stop()) would spin at full speed for ever: this safety net stops it after
+// a simulated day, and says so (issue 14). A script that ends by itself, a race of any sensible
+// length, ends long before.
+constexpr double kFastCap = 24 * 3600;
+
+namespace {
+std::string simulatedTime(double seconds) {
+  char text[64];
+  if (seconds >= 3600)
+    std::snprintf(text, sizeof text, "%g s (%g h)", seconds, seconds / 3600);
+  else
+    std::snprintf(text, sizeof text, "%g s", seconds);
+  return text;
+}
+}  // namespace
 
 int run(const RunOptions& options) {
   if (!options.results.empty()) {  // refused now, not after the race
@@ -46,16 +60,29 @@ int run(const RunOptions& options) {
     return 1;
   }
 
-  std::optional<double> duration = options.duration;
-  if (!duration && options.fast) {
-    duration = kFastDefaultDuration;
-    log::info("pitwall", "--fast without --duration: the run ends after 3600 s of simulated time");
-  }
-  if (duration)
-    loop.after(fromSeconds(*duration), [&] {
+  if (options.duration) {
+    loop.after(fromSeconds(*options.duration), [&] {
       log::info("pitwall", "the run's duration is over: stopping the cars");
       session.finish();
     });
+  }
+  bool capped = false;
+  if (!options.duration && options.fast) {
+    double cap = options.fastCap.value_or(kFastCap);
+    log::info("pitwall",
+              "--fast without --duration: the run lasts until the script ends it; one "
+              "still running after " +
+                  simulatedTime(cap) + " of simulated time is stopped (--fast-cap S)");
+    loop.after(fromSeconds(cap), [&session, &capped, cap] {
+      capped = true;
+      log::error("pitwall", "the script was still running after " + simulatedTime(cap) +
+                                " of simulated time, the --fast safety cap: stopping the cars. "
+                                "Give --duration S to a script that does not end the run "
+                                "itself (pitwall.stop()), or --fast-cap S to one that needs "
+                                "longer");
+      session.finish();
+    });
+  }
 
   Reloader& scripts = session.scripts();
   scripts.keepRunningOnError(options.watch || options.repl);
@@ -89,6 +116,7 @@ int run(const RunOptions& options) {
   }
   loop.run();  // ends through Session::finish, which every way out of a run calls
   repl.reset();
+  if (capped) return session.exitStatus(kExitCapped);
   return session.exitStatus(session.host().mainFailed() ? 1 : 0);
 }
 

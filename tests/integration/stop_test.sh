@@ -32,6 +32,12 @@ MODE=none $PITWALL run "$NAGGING" --fast --duration 5 --cars 3 --record "$TMP/d.
 check "--duration: exit status" 0 $?
 expect_stopped "--duration" "$TMP/d.jsonl" 3
 
+# the --fast safety cap: no --duration, and the script never ends the run
+MODE=none $PITWALL run "$NAGGING" --fast --fast-cap 5 --cars 3 --record "$TMP/c.jsonl" \
+  >/dev/null 2>&1
+check "--fast-cap: exit status" 124 $?
+expect_stopped "--fast-cap" "$TMP/c.jsonl" 3
+
 # pitwall.stop(), then commands from the same task, a pcall and a new task
 out=$(MODE=stop $PITWALL run "$NAGGING" --fast --cars 3 --record "$TMP/s.jsonl" 2>&1)
 check "pitwall.stop(): exit status" 0 $?
