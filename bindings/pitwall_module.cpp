@@ -254,9 +254,10 @@ int terminal(lua_State* L) {
   if (columns <= 0)
     if (const char* c = std::getenv("COLUMNS")) columns = std::strtol(c, nullptr, 10);
   if (columns <= 0) columns = 80;
-  lua_createtable(L, 0, 2);
+  lua_createtable(L, 0, 3);
   lua::setBoolean(L, "tty", tty);
   lua::setInteger(L, "columns", columns);
+  lua::setInteger(L, "output", static_cast<lua_Integer>(console::outputCount()));
   return 1;
 }
 

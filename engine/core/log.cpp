@@ -1,5 +1,7 @@
 #include "engine/core/log.hpp"
 
+#include "engine/core/console.hpp"
+
 #include <cstdio>
 
 namespace pitwall::log {
@@ -63,6 +65,7 @@ void write(Level level, std::string_view component, std::string_view message) {
     return;
   }
   line += '\n';
+  console::noteOutput();
   std::fwrite(line.data(), 1, line.size(), stderr);
 }
 

@@ -13,8 +13,9 @@
 --   board:final(rows)   -- prints the table wherever stdout goes, and ends the live drawing
 --
 -- A row is a table keyed like the columns; a missing value shows as "-". On a terminal the
--- board moves the cursor up over its last drawing (ANSI escapes) and redraws it; log lines
--- (stderr) that come in between push it down, and the next drawing starts below them. When
+-- board moves the cursor up over its last drawing (ANSI escapes) and redraws it; when anything
+-- else reached the terminal in between (a log line, a print: pitwall.terminal().output moved),
+-- drawing over it would erase it, so the next drawing starts anew below it. When
 -- stdout is not a terminal (a file, a CI log) only `final` prints, so logs stay readable.
 local Board = {}
 Board.__index = Board
@@ -110,18 +111,32 @@ local function write(self, lines, live)
   out:flush()
 end
 
+-- How many writes reached the terminal (pitwall.terminal().output); a test's board has none.
+local function output(self)
+  if self.out ~= pitwall.stdout then return 0 end
+  return pitwall.terminal().output
+end
+
+-- Something else was written since the last drawing: the next one starts anew below it.
+local function fresh(self)
+  if self.drawn > 0 and output(self) ~= self.mark then self.drawn = 0 end
+end
+
 --- Draws `rows` in place of the last drawing (terminals only; elsewhere it does nothing).
 function Board:show(rows)
   if not self.tty then return end
   local lines = self:render(rows)
+  fresh(self)
   write(self, lines, true)
   self.drawn = #lines
+  self.mark = output(self)
 end
 
 --- Prints `rows` as the final table (on a terminal over the live drawing), wherever stdout goes.
 function Board:final(rows)
   local lines = self:render(rows)
   if self.tty then
+    fresh(self)
     write(self, lines, true)
   else
     for _, l in ipairs(lines) do self.out:write(l, "\n") end
