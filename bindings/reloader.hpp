@@ -54,6 +54,8 @@ class Reloader {
   // The run is ending (docs/safety.md): the current version shuts down (ScriptHost::shutDown)
   // and no save starts another.
   void shutDown();
+  // Then, once the cars are stopped: the current version's last words (ScriptHost::lastWords).
+  void lastWords() { current_->lastWords(); }
 
   // pitwall.stop(), or the script died and nothing keeps the run going.
   std::function<void()> onStopRequested;

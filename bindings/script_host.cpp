@@ -260,7 +260,7 @@ int ScriptHost::searchAndRecord(lua_State* L) {
 
 bool ScriptHost::call(int nargs, int nresults, const char* what, const AnkiCar* car) {
   lua_State* L = L_;
-  if (shutDown_) {
+  if (shutDown_ && !lastWords_) {
     lua_pop(L, nargs + 1);
     return false;
   }
@@ -398,6 +398,22 @@ void ScriptHost::shutDown() {
   timers_.clear();
   auto hooks = std::move(atShutDown_);
   for (auto& fn : hooks) fn();
+}
+
+void ScriptHost::lastWords() {
+  if (!shutDown_ || lastWords_) return;
+  lua_State* L = L_;
+  int top = lua_gettop(L);
+  lua_getglobal(L, "pitwall");
+  if (lua_istable(L, -1) && lua_getfield(L, -1, "_lastWords") == LUA_TFUNCTION) {
+    // once: a second call finds the field gone
+    lua_pushnil(L);
+    lua_setfield(L, -3, "_lastWords");
+    lastWords_ = true;
+    call(0, 0, "the end of the run (pitwall._lastWords)");
+    lastWords_ = false;
+  }
+  lua_settop(L, top);
 }
 
 void ScriptHost::atShutDown(std::function<void()> fn) {

@@ -126,6 +126,11 @@ class ScriptHost {
   // Runs `fn` when this world shuts down (what it started that must end with it), or at once
   // when it already has.
   void atShutDown(std::function<void()> fn);
+  // After the shutdown and the cars' stops: the Lua library's last words, once
+  // (pitwall._lastWords: a race cut short prints its final table and writes its results). The
+  // one call into Lua after shutDown, budgeted like any callback; the cars take no command by
+  // then (AnkiCar::halt) and no timer or task can start.
+  void lastWords();
   // The memory this world's allocations hold now, and its cap (sandbox.hpp).
   const sandbox::Memory& memory() const { return memory_; }
   // In test mode: the first failure (error in a task or callback, failed expectation).
@@ -174,6 +179,7 @@ class ScriptHost {
   int nextTimer_ = 1;
   bool stopRequested_ = false;
   bool shutDown_ = false;
+  bool lastWords_ = false;  // lastWords() is running: its call() is let through
   bool memoryReported_ = false;
   std::optional<int> exitStatus_;
   bool inOnError_ = false;

@@ -371,6 +371,8 @@ void Session::finish() {
   if (scripts_) scripts_->shutDown();
   // Then every car's stop, the last command it takes (AnkiCar::halt).
   fleet_.haltAll();
+  // A race cut short says where it stood: the final table, the results (nothing can drive now).
+  if (scripts_) scripts_->lastWords();
   if (recorder_) recorder_->flush();
   loop_.after(kFlush, [this] {
     auto done = [this] {

@@ -126,6 +126,23 @@ function pitwall._saveCarried()
   return out
 end
 
+-- The library's last words (ScriptHost::lastWords): after the run's end has shut the script down
+-- and stopped the cars, a module may still say where things stood — a race cut short prints its
+-- final table and writes its results. Nothing can drive a car or start a timer by then.
+local lastWords = {}
+
+--- Registers fn() to run once at the end of the run, after the cars are stopped.
+function pitwall._atRunEnd(fn)
+  lastWords[#lastWords + 1] = fn
+end
+
+function pitwall._lastWords()
+  for _, fn in ipairs(lastWords) do
+    local ok, err = xpcall(fn, debug.traceback)
+    if not ok then pitwall._reportError("the end of the run", err) end
+  end
+end
+
 --- A shallow copy of a table: event tables are reused, so keep a copy to store one.
 function pitwall.copy(t)
   local c = {}

@@ -64,6 +64,14 @@ if carried.lastKind then
 end
 if carried.map then lastMap = track._adopt(carried.map) end
 
+-- A run that ends while a session races (--duration, Ctrl-C, pitwall.stop() from elsewhere, the
+-- --fast cap): the session says where it stood — its final table, its results file.
+pitwall._atRunEnd(function()
+  for _, session in ipairs(sessions) do
+    if session.phase == "racing" or session.phase == "ending" then session:_cut() end
+  end
+end)
+
 pitwall._carry("race", function()
   local out, kinds = {}, {}
   for k, session in ipairs(sessions) do out[k] = session:_carry() end
@@ -351,7 +359,7 @@ function Race:_rows()
       totalTime = lastCross and self.green and lastCross - self.green or nil,
       bestLap = t.best and t.best.time, lastLap = t.last and t.last.time,
       gap = gap, lapsBehind = behind,
-      finished = e.finished, falseStart = e.falseStart or false,
+      finished = e.finished or false, falseStart = e.falseStart or false,
     }
   end
   return rows
@@ -477,6 +485,21 @@ function Race:_board()
         format = function(v, row) return Board.gap(v, row.lapsBehind) end },
     },
   }
+end
+
+-- The run ended while the session raced: the standings as they were, once.
+function Race:_cut()
+  self.phase, self.state = "done", "done"
+  self:_standings(pitwall.now())
+  pitwall.log("warn", string.format("race: the run ended before the %s did: the standings when "
+    .. "it ended are its results", self.title))
+  if self.board then
+    self.board.title = self.title .. "   stopped"
+    self.board:final(self:_rows())
+  end
+  local path = self.options.results
+  if path == nil then path = pitwall.resultsFile end
+  if path then self.resultsPath = pitwall.writeResults(self:results(), race.columns, path) end
 end
 
 -- What the next version takes up (pitwall._carry above): the session's data, each entry's data

@@ -1,6 +1,6 @@
 -- The adversary of the stop tests (stop_test.sh, ble_stop_test.sh, mqtt_fleet_test.sh): a script
 -- that never stops commanding. Every 20 ms, from a timer, from a timer it schedules, and on every
--- position event, it sets every car's speed again. MODE picks how the run ends after 1 s, and
+-- position event, it sets every car's speed again, and once more from the run's last words. MODE picks how the run ends after 1 s, and
 -- the script commands again right after asking for the end:
 --   none    (the default) never: --duration, a signal or the test ends it
 --   stop    pitwall.stop(), then commands from the same task (in pcall) and from a new task
@@ -16,6 +16,12 @@ pitwall.every(0.02, command)
 pitwall.every(0.02, function() pitwall.after(0, command) end)
 for _, car in ipairs(cars) do
   car.onPosition = function() car:setSpeed(800) end
+end
+-- It claims the library's last words too (run after the stops, ScriptHost::lastWords): one more
+-- command, then it hogs the loop (not in the memory mode, which runs without a budget).
+pitwall._lastWords = function()
+  print("last words:", pcall(command))
+  if mode ~= "memory" then while true do end end
 end
 command()
 print("driving")

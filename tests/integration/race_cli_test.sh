@@ -40,6 +40,17 @@ check "time trial exit status" 0 "$rc"
 contains "time trial names the fastest lap" "Fastest lap: " "$out"
 check "time trial rows" 4 "$(wc -l < "$TMP/tt.csv" | tr -d ' ')"
 
+# A run cut short mid-race (--duration): the race says where it stood, once — the final table
+# titled "stopped", the results file with every car unfinished — and the run exits 0 as asked.
+out=$(LAPS=5 $PITWALL run "$SRC/examples/grand_prix.lua" --fast --cars 4 --duration 40 \
+  --results "$TMP/cut.csv" 2>"$TMP/cut.err"); rc=$?
+check "cut short: exit status" 0 "$rc"
+check "cut short: the final table once" 1 "$(echo "$out" | grep -c 'Grand prix, 5 laps   stopped')"
+check "cut short: no winner" "" "$(echo "$out" | grep '^Winner')"
+contains "cut short: says so" "the run ended before the Grand prix, 5 laps did" "$(cat "$TMP/cut.err")"
+check "cut short: a row per car" 5 "$(wc -l <"$TMP/cut.csv" | tr -d ' ')"
+check "cut short: nobody finished" 4 "$(grep -c ',false,false$' "$TMP/cut.csv")"
+
 # --ble: scan lap, grid, lights, one lap; every car left stopped and disconnected
 start_bus
 start_fake --adapters 1 --cars 4

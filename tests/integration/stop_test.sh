@@ -28,9 +28,13 @@ expect_stopped() {  # NAME RECORD CARS
 
 # --duration (virtual time)
 MODE=none $PITWALL run "$NAGGING" --fast --duration 5 --cars 3 --record "$TMP/d.jsonl" \
-  >/dev/null 2>&1
+  >"$TMP/d.out" 2>"$TMP/d.err"
 check "--duration: exit status" 0 $?
 expect_stopped "--duration" "$TMP/d.jsonl" 3
+# the script's hold on the library's last words: its command refused, its loop interrupted
+contains "last words: the command refused" "last words:	false" "$(cat "$TMP/d.out")"
+contains "last words: the loop interrupted" "the end of the run (pitwall._lastWords): still running" \
+  "$(cat "$TMP/d.err")"
 
 # the --fast safety cap: no --duration, and the script never ends the run
 MODE=none $PITWALL run "$NAGGING" --fast --fast-cap 5 --cars 3 --record "$TMP/c.jsonl" \
