@@ -578,6 +578,15 @@ int ScriptHost::addTimer(lua_State* L, Duration first, std::optional<Duration> p
     return handle;
   }
   Timer t;
+  // Errors name the timer by where its function was written: two failing timers are two places
+  // (the error flood counts each apart), not one "pitwall.every callback".
+  std::string what = period ? "pitwall.every callback" : "pitwall.after callback";
+  lua_pushvalue(L, -1);
+  lua_Debug ar;
+  if (lua_getinfo(L, ">S", &ar) && ar.linedefined > 0)
+    what.append(" (").append(ar.short_src).append(":").append(std::to_string(ar.linedefined)) +=
+        ')';
+  t.what = std::make_shared<const std::string>(std::move(what));
   t.fnRef = luaL_ref(L, LUA_REGISTRYINDEX);
   t.period = period;
   t.due = loop_.now() + first;
@@ -614,7 +623,8 @@ void ScriptHost::fireTimer(int handle) {
     skipMissed(t);
     const Loop::TimerId id = t.id = loop_.at(t.due, [this, handle] { fireTimer(handle); });
     lua_rawgeti(L_, LUA_REGISTRYINDEX, fnRef);
-    call(0, 0, "pitwall.every callback");
+    auto what = t.what;  // (the callback may cancel the timer)
+    call(0, 0, what->c_str());
     // A callback slower than its period: its next tick is the first after it returned, so the
     // timers that came due while it ran go first.
     auto again = timers_.find(handle);
@@ -624,10 +634,11 @@ void ScriptHost::fireTimer(int handle) {
       again->second.id = loop_.at(again->second.due, [this, handle] { fireTimer(handle); });
     }
   } else {
+    auto what = std::move(t.what);
     timers_.erase(it);
     lua_rawgeti(L_, LUA_REGISTRYINDEX, fnRef);
     luaL_unref(L_, LUA_REGISTRYINDEX, fnRef);
-    call(0, 0, "pitwall.after callback");
+    call(0, 0, what->c_str());
   }
 }
 

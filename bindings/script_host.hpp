@@ -150,6 +150,8 @@ class ScriptHost {
     Loop::TimerId id = 0;
     std::optional<Duration> period;
     TimePoint due{};
+    // "pitwall.every callback (race.lua:12)", as errors name it (shared: a tick copies it)
+    std::shared_ptr<const std::string> what;
   };
   void openLibraries();
   void trackRequire();

@@ -136,3 +136,17 @@ TEST_CASE_FIXTURE(FailingHandler, "the callback budget's interrupts are counted 
   CHECK(countLines("stack traceback:") == 1);
   CHECK(sum(counts("onPosition handler of car 1 \\(skull\\)")) == 19);
 }
+
+TEST_CASE_FIXTURE(FailingHandler,
+                  "two failing timers are two places, each named where it was written") {
+  start(R"(
+    pitwall.every(0.1, function() error("first") end)
+    pitwall.every(0.1, function() error("second") end)
+  )");
+  positions(250, 10ms);  // until 2.5 s: ticks at 0.1 … 2.4 s, 24 failures of each
+  CHECK(countLines("stack traceback:") == 2);
+  CHECK(countLines("error in pitwall.every callback (flood.lua:2): flood.lua:2: first") == 1);
+  CHECK(countLines("error in pitwall.every callback (flood.lua:3): flood.lua:3: second") == 1);
+  CHECK(sum(counts("pitwall.every callback \\(flood.lua:2\\)")) == 23);
+  CHECK(sum(counts("pitwall.every callback \\(flood.lua:3\\)")) == 23);
+}
