@@ -79,6 +79,13 @@ void FileWatch::readEvents() {
     for (char* p = buf; p < buf + n;) {
       auto* e = reinterpret_cast<inotify_event*>(p);
       p += sizeof(inotify_event) + e->len;
+      if (e->mask & IN_Q_OVERFLOW) {
+        // The kernel's queue overflowed (a flood of changes in a watched folder): events were
+        // lost, a save among them perhaps. Every watched file is taken as changed, after quiet.
+        for (const auto& [folder, names] : names_)
+          for (const auto& name : names) changed((fs::path(folder) / name).string(), IN_MODIFY);
+        continue;
+      }
       if (e->len == 0) continue;
       auto folder = folders_.find(e->wd);
       if (folder == folders_.end()) continue;

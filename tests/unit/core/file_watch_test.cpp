@@ -201,6 +201,22 @@ TEST_CASE_FIXTURE(Watching,
   CHECK(reports[0].paths.size() == 2);  // one read brought both saves: one report
 }
 
+TEST_CASE_FIXTURE(Watching, "a save lost in an overflow of the kernel's queue is still reported") {
+  auto script = folder.write("race.lua", "print(1)");
+  REQUIRE(watch.add(script));
+  long queue = 16384;
+  std::ifstream("/proc/sys/fs/inotify/max_queued_events") >> queue;
+  loop.post([&] {
+    // More changes in the folder than the kernel queues (two events a write: modify, close),
+    // then the save, whose events are lost in the overflow.
+    for (long i = 0; i < queue / 2 + 100; ++i) folder.write("noise.txt", std::to_string(i));
+    folder.write("race.lua", "print(2)");
+  });
+  REQUIRE(reported(1));
+  CHECK(reports[0].paths == std::vector<std::string>{script});
+  CHECK(reports[0].texts[0] == "print(2)");
+}
+
 TEST_CASE("a file in a folder that does not exist is refused with the reason") {
   Loop loop{ClockKind::Real};
   FileWatch watch{loop};
