@@ -131,7 +131,11 @@ int reload(lua_State* L) {
   UnderTest* ut = current(L);
   if (!ut) throw LuaError("no script under test to reload: start one with pitwall.sim.script");
   std::string what = lua::checkString(L, 1, "new version (a path or source text)");
-  double at = luaL_optnumber(L, 2, -1);
+  double at = lua_isnoneornil(L, 2) ? -1 : lua::checkNumber(L, 2, "at (engine time, s)");
+  if (!(at < 1e9))  // NaN too
+    throw LuaError("sim.reload: at " + lua::show(at) +
+                   " is not an engine time: give the seconds of the run at which the save comes "
+                   "(pitwall.now() + delay), or nothing for at once");
   bool file = isFile(what);
   Duration delay{};
   if (at >= 0) {
