@@ -459,7 +459,7 @@ void BlePeripheral::disconnectCentral() {
   s.device->callMethodAsync("Disconnect")
       .onInterface(api::kDevice)
       .withTimeout(kCallTimeout)
-      .uponReplyInvoke([&s](const sdbus::Error* e) {
+      .uponReplyInvoke([](const sdbus::Error* e) {
         if (e) log::warn(kComponent, "cannot drop the central: " + errorText(*e));
       });
   s.pump.kick();
