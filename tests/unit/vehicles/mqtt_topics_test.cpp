@@ -569,7 +569,7 @@ TEST_CASE("mqtt intents: an error about a hostile topic quotes it short and esca
   auto answer =
       intentError("pit1", IntentError{std::string(60000, '\xff'), std::string(60000, '"')}, kNow);
   CHECK(answer.payload.size() <= kMaxIntentError);
-  CHECK_NOTHROW((void)nlohmann::json::parse(answer.payload));
+  CHECK(nlohmann::json::parse(answer.payload).is_object());
 }
 
 TEST_CASE("mqtt topics: the readers refuse hostile payloads with an error, never an exception") {
