@@ -28,6 +28,7 @@
 
 #include "bindings/reloader.hpp"
 #include "engine/core/log.hpp"
+#include "engine/sim/grid.hpp"
 #include "tests/bench/frames.hpp"
 #include "tests/support/run_until.hpp"
 
@@ -124,6 +125,48 @@ void BM_Reload(benchmark::State& state) {
   state.SetLabel(large ? "large script" : "small script");
 }
 BENCHMARK(BM_Reload)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+// A race under way, reloaded: the grand prix's shape (4 simulated cars, 4 drivers, race.laps
+// with the leaderboard's bookkeeping) saved mid-race. Each reload carries the session into a
+// new Lua world (pitwall._carry, copyCarried), whose race.laps takes it up (maps, trackers, lap
+// timers, drivers' takeover) — the engine's part of a save of examples/grand_prix.lua.
+void BM_ReloadRace(benchmark::State& state) {
+  log::setLevel(log::Level::Error);
+  Loop loop(ClockKind::Virtual);
+  SimSession sim;
+  sim.world = std::make_unique<sim::World>(loop, *sim::loadLayout("oval"), 1);
+  Fleet fleet(loop);
+  for (int i = 0; i < 4; ++i) fleet.addSimulated(*sim.world, sim::gridSpec(sim.world->track(), i));
+  auto runFor = [&](Duration d) {
+    auto id = loop.after(d, [&] { loop.stop(); });
+    loop.run();
+    loop.cancel(id);
+  };
+  runFor(std::chrono::seconds(1));
+  fs::path dir = fs::temp_directory_path() / ("pitwall-race-bench-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  fs::path file = dir / "grand_prix.lua";
+  std::ofstream(file) << "local race = require 'pitwall.race'\n"
+                         "local lineup = {'cruiser', 'lanekeeper', 'follower', 'overtaker'}\n"
+                         "race.laps { laps = 1000, results = false,\n"
+                         "  drivers = function(car, i) return lineup[i] end }\n";
+  Reloader scripts(loop, fleet, &sim, HostOptions{});
+  if (!scripts.start(file.string())) return state.SkipWithError("the race did not start");
+  runFor(std::chrono::seconds(40));  // lights, then laps: mid-race
+  for (auto _ : state) {
+    auto reloaded = scripts.reload();
+    if (!reloaded) return state.SkipWithError(reloaded.error().c_str());
+  }
+  runFor(std::chrono::seconds(5));  // and it races on: every car driving, none ever stopped
+  for (const auto& car : sim.world->cars()) {
+    auto t = car->truth();
+    if (t.speed_mm_s <= 0 || t.stop_commands > 0)
+      return state.SkipWithError("a car stopped: the race did not survive the reloads");
+  }
+  state.counters["reloads"] = scripts.stats().reloads;
+  fs::remove_all(dir);
+}
+BENCHMARK(BM_ReloadRace)->Unit(benchmark::kMillisecond);
 
 // mark(), set as a global in each new version: the first event its handlers take stops the clock
 // (and the loop). The old version has no mark.
