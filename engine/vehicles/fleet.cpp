@@ -25,11 +25,15 @@ AnkiCar& Fleet::add(std::unique_ptr<Link> link, CarIdentity identity) {
   AnkiCar& car = *e->car;
   if (halted_) (void)car.halt();  // a car that joins after the end of the run obeys nothing
   car.onConnection = [this, e](bool up, const std::string& reason) {
-    if (up && !e->joined) {
-      e->joined = true;
-      if (onCar) onCar(*e->car);
+    // onCar may replace this very handler (a Lua world that takes the car hooks its events,
+    // chaining this one): nothing of the lambda is touched after it, only these copies.
+    Fleet* fleet = this;
+    Entry* entry = e;
+    if (up && !entry->joined) {
+      entry->joined = true;
+      if (fleet->onCar) fleet->onCar(*entry->car);
     }
-    if (onConnectionChange) onConnectionChange(*e->car, up, reason);
+    if (fleet->onConnectionChange) fleet->onConnectionChange(*entry->car, up, reason);
   };
   car.onFrame = [this, e](AnkiCar::Direction d, std::span<const std::uint8_t> f,
                           const anki::Message& m) {

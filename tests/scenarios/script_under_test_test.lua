@@ -67,3 +67,12 @@ local second = sim.script("pitwall.cars()[1]:setSpeed(650)")
 sim.run(0.5)
 expect.near(sim.truth(car).targetSpeed, 650, 0, "a second script under test")
 expect.eq(second.version, 1)
+
+-- a car that joins while the script under test runs is its car (pitwall.onCar): the world that
+-- takes the car hooks its events from inside the fleet's own connection handler
+sim.reload("pitwall.onCar = function(car) car:setSpeed(550) end")
+sim.run(0.5)
+local third = sim.addCar {}
+sim.run(0.5)
+expect.near(sim.truth(third).targetSpeed, 550, 0, "the late car driven by the script under test")
+expect.eq(second.version, 2)
