@@ -142,10 +142,31 @@ void copyCarried(ScriptHost& from, ScriptHost& to) {
   Copier copier(F, T, dropped, true);
   copier.openMemo();
   lua_getglobal(F, "pitwall");
+  int pitwall = lua_gettop(F);
   bool copied = false;
-  if (lua_istable(F, -1) && lua_getfield(F, -1, "_saveCarried") == LUA_TFUNCTION &&
-      from.call(0, 1, "pitwall (carrying the library's state into the new version)"))
-    copied = lua_istable(F, -1) && copier.copy(-1, "carried", 0);
+  if (lua_istable(F, pitwall) && lua_getfield(F, pitwall, "_saveCarried") == LUA_TFUNCTION) {
+    if (from.call(0, 1, "pitwall (carrying the library's state into the new version)") &&
+        lua_istable(F, -1)) {
+      // Then the user code the carriers queued (drivers' handovers), each in a call of its own
+      // with a budget of its own: it fills in the table above, or fails alone.
+      for (lua_Integer i = 1; i <= 100000; ++i) {
+        if (lua_getfield(F, pitwall, "_runHandover") != LUA_TFUNCTION) {
+          lua_pop(F, 1);
+          break;
+        }
+        lua_pushinteger(F, i);
+        if (!from.call(1, 1, "pitwall (handing over into the new version)")) continue;
+        bool more = lua_toboolean(F, -1);
+        lua_pop(F, 1);
+        if (!more) break;
+      }
+      copied = copier.copy(-1, "carried", 0);
+    } else {
+      log::error("reload",
+                 "the library's state could not be carried into the new version (see "
+                 "the error above): a race under way starts anew there");
+    }
+  }
   if (!copied) lua_newtable(T);
   copier.closeMemo();
   lua_settop(F, fromTop);

@@ -100,6 +100,7 @@ pitwall._carried = {}
 
 --- Registers `save`, which returns module `name`'s state for the next version.
 function pitwall._carry(name, save)
+  if carriers[name] then error("pitwall._carry: '" .. tostring(name) .. "' is carried already", 2) end
   carriers[name] = save
 end
 
@@ -108,7 +109,33 @@ function pitwall._takeCarried(name)
   return pitwall._carried[name]
 end
 
+-- The user code a carrier needs (a driver's handover) runs after every carrier has saved its own
+-- data, each piece in an engine call of its own (pitwall._runHandover, called by the reloader
+-- until it returns false): one that fails or runs over the callback budget costs only its own
+-- piece, never the library's state.
+local handovers = {}
+
+--- Queues fn() to run after the carriers, in an engine call of its own.
+function pitwall._afterCarry(fn)
+  handovers[#handovers + 1] = fn
+end
+
+function pitwall._runHandover(i)
+  local fn = handovers[i]
+  if fn == nil then
+    handovers = {}
+    return false
+  end
+  handovers[i] = false
+  if fn then
+    local ok, err = xpcall(fn, debug.traceback)
+    if not ok then pitwall._reportError("handing over into the new version", err) end
+  end
+  return true
+end
+
 function pitwall._saveCarried()
+  handovers = {}
   local out = {}
   -- what this version did not take up (a version that never loaded the module: a save that
   -- briefly emptied the script) goes on to the next as it came

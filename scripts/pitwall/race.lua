@@ -58,11 +58,19 @@ local listening = setmetatable({}, { __mode = "k" }) -- cars whose kinds this ve
 -- its results, one under way goes on where it was.
 local sessions = {}
 local lastMap
-local carried = pitwall._takeCarried("race") or { sessions = {} }
-if carried.lastKind then
+local carried = pitwall._takeCarried("race")
+if carried ~= nil and (type(carried) ~= "table" or type(carried.sessions) ~= "table") then
+  pitwall.log("warn", "race: what the version before carried is not a race library's state ("
+    .. type(carried) .. "); the sessions start anew")
+  carried = nil
+end
+carried = carried or { sessions = {} }
+if type(carried.lastKind) == "table" then
   for car, kind in pairs(carried.lastKind) do lastKind[car] = kind end
 end
-if carried.map then lastMap = track._adopt(carried.map) end
+if type(carried.map) == "table" and type(carried.map.pieces) == "table" then
+  lastMap = track._adopt(carried.map)
+end
 
 -- A run that ends while a session races (--duration, Ctrl-C, pitwall.stop() from elsewhere, the
 -- --fast cap): the session says where it stood — its final table, its results file.
@@ -520,14 +528,17 @@ function Race:_carry()
     end
     local d = e.driver
     if d then
-      local state
+      local h = { name = d.name }
+      ce.handover = h
       if d.handover and e.started and not e.finished then
-        local fine, result = xpcall(d.handover, debug.traceback, d)
-        if fine then state = result
-        else report("handover of driver " .. tostring(d.name or "?") .. " of " .. tostring(e.car),
-          result) end
+        -- the driver's own code: after the session's data is saved, in a call of its own
+        pitwall._afterCarry(function()
+          local fine, result = xpcall(d.handover, debug.traceback, d)
+          if fine then h.state = result
+          else report("handover of driver " .. tostring(d.name or "?") .. " of "
+            .. tostring(e.car), result) end
+        end)
       end
-      ce.handover = { name = d.name, state = state }
     end
     copies[e] = ce
   end
@@ -594,6 +605,7 @@ function Race:run()
   local index = #sessions + 1
   sessions[index] = self
   local c = carried.sessions[index]
+  if type(c) ~= "table" or type(c.order) ~= "table" or type(c.entries) ~= "table" then c = nil end
   carried.sessions[index] = nil
   for _, car in ipairs(self.cars) do
     if not listening[car] then
@@ -651,6 +663,7 @@ function Race:run()
     ticker:cancel()
     self.state = "done"
     self.phase = "ending"
+    self.endAt = pitwall.now() + 0.5
     self:_standings(pitwall.now())
     -- Every car brought to a stop.
     for _, e in ipairs(self.order) do
@@ -658,7 +671,9 @@ function Race:run()
       if e.car.connected then pcall(e.car.stop, e.car) end
     end
   end
-  pitwall.sleep(0.5) -- (car.speed is the last reported one: a stopped car reports nothing)
+  -- (car.speed is the last reported one: a stopped car reports nothing.) A version that took
+  -- the session up here waits out what is left of the half second, no more.
+  pitwall.sleep(math.max(0, (self.endAt or pitwall.now() + 0.5) - pitwall.now()))
   for _, e in ipairs(self.order) do e.unsubscribe(); e.timer:cancel(); e.statusSub:cancel() end
   self.phase = "done"
   if self.board then

@@ -46,7 +46,12 @@ function Start:_toGrid()
       taken[localize.nearestLane(e.car.offset or 0)] = e
     end
   end
-  if #moving == 0 then return end
+  if #moving == 0 then
+    -- a version that took the session up while the cars were settling waits out the rest
+    local left = (self.settleUntil or 0) - pitwall.now()
+    if left > 0 then pitwall.sleep(left) end
+    return
+  end
   pitwall.log("info", string.format("race: %d car(s) to the grid", #moving))
   -- A car's lane is known once it reports a position on the way (one that was put somewhere
   -- by hand has not reported where): then it is given the free lane nearest to its own.
@@ -95,7 +100,9 @@ function Start:_toGrid()
       .. "lane: put it in a lane of its own), or raise gridTimeout", #why, timeout,
       table.concat(why, "; ")), 0)
   end
-  pitwall.sleep(1) -- settled: a car still rolling at the first light would be a false start
+  -- settled: a car still rolling at the first light would be a false start
+  self.settleUntil = pitwall.now() + 1
+  pitwall.sleep(1)
 end
 
 -- Lights: `lights` (5) one a second, then out after `hold` s: green. A car that moves meanwhile

@@ -217,7 +217,7 @@ pitwall._carry("track", function()
   for st in pairs(scanning) do out[#out + 1] = st end
   if carriedScans == nil then -- this version never scanned: the scans carried to it go on
     local c = pitwall._takeCarried("track")
-    carriedScans = c and c.scans or {}
+    carriedScans = type(c) == "table" and type(c.scans) == "table" and c.scans or {}
   end
   for _, st in ipairs(carriedScans) do out[#out + 1] = st end
   return { scans = out }
@@ -226,10 +226,10 @@ end)
 local function takeScan(car)
   if carriedScans == nil then
     local c = pitwall._takeCarried("track")
-    carriedScans = c and c.scans or {}
+    carriedScans = type(c) == "table" and type(c.scans) == "table" and c.scans or {}
   end
   for k, st in ipairs(carriedScans) do
-    if st.car == car then
+    if type(st) == "table" and st.car == car and type(st.segs) == "table" then
       table.remove(carriedScans, k)
       return st
     end
