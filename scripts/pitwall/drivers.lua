@@ -206,7 +206,8 @@ local function report(where, message)
 end
 
 local function call(driver, method, car, ctx)
-  local fn = driver[method]
+  -- (no driver: a session the library runs until the script's call gives it one)
+  local fn = driver and driver[method]
   if not fn then return end
   local ok, err = xpcall(fn, debug.traceback, driver, car, ctx)
   if not ok then

@@ -82,7 +82,7 @@ end)
 
 pitwall._carry("race", function()
   local out, kinds = {}, {}
-  for k, session in ipairs(sessions) do out[k] = session:_carry() end
+  for k, session in pairs(sessions) do out[k] = session:_carry() end
   -- sessions this version did not take up (not yet, or a version without the race) go on to the
   -- next: a save that briefly empties the script does not lose the race
   for k, c in pairs(carried.sessions) do
@@ -312,7 +312,7 @@ function Race:_tick()
     local car = e.car
     if not e.started and now >= e.releaseAt then self:_start(e) end
     if e.started and not e.finished and car.connected then
-      e.ctx.limit = e.limit
+      if e.ctx then e.ctx.limit = e.limit end
       drivers.call(e.driver, "update", car, e.ctx)
       if e.limit and (car.targetSpeed or 0) > e.limit then pcall(car.setSpeed, car, e.limit, 2000) end
     elseif e.finished and car.connected and e.limit and (car.targetSpeed or 0) > e.limit then
@@ -510,87 +510,79 @@ function Race:_cut()
   if path then self.resultsPath = pitwall.writeResults(self:results(), race.columns, path) end
 end
 
--- What the next version takes up (pitwall._carry above): the session's data, each entry's data
--- and what its driver hands over; not the options, drivers, handlers or board, which the next
--- version brings.
-local SKIP = { options = true, board = true, lastKind = true }
-local SKIP_ENTRY = { driver = true, ctx = true, unsubscribe = true, statusSub = true }
-function Race:_carry()
-  local c = {}
-  for k, v in pairs(self) do
-    if not SKIP[k] then c[k] = v end
-  end
-  local copies = {}
-  for _, e in ipairs(self.order) do
-    local ce = {}
-    for k, v in pairs(e) do
-      if not SKIP_ENTRY[k] then ce[k] = v end
+-- Across reloads: what a session hands to the next version and how it takes it up
+-- (race_reload.lua).
+require("pitwall.race_reload")(Race, { modes = MODES, report = report })
+
+local PHASES = { new = "the map", grid = "to the grid", lights = "the lights", racing = "racing",
+  ending = "stopping the cars" }
+
+local function listenKinds(cars)
+  for _, car in ipairs(cars) do
+    if not listening[car] then
+      listening[car] = true
+      lastKind[car] = lastKind[car] or "none"
+      pitwall.listen(car, "onPosition", function() lastKind[car] = "position" end)
+      pitwall.listen(car, "onTransition", function() lastKind[car] = "transition" end)
     end
-    local d = e.driver
-    if d then
-      local h = { name = d.name }
-      ce.handover = h
-      if d.handover and e.started and not e.finished then
-        -- the driver's own code: after the session's data is saved, in a call of its own
-        pitwall._afterCarry(function()
-          local fine, result = xpcall(d.handover, debug.traceback, d)
-          if fine then h.state = result
-          else report("handover of driver " .. tostring(d.name or "?") .. " of "
-            .. tostring(e.car), result) end
-        end)
-      end
-    end
-    copies[e] = ce
   end
-  c.entries, c.order = {}, {}
-  for k, e in ipairs(self.order) do
-    local ce = copies[e]
-    if ce.limitedBy then ce.limitedBy = copies[ce.limitedBy] end
-    c.order[k], c.entries[e.car] = ce, ce
-  end
-  return c
 end
 
--- Takes up session `c` carried from the version before: its state as it was, this version's
--- options where they may change mid-session (drivers, title, board, period, …); the mode and
--- the cars cannot, the number of laps (or minutes) can.
-function Race:_takeUp(c)
+-- Sessions that were racing when the script was saved, taken up as this module loads (below) and
+-- directed without drivers until the script's own call comes to them: run index → session.
+local headless = {}
+local runs = 0 -- run() calls in this version: the k-th takes up the k-th session carried
+
+-- The script's call for a session taken up at load: this version's options, drivers and board;
+-- then it waits for the session's end like any run.
+function Race:_attach(new)
+  self.options = new.options
+  self:_applyOptions(new.options, new.mode, new.laps, new.seconds, new.title)
+  self.penalty = new.options.falseStartPenalty or self.penalty
+  pitwall.log("info", string.format("race: %s taken up by the new version (racing)", self.title))
+  self:_drivers()
+  self:_board()
+  pitwall.waitUntil(function() return self.phase == "done" end, nil, self.period)
+  return self
+end
+
+-- Racing until the session is done, then the end: every car stopped, the final table, the
+-- results, onEnd. A session taken up at load runs this in a task of its own.
+function Race:_race()
   local o = self.options
-  if c.mode ~= self.mode then
-    pitwall.log("warn", string.format("race: this version asks for a %s, but a %s is under way: "
-      .. "a session cannot change its kind; it goes on as a %s", MODES[self.mode]:lower(),
-      MODES[c.mode]:lower(), MODES[c.mode]:lower()))
-  end
-  local newMode, newLaps, newSeconds = self.mode, self.laps, self.seconds
-  for k, v in pairs(c) do
-    if k ~= "title" and k ~= "period" then self[k] = v end
-  end
-  if newMode ~= c.mode and not o.title then self.title = c.title end
-  if c.map then self.map = track._adopt(c.map) end
-  if o.cars and #o.cars ~= #c.cars then
-    pitwall.log("warn", string.format("race: this version names %d car(s), the session under way "
-      .. "has %d: the cars cannot change mid-session; it goes on with its own", #o.cars, #c.cars))
-  end
-  if self.phase == "done" then return end
-  if newMode == c.mode then
-    if self.mode == "laps" and newLaps and newLaps ~= c.laps then
-      local done = 0
-      for _, e in ipairs(self.order) do done = math.max(done, e.timer and e.timer.count or 0) end
-      if self.leaderFinished then
-        pitwall.log("warn", string.format("race: laps = %d: the race is already over (%d laps); "
-          .. "it stays so", newLaps, c.laps))
-      else
-        self.laps = math.max(newLaps, done + 1)
-        pitwall.log("info", string.format("race: %d laps instead of %d%s", self.laps, c.laps,
-          self.laps ~= newLaps and string.format(" (the leader has done %d already)", done) or ""))
-      end
-    elseif newSeconds and c.seconds and newSeconds ~= c.seconds and not self.timeUp
-      and not self.leaderFinished then
-      self.seconds = newSeconds
-      pitwall.log("info", string.format("race: %s instead of %s", Board.time(newSeconds),
-        Board.time(c.seconds)))
+  if self.phase == "racing" then
+    local ticker = pitwall.every(self.period, function()
+      if self.done then return end
+      local ok, err = xpcall(self._tick, debug.traceback, self)
+      if not ok then report("race director", err) end
+    end)
+    pitwall.waitUntil(function() return self.done end, nil, self.period)
+    ticker:cancel()
+    self.state = "done"
+    self.phase = "ending"
+    self.endAt = pitwall.now() + 0.5
+    self:_standings(pitwall.now())
+    -- Every car brought to a stop.
+    for _, e in ipairs(self.order) do
+      if e.started and not e.finished then drivers.call(e.driver, "finish", e.car, e.ctx) end
+      if e.car.connected then pcall(e.car.stop, e.car) end
     end
   end
+  -- (car.speed is the last reported one: a stopped car reports nothing.) A version that took
+  -- the session up here waits out what is left of the half second, no more.
+  pitwall.sleep(math.max(0, (self.endAt or pitwall.now() + 0.5) - pitwall.now()))
+  for _, e in ipairs(self.order) do e.unsubscribe(); e.timer:cancel(); e.statusSub:cancel() end
+  if self.board then
+    self.board.title = self.title .. "   results"
+    self.board:final(self:_rows())
+  end
+  o = self.options -- (the script's call may have come meanwhile)
+  local path = o.results
+  if path == nil then path = pitwall.resultsFile end
+  if path then self.resultsPath = pitwall.writeResults(self:results(), race.columns, path) end
+  self.phase = "done"
+  self:_emit("onEnd", self)
+  return self
 end
 
 --- Runs the session to its end inside a task; returns the session. A session that a reload of
@@ -602,26 +594,23 @@ function Race:run()
   end
   local o = self.options
   self.lastKind = lastKind
-  local index = #sessions + 1
+  runs = runs + 1
+  local index = runs
+  listenKinds(self.cars)
+  local h = headless[index]
+  if h then
+    headless[index] = nil
+    return h:_attach(self)
+  end
   sessions[index] = self
   local c = carried.sessions[index]
   if type(c) ~= "table" or type(c.order) ~= "table" or type(c.entries) ~= "table" then c = nil end
   carried.sessions[index] = nil
-  for _, car in ipairs(self.cars) do
-    if not listening[car] then
-      listening[car] = true
-      lastKind[car] = lastKind[car] or "none"
-      pitwall.listen(car, "onPosition", function() lastKind[car] = "position" end)
-      pitwall.listen(car, "onTransition", function() lastKind[car] = "transition" end)
-    end
-  end
   if c then
     self:_takeUp(c)
     if self.phase == "done" then return self end
-    local phases = { new = "the map", grid = "to the grid", lights = "the lights",
-      racing = "racing", ending = "stopping the cars" }
     pitwall.log("info", string.format("race: %s taken up by the new version (%s)", self.title,
-      phases[self.phase] or self.phase))
+      PHASES[self.phase] or self.phase))
   end
   self.phase = self.phase or "new"
   self.penalty = o.falseStartPenalty or self.penalty or 5
@@ -653,38 +642,7 @@ function Race:run()
     self.phase = "racing"
     self:_tick()
   end
-  if self.phase == "racing" then
-    local ticker = pitwall.every(self.period, function()
-      if self.done then return end
-      local ok, err = xpcall(self._tick, debug.traceback, self)
-      if not ok then report("race director", err) end
-    end)
-    pitwall.waitUntil(function() return self.done end, nil, self.period)
-    ticker:cancel()
-    self.state = "done"
-    self.phase = "ending"
-    self.endAt = pitwall.now() + 0.5
-    self:_standings(pitwall.now())
-    -- Every car brought to a stop.
-    for _, e in ipairs(self.order) do
-      if e.started and not e.finished then drivers.call(e.driver, "finish", e.car, e.ctx) end
-      if e.car.connected then pcall(e.car.stop, e.car) end
-    end
-  end
-  -- (car.speed is the last reported one: a stopped car reports nothing.) A version that took
-  -- the session up here waits out what is left of the half second, no more.
-  pitwall.sleep(math.max(0, (self.endAt or pitwall.now() + 0.5) - pitwall.now()))
-  for _, e in ipairs(self.order) do e.unsubscribe(); e.timer:cancel(); e.statusSub:cancel() end
-  self.phase = "done"
-  if self.board then
-    self.board.title = self.title .. "   results"
-    self.board:final(self:_rows())
-  end
-  local path = o.results
-  if path == nil then path = pitwall.resultsFile end
-  if path then self.resultsPath = pitwall.writeResults(self:results(), race.columns, path) end
-  self:_emit("onEnd", self)
-  return self
+  return self:_race()
 end
 
 for mode in pairs(MODES) do
@@ -692,6 +650,26 @@ for mode in pairs(MODES) do
     options = options or {}
     options.mode = mode
     return race.new(options):run()
+  end
+end
+
+-- A session that was racing when the script was saved goes on at once: its trackers and lap
+-- timers follow the cars, laps and finishes are counted, and the cars keep their last commanded
+-- speeds, until the script's own call — which may come later, after a pitwall.sleep — brings
+-- this version's options and drivers (Race:_attach). A version that never makes the call
+-- still sees the session to its end.
+for index, c in pairs(carried.sessions) do
+  if type(c) == "table" and type(c.order) == "table" and type(c.entries) == "table"
+    and c.phase == "racing" and MODES[c.mode] then
+    local h = setmetatable({ mode = c.mode, options = {}, cars = c.cars, lastKind = lastKind },
+      Race)
+    h:_takeUp(c)
+    carried.sessions[index] = nil
+    sessions[index], headless[index] = h, h
+    listenKinds(h.cars)
+    for _, e in ipairs(h.order) do e.loc = localize._adopt(e.loc) end
+    h:_timing(true)
+    pitwall.spawn(function() h:_race() end, "race " .. tostring(h.title))
   end
 end
 
