@@ -10,18 +10,18 @@ return function(Race, shared)
   -- What the next version takes up (race.lua registers it with pitwall._carry): the session's data, each entry's data
   -- and what its driver hands over; not the options, drivers, handlers or board, which the next
   -- version brings.
-  local SKIP = { options = true, board = true, lastKind = true }
-  local SKIP_ENTRY = { driver = true, ctx = true, unsubscribe = true, statusSub = true }
+  local LEFT_BEHIND = { options = true, board = true, lastKind = true }
+  local LEFT_BEHIND_ENTRY = { driver = true, ctx = true, unsubscribe = true, statusSub = true }
   function Race:_carry()
     local c = {}
     for k, v in pairs(self) do
-      if not SKIP[k] then c[k] = v end
+      if not LEFT_BEHIND[k] then c[k] = v end
     end
     local copies = {}
     for _, e in ipairs(self.order) do
       local ce = {}
       for k, v in pairs(e) do
-        if not SKIP_ENTRY[k] then ce[k] = v end
+        if not LEFT_BEHIND_ENTRY[k] then ce[k] = v end
       end
       local d = e.driver
       if d then
