@@ -321,6 +321,7 @@ void openPitwallModule(ScriptHost& host) {
   if (host.sim()) openSimModule(host);
   openMindroadModule(host);
   openAlphabotModule(host);
+  openViewModule(host);
 
   // Cars already known get their Lua objects now; later ones when they join
   // (ScriptHost::carJoined).

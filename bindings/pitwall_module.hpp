@@ -14,4 +14,6 @@ void openScriptUnderTest(lua_State* L);
 // nothing on the stack and sets its function in the `pitwall` table.
 void openMindroadModule(ScriptHost& host);
 void openAlphabotModule(ScriptHost& host);
+// pitwall.view (view_binding.cpp): what a script tells the race view.
+void openViewModule(ScriptHost& host);
 }  // namespace pitwall

@@ -24,6 +24,9 @@
 namespace pitwall {
 
 class CarBinding;
+namespace view {
+class Feed;
+}
 
 // The simulator as scripts see it (pitwall.sim): present for simulator runs and scenario tests.
 struct SimSession {
@@ -39,6 +42,8 @@ struct HostOptions {
   // Made detached: the cars' events reach this world only after attach() (a hot reload's new
   // version, until it has started).
   bool detached = false;
+  // The race view's feed (--view): pitwall.view reports to it; none: pitwall.view does nothing.
+  view::Feed* view = nullptr;
 };
 
 class ScriptHost {

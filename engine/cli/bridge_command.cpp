@@ -15,6 +15,11 @@ int bridge(const BridgeOptions& options) {
   auto made = Session::open(local, false, "bridge");
   if (!made) return 2;
   Session& session = *made;
+  if (options.view) {
+    if (int status = session.startView(*options.view, options.ble ? "ble" : "simulator", "bridge");
+        status != 0)
+      return status;
+  }
   if (int status = session.connectCars("bridge"); status != 0) return status;
   if (int status = session.startBridge(options.mqtt, options.hostId, options.readOnly, "bridge");
       status != 0) {

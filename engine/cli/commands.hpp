@@ -36,6 +36,8 @@ struct CarSource {
   MqttSettings mqtt;
   int remoteCars = 0;  // --remote-cars N: wait (up to --mqtt-timeout) until N are online
   double mqttTimeout = 5;
+  // --view [[HOST:]PORT]: serve the race view (docs/view.md); "" the default port; none: off
+  std::optional<std::string> view;
 };
 
 struct RunOptions : CarSource {

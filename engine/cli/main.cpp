@@ -1,6 +1,7 @@
 // pitwall — the command line (docs/cli.md).
 #include <CLI/CLI.hpp>
 #include <iostream>
+#include <list>
 
 #include "engine/cli/commands.hpp"
 #include "engine/core/log.hpp"
@@ -76,6 +77,29 @@ CLI::Option* addRemoteCars(CLI::App* cmd, pitwall::cli::CarSource& source) {
   return url;
 }
 
+// --view [[HOST:]PORT]: an option whose value may be left out. CLI11 tells whether it was given
+// only after parsing, so each one is kept here and copied to its command's options then.
+struct ViewOption {
+  CLI::Option* option = nullptr;
+  std::string value;
+  std::optional<std::string>* target = nullptr;
+};
+std::list<ViewOption> g_views;  // a list: the options keep pointers to the values
+
+void addView(CLI::App* cmd, std::optional<std::string>& target) {
+  auto& v = g_views.emplace_back();
+  v.target = &target;
+  v.option = cmd->add_option("--view", v.value,
+                             "Serve the race view in a browser on [HOST:]PORT (default "
+                             "127.0.0.1:8080; PORT 0: any free port) — docs/view.md")
+                 ->expected(0, 1);
+}
+
+void takeViews() {
+  for (auto& v : g_views)
+    if (v.option->count() > 0) *v.target = v.value;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -112,6 +136,7 @@ int main(int argc, char** argv) {
   // a broker lives in real time
   addRemoteCars(runCmd, run)->excludes(fastFlag);
 
+  addView(runCmd, run.view);
   auto* replFlag = runCmd->add_flag("--repl", run.repl,
                                     "Open a Lua prompt beside the script, in the same Lua world");
   runCmd->add_flag("--watch", run.watch,
@@ -125,6 +150,7 @@ int main(int argc, char** argv) {
       "repl", "A Lua prompt with the cars bound; the simulator runs behind it in real time");
   addCarSource(replCmd, repl, "before the prompt opens");
   addRemoteCars(replCmd, repl);
+  addView(replCmd, repl.view);
   replCmd->add_option("--history", repl.history,
                       "History file (default $PITWALL_HISTORY, else ~/.pitwall_history)");
 
@@ -136,6 +162,7 @@ int main(int argc, char** argv) {
   addMqtt(bridgeCmd, bridge.mqtt, bridge.mqttTimeout, "where the cars are published")->required();
   bridgeCmd->add_option("--host-id", bridge.hostId,
                         "The <host> of Anki/Host/<host>/… (default: this machine's host name)");
+  addView(bridgeCmd, bridge.view);
   bridgeCmd->add_flag("--read-only", bridge.readOnly, "Publish only; never execute intents");
   bridgeCmd->add_option("--duration", bridge.duration, "Stop after this many seconds")
       ->check(CLI::PositiveNumber);
@@ -213,6 +240,7 @@ int main(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 2;
   }
 
+  takeViews();
   bool testing = testCmd->parsed();
   if (!logLevel.empty()) {
     auto level = log::parseLevel(logLevel);

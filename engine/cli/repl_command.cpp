@@ -28,10 +28,16 @@ int repl(const ReplOptions& options) {
   Loop& loop = session.loop();
   // Until the prompt is up, Ctrl-C and SIGTERM end the start-up (the cars are stopped); once it
   // is, SIGINT is the REPL's and SIGTERM stays with the session.
+  if (options.view) {
+    if (int status = session.startView(*options.view, options.ble ? "ble" : "simulator", "repl");
+        status != 0)
+      return status;
+  }
   if (int status = session.connectCars("repl"); status != 0) return status;
 
   HostOptions host;
   host.seed = options.seed;
+  host.view = session.viewFeed();
   try {
     session.startHost(host);
   } catch (const std::exception& e) {

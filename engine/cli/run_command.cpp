@@ -48,11 +48,17 @@ int run(const RunOptions& options) {
     }
   }
   Loop& loop = session.loop();
+  if (options.view) {
+    if (int status = session.startView(*options.view, options.ble ? "ble" : "simulator", "run");
+        status != 0)
+      return status;
+  }
   if (int status = session.connectCars("run"); status != 0) return status;
 
   HostOptions host;
   host.seed = options.seed;
   host.results = options.results;
+  host.view = session.viewFeed();
   try {
     session.startHost(host);
   } catch (const std::exception& e) {

@@ -10,6 +10,7 @@
 
 #include "bindings/interrupt.hpp"
 #include "bindings/sandbox.hpp"
+#include "engine/core/console.hpp"
 #include "engine/core/log.hpp"
 #include "engine/protocol/anki/advertisement.hpp"
 #include "engine/sim/grid.hpp"
@@ -36,6 +37,8 @@ Session::~Session() {
   signals_.reset();
   if (recorder_) recorder_->flush();
   scripts_.reset();
+  server_.reset();
+  feed_.reset();
   bridge_.reset();
   remote_.reset();
   mqtt_.reset();
@@ -362,6 +365,39 @@ void Session::startHost(HostOptions options) {
   scripts_ =
       std::make_unique<Reloader>(loop_, fleet_, sim_.world ? &sim_ : nullptr, std::move(options));
   scripts_->onStopRequested = [this] { finish(); };
+}
+
+int Session::startView(const std::string& endpoint, const std::string& source,
+                       const char* command) {
+  auto options = view::parseEndpoint(endpoint);
+  if (!options) {
+    std::cerr << "pitwall " << command << ": " << options.error()
+              << " (--view takes an optional [HOST:]PORT: write --view=PORT, or put --view after "
+                 "the script)\n";
+    return 2;
+  }
+  auto assets = view::findAssets();
+  if (!assets) {
+    std::cerr << "pitwall " << command << ": " << assets.error() << "\n";
+    return 2;
+  }
+  options->assets = *assets;
+  feed_ = std::make_unique<view::Feed>(loop_, fleet_, source);
+  if (sim_.world) feed_->setTrack(sim_.world->track(), "layout");
+  feed_->followLog(true);
+  server_ = std::make_unique<view::Server>(loop_, *feed_, *options);
+  if (auto started = server_->start(); !started) {
+    std::cerr << "pitwall " << command << ": " << started.error() << "\n";
+    server_.reset();
+    feed_.reset();
+    return 2;
+  }
+  console::noteOutput();
+  std::cerr << "view: " << server_->url() << "\n";
+  if (options->host != "127.0.0.1" && options->host != "::1")
+    log::warn("view", "serving on " + options->host +
+                          ": anyone who can reach this machine can watch (read-only)");
+  return 0;
 }
 
 void Session::finish() {

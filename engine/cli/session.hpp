@@ -14,6 +14,8 @@
 #include "engine/vehicles/mqtt_bridge.hpp"
 #include "engine/vehicles/mqtt_remote.hpp"
 #include "engine/vehicles/recorder.hpp"
+#include "engine/view/feed.hpp"
+#include "engine/view/server.hpp"
 
 namespace pitwall::cli {
 
@@ -55,6 +57,11 @@ class Session {
   // Finds and connects the real cars (runs the loop until every car had a first attempt).
   std::optional<std::string> connectRealCars();
   void startHost(HostOptions options);
+  // --view: the race view's feed and server (docs/view.md); prints the URL. `source` says what
+  // the cars are. Non-zero (an error printed) when it cannot serve.
+  int startView(const std::string& endpoint, const std::string& source, const char* command);
+  view::Feed* viewFeed() { return feed_.get(); }
+  view::Server* viewServer() { return server_.get(); }
   // The one stop path (docs/safety.md): the script is shut down first (nothing of it runs or
   // commands again), then every car gets its stop as its last command, the record is flushed,
   // the stop frames are given time to reach the cars, real cars are disconnected, and
@@ -75,6 +82,9 @@ class Session {
   std::unique_ptr<MqttClient> mqtt_;
   std::unique_ptr<RemoteCars> remote_;
   std::unique_ptr<MqttBridge> bridge_;
+  // the race view: the feed follows the fleet (restores its hooks when destroyed, before it)
+  std::unique_ptr<view::Feed> feed_;
+  std::unique_ptr<view::Server> server_;
   int connectLocalCars(const char* command);
   int connectRemoteCars(const char* command);
   bool finishing_ = false;

@@ -1,6 +1,7 @@
 #pragma once
 // Logging with levels, to stderr. Each line carries the engine clock time when a clock is set,
 // so virtual-time runs log simulated seconds.
+#include <cstdint>
 #include <functional>
 #include <optional>
 #include <string>
@@ -18,6 +19,12 @@ std::optional<Level> parseLevel(std::string_view text);
 void setTimeSource(std::function<double()> seconds);
 // Where lines go; default is stderr. Tests capture lines through this.
 void setSink(std::function<void(Level, std::string_view line)> sink);
+
+// Taps see every line written at Info or above, whatever the level shown (the race view's event
+// log); a tap must not log. removeTap takes the id addTap returned.
+using Tap = std::function<void(Level, std::string_view component, std::string_view message)>;
+std::uint64_t addTap(Tap tap);
+void removeTap(std::uint64_t id);
 
 void write(Level level, std::string_view component, std::string_view message);
 inline void debug(std::string_view c, std::string_view m) {

@@ -188,6 +188,8 @@ end
 
 -- The start: to the grid, then the lights (race_start.lua).
 for name, fn in pairs(require "pitwall.race_start") do Race[name] = fn end
+-- What the race view shows (race_view.lua).
+for name, fn in pairs(require "pitwall.race_view") do Race[name] = fn end
 
 function Race:_start(e)
   e.started = true
@@ -614,13 +616,16 @@ function Race:run()
   end
   self.phase = self.phase or "new"
   self.penalty = o.falseStartPenalty or self.penalty or 5
+  self:_viewStart()
   if self.phase == "new" then
     self.map = self:_map()
     lastMap = self.map
+    self:_viewMap()
     self:_entries()
     self.phase = "grid"
   else
     for _, e in ipairs(self.order) do e.loc = localize._adopt(e.loc) end
+    self:_viewMap()
   end
   self:_drivers()
   if self.phase == "grid" then
@@ -669,6 +674,8 @@ for index, c in pairs(carried.sessions) do
     listenKinds(h.cars)
     for _, e in ipairs(h.order) do e.loc = localize._adopt(e.loc) end
     h:_timing(true)
+    h:_viewStart()
+    h:_viewMap()
     pitwall.spawn(function() h:_race() end, "race " .. tostring(h.title))
   end
 end

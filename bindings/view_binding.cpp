@@ -1,0 +1,175 @@
+// pitwall.view: what a script tells the race view (docs/view.md "race"). The race library
+// reports its sessions and the map a scan learnt; a script may add lines to the event log.
+//   pitwall.view.active          true when the run serves a view (--view)
+//   pitwall.view.race(t | nil)   the race's state: a table of plain data (no functions)
+//   pitwall.view.track(map)      a map of pitwall.track: its pieces are drawn (real cars)
+//   pitwall.view.event(text [, level])
+// Without a view they do nothing, so a script never needs to ask.
+#include <cmath>
+
+#include "bindings/lua_support.hpp"
+#include "bindings/pitwall_module.hpp"
+#include "bindings/script_host.hpp"
+#include "engine/view/feed.hpp"
+
+namespace pitwall {
+
+using lua::LuaError;
+
+namespace {
+
+constexpr int kMaxDepth = 16;
+constexpr std::size_t kMaxEntries = 100000;  // values in one race table, all levels
+
+view::Feed* feedOf(lua_State* L) {
+  return ScriptHost::from(L).options().view;
+}
+
+// A Lua value as JSON: tables with keys 1..n are arrays, others objects with string keys
+// (numbers become their text); functions and other non-data are refused with where they are.
+nlohmann::json toJson(lua_State* L, int idx, int depth, std::size_t& count,
+                      const std::string& where) {
+  if (++count > kMaxEntries)
+    throw LuaError("pitwall.view.race: the table holds more than " + std::to_string(kMaxEntries) +
+                   " values");
+  switch (lua_type(L, idx)) {
+    case LUA_TNIL:
+      return nullptr;
+    case LUA_TBOOLEAN:
+      return lua_toboolean(L, idx) != 0;
+    case LUA_TNUMBER:
+      if (lua_isinteger(L, idx)) return static_cast<long long>(lua_tointeger(L, idx));
+      {
+        double d = lua_tonumber(L, idx);
+        return std::isfinite(d) ? nlohmann::json(d) : nlohmann::json(nullptr);
+      }
+    case LUA_TSTRING: {
+      std::size_t n = 0;
+      const char* s = lua_tolstring(L, idx, &n);
+      return std::string(s, n);  // invalid UTF-8 is replaced when the feed is written
+    }
+    case LUA_TTABLE:
+      break;
+    default:
+      throw LuaError("pitwall.view.race: " + where + " is a " + luaL_typename(L, idx) +
+                     "; only data (tables, strings, numbers, booleans) goes to the view");
+  }
+  if (depth >= kMaxDepth)
+    throw LuaError("pitwall.view.race: " + where + " is nested deeper than " +
+                   std::to_string(kMaxDepth) + " tables");
+  idx = lua_absindex(L, idx);
+  luaL_checkstack(L, 4, "pitwall.view.race");
+  const lua_Integer n = static_cast<lua_Integer>(lua_rawlen(L, idx));
+  std::size_t keys = 0;
+  lua_pushnil(L);
+  while (lua_next(L, idx)) {
+    ++keys;
+    lua_pop(L, 1);
+  }
+  if (keys == static_cast<std::size_t>(n)) {  // an empty table is an empty list
+    nlohmann::json a = nlohmann::json::array();
+    for (lua_Integer i = 1; i <= n; ++i) {
+      lua_rawgeti(L, idx, i);
+      a.push_back(toJson(L, -1, depth + 1, count, where + "[" + std::to_string(i) + "]"));
+      lua_pop(L, 1);
+    }
+    return a;
+  }
+  nlohmann::json o = nlohmann::json::object();
+  lua_pushnil(L);
+  while (lua_next(L, idx)) {
+    std::string key;
+    if (lua_type(L, -2) == LUA_TSTRING) {
+      key = lua_tostring(L, -2);
+    } else if (lua_type(L, -2) == LUA_TNUMBER) {
+      lua_pushvalue(L, -2);
+      key = lua_tostring(L, -1);
+      lua_pop(L, 1);
+    } else {
+      throw LuaError("pitwall.view.race: " + where + " has a " + luaL_typename(L, -2) +
+                     " key; keys are strings or numbers");
+    }
+    o[key] = toJson(L, -1, depth + 1, count, where + "." + key);
+    lua_pop(L, 1);
+  }
+  return o;
+}
+
+int race(lua_State* L) {
+  view::Feed* feed = feedOf(L);
+  if (!feed) return 0;
+  if (lua_isnoneornil(L, 1)) {
+    feed->setRace(nullptr);
+    return 0;
+  }
+  luaL_checktype(L, 1, LUA_TTABLE);
+  std::size_t count = 0;
+  feed->setRace(toJson(L, 1, 0, count, "race"));
+  return 0;
+}
+
+// A map of pitwall.track ({pieces = {{id, turn = "left"|"right"|nil}, …}}) as a track to draw,
+// starting with the start piece (34) as layouts do. A simulator's layout is the truth and stays.
+int track(lua_State* L) {
+  view::Feed* feed = feedOf(L);
+  if (!feed) return 0;
+  luaL_checktype(L, 1, LUA_TTABLE);
+  if (feed->track() && feed->trackSourceIsLayout()) return 0;
+  lua_getfield(L, 1, "pieces");
+  if (!lua_istable(L, -1)) throw LuaError("pitwall.view.track: the map has no pieces list");
+  std::vector<sim::Piece> pieces;
+  const lua_Integer n = static_cast<lua_Integer>(lua_rawlen(L, -1));
+  if (n > 10000) throw LuaError("pitwall.view.track: a map of " + std::to_string(n) + " pieces?");
+  for (lua_Integer i = 1; i <= n; ++i) {
+    lua_rawgeti(L, -1, i);
+    if (!lua_istable(L, -1))
+      throw LuaError("pitwall.view.track: piece " + std::to_string(i) + " is not a table");
+    lua_getfield(L, -1, "id");
+    lua_Integer id = lua_tointeger(L, -1);
+    lua_getfield(L, -2, "turn");
+    std::string turn = lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1) : "";
+    lua_pop(L, 3);
+    if (id < 0 || id > 255)
+      throw LuaError("pitwall.view.track: piece " + std::to_string(i) + " has id " +
+                     std::to_string(id) + " (0–255)");
+    sim::Piece p;
+    p.id = static_cast<std::uint8_t>(id);
+    p.type = anki::pieceType(p.id);
+    p.turn = p.type == anki::PieceType::Curve ? (turn == "left" ? 1 : turn == "right" ? -1 : 0) : 0;
+    pieces.push_back(p);
+  }
+  lua_pop(L, 1);
+  auto start = std::find_if(pieces.begin(), pieces.end(),
+                            [](const sim::Piece& p) { return p.id == anki::kFinishBefore; });
+  if (start != pieces.end()) std::rotate(pieces.begin(), start, pieces.end());
+  feed->setTrack(sim::Track("scanned", std::move(pieces)), "scan");
+  return 0;
+}
+
+int event(lua_State* L) {
+  std::string text = lua::checkString(L, 1, "the event's text");
+  std::string level = lua_isnoneornil(L, 2) ? "info" : lua::checkString(L, 2, "level");
+  if (level != "info" && level != "warn" && level != "error")
+    throw LuaError("pitwall.view.event: level must be \"info\", \"warn\" or \"error\", got \"" +
+                   level.substr(0, 40) + "\"");
+  if (view::Feed* feed = feedOf(L)) feed->event(level, text.substr(0, 1000));
+  return 0;
+}
+
+}  // namespace
+
+void openViewModule(ScriptHost& host) {
+  lua_State* L = host.state();
+  lua_getglobal(L, "pitwall");
+  static const luaL_Reg functions[] = {{"race", lua::guarded<race>},
+                                       {"track", lua::guarded<track>},
+                                       {"event", lua::guarded<event>},
+                                       {nullptr, nullptr}};
+  luaL_newlib(L, functions);
+  lua_pushboolean(L, host.options().view != nullptr);
+  lua_setfield(L, -2, "active");
+  lua_setfield(L, -2, "view");
+  lua_pop(L, 1);
+}
+
+}  // namespace pitwall

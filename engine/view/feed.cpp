@@ -1,0 +1,238 @@
+#include "engine/view/feed.hpp"
+
+#include <cmath>
+
+#include "engine/core/log.hpp"
+#include "engine/view/geometry.hpp"
+
+namespace pitwall::view {
+
+namespace {
+constexpr std::size_t kEventsKept = 200;
+constexpr double kHistorySeconds = 60;
+constexpr double kHistoryStep = 0.1;  // at most 10 speed samples a second
+// Distinct colours for markers (car 1 first); repeats after 12.
+constexpr const char* kColours[] = {"#e6194b", "#3cb44b", "#ffe119", "#4363d8",
+                                    "#f58231", "#911eb4", "#42d4f4", "#f032e6",
+                                    "#bfef45", "#fabed4", "#469990", "#dcbeff"};
+
+double round3(double v) {
+  double r = std::round(v * 1000) / 1000;
+  return r == 0 ? 0 : r;
+}
+}  // namespace
+
+struct Feed::Car {
+  CarTracker tracker;
+  std::deque<std::pair<double, int>> speeds;  // (time, mm/s)
+};
+
+Feed::Feed(Loop& loop, Fleet& fleet, std::string source)
+    : loop_(loop), fleet_(fleet), source_(std::move(source)) {
+  previousOnFrame_ = std::move(fleet_.onFrame);
+  fleet_.onFrame = [this](AnkiCar& car, AnkiCar::Direction d, std::span<const std::uint8_t> f,
+                          const anki::Message& m) {
+    if (previousOnFrame_) previousOnFrame_(car, d, f, m);
+    frame(car, d, m);
+  };
+  previousOnConnection_ = std::move(fleet_.onConnectionChange);
+  fleet_.onConnectionChange = [this](AnkiCar& car, bool up, const std::string& reason) {
+    if (previousOnConnection_) previousOnConnection_(car, up, reason);
+    event(up ? "info" : "warn", car.label() + (up ? " connected" : " disconnected") +
+                                    (up || reason.empty() ? "" : ": " + reason));
+  };
+}
+
+Feed::~Feed() {
+  followLog(false);
+  fleet_.onFrame = std::move(previousOnFrame_);
+  fleet_.onConnectionChange = std::move(previousOnConnection_);
+}
+
+void Feed::followLog(bool on) {
+  if (on && !logTap_) {
+    logTap_ =
+        log::addTap([this](log::Level level, std::string_view component, std::string_view message) {
+          // warnings, errors, and what a reload says; the rest of the log stays in the terminal
+          if (level < log::Level::Warn && component != "reload") return;
+          event(level == log::Level::Error  ? "error"
+                : level == log::Level::Warn ? "warn"
+                                            : "info",
+                std::string(component) + ": " + std::string(message));
+        });
+  } else if (!on && logTap_) {
+    log::removeTap(logTap_);
+    logTap_ = 0;
+  }
+}
+
+Feed::Car& Feed::car(AnkiCar& car) {
+  auto& slot = cars_[car.identity().number];
+  if (!slot) {
+    slot = std::make_unique<Car>();
+    slot->tracker.setTrack(track_ ? &*track_ : nullptr);
+  }
+  return *slot;
+}
+
+const CarTracker* Feed::tracker(int number) const {
+  auto it = cars_.find(number);
+  return it == cars_.end() ? nullptr : &it->second->tracker;
+}
+
+void Feed::frame(AnkiCar& ankiCar, AnkiCar::Direction d, const anki::Message& m) {
+  if (d != AnkiCar::Direction::Rx) return;
+  const bool moves = std::holds_alternative<anki::PositionUpdate>(m) ||
+                     std::holds_alternative<anki::TransitionUpdate>(m) ||
+                     std::holds_alternative<anki::Delocalized>(m) ||
+                     std::holds_alternative<anki::SpeedUpdate>(m);
+  if (!moves) return;
+  Car& c = car(ankiCar);
+  const double now = loop_.seconds();
+  c.tracker.update(m, ankiCar.state(), now);
+  if (c.speeds.empty() || now - c.speeds.back().first >= kHistoryStep) {
+    c.speeds.emplace_back(now, ankiCar.state().speed_mm_s);
+    while (!c.speeds.empty() && c.speeds.front().first < now - kHistorySeconds)
+      c.speeds.pop_front();
+  }
+}
+
+void Feed::setTrack(std::optional<sim::Track> track, const std::string& source) {
+  track_ = std::move(track);
+  trackSource_ = track_ ? source : "none";
+  ++trackVersion_;
+  for (auto& [number, c] : cars_) c->tracker.setTrack(track_ ? &*track_ : nullptr);
+  if (track_)
+    event("info", "track: " + track_->name() + " (" + std::to_string(track_->size()) + " pieces, " +
+                      source + ")");
+}
+
+void Feed::setRace(nlohmann::json race) {
+  auto phaseOf = [](const nlohmann::json& r) -> std::string {
+    if (!r.is_object()) return "";
+    auto it = r.find("phase");
+    return it != r.end() && it->is_string() ? it->get<std::string>() : "";
+  };
+  std::string before = phaseOf(race_), after = phaseOf(race);
+  race_ = std::move(race);
+  if (!after.empty() && after != before) {
+    std::string title = race_.value("title", std::string("race"));
+    event("info", title + ": " + after);
+  }
+}
+
+void Feed::event(const std::string& level, const std::string& text) {
+  events_.push_back({nextEvent_++, loop_.seconds(), level, text});
+  while (events_.size() > kEventsKept) events_.pop_front();
+}
+
+nlohmann::json Feed::carJson(const AnkiCar& ankiCar) const {
+  const CarState& s = ankiCar.state();
+  const int number = ankiCar.identity().number;
+  const Car* c = nullptr;
+  if (auto it = cars_.find(number); it != cars_.end()) c = it->second.get();
+  nlohmann::json j = {
+      {"number", number},
+      {"name", ankiCar.identity().name},
+      {"color", kColours[(number - 1) % std::size(kColours)]},
+      {"connected", s.connected},
+      {"onTrack", s.on_track},
+      {"delocalized", s.delocalized},
+      {"reverse", s.reverse},
+      {"piece", s.piece},
+      {"location", s.location},
+      {"offset", round3(s.offset_mm)},
+      {"speed", s.speed_mm_s},
+      {"targetSpeed", s.target_speed_mm_s},
+      {"battery", s.battery_mv},
+      {"framesIn", s.frames_in},
+      {"framesOut", s.frames_out},
+      {"malformed", s.malformed},
+      {"pieceIndex", nullptr},
+      {"fraction", nullptr},
+      {"x", nullptr},
+      {"y", nullptr},
+      {"heading", nullptr},
+      {"positionTime", s.last_position_time >= 0 ? nlohmann::json(round3(s.last_position_time))
+                                                 : nlohmann::json(nullptr)},
+      {"lap", 0},
+      {"lapTimes", nlohmann::json::array()},
+      {"lastLap", nullptr},
+      {"bestLap", nullptr},
+  };
+  if (!c) return j;
+  const CarTracker& t = c->tracker;
+  j["lap"] = t.laps();
+  nlohmann::json laps = nlohmann::json::array();
+  double best = 0;
+  for (double l : t.lapTimes()) {
+    laps.push_back(round3(l));
+    if (best == 0 || l < best) best = l;
+  }
+  j["lapTimes"] = std::move(laps);
+  if (!t.lapTimes().empty()) {
+    j["lastLap"] = round3(t.lapTimes().back());
+    j["bestLap"] = round3(best);
+  }
+  if (track_ && t.pieceIndex() && !s.delocalized && s.on_track) {
+    Pose p = pointOnTrack(*track_, *t.pieceIndex(), t.fraction(), s.offset_mm);
+    j["pieceIndex"] = *t.pieceIndex();
+    j["fraction"] = round3(t.fraction());
+    j["x"] = round3(p.x);
+    j["y"] = round3(p.y);
+    j["heading"] = round3(p.heading);
+    j["positionTime"] = round3(t.positionTime());
+  }
+  return j;
+}
+
+nlohmann::json Feed::carsJson(bool history) const {
+  nlohmann::json cars = nlohmann::json::array();
+  for (const AnkiCar* car : fleet_.cars()) {
+    nlohmann::json j = carJson(*car);
+    if (history) {
+      nlohmann::json h = nlohmann::json::array();
+      if (auto it = cars_.find(car->identity().number); it != cars_.end())
+        for (const auto& [t, v] : it->second->speeds) h.push_back({round3(t), v});
+      j["speedHistory"] = std::move(h);
+    }
+    cars.push_back(std::move(j));
+  }
+  return cars;
+}
+
+nlohmann::json Feed::state() const {
+  nlohmann::json events = nlohmann::json::array();
+  for (const Event& e : events_)
+    events.push_back({{"seq", e.seq}, {"t", round3(e.t)}, {"level", e.level}, {"text", e.text}});
+  return {{"type", "state"},
+          {"version", 1},
+          {"source", source_},
+          {"time", round3(loop_.seconds())},
+          {"track", track_ ? trackJson(*track_, trackSource_) : nlohmann::json(nullptr)},
+          {"race", race_.is_null() ? nlohmann::json(nullptr) : race_},
+          {"replay", replay_.is_null() ? nlohmann::json(nullptr) : replay_},
+          {"cars", carsJson(true)},
+          {"events", std::move(events)}};
+}
+
+nlohmann::json Feed::update(std::uint64_t& cursor, std::uint64_t& trackSeen) const {
+  nlohmann::json events = nlohmann::json::array();
+  for (const Event& e : events_)
+    if (e.seq >= cursor)
+      events.push_back({{"seq", e.seq}, {"t", round3(e.t)}, {"level", e.level}, {"text", e.text}});
+  cursor = nextEvent_;
+  nlohmann::json j = {{"type", "update"},
+                      {"time", round3(loop_.seconds())},
+                      {"cars", carsJson(false)},
+                      {"race", race_.is_null() ? nlohmann::json(nullptr) : race_},
+                      {"replay", replay_.is_null() ? nlohmann::json(nullptr) : replay_},
+                      {"events", std::move(events)}};
+  if (trackSeen != trackVersion_) {
+    j["track"] = track_ ? trackJson(*track_, trackSource_) : nlohmann::json(nullptr);
+    trackSeen = trackVersion_;
+  }
+  return j;
+}
+
+}  // namespace pitwall::view

@@ -1,0 +1,87 @@
+#pragma once
+// What the race view shows (docs/view.md): the track, every car where the controller believes
+// it is, the race as the race library reports it, and an event log. The feed follows the fleet's
+// frames (chained on Fleet::onFrame and onConnectionChange, as the MQTT bridge does) and the
+// engine's log; the server turns it into /api/state and /ws updates. It sends nothing to a car.
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+#include "engine/core/loop.hpp"
+#include "engine/sim/track.hpp"
+#include "engine/vehicles/fleet.hpp"
+#include "engine/view/tracker.hpp"
+
+namespace pitwall::view {
+
+class Feed {
+ public:
+  // `source`: what the cars are ("simulator", "ble", "mqtt", "replay"), shown by the page.
+  Feed(Loop& loop, Fleet& fleet, std::string source);
+  ~Feed();
+  Feed(const Feed&) = delete;
+  Feed& operator=(const Feed&) = delete;
+
+  // The track drawn: a layout ("layout"), a map a scan learnt ("scan"); none clears it.
+  void setTrack(std::optional<sim::Track> track, const std::string& source);
+  const std::optional<sim::Track>& track() const { return track_; }
+  bool trackSourceIsLayout() const { return track_ && trackSource_ == "layout"; }
+  // The race as the race library reports it (pitwall.view.race): phase, title, rows, laps.
+  // null: no race. Any JSON object is taken as it is.
+  void setRace(nlohmann::json race);
+  // Playback of a recording (pitwall replay): duration, position, speed, paused.
+  void setReplay(nlohmann::json replay) { replay_ = std::move(replay); }
+  // One line of the event log: level "info", "warn" or "error".
+  void event(const std::string& level, const std::string& text);
+  // The engine's warnings and errors, and its reload lines, join the event log while `on`.
+  void followLog(bool on);
+
+  // The whole state: GET /api/state and a browser's first message on /ws.
+  nlohmann::json state() const;
+  // What changed for one browser: the cars and the race now, events after `cursor` (advanced),
+  // the track only when it changed since `trackSeen` (updated).
+  nlohmann::json update(std::uint64_t& cursor, std::uint64_t& trackSeen) const;
+  std::uint64_t eventCursor() const { return nextEvent_; }
+  std::uint64_t trackVersion() const { return trackVersion_; }
+
+  // A control message from a page ({"type":"control",…}): replays use it to pause, seek and set
+  // the speed. Unset: controls are refused.
+  std::function<void(const nlohmann::json& control)> onControl;
+
+  // The tracker of car `number` (for replay summaries and tests); nullptr when unknown.
+  const CarTracker* tracker(int number) const;
+
+ private:
+  struct Car;
+  Car& car(AnkiCar& car);
+  void frame(AnkiCar& car, AnkiCar::Direction d, const anki::Message& m);
+  nlohmann::json carJson(const AnkiCar& car) const;
+  nlohmann::json carsJson(bool history) const;
+
+  Loop& loop_;
+  Fleet& fleet_;
+  std::string source_;
+  std::optional<sim::Track> track_;
+  std::string trackSource_ = "none";
+  std::uint64_t trackVersion_ = 0;
+  nlohmann::json race_;
+  nlohmann::json replay_;
+  struct Event {
+    std::uint64_t seq;
+    double t;
+    std::string level, text;
+  };
+  std::deque<Event> events_;
+  std::uint64_t nextEvent_ = 0;
+  std::map<int, std::unique_ptr<Car>> cars_;
+  decltype(Fleet::onFrame) previousOnFrame_;
+  decltype(Fleet::onConnectionChange) previousOnConnection_;
+  std::uint64_t logTap_ = 0;
+};
+
+}  // namespace pitwall::view

@@ -1,0 +1,559 @@
+// The race view (docs/view.md): reads the feed at ws://<host>/ws and draws the track, the cars,
+// the leaderboard, the charts, the race's state and the event log. Plain JS, no build step;
+// uPlot (vendor/uPlot.iife.min.js) draws the charts.
+//
+// Stable DOM hooks (tests/view/browser_check.mjs relies on them):
+//   #track svg                      the track; road `path.road`, lanes `path.lane`,
+//                                   finish line `#finish-line`
+//   g.car-marker[data-number="N"]   one per car; contains `text.car-name` (the car's name);
+//                                   `data-x` / `data-y`: where it is drawn, mm in the track
+//                                   frame (y up), updated every animation frame;
+//                                   class `off-track` when not placed on the track
+//                                   (no position, delocalized, off the road), `disconnected`
+//                                   when the car is not connected
+//   #leaderboard tbody tr           one per car (race.rows when a race runs, else the cars)
+//   #race-phase                     the race's phase (scan, grid, lights, racing, ending, done)
+//   #connection                     exactly "live" when connected, "engine gone" when not
+//   #events li                      the event log, newest first
+//   #lap-chart, #speed-chart        the uPlot charts
+//   #replay                         replay controls, shown only when `replay` is non-null
+"use strict";
+
+const SVG_NS = "http://www.w3.org/2000/svg";
+const EXTRAPOLATE_MAX_S = 0.5;   // never guess further than this past the last position update
+const SPEED_WINDOW_S = 60;
+const EVENTS_MAX = 200;
+
+// ---------------------------------------------------------------------------------------------
+// Geometry: the same as engine/view/geometry.hpp. Frame: x right, y up, headings in degrees
+// counter-clockwise from +x; offsets are mm right of the driving direction.
+
+function pieceAngle(piece) {  // radians turned over the piece (signed, + left)
+  return piece.turn && piece.radius ? (piece.turn * piece.length) / piece.radius : 0;
+}
+
+// Length of piece `p` along the lane at `offset`: curves are longer on the outside.
+function laneLength(p, offset) {
+  if (!p.turn || !p.radius) return p.length;
+  return Math.abs(pieceAngle(p)) * (p.radius + p.turn * offset);
+}
+
+// The point `fraction` (0…1) along piece `index`, `offset` mm right of the centre line, and the
+// heading there: {x, y, heading}.
+function pointOnTrack(track, index, fraction, offset) {
+  const p = track.pieces[index];
+  const h = (p.heading * Math.PI) / 180;
+  let cx, cy, hd;
+  if (!p.turn || !p.radius) {
+    cx = p.x + Math.cos(h) * p.length * fraction;
+    cy = p.y + Math.sin(h) * p.length * fraction;
+    hd = h;
+  } else {
+    // Centre of the curve: `radius` to the left (turn +1) or right (turn −1) of the start.
+    const ox = p.x - p.turn * Math.sin(h) * p.radius;
+    const oy = p.y + p.turn * Math.cos(h) * p.radius;
+    const a = pieceAngle(p) * fraction;
+    const dx = p.x - ox, dy = p.y - oy;
+    cx = ox + dx * Math.cos(a) - dy * Math.sin(a);
+    cy = oy + dx * Math.sin(a) + dy * Math.cos(a);
+    hd = h + a;
+  }
+  // Right of the driving direction is (sin h, −cos h).
+  return { x: cx + Math.sin(hd) * offset, y: cy - Math.cos(hd) * offset,
+           heading: (hd * 180) / Math.PI };
+}
+
+// Moves `distance` mm along the lane at `offset` from (index, fraction); backwards when
+// `reverse`. Returns {index, fraction}.
+function advance(track, index, fraction, offset, distance, reverse) {
+  const n = track.pieces.length;
+  let guard = 4 * n + 4;
+  while (distance > 1e-6 && guard-- > 0) {
+    const len = Math.max(1, laneLength(track.pieces[index], offset));
+    const left = (reverse ? fraction : 1 - fraction) * len;
+    if (distance < left) {
+      fraction += ((reverse ? -1 : 1) * distance) / len;
+      break;
+    }
+    distance -= left;
+    index = reverse ? (index - 1 + n) % n : (index + 1) % n;
+    fraction = reverse ? 1 : 0;
+  }
+  return { index, fraction };
+}
+
+// Centre-line distance from the finish line to (index, fraction), 0 … lapLength.
+function lapProgress(track, index, fraction) {
+  let at = 0, finishAt = 0;
+  const finishIdx = track.pieces.findIndex((p) => p.id === 34);
+  for (let i = 0; i < track.pieces.length; i++) {
+    if (i === index) at += track.pieces[i].length * fraction;
+    else if (i < index) at += track.pieces[i].length;
+    if (i <= finishIdx) finishAt += track.pieces[i].length;
+  }
+  const lap = track.lapLength || track.pieces.reduce((s, p) => s + p.length, 0);
+  return (((at - finishAt) % lap) + lap) % lap;
+}
+
+// ---------------------------------------------------------------------------------------------
+// State of the page: reset by every "state" message.
+
+const view = {
+  track: null, cars: new Map(), race: null, replay: null, source: "", events: [],
+  time: 0,             // engine time of the last message
+  receivedAt: 0,       // performance.now() when it came
+  speeds: new Map(),   // number → [[t, speed], …] (the last 60 s)
+  markers: new Map(),  // number → {g, body, x, y, heading, placed}
+  lapChart: null, lapKey: "", speedChart: null, speedKey: "",
+  chartsDirty: true,
+};
+
+const $ = (sel) => document.querySelector(sel);
+function svgEl(tag, attrs, parent) {
+  const el = document.createElementNS(SVG_NS, tag);
+  for (const [k, v] of Object.entries(attrs || {})) el.setAttribute(k, v);
+  if (parent) parent.appendChild(el);
+  return el;
+}
+const fmtTime = (s) => (s == null ? "–" : s.toFixed(3));
+const fmtMm = (v) => (v == null ? "–" : (v > 0 ? "+" : "") + Math.round(v));
+
+// ---------------------------------------------------------------------------------------------
+// The track.
+
+let svg = null, carLayer = null;
+
+function drawTrack() {
+  const host = $("#track");
+  host.textContent = "";
+  svg = svgEl("svg", { preserveAspectRatio: "xMidYMid meet", role: "img" }, host);
+  const t = view.track;
+  if (!t || !t.pieces || !t.pieces.length) {
+    svg.setAttribute("viewBox", "0 0 1000 400");
+    svgEl("text", { x: 500, y: 200, class: "no-track", "text-anchor": "middle" }, svg)
+      .textContent = "no track known yet";
+    carLayer = svgEl("g", { class: "cars" }, svg);
+    view.markers.clear();
+    return;
+  }
+  svg.setAttribute("aria-label", `track ${t.name || ""}`);
+  const b = t.bounds, m = 140;
+  // Screen coordinates: y flipped (the feed's y is up).
+  svg.setAttribute("viewBox",
+    `${b.minX - m} ${-b.maxY - m} ${b.maxX - b.minX + 2 * m} ${b.maxY - b.minY + 2 * m}`);
+
+  const line = (offset) => {
+    const pts = [];
+    t.pieces.forEach((p, i) => {
+      const steps = p.turn ? 24 : 1;
+      for (let s = i === 0 ? 0 : 1; s <= steps; s++) pts.push(pointOnTrack(t, i, s / steps, offset));
+    });
+    const first = pts[0], last = pts[pts.length - 1];
+    const closed = Math.hypot(first.x - last.x, first.y - last.y) < 5;
+    return pts.map((q, i) => `${i ? "L" : "M"}${q.x.toFixed(1)},${(-q.y).toFixed(1)}`).join("") +
+      (closed ? "Z" : "");
+  };
+  const w = 2 * (t.roadHalfWidth || 96);
+  const centre = line(0);
+  svgEl("path", { class: "road-edge", d: centre, "stroke-width": w + 14 }, svg);
+  svgEl("path", { class: "road", d: centre, "stroke-width": w }, svg);
+  for (const o of t.lanes || []) svgEl("path", { class: "lane", d: line(o), "data-offset": o }, svg);
+  // Piece joins: faint ticks across the road.
+  t.pieces.forEach((p, i) => {
+    const a = pointOnTrack(t, i, 0, -w / 2), c = pointOnTrack(t, i, 0, w / 2);
+    svgEl("line", { class: "joint", x1: a.x, y1: -a.y, x2: c.x, y2: -c.y }, svg);
+  });
+  if (t.finish) {
+    const f = t.finish, h = (f.heading * Math.PI) / 180;
+    const rx = Math.sin(h), ry = -Math.cos(h);     // across the road (right of travel)
+    const half = w / 2;
+    const g = svgEl("g", { id: "finish-line" }, svg);
+    const pts = { x1: f.x - rx * half, y1: -(f.y - ry * half), x2: f.x + rx * half, y2: -(f.y + ry * half) };
+    svgEl("line", { ...pts, class: "finish-back" }, g);
+    svgEl("line", { ...pts, class: "finish-check" }, g);
+    const lx = f.x - rx * (half + 60), ly = f.y - ry * (half + 60);
+    svgEl("text", { x: lx, y: -ly, class: "finish-label", "text-anchor": "middle",
+                    "dominant-baseline": "middle" }, g).textContent = "FINISH";
+  }
+  carLayer = svgEl("g", { class: "cars" }, svg);
+  view.markers.clear();
+}
+
+function markerFor(car) {
+  let m = view.markers.get(car.number);
+  if (m) return m;
+  const g = svgEl("g", { class: "car-marker", "data-number": car.number }, carLayer);
+  const body = svgEl("g", { class: "car-body" }, g);
+  svgEl("rect", { x: -46, y: -26, width: 92, height: 52, rx: 16, class: "car-shape" }, body);
+  svgEl("path", { d: "M20,-16 L44,0 L20,16 Z", class: "car-nose" }, body);
+  svgEl("text", { class: "car-number", "text-anchor": "middle", "dominant-baseline": "central" }, g)
+    .textContent = car.number;
+  svgEl("text", { class: "car-name", y: -52, "text-anchor": "middle" }, g);
+  m = { g, body, x: null, y: null, heading: 0, placed: false };
+  view.markers.set(car.number, m);
+  return m;
+}
+
+// Where the car is now: its last position update moved on by speed × time since (≤ 0.5 s).
+function targetOf(car, now) {
+  const t = view.track;
+  if (!t || !t.pieces || !t.pieces.length || car.x == null || car.delocalized || !car.onTrack) {
+    return car.x == null ? null : { x: car.x, y: car.y, heading: car.heading || 0, moving: false };
+  }
+  if (car.pieceIndex == null || !t.pieces[car.pieceIndex])
+    return { x: car.x, y: car.y, heading: car.heading || 0, moving: false };
+  const dt = Math.min(EXTRAPOLATE_MAX_S, Math.max(0, now - (car.positionTime ?? now)));
+  const at = advance(t, car.pieceIndex, car.fraction || 0, car.offset || 0,
+                     Math.max(0, car.speed || 0) * dt, !!car.reverse);
+  const p = pointOnTrack(t, at.index, at.fraction, car.offset || 0);
+  if (car.reverse) p.heading += 180;
+  p.moving = true;
+  return p;
+}
+
+// Engine time now, estimated from the last message and the wall clock (replays at their speed).
+function engineNow() {
+  let rate = 1;
+  if (view.replay) rate = view.replay.paused ? 0 : view.replay.speed || 1;
+  return view.time + ((performance.now() - view.receivedAt) / 1000) * rate;
+}
+
+let lastFrame = performance.now();
+function frame(ts) {
+  const dt = Math.min(0.1, Math.max(0, (ts - lastFrame) / 1000));
+  lastFrame = ts;
+  const now = engineNow();
+  for (const car of view.cars.values()) {
+    if (!carLayer) break;
+    const m = markerFor(car);
+    const target = targetOf(car, now);
+    const placed = !!target && car.x != null && car.onTrack !== false && !car.delocalized;
+    if (target) {
+      if (m.x == null || !m.placed || !placed) {
+        m.x = target.x; m.y = target.y; m.heading = target.heading;
+      } else {
+        // Ease towards the target so a fresh update never makes the marker jump.
+        const k = 1 - Math.exp(-dt * 18);
+        const far = Math.hypot(target.x - m.x, target.y - m.y) > 400;
+        m.x = far ? target.x : m.x + (target.x - m.x) * k;
+        m.y = far ? target.y : m.y + (target.y - m.y) * k;
+        let dh = ((target.heading - m.heading + 540) % 360) - 180;
+        m.heading = far ? target.heading : m.heading + dh * k;
+      }
+    }
+    m.placed = placed;
+    m.g.classList.toggle("off-track", !placed);
+    m.g.classList.toggle("disconnected", car.connected === false);
+    m.g.classList.toggle("unseen", m.x == null);
+    if (m.x != null) {
+      m.g.setAttribute("transform", `translate(${m.x.toFixed(1)},${(-m.y).toFixed(1)})`);
+      m.body.setAttribute("transform", `rotate(${(-m.heading).toFixed(1)})`);
+      m.g.dataset.x = m.x.toFixed(1);
+      m.g.dataset.y = m.y.toFixed(1);
+    }
+  }
+  requestAnimationFrame(frame);
+}
+
+function syncMarkers() {
+  for (const [num, m] of view.markers) {
+    if (!view.cars.has(num)) { m.g.remove(); view.markers.delete(num); }
+  }
+  for (const car of view.cars.values()) {
+    const m = markerFor(car);
+    m.g.style.setProperty("--car", car.color || "#888");
+    m.g.querySelector("text.car-name").textContent = car.name || `car ${car.number}`;
+  }
+  const why = (c) => (c.connected === false ? "disconnected" : c.delocalized ? "delocalized"
+    : c.onTrack === false ? "off the track" : c.x == null ? "no position yet" : "");
+  const off = [...view.cars.values()].filter((c) => why(c));
+  const el = $("#off-track");
+  el.hidden = off.length === 0;
+  el.textContent = off.length
+    ? "Not on the track: " + off.map((c) => `${c.name || c.number} (${why(c)})`).join(", ") : "";
+}
+
+// ---------------------------------------------------------------------------------------------
+// Leaderboard, race state, events.
+
+function boardRows() {
+  if (view.race && Array.isArray(view.race.rows) && view.race.rows.length) return view.race.rows;
+  const t = view.track;
+  const progress = (c) => (t && c.pieceIndex != null && t.pieces[c.pieceIndex]
+    ? lapProgress(t, c.pieceIndex, c.fraction || 0) : -1);
+  const cars = [...view.cars.values()].sort((a, b) =>
+    (b.lap || 0) - (a.lap || 0) || progress(b) - progress(a) || a.number - b.number);
+  return cars.map((c, i) => ({
+    position: i + 1, number: c.number, car: c.name, driver: null, lap: c.lap || 0,
+    lastLap: c.lastLap, bestLap: c.bestLap, gap: null, speed: c.speed, lane: c.offset,
+  }));
+}
+
+function renderBoard() {
+  const tbody = $("#leaderboard tbody");
+  const rows = boardRows();
+  const best = Math.min(...rows.map((r) => r.bestLap ?? Infinity));
+  while (tbody.rows.length > rows.length) tbody.deleteRow(-1);
+  while (tbody.rows.length < rows.length) {
+    const tr = tbody.insertRow();
+    for (let i = 0; i < 9; i++) tr.insertCell();
+  }
+  rows.forEach((r, i) => {
+    const tr = tbody.rows[i];
+    const car = view.cars.get(r.number) || {};
+    tr.dataset.number = r.number;
+    tr.style.setProperty("--car", car.color || "#888");
+    tr.classList.toggle("disconnected", car.connected === false);
+    tr.classList.toggle("off-track", car.x == null || !!car.delocalized || car.onTrack === false);
+    tr.classList.toggle("finished", !!r.finished);
+    let gap = "–";
+    if (r.lapsBehind > 0) gap = `+${r.lapsBehind} lap${r.lapsBehind > 1 ? "s" : ""}`;
+    else if (r.gap != null) gap = r.gap === 0 ? "leader" : `+${r.gap.toFixed(3)}`;
+    const cells = [
+      r.position ?? i + 1,
+      `<span class="swatch"></span>${escapeHtml(r.car ?? car.name ?? `car ${r.number}`)}`,
+      escapeHtml(r.driver ?? "–"),
+      r.lap ?? "–", fmtTime(r.lastLap), fmtTime(r.bestLap), gap,
+      r.speed == null ? "–" : Math.round(r.speed), fmtMm(r.lane),
+    ];
+    cells.forEach((c, k) => {
+      const td = tr.cells[k];
+      if (k === 1) { if (td.innerHTML !== c) td.innerHTML = c; } else if (td.textContent !== String(c)) td.textContent = c;
+      if (k > 2 && k !== 1) td.className = "num";
+    });
+    tr.cells[5].classList.toggle("best", r.bestLap != null && r.bestLap === best);
+  });
+}
+
+function escapeHtml(s) {
+  return String(s).replace(/[&<>"']/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;", "'": "&#39;" }[c]));
+}
+
+function renderRace() {
+  const r = view.race;
+  const phase = $("#race-phase");
+  phase.textContent = r ? r.phase || "" : "no race";
+  phase.className = `phase phase-${r ? r.phase : "none"}`;
+  $("#race-title").textContent = r ? r.title || "" : "";
+  $("#race-status").textContent = r ? r.status || "" : "";
+  const lights = $("#race-lights");
+  lights.hidden = !(r && r.phase === "lights");
+  if (!lights.hidden) {
+    const on = r.light || 0, total = Math.max(5, on);
+    if (lights.childElementCount !== total) {
+      lights.textContent = "";
+      for (let i = 0; i < total; i++) lights.appendChild(document.createElement("i"));
+    }
+    [...lights.children].forEach((el, i) => el.classList.toggle("on", i < on));
+  }
+  $("#source").textContent = view.source ? `· ${view.source}` : "";
+  renderReplay();
+}
+
+function addEvents(list, reset) {
+  if (reset) view.events = [];
+  const seen = new Set(view.events.map((e) => e.seq));
+  for (const e of list || []) if (e.seq == null || !seen.has(e.seq)) view.events.push(e);
+  if (view.events.length > EVENTS_MAX) view.events.splice(0, view.events.length - EVENTS_MAX);
+  const ol = $("#events");
+  ol.textContent = "";
+  for (let i = view.events.length - 1; i >= 0; i--) {
+    const e = view.events[i];
+    const li = document.createElement("li");
+    li.className = `level-${e.level || "info"}`;
+    const t = document.createElement("span");
+    t.className = "t";
+    t.textContent = e.t == null ? "" : e.t.toFixed(1);
+    li.append(t, document.createTextNode(e.text || ""));
+    ol.appendChild(li);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Replay controls.
+
+let seeking = false;
+function renderReplay() {
+  const r = view.replay;
+  $("#replay").hidden = !r;
+  if (!r) return;
+  $("#replay-play").textContent = r.paused ? "Play" : "Pause";
+  const seek = $("#replay-seek");
+  seek.max = r.duration || 0;
+  if (!seeking) seek.value = r.position || 0;
+  $("#replay-time").textContent = `${(r.position || 0).toFixed(1)} / ${(r.duration || 0).toFixed(1)} s`;
+  const sel = $("#replay-speed");
+  if (document.activeElement !== sel && r.speed != null) sel.value = String(r.speed);
+}
+
+function control(msg) {
+  if (socket && socket.readyState === WebSocket.OPEN)
+    socket.send(JSON.stringify({ type: "control", ...msg }));
+}
+$("#replay-play").addEventListener("click", () => view.replay && control({ pause: !view.replay.paused }));
+$("#replay-seek").addEventListener("input", () => { seeking = true; });
+$("#replay-seek").addEventListener("change", (e) => { seeking = false; control({ seek: Number(e.target.value) }); });
+$("#replay-speed").addEventListener("change", (e) => control({ speed: Number(e.target.value) }));
+
+// ---------------------------------------------------------------------------------------------
+// Charts (uPlot).
+
+const chartAxes = (xLabel, yLabel) => [
+  { stroke: "#9aa4b2", grid: { stroke: "#2a313c" }, ticks: { stroke: "#2a313c" }, label: xLabel },
+  { stroke: "#9aa4b2", grid: { stroke: "#2a313c" }, ticks: { stroke: "#2a313c" }, label: yLabel, size: 60 },
+];
+
+function chartSize(el) {
+  return { width: Math.max(200, el.clientWidth), height: Math.max(160, Math.min(260, el.clientWidth * 0.42)) };
+}
+
+function makeChart(el, cars, xLabel, yLabel, xFmt) {
+  el.textContent = "";
+  if (typeof uPlot === "undefined") { el.textContent = "charts unavailable (uPlot not loaded)"; return null; }
+  const series = [{ label: xLabel, value: (u, v) => (v == null ? "–" : xFmt(v)) }];
+  for (const c of cars) {
+    series.push({ label: c.name || `car ${c.number}`, stroke: c.color || "#888", width: 2,
+                  spanGaps: true, points: { size: 5 } });
+  }
+  const opts = { ...chartSize(el), series, axes: chartAxes(xLabel, yLabel),
+                 scales: { x: { time: false } }, legend: { live: false }, cursor: { drag: { x: false, y: false } } };
+  return new uPlot(opts, [[], ...cars.map(() => [])], el);
+}
+
+function carKey() {
+  return [...view.cars.values()].map((c) => `${c.number}:${c.name}:${c.color}`).join("|");
+}
+
+function renderCharts() {
+  const cars = [...view.cars.values()].sort((a, b) => a.number - b.number);
+  const key = carKey();
+  if (key !== view.lapKey || !view.lapChart) {
+    view.lapChart?.destroy();
+    view.lapChart = makeChart($("#lap-chart"), cars, "lap", "seconds", (v) => `lap ${v}`);
+    view.lapKey = key;
+  }
+  if (key !== view.speedKey || !view.speedChart) {
+    view.speedChart?.destroy();
+    view.speedChart = makeChart($("#speed-chart"), cars, "time (s)", "mm/s", (v) => `${v.toFixed(1)} s`);
+    view.speedKey = key;
+  }
+  // Lap times: x = lap number.
+  const laps = cars.map((c) => {
+    const fromRace = view.race && view.race.lapTimes && view.race.lapTimes[String(c.number)];
+    return fromRace || c.lapTimes || [];
+  });
+  const maxLap = Math.max(0, ...laps.map((l) => l.length));
+  const lx = Array.from({ length: maxLap }, (_, i) => i + 1);
+  view.lapChart?.setData([lx, ...laps.map((l) => lx.map((_, i) => l[i] ?? null))]);
+  setEmpty("#lap-chart", maxLap ? "" : "no lap completed yet");
+  // Speeds: one shared time axis, the union of every car's sample times.
+  const since = view.time - SPEED_WINDOW_S;
+  const hist = cars.map((c) => (view.speeds.get(c.number) || []).filter((s) => s[0] >= since));
+  const times = [...new Set(hist.flatMap((h) => h.map((s) => s[0])))].sort((a, b) => a - b);
+  const col = new Map(times.map((t, i) => [t, i]));
+  const ys = hist.map((h) => {
+    const y = new Array(times.length).fill(null);
+    for (const [t, v] of h) y[col.get(t)] = v;
+    return y;
+  });
+  view.speedChart?.setData([times, ...ys]);
+  setEmpty("#speed-chart", times.length ? "" : "no speeds yet");
+}
+
+function setEmpty(sel, text) {
+  const el = $(sel);
+  if (text) el.dataset.empty = text; else delete el.dataset.empty;
+}
+
+function recordSpeed(car, t) {
+  if (car.speed == null) return;
+  let h = view.speeds.get(car.number);
+  if (!h) view.speeds.set(car.number, (h = []));
+  if (h.length && t - h[h.length - 1][0] < 0.1) return;  // at most 10 samples a second
+  h.push([t, car.speed]);
+  while (h.length && h[0][0] < t - SPEED_WINDOW_S) h.shift();
+}
+
+new ResizeObserver(() => {
+  for (const [chart, sel] of [[view.lapChart, "#lap-chart"], [view.speedChart, "#speed-chart"]])
+    if (chart) chart.setSize(chartSize($(sel)));
+}).observe($("main"));
+setInterval(() => { if (view.chartsDirty) { view.chartsDirty = false; renderCharts(); } }, 500);
+
+// ---------------------------------------------------------------------------------------------
+// The feed.
+
+function onState(s) {
+  view.track = s.track || null;
+  view.cars = new Map((s.cars || []).map((c) => [c.number, c]));
+  view.race = s.race || null;
+  view.replay = s.replay || null;
+  view.source = s.source || "";
+  view.time = s.time || 0;
+  view.receivedAt = performance.now();
+  view.speeds = new Map();
+  for (const c of s.cars || []) view.speeds.set(c.number, (c.speedHistory || []).map((p) => [p[0], p[1]]));
+  view.lapKey = view.speedKey = "";
+  drawTrack();
+  syncMarkers();
+  renderRace();
+  addEvents(s.events, true);
+  renderBoard();
+  renderCharts();
+}
+
+function onUpdate(u) {
+  if (u.time != null) { view.time = u.time; view.receivedAt = performance.now(); }
+  if (u.track !== undefined) { view.track = u.track; drawTrack(); }
+  let changed = !!u.track;
+  if (Array.isArray(u.cars)) {
+    const before = carKey();
+    for (const c of u.cars) {
+      view.cars.set(c.number, c);
+      recordSpeed(c, u.time ?? view.time);
+    }
+    changed = changed || carKey() !== before;
+  }
+  if (u.race !== undefined) view.race = u.race;
+  if (u.replay !== undefined) view.replay = u.replay;
+  syncMarkers();
+  renderRace();
+  if (u.events && u.events.length) addEvents(u.events, false);
+  renderBoard();
+  view.chartsDirty = true;
+  if (changed) renderCharts();
+}
+
+let socket = null;
+function setConnection(live) {
+  const el = $("#connection");
+  el.textContent = live ? "live" : "engine gone";
+  el.className = `connection ${live ? "live" : "gone"}`;
+  document.body.classList.toggle("engine-gone", !live);
+}
+
+function connect() {
+  const ws = new WebSocket(`${location.protocol === "https:" ? "wss" : "ws"}://${location.host}/ws`);
+  socket = ws;
+  let retried = false;
+  const retry = () => {
+    if (retried) return;
+    retried = true;
+    if (socket === ws) socket = null;
+    setConnection(false);
+    setTimeout(connect, 1000);
+  };
+  ws.onmessage = (ev) => {
+    let msg;
+    try { msg = JSON.parse(ev.data); } catch { return; }
+    if (msg.type === "state") { onState(msg); setConnection(true); }
+    else if (msg.type === "update") onUpdate(msg);
+    else if (msg.type === "error") addEvents([{ t: view.time, level: "error", text: msg.message }], false);
+  };
+  ws.onclose = retry;
+  ws.onerror = () => { retry(); try { ws.close(); } catch { /* already closed */ } };
+}
+
+drawTrack();
+connect();
+requestAnimationFrame(frame);

@@ -1,0 +1,55 @@
+#pragma once
+// The race view's HTTP + WebSocket server (docs/view.md), on the engine's one loop (Boost.Beast):
+//   GET /            the page, and its assets, from the installed data folder
+//   GET /api/state   the feed's whole state as JSON
+//   GET /ws          a WebSocket: the state, then updates at most `maxRate` a second
+// A browser that reads slowly gets fewer updates, never a queue: each connection has at most one
+// write in flight and the next update is built when it is done. A closed or stalled browser
+// costs the loop nothing (writes are asynchronous; a write that stalls past a limit closes it).
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "engine/core/loop.hpp"
+#include "engine/core/result.hpp"
+#include "engine/view/feed.hpp"
+
+namespace pitwall::view {
+
+struct ServerOptions {
+  std::string host = "127.0.0.1";  // another address only when given (--view HOST:PORT)
+  std::uint16_t port = 0;          // 0: any free port
+  std::filesystem::path assets;    // the page's folder (index.html, view.js, vendor/…)
+  double maxRate = 30;             // updates a second per browser, at most
+};
+
+// "[HOST:]PORT" from the command line; an empty text is the default port. The error says what
+// was wrong and what to write.
+inline constexpr std::uint16_t kDefaultPort = 8080;
+Result<ServerOptions, std::string> parseEndpoint(const std::string& text);
+// Where the page's assets are: $PITWALL_VIEW_DIR, the installed data folder beside the binary
+// (../share/pitwall/view), or the build tree's copy. The error names the places looked at.
+Result<std::filesystem::path, std::string> findAssets();
+
+class Server {
+ public:
+  Server(Loop& loop, Feed& feed, ServerOptions options);
+  ~Server();
+  Server(const Server&) = delete;
+  Server& operator=(const Server&) = delete;
+
+  // Binds and listens; the error names the address and what to do (a port in use, say).
+  Result<bool, std::string> start();
+  void stop();  // closes every connection; the pages show "engine gone"
+  std::uint16_t port() const;
+  std::string url() const;
+  std::size_t clients() const;  // open WebSockets
+  std::uint64_t updatesSent() const;
+
+ private:
+  struct Impl;
+  std::shared_ptr<Impl> impl_;
+};
+
+}  // namespace pitwall::view

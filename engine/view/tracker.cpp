@@ -1,0 +1,88 @@
+#include "engine/view/tracker.hpp"
+
+#include <algorithm>
+
+namespace pitwall::view {
+
+namespace {
+
+// Where along a piece a location code lies (simulator.md "Location codes"): codes per row and
+// their fractions. Real pieces carry more codes on curves; the page interpolates between reports.
+double codeFraction(anki::PieceType type, int location, bool reverse) {
+  double f = 0.5;
+  switch (type) {
+    case anki::PieceType::StartLong: {
+      static constexpr double kAt[2] = {0.32, 0.85};
+      f = kAt[location % 2];
+      break;
+    }
+    case anki::PieceType::StartShort:
+      f = 0.6;
+      break;
+    default: {
+      static constexpr double kAt[3] = {1.0 / 6, 0.5, 5.0 / 6};
+      f = kAt[location % 3];
+    }
+  }
+  // codes are read in the car's own frame: driving backwards, they run the other way
+  return reverse ? 1 - f : f;
+}
+
+}  // namespace
+
+void CarTracker::setTrack(const sim::Track* track) {
+  track_ = track && track->size() ? track : nullptr;
+  index_.reset();
+}
+
+std::optional<std::size_t> CarTracker::locate(int pieceId, bool reverse) const {
+  if (!track_) return std::nullopt;
+  const auto& pieces = track_->pieces();
+  const std::size_t n = pieces.size();
+  if (index_ && pieces[*index_].id == pieceId) return index_;
+  if (index_) {  // the next piece with that id along the driving direction
+    for (std::size_t step = 1; step <= n; ++step) {
+      std::size_t i = reverse ? (*index_ + n * step - step) % n : (*index_ + step) % n;
+      if (pieces[i].id == pieceId) return i;
+    }
+    return std::nullopt;
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    if (pieces[i].id == pieceId) return i;
+  return std::nullopt;
+}
+
+void CarTracker::crossFinish(double now) {
+  if (lastCrossing_) lapTimes_.push_back(now - *lastCrossing_);
+  lastCrossing_ = now;
+  crossedSinceStartPiece_ = true;
+}
+
+void CarTracker::update(const anki::Message& message, const CarState& state, double now) {
+  if (const auto* p = std::get_if<anki::PositionUpdate>(&message)) {
+    const bool reverse = state.reverse;
+    // A lap whose transition frame was lost: the first report after the line counts it.
+    if (p->piece_id == anki::kFinishAfter && lastPieceId_ == anki::kFinishBefore && !reverse &&
+        !crossedSinceStartPiece_)
+      crossFinish(now);
+    if (p->piece_id == anki::kFinishBefore) crossedSinceStartPiece_ = false;
+    lastPieceId_ = p->piece_id;
+    index_ = locate(p->piece_id, reverse);
+    fraction_ = codeFraction(anki::pieceType(p->piece_id), p->location_id, reverse);
+    positionTime_ = now;
+  } else if (std::holds_alternative<anki::TransitionUpdate>(message)) {
+    // The car left the piece it last reported: 34 → 33 driving forward is the finish line.
+    if (lastPieceId_ == anki::kFinishBefore && !state.reverse && !crossedSinceStartPiece_)
+      crossFinish(now);
+    if (track_ && index_) {
+      const std::size_t n = track_->size();
+      index_ = state.reverse ? (*index_ + n - 1) % n : (*index_ + 1) % n;
+      fraction_ = state.reverse ? 1 : 0;
+      positionTime_ = now;
+    }
+  } else if (std::holds_alternative<anki::Delocalized>(message)) {
+    index_.reset();
+  }
+}
+
+}  // namespace pitwall::view

@@ -1,0 +1,46 @@
+#pragma once
+// Where the controller believes a car is, from the frames it sends (docs/view.md "Cars"): the
+// piece of the track (matched by id along the driving order), the fraction of it, and its laps.
+// The view's feed and `pitwall replay` follow every car through one of these. A lap ends on the
+// transition from the start piece (34) to the piece after the finish line (33) driving forward
+// (as pitwall.laps counts it); the first crossing starts lap 1.
+#include <optional>
+#include <vector>
+
+#include "engine/protocol/anki/messages.hpp"
+#include "engine/sim/track.hpp"
+#include "engine/vehicles/anki_car.hpp"
+
+namespace pitwall::view {
+
+class CarTracker {
+ public:
+  // Follows a car on `track` (none: laps are still counted, no position is known).
+  void setTrack(const sim::Track* track);
+  // A frame from the car (its state already updated), at engine time `now`.
+  void update(const anki::Message& message, const CarState& state, double now);
+  void delocalized() { index_.reset(); }
+
+  std::optional<std::size_t> pieceIndex() const { return index_; }
+  double fraction() const { return fraction_; }
+  double positionTime() const { return positionTime_; }  // when index/fraction were last set
+
+  int laps() const { return static_cast<int>(lapTimes_.size()); }
+  const std::vector<double>& lapTimes() const { return lapTimes_; }
+  std::optional<double> lastCrossing() const { return lastCrossing_; }
+
+ private:
+  void crossFinish(double now);
+  std::optional<std::size_t> locate(int pieceId, bool reverse) const;
+
+  const sim::Track* track_ = nullptr;
+  std::optional<std::size_t> index_;
+  double fraction_ = 0;
+  double positionTime_ = -1;
+  int lastPieceId_ = -1;
+  bool crossedSinceStartPiece_ = false;
+  std::optional<double> lastCrossing_;
+  std::vector<double> lapTimes_;
+};
+
+}  // namespace pitwall::view

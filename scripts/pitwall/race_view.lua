@@ -1,0 +1,87 @@
+-- The race as the race view shows it (docs/view.md "race"): a session reports its phase, its
+-- table and every lap to pitwall.view ten times a second while it runs. Without --view,
+-- pitwall.view.active is false and nothing is built. Methods mixed into Race (race.lua).
+local View = {}
+
+-- The publishers of this version's sessions (a timer is no data to carry across a reload: the
+-- next version starts its own).
+local publishers = setmetatable({}, { __mode = "k" })
+
+local VIEW_PHASES = { new = "scan", grid = "grid", lights = "lights", racing = "racing",
+  ending = "ending", done = "done" }
+
+local function driverName(driver)
+  if type(driver) ~= "table" then return nil end
+  local name = rawget(driver, "name")
+  if name == nil then
+    local class = getmetatable(driver)
+    name = type(class) == "table" and rawget(class, "name") or nil
+    if name == nil and type(class) == "table" and type(class.__index) == "table" then
+      name = rawget(class.__index, "name")
+    end
+  end
+  return type(name) == "string" and name or nil
+end
+
+--- The session as plain data for pitwall.view.race.
+function View:_viewState()
+  local phase = VIEW_PHASES[self.phase or "new"] or tostring(self.phase)
+  local state = {
+    title = self.title, mode = self.mode, phase = phase, laps = self.laps,
+    seconds = self.seconds, green = self.green, rows = {}, lapTimes = {},
+  }
+  if phase == "lights" then state.light, state.lights = self.light or 0, self.options.lights or 5 end
+  if self.order and #self.order > 0 and self.order[1].timer then
+    if self.green then
+      local ok, status = pcall(self._status, self, pitwall.now())
+      if ok then state.status = status end
+    end
+    local ok, rows = pcall(self._rows, self)
+    if ok then
+      for k, row in ipairs(rows) do
+        local e = self.order[k]
+        local car = e.car
+        row.driver = driverName(e.driver)
+        row.speed = car.speed
+        row.lane = car.offset
+        row.connected = car.connected
+        local times = {}
+        for i, lap in ipairs(e.timer.history or {}) do times[i] = lap.time end
+        state.lapTimes[tostring(car.number)] = times
+        state.rows[k] = row
+      end
+    end
+  end
+  if phase == "done" then state.status = state.status or "results" end
+  return state
+end
+
+--- Starts reporting this session to the view (once per session and version).
+function View:_viewStart()
+  if not (pitwall.view and pitwall.view.active) or publishers[self] then return end
+  local failed = false
+  local function publish()
+    local ok, err = pcall(function() pitwall.view.race(self:_viewState()) end)
+    if not ok and not failed then
+      failed = true -- said once: the race goes on without its picture
+      pitwall.log("warn", "race: the view cannot show " .. tostring(self.title) .. ": "
+        .. tostring(err))
+    end
+  end
+  publish()
+  local timer
+  timer = pitwall.every(0.1, function()
+    publish()
+    if self.phase == "done" then timer:cancel() end
+  end)
+  publishers[self] = timer
+end
+
+--- The map the session races on, drawn by the view (a simulator's layout stays).
+function View:_viewMap()
+  if self.map and pitwall.view and pitwall.view.active then
+    pcall(pitwall.view.track, self.map)
+  end
+end
+
+return View
