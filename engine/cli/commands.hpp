@@ -87,6 +87,13 @@ struct BridgeOptions : CarSource {
 };
 int bridge(const BridgeOptions& options);
 
+// pitwall view --mqtt URL: a spectator — the race view of the cars that bridges publish on the
+// broker, read-only (nothing is ever published). --track is the layout drawn (docs/view.md).
+struct ViewOptions : CarSource {
+  std::optional<double> duration;  // seconds; none: until SIGINT/SIGTERM
+};
+int view(const ViewOptions& options);
+
 // A BLE peripheral that looks like an Anki car to a central, driven by the simulator
 // (tests/qemu: the real bluetoothd end to end).
 struct EmulateOptions {
@@ -98,6 +105,27 @@ struct EmulateOptions {
   std::optional<double> duration;  // seconds; none: until SIGINT/SIGTERM
 };
 int emulateCar(const EmulateOptions& options);
+
+// pitwall replay FILE: a --record file played back through the codec and the car model
+// (docs/view.md "Replays"): a summary per car, the race view, or a script's handlers.
+struct ReplayOptions {
+  std::string file;
+  bool summary = false;  // --summary: the table per car (the default without --view, --script)
+  bool json = false;     // --json: the summary as one JSON object per car per line
+  std::optional<std::string> view;  // --view [[HOST:]PORT]: play it in the race view, real time
+  double speed = 1;                 // --speed X with --view: 0.1..100
+  std::string track = "oval";       // --track: the layout the view draws (a record does not say)
+  std::string script;               // --script S.lua: the recorded events reach its handlers
+  std::uint64_t seed = 1;           // the script's math.random
+};
+int replay(const ReplayOptions& options);
+
+// pitwall track show LAYOUT|FILE [--svg OUT]: a layout's summary, and its drawing as SVG.
+struct TrackShowOptions {
+  std::string layout;
+  std::string svg;  // empty: none; "-": stdout
+};
+int trackShow(const TrackShowOptions& options);
 
 int decode(const std::string& protocol, const std::vector<std::string>& hex);
 int encode(const std::string& protocol, const std::vector<std::string>& words);

@@ -167,6 +167,17 @@ int main(int argc, char** argv) {
   bridgeCmd->add_option("--duration", bridge.duration, "Stop after this many seconds")
       ->check(CLI::PositiveNumber);
 
+  cli::ViewOptions spectator;
+  auto* viewCmd = app.add_subcommand(
+      "view", "Watch the cars that bridges publish on an MQTT broker in the race view, read-only");
+  addMqtt(viewCmd, spectator.mqtt, spectator.mqttTimeout, "where bridges publish their cars")
+      ->required();
+  viewCmd->add_option("--track", spectator.track,
+                      "The layout drawn: a name (oval, …) or a layout file (default oval)");
+  addView(viewCmd, spectator.view);
+  viewCmd->add_option("--duration", spectator.duration, "Stop after this many seconds")
+      ->check(CLI::PositiveNumber);
+
   cli::ScanOptions scan;
   auto* scanCmd = app.add_subcommand("scan", "List the Anki cars in Bluetooth range");
   scanCmd->add_option("--timeout", scan.timeout, "Seconds to listen (default 5)")
@@ -257,6 +268,7 @@ int main(int argc, char** argv) {
   if (runCmd->parsed()) return cli::run(run);
   if (replCmd->parsed()) return cli::repl(repl);
   if (bridgeCmd->parsed()) return cli::bridge(bridge);
+  if (viewCmd->parsed()) return cli::view(spectator);
   if (scanCmd->parsed()) return cli::scan(scan);
   if (emulateCmd->parsed()) return cli::emulateCar(emulate);
   if (robotCmd->parsed()) return cli::simRobot(robot);

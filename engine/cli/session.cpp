@@ -33,6 +33,10 @@ Session::Session(ble::CentralOptions options) : loop_(ClockKind::Real), fleet_(l
   central_ = std::make_unique<ble::Central>(loop_, fleet_, std::move(options));
 }
 
+Session::Session(ClockKind clock) : loop_(clock), fleet_(loop_) {
+  log::setTimeSource([this] { return loop_.seconds(); });
+}
+
 Session::~Session() {
   signals_.reset();
   if (recorder_) recorder_->flush();
@@ -72,6 +76,12 @@ std::unique_ptr<Session> Session::open(const CarSource& source, bool fast, const
   session->catchSignals();
   interrupt::setBudget(std::chrono::milliseconds(std::llround(source.budget * 1000)));
   sandbox::setMemoryLimit(static_cast<std::size_t>(source.luaMemory) << 20);
+  return session;
+}
+
+std::unique_ptr<Session> Session::openReplay(ClockKind clock) {
+  auto session = std::make_unique<Session>(clock);
+  session->catchSignals();
   return session;
 }
 
@@ -226,6 +236,7 @@ int Session::connectRemoteCars(const char* command) {
   }
   remote_ = std::make_unique<RemoteCars>(loop_, fleet_, *mqtt_,
                                          topics::PayloadLimits{source_.mqtt.maxPayload});
+  remote_->setReadOnly(spectator_);
   // The callbacks outlive this wait (a late sync, a refusal on a later reconnection): they share
   // this state and do nothing once the wait is over.
   struct Start {
@@ -382,8 +393,7 @@ int Session::startView(const std::string& endpoint, const std::string& source,
     return 2;
   }
   options->assets = *assets;
-  feed_ = std::make_unique<view::Feed>(loop_, fleet_, source);
-  if (sim_.world) feed_->setTrack(sim_.world->track(), "layout");
+  startFeed(source);
   feed_->followLog(true);
   server_ = std::make_unique<view::Server>(loop_, *feed_, *options);
   if (auto started = server_->start(); !started) {
@@ -400,13 +410,22 @@ int Session::startView(const std::string& endpoint, const std::string& source,
   return 0;
 }
 
+view::Feed& Session::startFeed(const std::string& source) {
+  if (!feed_) {
+    feed_ = std::make_unique<view::Feed>(loop_, fleet_, source);
+    if (sim_.world) feed_->setTrack(sim_.world->track(), "layout");
+  }
+  return *feed_;
+}
+
 void Session::finish() {
   if (finishing_) return;
   finishing_ = true;
   // First the script: from here nothing of it runs, so nothing it does can follow the stop.
   if (scripts_) scripts_->shutDown();
-  // Then every car's stop, the last command it takes (AnkiCar::halt).
-  fleet_.haltAll();
+  // Then every car's stop, the last command it takes (AnkiCar::halt); a spectator's cars are
+  // other hosts' and get nothing from it.
+  if (!spectator_) fleet_.haltAll();
   // A race cut short says where it stood: the final table, the results (nothing can drive now).
   if (scripts_) scripts_->lastWords();
   if (recorder_) recorder_->flush();

@@ -25,6 +25,8 @@ class Session {
   Session(ClockKind clock, sim::Track track, std::uint64_t seed);
   // Real cars through BlueZ, on the real clock. Throws ble::BleError when there is no bus.
   explicit Session(ble::CentralOptions options);
+  // A replay (pitwall replay): no simulator, no radio; the record's cars join the fleet.
+  explicit Session(ClockKind clock);
   ~Session();
 
   // The session `pitwall COMMAND` asks for with `source` (the simulator in real time, or in
@@ -32,6 +34,8 @@ class Session {
   // code running, stops the cars and ends the run with status 130; a second leaves at once (the
   // stops are sent all the same). nullptr after printing "pitwall COMMAND: why" (exit status 2).
   static std::unique_ptr<Session> open(const CarSource& source, bool fast, const char* command);
+  // The session of a replay, catching SIGINT and SIGTERM as open() does.
+  static std::unique_ptr<Session> openReplay(ClockKind clock);
   // Puts the cars of the source on the run (the grid, or the real cars found, then with --mqtt the
   // remote cars). 0, or the exit status after printing why not: 1 (simulated cars did not
   // connect), 2 (no BLE cars, no broker, too few remote cars), 130.
@@ -60,7 +64,13 @@ class Session {
   // --view: the race view's feed and server (docs/view.md); prints the URL. `source` says what
   // the cars are. Non-zero (an error printed) when it cannot serve.
   int startView(const std::string& endpoint, const std::string& source, const char* command);
+  // The view's feed without a server (a replay's summary counts laps with it); startView makes
+  // it when there is none.
+  view::Feed& startFeed(const std::string& source);
   view::Feed* viewFeed() { return feed_.get(); }
+  // A spectator (pitwall view): remote cars are read-only, and the end of the run sends them
+  // nothing (they are their bridges' cars, not ours).
+  void spectate() { spectator_ = true; }
   view::Server* viewServer() { return server_.get(); }
   // The one stop path (docs/safety.md): the script is shut down first (nothing of it runs or
   // commands again), then every car gets its stop as its last command, the record is flushed,
@@ -88,6 +98,7 @@ class Session {
   int connectLocalCars(const char* command);
   int connectRemoteCars(const char* command);
   bool finishing_ = false;
+  bool spectator_ = false;
   void catchSignals();
   void flushRecordPeriodically();
   CarSource source_;

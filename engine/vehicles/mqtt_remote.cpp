@@ -54,6 +54,13 @@ RemoteCars::RemoteCars(Loop& loop, Fleet& fleet, MqttClient& client, topics::Pay
   client_.subscribe(syncTopic_, 1);
   client_.onConnected = [this] {
     brokerUp_ = true;
+    if (readOnly_) {  // a spectator publishes nothing: the retained state comes as it comes
+      if (auto done = std::move(synced_)) {
+        synced_ = nullptr;
+        done();
+      }
+      return;
+    }
     // After the retained state of the subscriptions above (same client, same QoS: in order).
     client_.publish(syncTopic_, "{}", 1, false);
   };
@@ -242,6 +249,7 @@ void RemoteCars::update(const std::string& id, Car& car) {
 }
 
 bool RemoteCars::sendCommand(const std::string& car, std::span<const std::uint8_t> frame) {
+  if (readOnly_) return false;
   auto message = anki::decode(frame);
   if (!message) return false;
   if (std::holds_alternative<anki::SdkMode>(*message)) return true;

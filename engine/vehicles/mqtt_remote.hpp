@@ -37,6 +37,11 @@ class RemoteCars {
   // The client must not be connected yet (its handlers are set here). The loop, the fleet and
   // the client outlive this object.
   RemoteCars(Loop& loop, Fleet& fleet, MqttClient& client, topics::PayloadLimits limits = {});
+  // A spectator (pitwall view --mqtt): nothing is ever published — no sync marker (synced()
+  // comes with the connection; the retained state follows as it arrives) and no command: a
+  // car's command is refused unsent. Set before start().
+  void setReadOnly(bool readOnly) { readOnly_ = readOnly; }
+  bool readOnly() const { return readOnly_; }
   ~RemoteCars();
   RemoteCars(const RemoteCars&) = delete;
   RemoteCars& operator=(const RemoteCars&) = delete;
@@ -81,6 +86,7 @@ class RemoteCars {
   std::map<std::string, Car> cars_;
   std::map<std::string, bool> hosts_;  // HostStatus as last published
   bool brokerUp_ = false;
+  bool readOnly_ = false;
   std::function<void()> synced_;
   std::function<void(const std::string&)> failed_;
 };

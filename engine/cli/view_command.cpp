@@ -1,0 +1,29 @@
+// pitwall view --mqtt URL: a spectator's race view (docs/view.md "Spectators"). The cars that
+// bridges on other hosts publish join as remote cars, read-only: nothing is ever published, no
+// command is sent, and the end sends no stop (they are their bridges' cars).
+#include <iostream>
+
+#include "engine/cli/commands.hpp"
+#include "engine/cli/session.hpp"
+#include "engine/core/log.hpp"
+
+namespace pitwall::cli {
+
+int view(const ViewOptions& options) {
+  CarSource source = options;
+  source.cars = 0;  // no simulated car: the world is only the layout drawn
+  auto made = Session::open(source, false, "view");
+  if (!made) return 2;
+  Session& session = *made;
+  session.spectate();
+  if (int status = session.startView(options.view.value_or(""), "mqtt", "view"); status != 0)
+    return status;
+  if (int status = session.connectCars("view"); status != 0) return status;
+  log::info("pitwall", "watching the cars on " + options.mqtt.url + " (read-only); Ctrl-C to stop");
+  if (options.duration)
+    session.loop().after(fromSeconds(*options.duration), [&] { session.finish(); });
+  session.loop().run();  // ends through Session::finish: SIGINT, SIGTERM, --duration
+  return session.interrupted() ? 130 : 0;
+}
+
+}  // namespace pitwall::cli
