@@ -51,7 +51,9 @@ std::optional<std::filesystem::path> assetPath(const std::filesystem::path& root
     if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-' ||
           c == '/'))
       return std::nullopt;
-  if (rel.find("..") != std::string::npos || rel.find("//") != std::string::npos)
+  // never absolute (root / "/etc/passwd" is /etc/passwd), never up, never empty parts
+  if (rel.front() == '/' || rel.find("..") != std::string::npos ||
+      rel.find("//") != std::string::npos)
     return std::nullopt;
   return root / rel;
 }
@@ -96,7 +98,8 @@ struct Server::Impl::Socket : std::enable_shared_from_this<Socket> {
   std::string reply;     // an answer to a page's message, sent before the next update
   std::uint64_t cursor = 0, trackSeen = 0;
   bool writing = false, closed = false;
-  std::chrono::steady_clock::time_point lastWrite{};
+  std::chrono::steady_clock::time_point lastWrite{};  // the last message written
+  std::chrono::steady_clock::time_point lastLook{};   // the last update built (the pace)
 
   void start(http::request<http::string_body> request) {
     server->open++;
@@ -139,7 +142,7 @@ struct Server::Impl::Socket : std::enable_shared_from_this<Socket> {
   void write(std::string text) {
     out = std::move(text);
     writing = true;
-    lastWrite = std::chrono::steady_clock::now();
+    lastWrite = lastLook = std::chrono::steady_clock::now();
     stall.expires_after(kWriteStall);
     stall.async_wait([weak = weak_from_this()](beast::error_code ec) {
       auto self = weak.lock();
@@ -163,7 +166,7 @@ struct Server::Impl::Socket : std::enable_shared_from_this<Socket> {
     if (closed) return;
     auto period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
         std::chrono::duration<double>(1.0 / std::max(server->options.maxRate, 0.1)));
-    pace.expires_at(lastWrite + period);
+    pace.expires_at(lastLook + period);
     pace.async_wait([self = shared_from_this()](beast::error_code ec) {
       if (ec || self->closed) return;
       self->send();
@@ -180,8 +183,7 @@ struct Server::Impl::Socket : std::enable_shared_from_this<Socket> {
     bool unchanged = body == lastSent && cursor == cursor0 && trackSeen == seen0;
     if (unchanged && std::chrono::steady_clock::now() - lastWrite < kHeartbeat) {
       // nothing new: look again a period later, without writing
-      lastWrite += std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-          std::chrono::duration<double>(1.0 / std::max(server->options.maxRate, 0.1)));
+      lastLook = std::chrono::steady_clock::now();
       return next();
     }
     lastSent = body;

@@ -1,0 +1,146 @@
+// The view's feed against the simulator's ground truth: a real World, real SimLinks, the real
+// codec and car model; the feed's placement of every car, its laps, the event log, the race
+// reported by a script's side, and the fleet's other observers kept.
+#include <doctest/doctest.h>
+
+#include <cmath>
+
+#include "engine/core/log.hpp"
+#include "engine/sim/world.hpp"
+#include "engine/vehicles/fleet.hpp"
+#include "engine/view/feed.hpp"
+#include "engine/view/geometry.hpp"
+
+using namespace pitwall;
+
+namespace {
+
+struct Race {
+  Loop loop{ClockKind::Virtual};
+  sim::World world;
+  Fleet fleet{loop};
+  std::unique_ptr<view::Feed> feed;
+  explicit Race(sim::Track track = sim::namedLayout("oval").value())
+      : world(loop, std::move(track), 1) {}
+  void run(double seconds) {
+    loop.at(loop.now() + fromSeconds(seconds), [this] { loop.stop(); });
+    loop.run();
+  }
+};
+
+}  // namespace
+
+TEST_CASE("view feed: cars are placed where the simulator has them, and laps are counted") {
+  // the named layouts, and one whose pieces all share two ids (matched along the driving order)
+  std::vector<sim::Track> tracks;
+  for (const auto& name : sim::layoutNames()) tracks.push_back(sim::namedLayout(name).value());
+  tracks.push_back(
+      sim::parseLayout("start S:36 L:17 L:17 S:36 S:36 L:17 L:17", "same ids").value());
+  for (const auto& track : tracks) {
+    CAPTURE(track.name());
+    Race r(track);
+    r.feed = std::make_unique<view::Feed>(r.loop, r.fleet, "simulator");
+    r.feed->setTrack(r.world.track(), "layout");
+    sim::CarSpec a{.name = "a", .piece_index = 0, .offset_mm = -68};
+    sim::CarSpec b{.name = "b", .piece_index = 0, .offset_mm = 68};
+    auto& ca = r.fleet.addSimulated(r.world, a);
+    auto& cb = r.fleet.addSimulated(r.world, b);
+    r.run(0.5);
+    REQUIRE(ca.sdkMode(true));
+    REQUIRE(cb.sdkMode(true));
+    REQUIRE(ca.setSpeed(700, 2000));
+    REQUIRE(cb.setSpeed(1000, 2000));
+    int checked = 0;
+    for (int step = 0; step < 300; ++step) {  // 30 s, looked at every 0.1 s
+      r.run(0.1);
+      auto state = r.feed->state();
+      for (std::size_t k = 0; k < 2; ++k) {
+        const auto& car = state["cars"][k];
+        auto truth = r.world.cars()[k]->truth();
+        if (car["x"].is_null()) continue;
+        // the feed's piece is the simulator's (ids repeat on a track: matched along the order)
+        // (or the piece before, when the car crossed into this one since its last report)
+        const std::size_t n = r.world.track().size();
+        const auto index = car["pieceIndex"].get<std::size_t>();
+        const bool justCrossed = truth.piece_distance_mm < 30 && (index + 1) % n == truth.piece_index;
+        CHECK((index == truth.piece_index || justCrossed));
+        const auto& piece = r.world.track().piece(truth.piece_index);
+        view::Pose real = view::pointOnTrack(
+            r.world.track(), truth.piece_index,
+            truth.piece_distance_mm / piece.length(truth.offset_mm), truth.offset_mm);
+        // within the spacing of the location codes, and on the road
+        CHECK(std::hypot(car["x"].get<double>() - real.x, car["y"].get<double>() - real.y) < 200);
+        ++checked;
+      }
+    }
+    CHECK(checked > 400);
+    auto state = r.feed->state();
+    for (std::size_t k = 0; k < 2; ++k) {
+      auto truth = r.world.cars()[k]->truth();
+      // the first crossing starts lap 1
+      CHECK(state["cars"][k]["lap"].get<int>() == truth.laps - 1);
+      CHECK(truth.laps >= 3);
+      for (double t : state["cars"][k]["lapTimes"]) CHECK(t > 2.0);
+      CHECK(state["cars"][k]["speedHistory"].size() > 100);
+    }
+  }
+}
+
+TEST_CASE("view feed: connections and log lines join the event log; others' hooks still run") {
+  Race r;
+  int framesSeen = 0;
+  r.fleet.onFrame = [&](AnkiCar&, AnkiCar::Direction, std::span<const std::uint8_t>,
+                        const anki::Message&) { ++framesSeen; };
+  r.feed = std::make_unique<view::Feed>(r.loop, r.fleet, "simulator");
+  r.feed->followLog(true);
+  auto& car = r.fleet.addSimulated(r.world, sim::CarSpec{.name = "skull"});
+  r.run(0.5);
+  (void)car.sdkMode(true);
+  r.run(0.2);
+  CHECK(framesSeen > 0);
+  pitwall::log::warn("race", "something to see");
+  pitwall::log::info("quiet", "not for the view");
+  auto state = r.feed->state();
+  std::vector<std::string> texts;
+  for (const auto& e : state["events"]) texts.push_back(e["text"]);
+  CHECK(std::find(texts.begin(), texts.end(), "car 1 (skull) connected") != texts.end());
+  CHECK(std::find(texts.begin(), texts.end(), "race: something to see") != texts.end());
+  CHECK(std::find(texts.begin(), texts.end(), "quiet: not for the view") == texts.end());
+  // updates carry only new events
+  std::uint64_t cursor = 0, track = 0;
+  CHECK(r.feed->update(cursor, track)["events"].size() == texts.size());
+  CHECK(r.feed->update(cursor, track)["events"].empty());
+  r.feed->event("info", "one more");
+  CHECK(r.feed->update(cursor, track)["events"].size() == 1);
+  // the log keeps its last 200 lines, not more
+  for (int i = 0; i < 1000; ++i) r.feed->event("info", std::to_string(i));
+  CHECK(r.feed->state()["events"].size() == 200);
+  CHECK(r.feed->state()["events"].back()["text"] == "999");
+  // the feed gone, the fleet's hooks are the ones from before
+  r.feed.reset();
+  int before = framesSeen;
+  (void)car.ping();
+  r.run(0.2);
+  CHECK(framesSeen > before);
+}
+
+TEST_CASE("view feed: the race as reported; phases are logged; the track only when it changed") {
+  Race r;
+  r.feed = std::make_unique<view::Feed>(r.loop, r.fleet, "ble");
+  // a browser had the track (none) with the state: updates leave it out until it changes
+  std::uint64_t cursor = 0, seen = r.feed->trackVersion();
+  CHECK(r.feed->state()["track"].is_null());
+  CHECK_FALSE(r.feed->update(cursor, seen).contains("track"));
+  r.feed->setTrack(r.world.track(), "scan");
+  auto next = r.feed->update(cursor, seen);
+  REQUIRE(next.contains("track"));
+  CHECK(next["track"]["source"] == "scan");
+  r.feed->setRace({{"title", "GP"}, {"phase", "grid"}});
+  r.feed->setRace({{"title", "GP"}, {"phase", "grid"}, {"rows", nlohmann::json::array()}});
+  r.feed->setRace({{"title", "GP"}, {"phase", "lights"}, {"light", 3}});
+  auto state = r.feed->state();
+  CHECK(state["race"]["light"] == 3);
+  int phases = 0;
+  for (const auto& e : state["events"]) phases += e["text"].get<std::string>().starts_with("GP: ");
+  CHECK(phases == 2);  // grid once, lights once
+}

@@ -1,0 +1,327 @@
+// The race view's server on real loopback sockets: files, /api/state, the WebSocket's pace, and
+// adversaries — a browser that never reads, hostile requests and messages, a port in use. The
+// engine's loop runs here; each client runs in a thread of its own (a browser is another process).
+#include <doctest/doctest.h>
+
+#include <atomic>
+#include <boost/asio/connect.hpp>
+#include <boost/asio/write.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <boost/beast/websocket.hpp>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include "engine/vehicles/fleet.hpp"
+#include "engine/view/server.hpp"
+#include "tests/support/run_until.hpp"
+
+using namespace pitwall;
+namespace asio = boost::asio;
+namespace beast = boost::beast;
+namespace http = beast::http;
+namespace websocket = beast::websocket;
+using tcp = asio::ip::tcp;
+using testing::runUntil;
+
+namespace {
+
+struct Assets {
+  std::filesystem::path dir;
+  Assets() {
+    dir = std::filesystem::temp_directory_path() /
+          ("pitwall-view-test-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir / "vendor");
+    std::ofstream(dir / "index.html") << "<!doctype html><title>race view</title>";
+    std::ofstream(dir / "vendor" / "lib.js") << "// lib";
+    std::ofstream(dir.parent_path() / "pitwall-view-secret.txt") << "secret";
+  }
+  ~Assets() {
+    std::filesystem::remove_all(dir);
+    std::filesystem::remove(dir.parent_path() / "pitwall-view-secret.txt");
+  }
+};
+
+struct Rig {
+  Assets assets;
+  Loop loop{ClockKind::Real};
+  Fleet fleet{loop};
+  view::Feed feed{loop, fleet, "simulator"};
+  std::unique_ptr<view::Server> server;
+  explicit Rig(double rate = 30) {
+    view::ServerOptions o;
+    o.port = 0;
+    o.assets = assets.dir;
+    o.maxRate = rate;
+    server = std::make_unique<view::Server>(loop, feed, o);
+    REQUIRE(server->start());
+  }
+  // Runs `client` in a thread while the loop runs; returns when it is done (or after `limit`).
+  void with(const std::function<void(std::uint16_t port)>& client,
+            Duration limit = std::chrono::seconds(20)) {
+    std::atomic<bool> done{false};
+    std::thread t([&] {
+      try {
+        client(server->port());
+      } catch (const std::exception& e) {
+        failure = e.what();  // reported below, on the test's thread
+      }
+      done = true;
+    });
+    runUntil(
+        loop, [&] { return done.load(); }, limit);
+    t.join();
+    CHECK_MESSAGE(failure.empty(), "the client failed: " << failure);
+  }
+  std::string failure;
+};
+
+http::response<http::string_body> get(std::uint16_t port, const std::string& target,
+                                      http::verb verb = http::verb::get,
+                                      const std::string& extraHeader = "") {
+  asio::io_context io;
+  beast::tcp_stream stream(io);
+  stream.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
+  std::string req = std::string(http::to_string(verb)) + " " + target +
+                    " HTTP/1.1\r\nHost: 127.0.0.1\r\n";
+  if (!extraHeader.empty()) req += "X-Big: " + extraHeader + "\r\n";
+  req += "Connection: close\r\n\r\n";
+  beast::error_code wec;
+  asio::write(stream.socket(), asio::buffer(req), wec);
+  beast::flat_buffer buffer;
+  http::response<http::string_body> res;
+  beast::error_code ec;
+  http::read(stream, buffer, res, ec);
+  if (ec) res.result(http::status::unknown);
+  return res;
+}
+
+struct WsClient {
+  asio::io_context io;
+  websocket::stream<tcp::socket> ws{io};
+  explicit WsClient(std::uint16_t port) {
+    ws.next_layer().connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
+    ws.handshake("127.0.0.1", "/ws");
+  }
+  nlohmann::json read() {
+    beast::flat_buffer b;
+    ws.read(b);
+    return nlohmann::json::parse(beast::buffers_to_string(b.data()));
+  }
+};
+
+}  // namespace
+
+TEST_CASE("view server: the page, its assets and /api/state; nothing outside the folder") {
+  Rig rig;
+  rig.with([](std::uint16_t port) {
+    auto page = get(port, "/");
+    CHECK(page.result() == http::status::ok);
+    CHECK(page.body().find("race view") != std::string::npos);
+    CHECK(std::string(page[http::field::content_type]).starts_with("text/html"));
+    CHECK(get(port, "/vendor/lib.js").result() == http::status::ok);
+    auto state = get(port, "/api/state");
+    REQUIRE(state.result() == http::status::ok);
+    auto j = nlohmann::json::parse(state.body());
+    CHECK(j["type"] == "state");
+    CHECK(j["source"] == "simulator");
+    CHECK(j["cars"].is_array());
+    for (const char* bad :
+         {"/../pitwall-view-secret.txt", "/vendor/../../pitwall-view-secret.txt",
+          "/%2e%2e/pitwall-view-secret.txt", "//etc/passwd", "/vendor", "/nothing.js", "/a\\b"})
+      CHECK_MESSAGE(get(port, bad).result() == http::status::not_found, std::string(bad));
+    CHECK(get(port, "/api/state", http::verb::post).result() == http::status::method_not_allowed);
+    // a header beyond the limit: refused, and the server goes on
+    CHECK(get(port, "/", http::verb::get, std::string(64 * 1024, 'x')).result() !=
+          http::status::ok);
+    CHECK(get(port, "/api/state").result() == http::status::ok);
+  });
+}
+
+TEST_CASE("view server: a port in use is refused with what to do; --view's forms") {
+  Rig rig;
+  view::ServerOptions o;
+  o.port = rig.server->port();
+  o.assets = rig.assets.dir;
+  view::Server second(rig.loop, rig.feed, o);
+  auto started = second.start();
+  REQUIRE_FALSE(started);
+  CHECK(started.error().find("in use") != std::string::npos);
+  CHECK(started.error().find("--view") != std::string::npos);
+  CHECK(started.error().find(std::to_string(o.port)) != std::string::npos);
+
+  auto def = view::parseEndpoint("");
+  REQUIRE(def);
+  CHECK(def->host == "127.0.0.1");  // loopback unless another address is given
+  CHECK(def->port == view::kDefaultPort);
+  CHECK(view::parseEndpoint("9000")->port == 9000);
+  CHECK(view::parseEndpoint("9000")->host == "127.0.0.1");
+  CHECK(view::parseEndpoint("0.0.0.0:8081")->host == "0.0.0.0");
+  CHECK(view::parseEndpoint("[::1]:8082")->host == "::1");
+  CHECK(view::parseEndpoint("localhost:8083")->host == "127.0.0.1");
+  for (const char* bad : {"examples/grand_prix.lua", "99999", "-1", "8080x", "example.com:80",
+                          "1.2.3.4:", "[::1]", ":", "1e3", "18446744073709551617"}) {
+    auto r = view::parseEndpoint(bad);
+    CHECK_MESSAGE(!r, bad);
+    if (!r) CHECK(r.error().find(bad) != std::string::npos);
+  }
+}
+
+TEST_CASE("view server: /ws sends the state, then at most the rate, and only what changed") {
+  Rig rig(20);
+  // something changes all the time: an event every 2 ms
+  std::function<void()> tick = [&] {
+    rig.feed.event("info", "tick");
+    rig.loop.after(std::chrono::milliseconds(2), tick);
+  };
+  rig.loop.after(std::chrono::milliseconds(2), tick);
+  int updates = 0;
+  double first = -1, last = -1;
+  rig.with([&](std::uint16_t port) {
+    WsClient c(port);
+    CHECK(c.read()["type"] == "state");
+    auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(1500);
+    while (std::chrono::steady_clock::now() < until) {
+      auto u = c.read();
+      CHECK(u["type"] == "update");
+      CHECK(u["events"].size() > 0);
+      if (first < 0) first = u["time"];
+      last = u["time"];
+      ++updates;
+    }
+  });
+  // 20 a second at most: over the engine time they span, never more (and they did flow)
+  CHECK(updates >= 10);
+  CHECK(updates - 1 <= (last - first) * 20 + 1);
+}
+
+TEST_CASE("view server: a browser that never reads costs the others nothing and is closed") {
+  Rig rig(30);
+  // a fat state: 200 events of 1000 characters, changing every 5 ms — a stalled socket fills
+  std::function<void()> tick = [&] {
+    rig.feed.event("info", std::string(1000, 'x'));
+    rig.loop.after(std::chrono::milliseconds(5), tick);
+  };
+  rig.loop.after(std::chrono::milliseconds(5), tick);
+  // the loop's own timers keep their time while the stalled browser is attached
+  double worstLate = 0;
+  std::function<void()> beat;
+  auto due = rig.loop.now() + std::chrono::milliseconds(10);
+  beat = [&] {
+    worstLate = std::max(worstLate, toSeconds(rig.loop.now() - due));
+    due = rig.loop.now() + std::chrono::milliseconds(10);
+    rig.loop.after(std::chrono::milliseconds(10), beat);
+  };
+  rig.loop.after(std::chrono::milliseconds(10), beat);
+  int healthy = 0;
+  std::size_t clientsWhileStalled = 0;
+  rig.with(
+      [&](std::uint16_t port) {
+        WsClient stalled(port);  // handshakes, then reads nothing, ever
+        stalled.ws.next_layer().set_option(asio::socket_base::receive_buffer_size(4096));
+        WsClient good(port);
+        (void)good.read();
+        auto until = std::chrono::steady_clock::now() + std::chrono::seconds(7);
+        while (std::chrono::steady_clock::now() < until) {
+          (void)good.read();
+          ++healthy;
+          if (healthy == 30) clientsWhileStalled = rig.server->clients();
+        }
+      },
+      std::chrono::seconds(30));
+  CHECK(healthy >= 100);  // ~30 a second for 7 s, the stalled one beside it
+  CHECK(clientsWhileStalled == 2);
+  // the stalled browser was closed after 5 s of not reading; the good one stays
+  CHECK(runUntil(
+      rig.loop, [&] { return rig.server->clients() <= 1; }, std::chrono::seconds(2)));
+  CHECK(worstLate < 0.5);  // no write ever blocked the loop
+}
+
+TEST_CASE("view server: hostile messages from a page are refused and the others go on") {
+  Rig rig(30);
+  int controls = 0;
+  std::string lastControl;
+  rig.with([&](std::uint16_t port) {
+    {
+      WsClient c(port);
+      (void)c.read();
+      c.ws.text(true);
+      // a control on a live run: answered with an error, never obeyed
+      c.ws.write(asio::buffer(std::string(R"({"type":"control","pause":true})")));
+      for (int i = 0; i < 50; ++i) {
+        auto m = c.read();
+        if (m["type"] == "error") {
+          CHECK(m["message"].get<std::string>().find("replay") != std::string::npos);
+          break;
+        }
+        CHECK(i < 49);
+      }
+      // junk, deep nesting, a flood: ignored
+      c.ws.write(asio::buffer(std::string("not json")));
+      c.ws.write(asio::buffer(std::string(30000, '[')));
+      c.ws.write(asio::buffer(std::string(R"({"type":"control","seek":1e999})")));
+      for (int i = 0; i < 2000; ++i) c.ws.write(asio::buffer(std::string(R"({"type":"hello"})")));
+      CHECK(c.read()["type"] == "update");
+    }
+    {
+      WsClient c(port);  // a message beyond 64 KiB: this browser is closed
+      (void)c.read();
+      c.ws.binary(true);
+      beast::error_code ec;
+      c.ws.write(asio::buffer(std::string(1 << 20, 'x')), ec);
+      beast::flat_buffer b;
+      for (int i = 0; i < 100 && !ec; ++i) c.ws.read(b, ec);
+      CHECK(ec);
+    }
+    {
+      WsClient c(port);  // invalid UTF-8 in a text frame: closed by the WebSocket rules
+      (void)c.read();
+      c.ws.text(true);
+      beast::error_code ec;
+      c.ws.write(asio::buffer(std::string("{\"type\":\"\xff\xfe\"}")), ec);
+      beast::flat_buffer b;
+      for (int i = 0; i < 100 && !ec; ++i) c.ws.read(b, ec);
+      CHECK(ec);
+    }
+    WsClient after(port);  // and the server goes on
+    CHECK(after.read()["type"] == "state");
+  });
+  // with a replay's handler, controls reach it
+  rig.feed.onControl = [&](const nlohmann::json& m) {
+    ++controls;
+    lastControl = m.dump();
+  };
+  rig.with([&](std::uint16_t port) {
+    WsClient c(port);
+    (void)c.read();
+    c.ws.text(true);
+    c.ws.write(asio::buffer(std::string(R"({"type":"control","seek":12.5})")));
+    (void)c.read();
+    (void)c.read();
+  });
+  CHECK(controls == 1);
+  CHECK(lastControl.find("12.5") != std::string::npos);
+}
+
+TEST_CASE("view server: stop() closes every browser (the page says the engine is gone)") {
+  Rig rig;
+  bool closed = false;
+  std::atomic<bool> connected{false};
+  std::thread t([&] {
+    WsClient c(rig.server->port());
+    (void)c.read();
+    connected = true;
+    beast::error_code ec;
+    beast::flat_buffer b;
+    while (!ec) c.ws.read(b, ec);
+    closed = true;
+  });
+  REQUIRE(runUntil(rig.loop, [&] { return connected.load(); }));
+  rig.server->stop();
+  runUntil(
+      rig.loop, [&] { return false; }, std::chrono::milliseconds(200));
+  t.join();
+  CHECK(closed);
+}
