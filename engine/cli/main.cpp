@@ -86,13 +86,14 @@ struct ViewOption {
 };
 std::list<ViewOption> g_views;  // a list: the options keep pointers to the values
 
-void addView(CLI::App* cmd, std::optional<std::string>& target) {
+CLI::Option* addView(CLI::App* cmd, std::optional<std::string>& target) {
   auto& v = g_views.emplace_back();
   v.target = &target;
   v.option = cmd->add_option("--view", v.value,
                              "Serve the race view in a browser on [HOST:]PORT (default "
                              "127.0.0.1:8080; PORT 0: any free port) — docs/view.md")
                  ->expected(0, 1);
+  return v.option;
 }
 
 void takeViews() {
@@ -228,6 +229,47 @@ int main(int argc, char** argv) {
                    "MB of memory a scenario's Lua world may hold (default 512; 0: no limit)")
       ->check(CLI::Range(0, 1 << 20));
 
+  cli::ReplayOptions replay;
+  auto* replayCmd = app.add_subcommand(
+      "replay",
+      "Play a --record file back through the codec and the car model: a summary per car, the "
+      "race view, or a script's handlers (docs/view.md)");
+  replayCmd->add_option("file", replay.file, "The record: JSON lines written by --record")
+      ->required();
+  replayCmd->add_flag("--summary", replay.summary,
+                      "Print a table per car: laps, best and last lap, frames in and out, "
+                      "malformed frames (the default without --view and --script)");
+  replayCmd->add_flag("--json", replay.json,
+                      "The summary as one JSON object per car per line instead of the table");
+  auto* replayView = addView(replayCmd, replay.view);
+  replayCmd
+      ->add_option("--speed", replay.speed, "With --view: playback speed, 0.1..100 (default 1)")
+      ->check(CLI::Range(0.1, 100.0))
+      ->needs(replayView);
+  replayCmd
+      ->add_option("--track", replay.track,
+                   "With --view: the layout drawn, a name or a file (a record does not say which; "
+                   "default oval)")
+      ->needs(replayView);
+  auto* replayScript = replayCmd->add_option(
+      "--script", replay.script,
+      "Deliver the recorded events to this Lua script's handlers, in virtual time; its commands "
+      "are logged, not sent");
+  replayScript->excludes(replayView);
+  replayCmd->add_option("--seed", replay.seed, "With --script: the seed of math.random")
+      ->needs(replayScript);
+
+  cli::TrackShowOptions trackShow;
+  auto* trackCmd = app.add_subcommand("track", "Track layouts");
+  trackCmd->require_subcommand(1);
+  auto* trackShowCmd = trackCmd->add_subcommand(
+      "show", "Describe a layout and draw it as the race view does: pitwall track show oval");
+  trackShowCmd
+      ->add_option("layout", trackShow.layout,
+                   "A layout name (oval, kidney, long) or a layout file")
+      ->required();
+  trackShowCmd->add_option("--svg", trackShow.svg, "Write the drawing as SVG to OUT (- : stdout)");
+
   std::string protocol;
   std::vector<std::string> words;
   auto* decodeCmd = app.add_subcommand("decode", "Decode one frame: pitwall decode anki \"01 17\"");
@@ -272,6 +314,8 @@ int main(int argc, char** argv) {
   if (scanCmd->parsed()) return cli::scan(scan);
   if (emulateCmd->parsed()) return cli::emulateCar(emulate);
   if (robotCmd->parsed()) return cli::simRobot(robot);
+  if (replayCmd->parsed()) return cli::replay(replay);
+  if (trackShowCmd->parsed()) return cli::trackShow(trackShow);
   if (testing) {
     if (test.paths.empty()) test.paths.push_back("tests/scenarios");
     return cli::test(test);

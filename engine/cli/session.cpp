@@ -82,6 +82,7 @@ std::unique_ptr<Session> Session::open(const CarSource& source, bool fast, const
 std::unique_ptr<Session> Session::openReplay(ClockKind clock) {
   auto session = std::make_unique<Session>(clock);
   session->catchSignals();
+  session->spectate();  // a record's cars: the end of the replay has nothing to stop
   return session;
 }
 

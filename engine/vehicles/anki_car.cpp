@@ -134,6 +134,13 @@ AnkiCar::Sent AnkiCar::disconnect() {
   return sent;
 }
 
+void AnkiCar::rewind() {
+  state_ = CarState{};
+  state_.connected = link_.connected();
+  pingSentAt_.reset();
+  lastPingRtt_.reset();
+}
+
 void AnkiCar::receive(std::span<const std::uint8_t> frame) {
   auto decoded = decode(frame);
   if (!decoded) {

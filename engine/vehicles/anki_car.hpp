@@ -95,6 +95,10 @@ class AnkiCar {
   // Every frame in and out, for recording.
   std::function<void(Direction, std::span<const std::uint8_t>, const anki::Message&)> onFrame;
 
+  // Forgets what the car's frames said (a replay moving back to its start): the state as it
+  // was when the car connected.
+  void rewind();
+
   // Entry point of frames from the link (public for tests and benchmarks).
   void receive(std::span<const std::uint8_t> frame);
 

@@ -75,6 +75,10 @@ Feed::Car& Feed::car(AnkiCar& car) {
   return *slot;
 }
 
+void Feed::reset() {
+  cars_.clear();
+}
+
 const CarTracker* Feed::tracker(int number) const {
   auto it = cars_.find(number);
   return it == cars_.end() ? nullptr : &it->second->tracker;
@@ -88,7 +92,7 @@ void Feed::frame(AnkiCar& ankiCar, AnkiCar::Direction d, const anki::Message& m)
                      std::holds_alternative<anki::SpeedUpdate>(m);
   if (!moves) return;
   Car& c = car(ankiCar);
-  const double now = loop_.seconds();
+  const double now = this->now();
   c.tracker.update(m, ankiCar.state(), now);
   if (c.speeds.empty() || now - c.speeds.back().first >= kHistoryStep) {
     c.speeds.emplace_back(now, ankiCar.state().speed_mm_s);
@@ -122,7 +126,7 @@ void Feed::setRace(nlohmann::json race) {
 }
 
 void Feed::event(const std::string& level, const std::string& text) {
-  events_.push_back({nextEvent_++, loop_.seconds(), level, text});
+  events_.push_back({nextEvent_++, now(), level, text});
   while (events_.size() > kEventsKept) events_.pop_front();
 }
 
@@ -208,7 +212,7 @@ nlohmann::json Feed::state() const {
   return {{"type", "state"},
           {"version", 1},
           {"source", source_},
-          {"time", round3(loop_.seconds())},
+          {"time", round3(now())},
           {"track", track_ ? trackJson(*track_, trackSource_) : nlohmann::json(nullptr)},
           {"race", race_.is_null() ? nlohmann::json(nullptr) : race_},
           {"replay", replay_.is_null() ? nlohmann::json(nullptr) : replay_},
@@ -223,7 +227,7 @@ nlohmann::json Feed::update(std::uint64_t& cursor, std::uint64_t& trackSeen) con
       events.push_back({{"seq", e.seq}, {"t", round3(e.t)}, {"level", e.level}, {"text", e.text}});
   cursor = nextEvent_;
   nlohmann::json j = {{"type", "update"},
-                      {"time", round3(loop_.seconds())},
+                      {"time", round3(now())},
                       {"cars", carsJson(false)},
                       {"race", race_.is_null() ? nlohmann::json(nullptr) : race_},
                       {"replay", replay_.is_null() ? nlohmann::json(nullptr) : replay_},

@@ -53,6 +53,13 @@ class Feed {
   // the speed. Unset: controls are refused.
   std::function<void(const nlohmann::json& control)> onControl;
 
+  // The time the feed stamps and shows, in seconds; unset: the loop's. A replay sets its
+  // position in the record, so laps are timed in the record's time at any playback speed.
+  void setClock(std::function<double()> seconds) { clock_ = std::move(seconds); }
+  // Forgets every car's tracker and speed history (a replay moving backwards replays the frames
+  // from the start); the track, the race, the events stay.
+  void reset();
+
   // The tracker of car `number` (for replay summaries and tests); nullptr when unknown.
   const CarTracker* tracker(int number) const;
 
@@ -63,8 +70,11 @@ class Feed {
   nlohmann::json carJson(const AnkiCar& car) const;
   nlohmann::json carsJson(bool history) const;
 
+  double now() const { return clock_ ? clock_() : loop_.seconds(); }
+
   Loop& loop_;
   Fleet& fleet_;
+  std::function<double()> clock_;
   std::string source_;
   std::optional<sim::Track> track_;
   std::string trackSource_ = "none";

@@ -62,7 +62,8 @@ TEST_CASE("view feed: cars are placed where the simulator has them, and laps are
         // (or the piece before, when the car crossed into this one since its last report)
         const std::size_t n = r.world.track().size();
         const auto index = car["pieceIndex"].get<std::size_t>();
-        const bool justCrossed = truth.piece_distance_mm < 30 && (index + 1) % n == truth.piece_index;
+        const bool justCrossed =
+            truth.piece_distance_mm < 30 && (index + 1) % n == truth.piece_index;
         CHECK((index == truth.piece_index || justCrossed));
         const auto& piece = r.world.track().piece(truth.piece_index);
         view::Pose real = view::pointOnTrack(

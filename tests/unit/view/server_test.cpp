@@ -5,8 +5,8 @@
 
 #include <atomic>
 #include <boost/asio/connect.hpp>
-#include <boost/asio/write.hpp>
 #include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/write.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
@@ -84,8 +84,8 @@ http::response<http::string_body> get(std::uint16_t port, const std::string& tar
   asio::io_context io;
   beast::tcp_stream stream(io);
   stream.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
-  std::string req = std::string(http::to_string(verb)) + " " + target +
-                    " HTTP/1.1\r\nHost: 127.0.0.1\r\n";
+  std::string req =
+      std::string(http::to_string(verb)) + " " + target + " HTTP/1.1\r\nHost: 127.0.0.1\r\n";
   if (!extraHeader.empty()) req += "X-Big: " + extraHeader + "\r\n";
   req += "Connection: close\r\n\r\n";
   beast::error_code wec;

@@ -1,0 +1,238 @@
+// pitwall replay FILE: a --record file read back through the same codec and car model as the run
+// (docs/view.md "Replays"). Only the bytes of the frames from the cars are trusted; every event
+// and lap is computed again. The cars are replayed, so nothing is ever sent: what a script (or
+// the end of the run) commands is logged as not sent.
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "engine/cli/commands.hpp"
+#include "engine/cli/session.hpp"
+#include "engine/core/log.hpp"
+#include "engine/vehicles/record_player.hpp"
+#include "engine/vehicles/record_reader.hpp"
+
+namespace pitwall::cli {
+
+namespace {
+
+constexpr std::size_t kBadLinesShown = 20;  // then a count: a binary file is not 10⁶ lines
+constexpr auto kProgressEvery = std::chrono::milliseconds(100);  // the view's replay object
+
+double micro(double seconds) {
+  return std::round(seconds * 1e6) / 1e6;
+}
+
+std::string lapText(const std::vector<double>& laps, bool best) {
+  if (laps.empty()) return "-";
+  double v = best ? *std::min_element(laps.begin(), laps.end()) : laps.back();
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3f", v);
+  return text;
+}
+
+// The summary per car: the laps the view's feed counted, the frames the car model saw.
+void printSummary(const RecordPlayer& player, const view::Feed& feed, bool json) {
+  if (!json)
+    std::printf("%-4s %5s %9s %9s %8s %8s %9s\n", "CAR", "LAPS", "BEST", "LAST", "IN", "OUT",
+                "MALFORMED");
+  for (int number : player.recordedCars()) {
+    const AnkiCar* car = player.car(number);
+    const view::CarTracker* tracker = feed.tracker(car->identity().number);
+    static const std::vector<double> kNone;
+    const std::vector<double>& laps = tracker ? tracker->lapTimes() : kNone;
+    const CarState& s = car->state();
+    if (json) {
+      nlohmann::ordered_json times = nlohmann::ordered_json::array();
+      for (double l : laps) times.push_back(micro(l));
+      nlohmann::ordered_json row = {
+          {"car", number},
+          {"laps", laps.size()},
+          {"bestLap", laps.empty() ? nlohmann::ordered_json(nullptr)
+                                   : nlohmann::ordered_json(
+                                         micro(*std::min_element(laps.begin(), laps.end())))},
+          {"lastLap", laps.empty() ? nlohmann::ordered_json(nullptr)
+                                   : nlohmann::ordered_json(micro(laps.back()))},
+          {"lapTimes", std::move(times)},
+          {"framesIn", s.frames_in},
+          {"framesOut", player.framesOut(number)},
+          {"malformed", s.malformed},
+      };
+      std::cout << row.dump() << "\n";
+    } else {
+      std::printf("%-4d %5zu %9s %9s %8llu %8llu %9llu\n", number, laps.size(),
+                  lapText(laps, true).c_str(), lapText(laps, false).c_str(),
+                  static_cast<unsigned long long>(s.frames_in),
+                  static_cast<unsigned long long>(player.framesOut(number)),
+                  static_cast<unsigned long long>(s.malformed));
+    }
+  }
+  std::cout.flush();
+}
+
+// A control message from the page: {"pause": bool} | {"seek": seconds} | {"speed": x}. What is
+// wrong is said in the view's event log (as a warning).
+void control(RecordPlayer& player, const nlohmann::json& message) {
+  auto refuse = [](const std::string& why) { log::warn("replay", "control refused: " + why); };
+  if (auto p = message.find("pause"); p != message.end()) {
+    if (!p->is_boolean()) return refuse("\"pause\" must be true or false");
+    player.pause(p->get<bool>());
+  }
+  if (auto s = message.find("speed"); s != message.end()) {
+    if (!s->is_number() || !(s->get<double>() >= 0.1 && s->get<double>() <= 100))
+      return refuse("\"speed\" must be a number 0.1..100");
+    player.setSpeed(s->get<double>());
+  }
+  if (auto s = message.find("seek"); s != message.end()) {
+    if (!s->is_number() || !std::isfinite(s->get<double>()))
+      return refuse("\"seek\" must be a number of seconds");
+    player.seek(s->get<double>());
+  }
+}
+
+}  // namespace
+
+int replay(const ReplayOptions& options) {
+  const std::string& file = options.file;
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec)) {
+    std::cerr << "pitwall replay: " << file << " is a folder; give a --record file\n";
+    return 2;
+  }
+  std::ifstream in(file, std::ios::binary);
+  if (!in) {
+    std::cerr << "pitwall replay: cannot read " << file << ": " << std::strerror(errno) << "\n";
+    return 2;
+  }
+  Record record = readRecord(in);
+  if (in.bad()) {
+    std::cerr << "pitwall replay: cannot read " << file << ": " << std::strerror(errno) << "\n";
+    return 2;
+  }
+  for (std::size_t i = 0; i < record.bad.size() && i < kBadLinesShown; ++i)
+    std::cerr << file << ":" << record.bad[i].line << ": " << record.bad[i].why << "\n";
+  if (record.bad.size() > kBadLinesShown)
+    std::cerr << file << ": " << record.bad.size() - kBadLinesShown << " more bad lines\n";
+  if (record.frames.empty()) {
+    std::cerr << "pitwall replay: " << file
+              << (record.bad.empty() ? " is empty"
+                                     : " has no line that is a frame (" +
+                                           std::to_string(record.bad.size()) + " bad lines)")
+              << "; a record is what `pitwall run --record FILE` writes\n";
+    return 1;
+  }
+  if (!record.bad.empty())
+    log::warn("replay", std::to_string(record.bad.size()) + " bad line" +
+                            (record.bad.size() == 1 ? "" : "s") + " of " + file +
+                            " left out; replaying the " + std::to_string(record.frames.size()) +
+                            " frames that are whole");
+
+  std::optional<sim::Track> track;
+  if (options.view) {
+    auto layout = sim::loadLayout(options.track);
+    if (!layout) {
+      std::cerr << "pitwall replay: " << layout.error() << "\n";
+      return 2;
+    }
+    track = std::move(*layout);
+  }
+
+  // The view plays the record in real time; a summary and a script take it in virtual time.
+  auto session = Session::openReplay(options.view ? ClockKind::Real : ClockKind::Virtual);
+  Loop& loop = session->loop();
+  view::Feed* feed = nullptr;
+  if (options.view) {
+    if (int status = session->startView(*options.view, "replay", "replay"); status != 0)
+      return status;
+    feed = session->viewFeed();
+    feed->setTrack(std::move(track), "layout");
+  } else {
+    feed = &session->startFeed("replay");
+  }
+
+  RecordPlayer player(loop, session->fleet(), std::move(record.frames));
+  // The feed and the log tell the record's time; both let go of the player before it goes.
+  struct Clocks {
+    view::Feed* feed;
+    Loop& loop;
+    ~Clocks() {
+      feed->setClock(nullptr);
+      feed->onControl = nullptr;
+      log::setTimeSource([&loop = loop] { return loop.seconds(); });
+    }
+  } clocks{feed, loop};
+  feed->setClock([&player] { return player.position(); });
+  log::setTimeSource([&player] { return player.position(); });
+  player.onRewind = [feed] { feed->reset(); };
+
+  const bool summary = options.summary || options.json || (!options.view && options.script.empty());
+  if (options.view) {
+    auto publish = [&player, feed, &file] {
+      feed->setReplay({{"duration", micro(player.duration())},
+                       {"position", micro(player.position())},
+                       {"speed", player.speed()},
+                       {"paused", player.paused()},
+                       {"file", std::filesystem::path(file).filename().string()}});
+    };
+    feed->onControl = [&player, publish](const nlohmann::json& message) {
+      control(player, message);
+      publish();
+    };
+    // the position moves with the clock: the replay object follows it
+    std::function<void()> tick;
+    tick = [&loop, &tick, publish] {
+      publish();
+      loop.after(kProgressEvery, tick);
+    };
+    player.setSpeed(options.speed);
+    publish();
+    loop.after(kProgressEvery, tick);
+    player.onEnd = [] {
+      log::info("replay", "the end of the record; the view is served until Ctrl-C");
+    };
+    player.play();
+    loop.run();  // until Ctrl-C or SIGTERM (Session::finish)
+    if (summary) printSummary(player, *feed, options.json);
+    return session->exitStatus(0);
+  }
+
+  if (!options.script.empty()) {
+    HostOptions host;
+    host.seed = options.seed;
+    try {
+      session->startHost(host);
+    } catch (const std::exception& e) {
+      std::cerr << "pitwall replay: " << e.what() << "\n";
+      return 1;
+    }
+    player.onEnd = [&session, &player] {
+      log::info("replay",
+                "the record is over (" + std::to_string(player.duration()) + " s): ending the run");
+      session->finish();
+    };
+    auto started = session->scripts().start(options.script);
+    if (!started) {
+      std::cerr << "pitwall replay: " << started.error() << "\n";
+      session->finish();
+      loop.run();
+      return 1;
+    }
+    player.play();
+    loop.run();  // ends through Session::finish: the record's end, pitwall.stop(), a signal
+    if (summary) printSummary(player, *feed, options.json);
+    return session->exitStatus(session->host().mainFailed() ? 1 : 0);
+  }
+
+  player.onEnd = [&loop] { loop.stop(); };
+  player.play();
+  loop.run();
+  if (session->interrupted()) return 130;
+  printSummary(player, *feed, options.json);
+  return 0;
+}
+
+}  // namespace pitwall::cli

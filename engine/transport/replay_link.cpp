@@ -1,0 +1,41 @@
+#include "engine/transport/replay_link.hpp"
+
+#include "engine/core/hex.hpp"
+#include "engine/core/log.hpp"
+#include "engine/protocol/anki/codec.hpp"
+#include "engine/protocol/anki/message_json.hpp"
+
+namespace pitwall {
+
+ReplayLink::ReplayLink(std::string label) : label_(std::move(label)) {}
+
+void ReplayLink::connect() {
+  if (connected_) return;
+  connected_ = true;
+  deliverState(true, "");
+}
+
+void ReplayLink::disconnect() {
+  if (!connected_) return;
+  connected_ = false;
+  deliverState(false, "disconnected");
+}
+
+bool ReplayLink::send(std::span<const std::uint8_t> frame) {
+  if (!connected_) return false;
+  // "set-speed {"accel_mm_s2":1000,…}": the name and the fields, as `pitwall decode` shows them
+  std::string text;
+  if (auto decoded = anki::decode(frame)) {
+    auto j = anki::toJson(*decoded);
+    text = j.value("name", std::string("frame"));
+    j.erase("name");
+    j.erase("id");
+    if (!j.empty()) text += " " + j.dump();
+  } else {
+    text = "frame " + toHex(frame);
+  }
+  log::info(label_, text + " not sent: a replay");
+  return true;
+}
+
+}  // namespace pitwall

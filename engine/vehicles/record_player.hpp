@@ -1,0 +1,84 @@
+#pragma once
+// Plays a record back (pitwall replay, docs/view.md "Replays"): one car per recorded car number
+// joins the fleet over a ReplayLink, and each recorded frame from a car (rx) reaches its AnkiCar
+// at its recorded time, through the same codec and model as in the run, so every event and lap
+// is computed again from the bytes. Frames to the cars (tx) are counted, not delivered: they are
+// what the run sent.
+//
+// Time: position p of the record (seconds) is reached at loop time anchor + (p − anchorPos) /
+// speed. On a virtual clock with speed 1 the loop's time is the record's time. On the real clock
+// the playback can be paused, sped up and moved (seek): forward, the frames in between are
+// delivered at once; backward, the cars and whoever follows them (onRewind) forget what they
+// knew and the frames from the start are delivered again at once, up to the target.
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <vector>
+
+#include "engine/core/loop.hpp"
+#include "engine/transport/replay_link.hpp"
+#include "engine/vehicles/fleet.hpp"
+#include "engine/vehicles/record_reader.hpp"
+
+namespace pitwall {
+
+class RecordPlayer {
+ public:
+  // Adds the cars to `fleet` (in order of their recorded numbers, each connected at once), so
+  // fleet car k is the k-th smallest number of the record: the same numbers as in the run when
+  // the run's cars are all in it.
+  RecordPlayer(Loop& loop, Fleet& fleet, std::vector<RecordedFrame> frames);
+  ~RecordPlayer();
+  RecordPlayer(const RecordPlayer&) = delete;
+  RecordPlayer& operator=(const RecordPlayer&) = delete;
+
+  void play();  // from position 0
+  void pause(bool paused);
+  void seek(double seconds);    // clamped to 0..duration()
+  void setSpeed(double speed);  // > 0
+
+  // Seconds into the record: while a frame is delivered, its time.
+  double position() const;
+  double duration() const { return times_.empty() ? 0 : times_.back(); }
+  double speed() const { return speed_; }
+  bool paused() const { return paused_; }
+  bool ended() const { return next_ >= frames_.size(); }
+
+  // The recorded car numbers, ascending, and the fleet's car for one of them.
+  const std::vector<int>& recordedCars() const { return numbers_; }
+  AnkiCar* car(int recorded) const;
+  std::uint64_t framesOut(int recorded) const;  // tx frames of that car in the record
+
+  // Every frame has been delivered (again, after a seek backwards).
+  std::function<void()> onEnd;
+  // Before frames are delivered again from the start: forget what the frames taught.
+  std::function<void()> onRewind;
+
+ private:
+  void deliverUpTo(double position);
+  void deliver(std::size_t index);
+  void schedule();
+  void anchor(double position);
+  double elapsedPosition() const;
+
+  Loop& loop_;
+  Fleet& fleet_;
+  std::vector<RecordedFrame> frames_;
+  std::vector<double> times_;  // when each frame plays: its t, never before the one before
+  std::vector<int> numbers_;
+  struct Car {
+    AnkiCar* car = nullptr;
+    ReplayLink* link = nullptr;
+    std::uint64_t framesOut = 0;
+  };
+  std::map<int, Car> cars_;
+  std::size_t next_ = 0;
+  Loop::TimerId timer_ = 0;
+  bool playing_ = false, paused_ = false;
+  double speed_ = 1;
+  TimePoint anchorLoop_{0};
+  double anchorPos_ = 0;
+  std::optional<double> delivering_;  // the time of the frame being delivered
+};
+
+}  // namespace pitwall

@@ -1,0 +1,169 @@
+#include "engine/vehicles/record_reader.hpp"
+
+#include <doctest/doctest.h>
+
+#include <sstream>
+
+using namespace pitwall;
+
+namespace {
+
+const std::string kLine =
+    R"({"t":0.330000,"car":1,"dir":"rx","hex":"10 27 05 11 00 00 00 00 58 02 40 00 00 00 00 00 00",)"
+    R"("msg":{"id":"0x27","name":"position-update"}})";
+
+RecordedFrame frameOf(std::string_view line, double lastTime = 0) {
+  auto parsed = parseRecordLine(line, lastTime);
+  REQUIRE_MESSAGE(std::holds_alternative<RecordedFrame>(parsed), std::get<std::string>(parsed));
+  return std::get<RecordedFrame>(parsed);
+}
+
+std::string whyNot(std::string_view line, double lastTime = 0) {
+  auto parsed = parseRecordLine(line, lastTime);
+  REQUIRE_MESSAGE(std::holds_alternative<std::string>(parsed), "the line was taken as a frame");
+  return std::get<std::string>(parsed);
+}
+
+// Every character of an error can go to a terminal: printable ASCII (and the ellipsis of a cut).
+bool printable(const std::string& text) {
+  std::string rest = text;
+  for (auto at = rest.find("…"); at != rest.npos; at = rest.find("…")) rest.erase(at, 3);
+  for (unsigned char c : rest)
+    if (c < 0x20 || c >= 0x7f) return false;
+  return true;
+}
+
+std::string nested(int depth) {
+  return std::string(depth, '[') + std::string(depth, ']');
+}
+
+Record read(const std::string& text) {
+  std::istringstream in(text);
+  return readRecord(in);
+}
+
+}  // namespace
+
+TEST_CASE("a line as the recorder writes it is a frame: time, car, direction and bytes") {
+  RecordedFrame f = frameOf(kLine);
+  CHECK(f.t == doctest::Approx(0.33));
+  CHECK(f.car == 1);
+  CHECK_FALSE(f.tx);
+  REQUIRE(f.bytes.size() == 17);
+  CHECK(f.bytes[0] == 0x10);
+  CHECK(f.bytes[1] == 0x27);
+  CHECK(frameOf(R"({"t":1,"car":64,"dir":"tx","hex":"06 24 e8 03 a8 61 00"})").tx);
+}
+
+TEST_CASE("the bytes come from \"hex\", never from \"msg\"") {
+  // a msg that says something else, and none at all
+  RecordedFrame f = frameOf(R"({"t":1,"car":2,"dir":"rx","hex":"01 17","msg":{"name":"x"}})");
+  CHECK(f.bytes == std::vector<std::uint8_t>{0x01, 0x17});
+  CHECK(frameOf(R"({"t":1,"car":2,"dir":"rx","hex":"0117"})").bytes.size() == 2);
+  CHECK(frameOf(R"({"t":1,"car":2,"dir":"rx","hex":"0A 1B"})").bytes ==
+        std::vector<std::uint8_t>{0x0a, 0x1b});
+}
+
+TEST_CASE("a line that is not a frame is set aside with the reason") {
+  struct Case {
+    std::string line, why;
+  };
+  const Case cases[] = {
+      {"garbage", "not JSON"},
+      {R"({"t":1,"car":1,"dir":"rx","hex":"01 17")", "not JSON"},  // cut short
+      {"[1,2]", "not a JSON object"},
+      {R"({"car":1,"dir":"rx","hex":"01 17"})", R"(no "t")"},
+      {R"({"t":"1","car":1,"dir":"rx","hex":"01 17"})", R"("t" is not a number)"},
+      {R"({"t":-0.5,"car":1,"dir":"rx","hex":"01 17"})", "out of range"},
+      {R"({"t":1e300,"car":1,"dir":"rx","hex":"01 17"})", "out of range"},
+      {R"({"t":1e400,"car":1,"dir":"rx","hex":"01 17"})", "not JSON"},  // beyond a double
+      {R"({"t":1,"dir":"rx","hex":"01 17"})", R"(no "car")"},
+      {R"({"t":1,"car":0,"dir":"rx","hex":"01 17"})", R"("car" must be an integer 1..64, not 0)"},
+      {R"({"t":1,"car":65,"dir":"rx","hex":"01 17"})", "not 65"},
+      {R"({"t":1,"car":1.5,"dir":"rx","hex":"01 17"})", "not 1.5"},
+      {R"({"t":1,"car":"1","dir":"rx","hex":"01 17"})", "must be an integer"},
+      {R"({"t":1,"car":18446744073709551615,"dir":"rx","hex":"01 17"})", "must be an integer"},
+      {R"({"t":1,"car":-9223372036854775808,"dir":"rx","hex":"01 17"})", "must be an integer"},
+      {R"({"t":1,"car":99999999999999999999999,"dir":"rx","hex":"01 17"})", "must be an integer"},
+      {R"({"t":1,"car":1,"hex":"01 17"})", R"(no "dir")"},
+      {R"({"t":1,"car":1,"dir":"up","hex":"01 17"})", R"("dir" must be "rx" or "tx")"},
+      {R"({"t":1,"car":1,"dir":"rx"})", R"(no "hex")"},
+      {R"({"t":1,"car":1,"dir":"rx","hex":17})", R"("hex" is not a string)"},
+      {R"({"t":1,"car":1,"dir":"rx","hex":""})", R"("hex" is empty)"},
+      {R"({"t":1,"car":1,"dir":"rx","hex":"01 1"})", R"("hex")"},
+      {R"({"t":1,"car":1,"dir":"rx","hex":"zz"})", R"("hex")"},
+      {"{\"t\":1,\"car\":1,\"dir\":\"rx\",\"hex\":\"\xff\xfe\"}", "ill-formed UTF-8"},
+      {"{\"t\":1,\"car\":1,\"dir\":\"r\xc3\x28\",\"hex\":\"01\"}", "ill-formed UTF-8"},
+      {"{\"t\":\xff}", "not JSON"},
+      {std::string("\0\0\0", 3), "not JSON"},
+      {nested(10000), "nested deeper than 16"},
+      {std::string(30000, '['), "nested deeper than 16"},
+      {R"({"t":1,"car":1,"dir":"rx","hex":"01 17","msg":)" + nested(100) + "}",
+       "nested deeper than 16"},
+  };
+  for (const Case& c : cases) {
+    CAPTURE(c.line.substr(0, 80));
+    std::string why = whyNot(c.line);
+    CHECK_MESSAGE(why.find(c.why) != std::string::npos, why);
+    CHECK_MESSAGE(printable(why), why);
+    CHECK(why.size() < 240);
+  }
+}
+
+TEST_CASE("a frame may lie a millisecond before the one before it, not more") {
+  const std::string at5 = R"({"t":5.0,"car":1,"dir":"rx","hex":"01 17"})";
+  const std::string justBefore = R"({"t":4.9995,"car":1,"dir":"rx","hex":"01 17"})";
+  CHECK(frameOf(justBefore, 5.0).t == doctest::Approx(4.9995));
+  std::string why = whyNot(R"({"t":4.5,"car":1,"dir":"rx","hex":"01 17"})", 5.0);
+  CHECK(why.find("goes back in time") != std::string::npos);
+  CHECK(frameOf(at5, 5.0).t == 5.0);
+}
+
+TEST_CASE("a record cut short and corrupted in the middle keeps its whole lines, numbered") {
+  const std::string good = R"({"t":1,"car":1,"dir":"rx","hex":"01 17"})";
+  Record r = read(good + "\n" +       // 1
+                  "garbage \xff\n" +  // 2
+                  "\n" +              // 3: blank, skipped
+                  R"({"t":2,"car":2,"dir":"tx","hex":"01 16"})"
+                  "\r\n"                                  // 4: CRLF
+                  + R"({"t":3,"car":1,"dir":"rx","he)");  // 5: the last line, cut
+  REQUIRE(r.frames.size() == 2);
+  CHECK(r.frames[0].line == 1);
+  CHECK(r.frames[1].line == 4);
+  CHECK(r.frames[1].tx);
+  REQUIRE(r.bad.size() == 2);
+  CHECK(r.bad[0].line == 2);
+  CHECK(r.bad[0].why.find("not JSON") == 0);
+  CHECK(printable(r.bad[0].why));
+  CHECK(r.bad[1].line == 5);
+  CHECK(r.bad[1].why.find("not JSON") == 0);
+}
+
+TEST_CASE("a line over 64 KiB is skipped unread, and the lines after it are read") {
+  const std::string good = R"({"t":1,"car":1,"dir":"rx","hex":"01 17"})";
+  std::string huge = R"({"t":1,"car":1,"dir":"rx","hex":")" + std::string(1 << 20, 'a') + "\"}";
+  Record r = read(good + "\n" + huge + "\n" + good + "\n" + huge);  // the last one without \n
+  REQUIRE(r.frames.size() == 2);
+  CHECK(r.frames[1].line == 3);
+  REQUIRE(r.bad.size() == 2);
+  CHECK(r.bad[0].line == 2);
+  CHECK(r.bad[0].why == "a line of " + std::to_string(huge.size()) +
+                            " bytes, longer than 65536: not a frame of a record");
+  CHECK(r.bad[1].line == 4);
+}
+
+TEST_CASE("a line of exactly 64 KiB is read; one byte more is not") {
+  const std::string good = R"({"t":1,"car":1,"dir":"rx","hex":"01 17"})";
+  std::string padded = good + std::string(kMaxLineBytes - good.size(), ' ');
+  Record r = read(padded + "\n" + padded + " \n");
+  CHECK(r.frames.size() == 1);
+  REQUIRE(r.bad.size() == 1);
+  CHECK(r.bad[0].line == 2);
+}
+
+TEST_CASE("an empty record has no frames and no bad lines") {
+  Record r = read("");
+  CHECK(r.frames.empty());
+  CHECK(r.bad.empty());
+  CHECK(read("\n\n  \n").frames.empty());
+}
