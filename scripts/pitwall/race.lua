@@ -173,7 +173,11 @@ function Race:_map()
   end
   local scanOptions = type(o.scan) == "table" and o.scan or {}
   pitwall.log("info", "race: scan lap with " .. tostring(self.cars[1]))
-  return track.scan(self.cars[1], scanOptions)
+  self.scanning = true -- (the view shows the phase)
+  local ok, map = pcall(track.scan, self.cars[1], scanOptions)
+  self.scanning = nil
+  if not ok then error(map, 0) end
+  return map
 end
 
 -- Progress in laps: laps done + fraction of the lap (negative before the first crossing).
@@ -618,6 +622,7 @@ function Race:run()
   self.penalty = o.falseStartPenalty or self.penalty or 5
   self:_viewStart()
   if self.phase == "new" then
+    self.scanning = nil -- (a scan a reload cut short starts again, or is not needed)
     self.map = self:_map()
     lastMap = self.map
     self:_viewMap()

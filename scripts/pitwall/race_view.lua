@@ -7,7 +7,8 @@ local View = {}
 -- next version starts its own).
 local publishers = setmetatable({}, { __mode = "k" })
 
-local VIEW_PHASES = { new = "scan", grid = "grid", lights = "lights", racing = "racing",
+-- (A new session that is not scanning is on its way to the grid: it has its map already.)
+local VIEW_PHASES = { new = "grid", grid = "grid", lights = "lights", racing = "racing",
   ending = "ending", done = "done" }
 
 local function driverName(driver)
@@ -26,6 +27,7 @@ end
 --- The session as plain data for pitwall.view.race.
 function View:_viewState()
   local phase = VIEW_PHASES[self.phase or "new"] or tostring(self.phase)
+  if self.phase == "new" and self.scanning then phase = "scan" end
   local state = {
     title = self.title, mode = self.mode, phase = phase, laps = self.laps,
     seconds = self.seconds, green = self.green, rows = {}, lapTimes = {},

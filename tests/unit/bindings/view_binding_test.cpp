@@ -1,0 +1,161 @@
+// pitwall.view (bindings/view_binding.cpp) and the race library's reports to the race view
+// (scripts/pitwall/race_view.lua): hostile tables refused with where they are, and a real race
+// in virtual time whose phases, table and laps reach the feed — laps the same as the feed's own.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+
+#include "bindings/script_host.hpp"
+#include "engine/sim/grid.hpp"
+#include "engine/vehicles/fleet.hpp"
+#include "engine/view/feed.hpp"
+
+using namespace pitwall;
+
+namespace {
+
+std::string error(lua_State* L, const std::string& code) {
+  if (luaL_dostring(L, code.c_str()) == LUA_OK) return "";
+  std::string e = lua_tostring(L, -1) ? lua_tostring(L, -1) : "?";
+  lua_pop(L, 1);
+  return e;
+}
+
+}  // namespace
+
+TEST_CASE("pitwall.view: data goes to the view; anything else is refused with where it is") {
+  Loop loop{ClockKind::Virtual};
+  Fleet fleet{loop};
+  view::Feed feed(loop, fleet, "simulator");
+  HostOptions options;
+  options.view = &feed;
+  ScriptHost host(loop, fleet, nullptr, options);
+  lua_State* L = host.state();
+  CHECK(error(L, "assert(pitwall.view.active)") == "");
+  CHECK(error(L,
+              "pitwall.view.race{title = 'GP', phase = 'grid', rows = {{car = 'a', lap = 1}},"
+              " lapTimes = {['3'] = {4.5, 4.25}}, nan = 0/0, inf = math.huge, empty = {},"
+              " bad = 'caf\\xff\\xfe'}") == "");
+  auto race = feed.state()["race"];
+  CHECK(race["title"] == "GP");
+  CHECK(race["rows"][0]["car"] == "a");
+  CHECK(race["lapTimes"]["3"][1] == 4.25);
+  CHECK(race["nan"].is_null());
+  CHECK(race["inf"].is_null());
+  CHECK(race["empty"].is_array());
+  // invalid UTF-8 reaches a browser replaced, never as a broken feed
+  CHECK(feed.state().dump(-1, ' ', false, nlohmann::json::error_handler_t::replace).find("caf") !=
+        std::string::npos);
+
+  CHECK(error(L, "pitwall.view.race{rows = {{car = print}}}")
+            .find("race.rows[1].car is a function") != std::string::npos);
+  CHECK(error(L, "local t = {} t.self = t pitwall.view.race(t)").find("nested deeper than 16") !=
+        std::string::npos);
+  CHECK(error(L, "local t = {} for i = 1, 200000 do t[i] = i end pitwall.view.race(t)")
+            .find("more than 100000 values") != std::string::npos);
+  CHECK(error(L, "pitwall.view.race{[{}] = 1}").find("has a table key") != std::string::npos);
+  CHECK(error(L, "pitwall.view.race(42)") != "");
+  CHECK(error(L, "pitwall.view.event('hello', 'loud')").find("level must be") != std::string::npos);
+  // a refused table leaves the last good one
+  CHECK(feed.state()["race"]["title"] == "GP");
+  CHECK(error(L, "pitwall.view.race(nil)") == "");
+  CHECK(feed.state()["race"].is_null());
+
+  CHECK(error(L, "pitwall.view.event(string.rep('x', 5000), 'warn')") == "");
+  auto events = feed.state()["events"];
+  CHECK(events.back()["level"] == "warn");
+  CHECK(events.back()["text"].get<std::string>().size() == 1000);
+
+  // a scanned map is drawn (ids, turns), starting with the start piece like a layout
+  CHECK(error(L,
+              "pitwall.view.track{pieces = {{id = 33}, {id = 36}, {id = 17, turn = 'left'},"
+              " {id = 18, turn = 'left'}, {id = 39}, {id = 40}, {id = 20, turn = 'left'},"
+              " {id = 23, turn = 'left'}, {id = 34}}}") == "");
+  REQUIRE(feed.track());
+  CHECK(feed.track()->pieces().front().id == 34);
+  CHECK(feed.track()->pieces()[3].turn == 1);
+  CHECK(feed.state()["track"]["source"] == "scan");
+  CHECK(error(L, "pitwall.view.track{pieces = {{id = 300}}}").find("id 300") != std::string::npos);
+}
+
+TEST_CASE("pitwall.view without a view: nothing happens, nothing fails") {
+  Loop loop{ClockKind::Virtual};
+  Fleet fleet{loop};
+  ScriptHost host(loop, fleet, nullptr, HostOptions{});
+  lua_State* L = host.state();
+  CHECK(error(L,
+              "assert(pitwall.view.active == false) pitwall.view.race{a = 1}"
+              " pitwall.view.event('x')") == "");
+}
+
+TEST_CASE("race library → view: phases in order, the table with drivers, the same laps") {
+  setenv("PITWALL_SCRIPTS", PITWALL_SOURCE_DIR "/scripts", 1);
+  Loop loop{ClockKind::Virtual};
+  SimSession sim;
+  sim.world = std::make_unique<sim::World>(loop, *sim::loadLayout("oval"), 1);
+  Fleet fleet{loop};
+  for (int i = 0; i < 3; ++i) fleet.addSimulated(*sim.world, sim::gridSpec(sim.world->track(), i));
+  auto until = loop.after(std::chrono::seconds(1), [&] { loop.stop(); });
+  loop.run();
+  loop.cancel(until);
+  view::Feed feed(loop, fleet, "simulator");
+  feed.setTrack(sim.world->track(), "layout");
+  HostOptions options;
+  options.view = &feed;
+  ScriptHost host(loop, fleet, &sim, options);
+  std::vector<std::string> phases;
+  nlohmann::json last;
+  std::function<void()> watch = [&] {
+    auto race = feed.state()["race"];
+    if (race.is_object()) {
+      std::string phase = race["phase"];
+      if (phases.empty() || phases.back() != phase) phases.push_back(phase);
+      last = race;
+    }
+    loop.after(std::chrono::milliseconds(50), watch);
+  };
+  loop.after(std::chrono::milliseconds(50), watch);
+  auto started = host.startString(R"(
+    local race = require "pitwall.race"
+    local drivers = require "pitwall.drivers"
+    local names = {"cruiser", "lanekeeper", "follower"}
+    race.laps{laps = 3, title = "Test GP",
+      drivers = function(car, i) return drivers.load(names[i]).new{speed = 900 + 50 * i} end}
+    pitwall.sleep(0.5)
+    pitwall.stop()
+  )",
+                                  "gp");
+  REQUIRE(started);
+  host.onStopRequested = [&] { loop.stop(); };
+  auto cap = loop.after(std::chrono::seconds(300), [&] { loop.stop(); });
+  loop.run();
+  loop.cancel(cap);
+  CHECK(host.errorCount() == 0);
+  std::vector<std::string> expected{"grid", "lights", "racing", "ending", "done"};
+  std::string got;
+  for (const auto& p : phases) got += p + " ";
+  CAPTURE(got);
+  CHECK(phases == expected);
+  REQUIRE(last["rows"].size() == 3);
+  std::vector<std::string> seen;
+  for (const auto& row : last["rows"]) {
+    seen.push_back(row["driver"]);
+    CHECK(row["finished"] == true);
+    CHECK(row["laps"] == 3);
+    // the race library's laps are the last laps the feed counted (the drive to the grid
+    // crossed the line before them), to the millisecond
+    const auto* tracker = feed.tracker(row["number"].get<int>());
+    REQUIRE(tracker);
+    auto mine = last["lapTimes"][std::to_string(row["number"].get<int>())];
+    REQUIRE(mine.size() == 3);
+    REQUIRE(tracker->lapTimes().size() >= 3);
+    for (std::size_t k = 0; k < 3; ++k)
+      CHECK(
+          mine[k].get<double>() ==
+          doctest::Approx(tracker->lapTimes()[tracker->lapTimes().size() - 3 + k]).epsilon(0.001));
+  }
+  std::sort(seen.begin(), seen.end());
+  CHECK(seen == std::vector<std::string>{"cruiser", "follower", "lanekeeper"});
+  CHECK(last["title"] == "Test GP");
+  CHECK(last["status"].is_string());
+}
