@@ -174,6 +174,7 @@ function Race:_map()
   local scanOptions = type(o.scan) == "table" and o.scan or {}
   pitwall.log("info", "race: scan lap with " .. tostring(self.cars[1]))
   self.scanning = true -- (the view shows the phase)
+  self:_viewStart()
   local ok, map = pcall(track.scan, self.cars[1], scanOptions)
   self.scanning = nil
   if not ok then error(map, 0) end
@@ -620,16 +621,17 @@ function Race:run()
   end
   self.phase = self.phase or "new"
   self.penalty = o.falseStartPenalty or self.penalty or 5
-  self:_viewStart()
   if self.phase == "new" then
     self.scanning = nil -- (a scan a reload cut short starts again, or is not needed)
     self.map = self:_map()
     lastMap = self.map
+    self:_viewStart()
     self:_viewMap()
     self:_entries()
     self.phase = "grid"
   else
     for _, e in ipairs(self.order) do e.loc = localize._adopt(e.loc) end
+    self:_viewStart()
     self:_viewMap()
   end
   self:_drivers()

@@ -1,8 +1,10 @@
-// Loads the race view in headless Chromium and checks what an audience would see
+// Loads the race view in headless Chromium (or Firefox) and checks what an audience would see
 // (docs/view.md; the DOM hooks are listed at the top of engine/view/page/view.js).
 //
 //   node browser_check.mjs URL SCREENSHOT.png [--expect-cars N] [--kill PID]
-//                          [--timeout SECONDS] [--chromium PATH]
+//                          [--timeout SECONDS] [--chromium PATH] [--firefox PATH]
+//
+// --firefox PATH drives Debian's firefox-esr through WebDriver BiDi instead of Chromium.
 //
 // Checks: the page loads without script errors or failed requests; "live"; the track is drawn
 // (path.road with a path, lanes, the finish line); N car markers, each with a name; N rows in the
@@ -16,12 +18,13 @@ import puppeteer from "puppeteer-core";
 function usage(message) {
   if (message) console.error(`browser_check: ${message}`);
   console.error("usage: node browser_check.mjs URL SCREENSHOT.png [--expect-cars N] [--kill PID] " +
-                "[--timeout SECONDS] [--chromium PATH]");
+                "[--timeout SECONDS] [--chromium PATH] [--firefox PATH]");
   process.exit(2);
 }
 
 const args = process.argv.slice(2);
-const opts = { cars: null, kill: null, timeout: 30, chromium: process.env.CHROMIUM || "/usr/bin/chromium" };
+const opts = { cars: null, kill: null, timeout: 30, chromium: process.env.CHROMIUM || "/usr/bin/chromium",
+  firefox: null };
 const positional = [];
 for (let i = 0; i < args.length; i++) {
   const a = args[i];
@@ -30,6 +33,7 @@ for (let i = 0; i < args.length; i++) {
   else if (a === "--kill") opts.kill = Number(value());
   else if (a === "--timeout") opts.timeout = Number(value());
   else if (a === "--chromium") opts.chromium = value();
+  else if (a === "--firefox") opts.firefox = value();
   else if (a.startsWith("--")) usage(`unknown option ${a}`);
   else positional.push(a);
 }
@@ -57,8 +61,20 @@ async function waitFor(page, name, fn, arg) {
 
 const loopback = new Set(["127.0.0.1", "localhost", "[::1]", "::1"]);
 let browser;
+const browserName = opts.firefox ? "firefox" : "chromium";
 try {
-  browser = await puppeteer.launch({
+  browser = opts.firefox ? await puppeteer.launch({
+    browser: "firefox",
+    executablePath: opts.firefox,
+    headless: true,
+    defaultViewport: { width: 1600, height: 1000 },
+    // no network but loopback: no updates, no telemetry, no first-run pages
+    extraPrefsFirefox: { "network.proxy.type": 0, "app.update.enabled": false,
+      "datareporting.policy.dataSubmissionEnabled": false, "toolkit.telemetry.enabled": false,
+      "browser.shell.checkDefaultBrowser": false, "network.captive-portal-service.enabled": false,
+      "network.connectivity-service.enabled": false },
+    timeout: timeoutMs,
+  }) : await puppeteer.launch({
     executablePath: opts.chromium,
     headless: true,  // the new headless mode
     args: [
@@ -71,7 +87,7 @@ try {
     timeout: timeoutMs,
   });
 } catch (e) {
-  fail("chromium starts", `${opts.chromium}: ${e.message.split("\n")[0]}`);
+  fail(`${browserName} starts`, `${opts.firefox || opts.chromium}: ${e.message.split("\n")[0]}`);
   process.exit(1);
 }
 

@@ -145,3 +145,29 @@ TEST_CASE("view feed: the race as reported; phases are logged; the track only wh
   for (const auto& e : state["events"]) phases += e["text"].get<std::string>().starts_with("GP: ");
   CHECK(phases == 2);  // grid once, lights once
 }
+
+TEST_CASE("view feed: a car lifted off the track is shown as such, and placed again when back") {
+  Race r;
+  r.feed = std::make_unique<view::Feed>(r.loop, r.fleet, "simulator");
+  r.feed->setTrack(r.world.track(), "layout");
+  auto& car = r.fleet.addSimulated(r.world, sim::CarSpec{.name = "skull"});
+  r.run(0.5);
+  REQUIRE(car.sdkMode(true));
+  REQUIRE(car.setSpeed(600, 2000));
+  r.run(3);
+  auto placed = r.feed->state()["cars"][0];
+  CHECK_FALSE(placed["x"].is_null());
+  CHECK(placed["delocalized"] == false);
+  r.world.cars()[0]->lift();
+  r.run(0.5);
+  auto lifted = r.feed->state()["cars"][0];
+  CHECK(lifted["delocalized"] == true);
+  CHECK(lifted["x"].is_null());  // not drawn where it was: the page lists it as off the track
+  CHECK(lifted["pieceIndex"].is_null());
+  r.world.cars()[0]->place(4, 0);
+  REQUIRE(car.setSpeed(600, 2000));
+  r.run(3);
+  auto back = r.feed->state()["cars"][0];
+  CHECK(back["delocalized"] == false);
+  CHECK_FALSE(back["x"].is_null());
+}
