@@ -1,0 +1,74 @@
+// Reading a --record file back (engine/vehicles/record_reader.hpp), the input of `pitwall replay`:
+// any bytes are a file. Never a crash or an exception; every line is a frame, a bad line with its
+// number and a short reason, valid UTF-8 without control characters, or blank; frames keep the
+// reader's promises (car 1..64, t within range and never going back by more than the slack, a
+// non-empty frame); the parse of one line is the same alone as within the file.
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <sstream>
+#include <string>
+
+#include "engine/vehicles/record_reader.hpp"
+#include "tests/fuzz/fuzz_check.hpp"
+
+using namespace pitwall;
+
+namespace {
+// Valid UTF-8 without control characters: what a terminal shows as it is.
+bool printable(const std::string& s) {
+  for (std::size_t i = 0; i < s.size();) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    if (c < 0x20 || c == 0x7f) return false;
+    std::size_t n = c < 0x80           ? 1
+                    : (c >> 5) == 0x6  ? 2
+                    : (c >> 4) == 0xe  ? 3
+                    : (c >> 3) == 0x1e ? 4
+                                       : 0;
+    if (n == 0 || i + n > s.size()) return false;
+    for (std::size_t k = 1; k < n; ++k)
+      if ((static_cast<unsigned char>(s[i + k]) >> 6) != 0x2) return false;
+    i += n;
+  }
+  return true;
+}
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  std::istringstream in(text);
+  Record record = readRecord(in);
+
+  std::size_t lines = 0;
+  for (char c : text) lines += c == '\n';
+  if (!text.empty() && text.back() != '\n') ++lines;
+  FUZZ_CHECK(record.frames.size() + record.bad.size() <= lines, text);
+
+  double last = -1;
+  std::size_t lastLine = 0;
+  for (const auto& f : record.frames) {
+    FUZZ_CHECK(f.car >= 1 && f.car <= kMaxRecordedCar, text);
+    FUZZ_CHECK(std::isfinite(f.t) && f.t >= 0 && f.t <= kMaxRecordedTime, text);
+    FUZZ_CHECK(last < 0 || f.t >= last - kBackwardsSlack - 1e-9, text);
+    FUZZ_CHECK(!f.bytes.empty(), text);
+    FUZZ_CHECK(f.line > lastLine && f.line <= lines, text);
+    last = std::max(last, f.t);
+    lastLine = f.line;
+  }
+  lastLine = 0;
+  for (const auto& b : record.bad) {
+    FUZZ_CHECK(b.line > lastLine && b.line <= lines, text);
+    FUZZ_CHECK(!b.why.empty() && b.why.size() < 400, text);
+    FUZZ_CHECK(printable(b.why), b.why);
+    lastLine = b.line;
+  }
+  // the first line alone reads the same as in the file
+  std::string first = text.substr(0, text.find('\n'));
+  if (!first.empty() && first.back() == '\r') first.pop_back();
+  if (first.size() <= kMaxLineBytes && first.find_first_not_of(" \t") != std::string::npos) {
+    auto alone = parseRecordLine(first, 0);  // the reader starts at t = 0
+    const bool frame = !record.frames.empty() && record.frames.front().line == 1;
+    FUZZ_CHECK(std::holds_alternative<RecordedFrame>(alone) == frame, first);
+  }
+  return 0;
+}
