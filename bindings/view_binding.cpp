@@ -115,7 +115,10 @@ int track(lua_State* L) {
   if (!feed) return 0;
   luaL_checktype(L, 1, LUA_TTABLE);
   if (feed->track() && feed->trackSourceIsLayout()) return 0;
-  lua_getfield(L, 1, "pieces");
+  // Raw reads only: no metamethod of the script's runs here (a Lua error would jump over the
+  // C++ objects below).
+  lua_pushliteral(L, "pieces");
+  lua_rawget(L, 1);
   if (!lua_istable(L, -1)) throw LuaError("pitwall.view.track: the map has no pieces list");
   std::vector<sim::Piece> pieces;
   const lua_Integer n = static_cast<lua_Integer>(lua_rawlen(L, -1));
@@ -124,14 +127,18 @@ int track(lua_State* L) {
     lua_rawgeti(L, -1, i);
     if (!lua_istable(L, -1))
       throw LuaError("pitwall.view.track: piece " + std::to_string(i) + " is not a table");
-    lua_getfield(L, -1, "id");
-    lua_Integer id = lua_tointeger(L, -1);
-    lua_getfield(L, -2, "turn");
+    lua_pushliteral(L, "id");
+    lua_rawget(L, -2);
+    int isInteger = 0;
+    lua_Integer id = lua_tointegerx(L, -1, &isInteger);
+    lua_pushliteral(L, "turn");
+    lua_rawget(L, -3);
     std::string turn = lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1) : "";
     lua_pop(L, 3);
-    if (id < 0 || id > 255)
-      throw LuaError("pitwall.view.track: piece " + std::to_string(i) + " has id " +
-                     std::to_string(id) + " (0–255)");
+    if (!isInteger || id < 0 || id > 255)
+      throw LuaError("pitwall.view.track: piece " + std::to_string(i) +
+                     " needs an id, a road piece number 0–255" +
+                     (isInteger ? ", not " + std::to_string(id) : ""));
     sim::Piece p;
     p.id = static_cast<std::uint8_t>(id);
     p.type = anki::pieceType(p.id);

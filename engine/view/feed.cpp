@@ -11,6 +11,9 @@ namespace {
 constexpr std::size_t kEventsKept = 200;
 constexpr double kHistorySeconds = 60;
 constexpr double kHistoryStep = 0.1;  // at most 10 speed samples a second
+// Lap times sent per car: the latest ones (lapTimesFrom numbers the first)
+constexpr std::size_t kLapsInState = 1000;
+constexpr std::size_t kLapsInUpdate = 100;
 // Distinct colours for markers (car 1 first); repeats after 12.
 constexpr const char* kColours[] = {"#e6194b", "#3cb44b", "#ffe119", "#4363d8",
                                     "#f58231", "#911eb4", "#42d4f4", "#f032e6",
@@ -77,6 +80,7 @@ Feed::Car& Feed::car(AnkiCar& car) {
 
 void Feed::reset() {
   cars_.clear();
+  ++changes_;
 }
 
 const CarTracker* Feed::tracker(int number) const {
@@ -91,6 +95,7 @@ void Feed::frame(AnkiCar& ankiCar, AnkiCar::Direction d, const anki::Message& m)
                      std::holds_alternative<anki::Delocalized>(m) ||
                      std::holds_alternative<anki::SpeedUpdate>(m);
   if (!moves) return;
+  ++changes_;
   Car& c = car(ankiCar);
   // A position update's time is in the car's state already (one clock read fewer per frame)
   const double now = !clock_ && std::holds_alternative<anki::PositionUpdate>(m)
@@ -108,6 +113,7 @@ void Feed::setTrack(std::optional<sim::Track> track, const std::string& source) 
   track_ = std::move(track);
   trackSource_ = track_ ? source : "none";
   ++trackVersion_;
+  ++changes_;
   for (auto& [number, c] : cars_) c->tracker.setTrack(track_ ? &*track_ : nullptr);
   if (track_)
     event("info", "track: " + track_->name() + " (" + std::to_string(track_->size()) + " pieces, " +
@@ -122,18 +128,22 @@ void Feed::setRace(nlohmann::json race) {
   };
   std::string before = phaseOf(race_), after = phaseOf(race);
   race_ = std::move(race);
+  ++changes_;
   if (!after.empty() && after != before) {
-    std::string title = race_.value("title", std::string("race"));
-    event("info", title + ": " + after);
+    auto title = race_.find("title");
+    event("info", (title != race_.end() && title->is_string() ? title->get<std::string>()
+                                                              : std::string("race")) +
+                      ": " + after);
   }
 }
 
 void Feed::event(const std::string& level, const std::string& text) {
   events_.push_back({nextEvent_++, now(), level, text});
+  ++changes_;
   while (events_.size() > kEventsKept) events_.pop_front();
 }
 
-nlohmann::json Feed::carJson(const AnkiCar& ankiCar) const {
+nlohmann::json Feed::carJson(const AnkiCar& ankiCar, std::size_t laps) const {
   const CarState& s = ankiCar.state();
   const int number = ankiCar.identity().number;
   const Car* c = nullptr;
@@ -164,22 +174,23 @@ nlohmann::json Feed::carJson(const AnkiCar& ankiCar) const {
                                                  : nlohmann::json(nullptr)},
       {"lap", 0},
       {"lapTimes", nlohmann::json::array()},
+      {"lapTimesFrom", 1},
       {"lastLap", nullptr},
       {"bestLap", nullptr},
   };
   if (!c) return j;
   const CarTracker& t = c->tracker;
   j["lap"] = t.laps();
-  nlohmann::json laps = nlohmann::json::array();
-  double best = 0;
-  for (double l : t.lapTimes()) {
-    laps.push_back(round3(l));
-    if (best == 0 || l < best) best = l;
-  }
-  j["lapTimes"] = std::move(laps);
-  if (!t.lapTimes().empty()) {
-    j["lastLap"] = round3(t.lapTimes().back());
-    j["bestLap"] = round3(best);
+  // the latest `laps` of them: a long session's list does not grow every update
+  const auto& all = t.lapTimes();
+  const std::size_t from = all.size() > laps ? all.size() - laps : 0;
+  nlohmann::json times = nlohmann::json::array();
+  for (std::size_t k = from; k < all.size(); ++k) times.push_back(round3(all[k]));
+  j["lapTimes"] = std::move(times);
+  j["lapTimesFrom"] = from + 1;
+  if (!all.empty()) {
+    j["lastLap"] = round3(all.back());
+    j["bestLap"] = round3(*t.bestLap());
   }
   if (track_ && t.pieceIndex() && !s.delocalized && s.on_track) {
     Pose p = pointOnTrack(*track_, *t.pieceIndex(), t.fraction(), s.offset_mm);
@@ -196,7 +207,7 @@ nlohmann::json Feed::carJson(const AnkiCar& ankiCar) const {
 nlohmann::json Feed::carsJson(bool history) const {
   nlohmann::json cars = nlohmann::json::array();
   for (const AnkiCar* car : fleet_.cars()) {
-    nlohmann::json j = carJson(*car);
+    nlohmann::json j = carJson(*car, history ? kLapsInState : kLapsInUpdate);
     if (history) {
       nlohmann::json h = nlohmann::json::array();
       if (auto it = cars_.find(car->identity().number); it != cars_.end())
@@ -208,10 +219,16 @@ nlohmann::json Feed::carsJson(bool history) const {
   return cars;
 }
 
-nlohmann::json Feed::state() const {
+nlohmann::json Feed::eventsJson(std::uint64_t from) const {
   nlohmann::json events = nlohmann::json::array();
   for (const Event& e : events_)
-    events.push_back({{"seq", e.seq}, {"t", round3(e.t)}, {"level", e.level}, {"text", e.text}});
+    if (e.seq >= from)
+      events.push_back({{"seq", e.seq}, {"t", round3(e.t)}, {"level", e.level}, {"text", e.text}});
+  return events;
+}
+
+nlohmann::json Feed::state() const {
+  nlohmann::json events = eventsJson(0);
   return {{"type", "state"},
           {"version", 1},
           {"source", source_},
@@ -224,10 +241,7 @@ nlohmann::json Feed::state() const {
 }
 
 nlohmann::json Feed::update(std::uint64_t& cursor, std::uint64_t& trackSeen) const {
-  nlohmann::json events = nlohmann::json::array();
-  for (const Event& e : events_)
-    if (e.seq >= cursor)
-      events.push_back({{"seq", e.seq}, {"t", round3(e.t)}, {"level", e.level}, {"text", e.text}});
+  nlohmann::json events = eventsJson(cursor);
   cursor = nextEvent_;
   nlohmann::json j = {{"type", "update"},
                       {"time", round3(now())},
@@ -240,6 +254,27 @@ nlohmann::json Feed::update(std::uint64_t& cursor, std::uint64_t& trackSeen) con
     trackSeen = trackVersion_;
   }
   return j;
+}
+
+std::string Feed::updateText(std::uint64_t& cursor, std::uint64_t& trackSeen) const {
+  constexpr auto kReplace = nlohmann::json::error_handler_t::replace;
+  if (sharedAt_ != changes_) {
+    nlohmann::json shared = {{"cars", carsJson(false)},
+                             {"race", race_.is_null() ? nlohmann::json(nullptr) : race_},
+                             {"replay", replay_.is_null() ? nlohmann::json(nullptr) : replay_}};
+    shared_ = shared.dump(-1, ' ', false, kReplace);
+    shared_ = shared_.substr(1, shared_.size() - 2);  // its members, without the braces
+    sharedAt_ = changes_;
+  }
+  std::string text = R"({"type":"update","time":)" + nlohmann::json(round3(now())).dump() + "," +
+                     shared_ + R"(,"events":)" + eventsJson(cursor).dump(-1, ' ', false, kReplace);
+  cursor = nextEvent_;
+  if (trackSeen != trackVersion_) {
+    text += R"(,"track":)" + (track_ ? trackJson(*track_, trackSource_) : nlohmann::json(nullptr))
+                                 .dump(-1, ' ', false, kReplace);
+    trackSeen = trackVersion_;
+  }
+  return text + "}";
 }
 
 }  // namespace pitwall::view

@@ -35,7 +35,10 @@ class Feed {
   // null: no race. Any JSON object is taken as it is.
   void setRace(nlohmann::json race);
   // Playback of a recording (pitwall replay): duration, position, speed, paused.
-  void setReplay(nlohmann::json replay) { replay_ = std::move(replay); }
+  void setReplay(nlohmann::json replay) {
+    replay_ = std::move(replay);
+    ++changes_;
+  }
   // One line of the event log: level "info", "warn" or "error".
   void event(const std::string& level, const std::string& text);
   // The engine's warnings and errors, and its reload lines, join the event log while `on`.
@@ -46,6 +49,13 @@ class Feed {
   // What changed for one browser: the cars and the race now, events after `cursor` (advanced),
   // the track only when it changed since `trackSeen` (updated).
   nlohmann::json update(std::uint64_t& cursor, std::uint64_t& trackSeen) const;
+  // The same update as text, for the server: the cars, the race and the replay are serialised
+  // once per change of the feed and shared by every browser; only the events and the track are
+  // each browser's own.
+  std::string updateText(std::uint64_t& cursor, std::uint64_t& trackSeen) const;
+  // Counts every change of what an update carries but the time: a frame that moved a car, the
+  // race, the replay, an event, the track. Equal counts: nothing to send.
+  std::uint64_t changes() const { return changes_; }
   std::uint64_t eventCursor() const { return nextEvent_; }
   std::uint64_t trackVersion() const { return trackVersion_; }
 
@@ -67,7 +77,7 @@ class Feed {
   struct Car;
   Car& car(AnkiCar& car);
   void frame(AnkiCar& car, AnkiCar::Direction d, const anki::Message& m);
-  nlohmann::json carJson(const AnkiCar& car) const;
+  nlohmann::json carJson(const AnkiCar& car, std::size_t laps) const;
   nlohmann::json carsJson(bool history) const;
 
   double now() const { return clock_ ? clock_() : loop_.seconds(); }
@@ -92,6 +102,10 @@ class Feed {
   decltype(Fleet::onFrame) previousOnFrame_;
   decltype(Fleet::onConnectionChange) previousOnConnection_;
   std::uint64_t logTap_ = 0;
+  std::uint64_t changes_ = 0;
+  mutable std::string shared_;  // updateText's shared part, as of change sharedAt_
+  mutable std::uint64_t sharedAt_ = ~std::uint64_t{0};
+  nlohmann::json eventsJson(std::uint64_t from) const;
 };
 
 }  // namespace pitwall::view

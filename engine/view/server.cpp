@@ -27,6 +27,10 @@ namespace {
 constexpr auto kWriteStall = std::chrono::seconds(5);  // a browser that reads nothing for this long
 constexpr auto kHeartbeat = std::chrono::seconds(1);   // an unchanged state is sent this often
 constexpr std::size_t kMaxIncoming = 64 * 1024;        // a page's message, a request's body
+constexpr auto kRequestTimeout = std::chrono::seconds(10);  // for a request to arrive whole
+constexpr std::size_t kMaxBrowsers = 64;                    // WebSockets at once
+constexpr std::size_t kMaxConnections = 128;  // HTTP connections at once (not upgraded)
+constexpr auto kAcceptRetry = std::chrono::milliseconds(250);  // after a failed accept()
 
 std::string_view contentType(const std::filesystem::path& path) {
   const std::string ext = path.extension().string();
@@ -62,7 +66,7 @@ std::optional<std::filesystem::path> assetPath(const std::filesystem::path& root
 
 struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   Impl(Loop& l, Feed& f, ServerOptions o)
-      : loop(l), feed(f), options(std::move(o)), acceptor(l.io()) {}
+      : loop(l), feed(f), options(std::move(o)), acceptor(l.io()), retry(l.io()) {}
 
   struct Http;
   struct Socket;
@@ -71,6 +75,8 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   Feed& feed;
   ServerOptions options;
   tcp::acceptor acceptor;
+  asio::steady_timer retry;  // accept() again after a failure
+  bool acceptFailing = false;
   bool stopped = false;
   std::list<std::weak_ptr<Http>> https;
   std::list<std::weak_ptr<Socket>> sockets;
@@ -93,9 +99,9 @@ struct Server::Impl::Socket : std::enable_shared_from_this<Socket> {
   websocket::stream<beast::tcp_stream> ws;
   asio::steady_timer pace, stall;
   beast::flat_buffer in;
-  std::string out;       // the message being written
-  std::string lastSent;  // the last update without its time, to skip unchanged ones
-  std::string reply;     // an answer to a page's message, sent before the next update
+  std::string out;                                // the message being written
+  std::uint64_t lastChanges = ~std::uint64_t{0};  // the feed's changes() at the last update
+  std::string reply;  // an answer to a page's message, sent before the next update
   std::uint64_t cursor = 0, trackSeen = 0;
   bool writing = false, closed = false;
   std::chrono::steady_clock::time_point lastWrite{};  // the last message written
@@ -103,6 +109,11 @@ struct Server::Impl::Socket : std::enable_shared_from_this<Socket> {
 
   void start(http::request<http::string_body> request) {
     server->open++;
+    // A small send buffer: a browser that stops reading is noticed (and closed) in seconds,
+    // not after the kernel has buffered megabytes of updates for it.
+    beast::error_code ignored;
+    beast::get_lowest_layer(ws).socket().set_option(asio::socket_base::send_buffer_size(64 * 1024),
+                                                    ignored);
     ws.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
     ws.read_message_max(kMaxIncoming);
     ws.async_accept(request, [self = shared_from_this()](beast::error_code ec) {
@@ -125,18 +136,27 @@ struct Server::Impl::Socket : std::enable_shared_from_this<Socket> {
     });
   }
 
+  // A page's message. Nothing in it may throw out of the loop (that would end the run with
+  // the cars at speed): the type is checked before it is read, and the control's handler is
+  // guarded.
   void message(const std::string& text) {
     nlohmann::json m = nlohmann::json::parse(text, nullptr, false);
-    if (!m.is_object() || m.value("type", std::string()) != "control") return;
-    if (!server->feed.onControl) {
-      reply = nlohmann::json{{"type", "error"},
-                             {"message",
-                              "controls are for replays (pitwall replay FILE --view); "
-                              "this is a live run"}}
-                  .dump();
+    if (!m.is_object()) return;
+    auto type = m.find("type");
+    if (type == m.end() || !type->is_string() || type->get_ref<const std::string&>() != "control")
       return;
+    auto refuse = [this](const std::string& why) {
+      reply = nlohmann::json{{"type", "error"}, {"message", why}}.dump(
+          -1, ' ', false, nlohmann::json::error_handler_t::replace);
+    };
+    if (!server->feed.onControl)
+      return refuse("controls are for replays (pitwall replay FILE --view); this is a live run");
+    try {
+      server->feed.onControl(m);
+    } catch (const std::exception& e) {
+      log::warn("view", std::string("a page's control was refused: ") + e.what());
+      refuse(std::string("control refused: ") + e.what());
     }
-    server->feed.onControl(m);
   }
 
   void write(std::string text) {
@@ -175,20 +195,16 @@ struct Server::Impl::Socket : std::enable_shared_from_this<Socket> {
 
   void send() {
     if (!reply.empty()) return write(std::exchange(reply, {}));
-    auto cursor0 = cursor, seen0 = trackSeen;
-    nlohmann::json u = server->feed.update(cursor, trackSeen);
-    double time = u["time"];
-    u.erase("time");
-    std::string body = u.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-    bool unchanged = body == lastSent && cursor == cursor0 && trackSeen == seen0;
+    const Feed& feed = server->feed;
+    bool unchanged = feed.changes() == lastChanges && feed.eventCursor() == cursor &&
+                     feed.trackVersion() == trackSeen;
     if (unchanged && std::chrono::steady_clock::now() - lastWrite < kHeartbeat) {
       // nothing new: look again a period later, without writing
       lastLook = std::chrono::steady_clock::now();
       return next();
     }
-    lastSent = body;
-    u["time"] = time;
-    write(u.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
+    lastChanges = feed.changes();
+    write(feed.updateText(cursor, trackSeen));  // the cars' part built once for every browser
   }
 
   void close() {
@@ -218,12 +234,27 @@ struct Server::Impl::Http : std::enable_shared_from_this<Http> {
     parser.emplace();
     parser->body_limit(kMaxIncoming);
     parser->header_limit(16 * 1024);
-    stream.expires_after(std::chrono::seconds(30));
+    stream.expires_after(kRequestTimeout);  // a request (or the next on a kept-alive connection)
     http::async_read(stream, buffer, *parser,
                      [self = shared_from_this()](beast::error_code ec, std::size_t) {
+                       // too large: said, then closed (nothing else of it is read)
+                       if (ec == http::error::header_limit)
+                         return self->refuse(http::status::request_header_fields_too_large,
+                                             "the request's header is over 16 KiB\n");
+                       if (ec == http::error::body_limit)
+                         return self->refuse(http::status::payload_too_large,
+                                             "the view takes no body over 64 KiB\n");
                        if (ec) return self->close();
                        self->handle(self->parser->release());
                      });
+  }
+
+  // An answer to a request that is not read to its end; the connection closes after it.
+  void refuse(http::status status, std::string body) {
+    http::request<http::string_body> req;
+    req.version(11);
+    req.keep_alive(false);
+    text(req, status, "text/plain", std::move(body));
   }
 
   template <class Body>
@@ -248,6 +279,7 @@ struct Server::Impl::Http : std::enable_shared_from_this<Http> {
     res.keep_alive(req.keep_alive());
     res.body() = std::move(body);
     res.prepare_payload();
+    if (req.method() == http::verb::head) res.body().clear();  // the length stays, not the body
     respond(std::move(res));
   }
 
@@ -256,6 +288,21 @@ struct Server::Impl::Http : std::enable_shared_from_this<Http> {
     if (websocket::is_upgrade(req)) {
       if (target != "/ws")
         return text(req, http::status::not_found, "text/plain", "WebSocket only on /ws\n");
+      // Only the view's own page: another site open in the same browser may not connect (it
+      // could not be stopped from sending what it likes). Tools that are no browser send no
+      // Origin.
+      if (auto origin = req.find(http::field::origin); origin != req.end()) {
+        auto host = req.find(http::field::host);
+        if (host == req.end() ||
+            std::string(origin->value()) != "http://" + std::string(host->value()))
+          return text(req, http::status::forbidden, "text/plain",
+                      "the race view's WebSocket is for its own page, not for " +
+                          std::string(origin->value()).substr(0, 200) + "\n");
+      }
+      if (server->open >= kMaxBrowsers)
+        return text(
+            req, http::status::service_unavailable, "text/plain",
+            "the view serves " + std::to_string(kMaxBrowsers) + " browsers at most; close one\n");
       stream.expires_never();
       auto socket = std::make_shared<Socket>(server, stream.release_socket());
       server->sockets.push_back(socket);
@@ -289,10 +336,27 @@ struct Server::Impl::Http : std::enable_shared_from_this<Http> {
 
 void Server::Impl::accept() {
   acceptor.async_accept([self = shared_from_this()](beast::error_code ec, tcp::socket socket) {
-    if (self->stopped) return;
-    if (!ec) {
-      self->https.remove_if([](const auto& w) { return w.expired(); });
-      self->sockets.remove_if([](const auto& w) { return w.expired(); });
+    if (self->stopped || ec == asio::error::operation_aborted) return;
+    if (ec) {
+      // Out of file descriptors (EMFILE), buffers, memory: every accept() would fail at once
+      // again, so waiting costs nothing and spinning would take the loop. Said once a streak.
+      if (!self->acceptFailing)
+        log::warn("view", "cannot take a browser's connection (" + ec.message() +
+                              "): trying again every 250 ms");
+      self->acceptFailing = true;
+      self->retry.expires_after(kAcceptRetry);
+      self->retry.async_wait([self](beast::error_code e) {
+        if (!e && !self->stopped) self->accept();
+      });
+      return;
+    }
+    self->acceptFailing = false;
+    self->https.remove_if([](const auto& w) { return w.expired(); });
+    self->sockets.remove_if([](const auto& w) { return w.expired(); });
+    if (self->https.size() >= kMaxConnections) {
+      beast::error_code ignored;  // more connections than any audience: this one is closed
+      socket.close(ignored);
+    } else {
       auto http = std::make_shared<Http>(self, std::move(socket));
       self->https.push_back(http);
       http->read();
@@ -347,6 +411,7 @@ void Server::stop() {
   if (impl_->stopped) return;
   impl_->stopped = true;
   beast::error_code ignored;
+  impl_->retry.cancel();
   impl_->acceptor.close(ignored);
   impl_->closeAll();
 }

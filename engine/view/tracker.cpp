@@ -53,7 +53,11 @@ std::optional<std::size_t> CarTracker::locate(int pieceId, bool reverse) const {
 }
 
 void CarTracker::crossFinish(double now) {
-  if (lastCrossing_) lapTimes_.push_back(now - *lastCrossing_);
+  if (lastCrossing_) {
+    const double lap = now - *lastCrossing_;
+    lapTimes_.push_back(lap);
+    if (!best_ || lap < *best_) best_ = lap;
+  }
   lastCrossing_ = now;
   crossedSinceStartPiece_ = true;
 }

@@ -28,6 +28,7 @@ class CarTracker {
   int laps() const { return static_cast<int>(lapTimes_.size()); }
   const std::vector<double>& lapTimes() const { return lapTimes_; }
   std::optional<double> lastCrossing() const { return lastCrossing_; }
+  std::optional<double> bestLap() const { return best_; }
 
  private:
   void crossFinish(double now);
@@ -41,6 +42,7 @@ class CarTracker {
   bool crossedSinceStartPiece_ = false;
   std::optional<double> lastCrossing_;
   std::vector<double> lapTimes_;
+  std::optional<double> best_;
 };
 
 }  // namespace pitwall::view

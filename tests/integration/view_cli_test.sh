@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # --view as a user runs it (docs/view.md): bound to 127.0.0.1 unless another address is given,
 # a port in use or a bad form refused with a clear error before any car moves, /api/state's
-# schema with every placed car on the drawn road, /ws paced to 30 updates a second, and the view
-# on `repl` and `bridge` too. Python (python3-websocket) plays the page's side.
+# schema with every placed car on the drawn road, /ws paced to 30 updates a second, a flood of
+# connections past the file descriptor limit (no spin), and the view on `repl` and `bridge` too. Python (python3-websocket) plays the page's side.
 source "$(dirname "$0")/lib.sh"
 PIDS=()
 cleanup() {
@@ -142,7 +142,51 @@ port=${port%/}
 check "--view 0.0.0.0:0 binds every address" "0.0.0.0" "$(listening_on "$port")"
 contains "--view 0.0.0.0: warned" "anyone who can reach this machine can watch" "$(cat "$TMP/any.err")"
 
-# 5. The view on the REPL and on a bridge (the bridge without a broker: it keeps retrying, the
+# 5. Out of file descriptors (a flood of connections against a low limit): the engine waits and
+#    says so, it does not spin on accept(); once they are gone the view answers again.
+( ulimit -n 64; exec "$PITWALL" run "$SRC/examples/grand_prix.lua" --view 127.0.0.1:0 \
+    >"$TMP/fd.out" 2>"$TMP/fd.err" ) &
+fdpid=$!
+PIDS+=($fdpid)
+wait_for "$TMP/fd.err" '^view: http://' 20 || fail "no view URL with 64 file descriptors"
+URL=$(grep -oE '^view: http://[^ ]+' "$TMP/fd.err" | head -1 | sed 's/^view: //')
+flood=$(timeout 60 python3 - "$URL" "$fdpid" <<'PY'
+import os, socket, sys, time, urllib.request
+url, pid = sys.argv[1], int(sys.argv[2])
+host, port = url.split("//")[1].rstrip("/").split(":")
+def cpu():  # utime + stime of the engine, seconds
+    f = open(f"/proc/{pid}/stat").read().rsplit(")", 1)[1].split()
+    return (int(f[11]) + int(f[12])) / os.sysconf("SC_CLK_TCK")
+held = []
+for _ in range(100):
+    s = socket.socket()
+    s.settimeout(2)
+    try:
+        s.connect((host, int(port)))
+        held.append(s)
+    except OSError:
+        s.close()
+time.sleep(0.5)  # the engine takes what it can and then runs out
+before = cpu()
+time.sleep(2)
+busy = cpu() - before
+for s in held:
+    s.close()
+ok = False
+deadline = time.time() + 10
+while time.time() < deadline and not ok:
+    try:
+        ok = urllib.request.urlopen(url + "api/state", timeout=2).status == 200
+    except OSError:
+        time.sleep(0.1)
+print("ok" if busy < 1.0 and ok else "bad", round(busy, 2), ok)
+PY
+)
+contains "out of file descriptors: no spin (CPU of 2 s), the view answers after" "ok" "$flood"
+echo "  ($flood)"
+contains "out of file descriptors: said" "cannot take a browser's connection" "$(cat "$TMP/fd.err")"
+
+# 6. The view on the REPL and on a bridge (the bridge without a broker: it keeps retrying, the
 #    view shows its cars meanwhile).
 mkfifo "$TMP/repl.in"
 sleep 60 >"$TMP/repl.in" &

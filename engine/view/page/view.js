@@ -398,8 +398,9 @@ $("#replay-speed").addEventListener("change", (e) => control({ speed: Number(e.t
 // ---------------------------------------------------------------------------------------------
 // Charts (uPlot).
 
-const chartAxes = (xLabel, yLabel) => [
-  { stroke: "#9aa4b2", grid: { stroke: "#2a313c" }, ticks: { stroke: "#2a313c" }, label: xLabel },
+const chartAxes = (xLabel, yLabel, wholeX) => [
+  { stroke: "#9aa4b2", grid: { stroke: "#2a313c" }, ticks: { stroke: "#2a313c" }, label: xLabel,
+    ...(wholeX ? { incrs: [1, 2, 5, 10, 20, 50, 100, 200, 500, 1000] } : {}) },
   { stroke: "#9aa4b2", grid: { stroke: "#2a313c" }, ticks: { stroke: "#2a313c" }, label: yLabel, size: 60 },
 ];
 
@@ -415,7 +416,7 @@ function makeChart(el, cars, xLabel, yLabel, xFmt) {
     series.push({ label: c.name || `car ${c.number}`, stroke: c.color || "#888", width: 2,
                   spanGaps: true, points: { size: 5 } });
   }
-  const opts = { ...chartSize(el), series, axes: chartAxes(xLabel, yLabel),
+  const opts = { ...chartSize(el), series, axes: chartAxes(xLabel, yLabel, xLabel === "lap"),
                  scales: { x: { time: false } }, legend: { live: false }, cursor: { drag: { x: false, y: false } } };
   return new uPlot(opts, [[], ...cars.map(() => [])], el);
 }
@@ -437,14 +438,18 @@ function renderCharts() {
     view.speedChart = makeChart($("#speed-chart"), cars, "time (s)", "mm/s", (v) => `${v.toFixed(1)} s`);
     view.speedKey = key;
   }
-  // Lap times: x = lap number.
+  // Lap times: x = lap number. The race's table has every lap of its session; a car's own list
+  // (no race: a replay, a spectator) holds its latest laps, the first of them lap lapTimesFrom.
   const laps = cars.map((c) => {
     const fromRace = view.race && view.race.lapTimes && view.race.lapTimes[String(c.number)];
-    return fromRace || c.lapTimes || [];
+    if (fromRace) return { from: 1, times: fromRace };
+    return { from: c.lapTimesFrom || 1, times: c.lapTimes || [] };
   });
-  const maxLap = Math.max(0, ...laps.map((l) => l.length));
-  const lx = Array.from({ length: maxLap }, (_, i) => i + 1);
-  view.lapChart?.setData([lx, ...laps.map((l) => lx.map((_, i) => l[i] ?? null))]);
+  const first = Math.min(Infinity, ...laps.filter((l) => l.times.length).map((l) => l.from));
+  const last = Math.max(0, ...laps.map((l) => l.from + l.times.length - 1));
+  const maxLap = Number.isFinite(first) ? last : 0;
+  const lx = maxLap ? Array.from({ length: last - first + 1 }, (_, i) => first + i) : [];
+  view.lapChart?.setData([lx, ...laps.map((l) => lx.map((n) => l.times[n - l.from] ?? null))]);
   setEmpty("#lap-chart", maxLap ? "" : "no lap completed yet");
   // Speeds: one shared time axis, the union of every car's sample times.
   const since = view.time - SPEED_WINDOW_S;

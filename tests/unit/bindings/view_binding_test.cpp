@@ -75,7 +75,18 @@ TEST_CASE("pitwall.view: data goes to the view; anything else is refused with wh
   CHECK(feed.track()->pieces().front().id == 34);
   CHECK(feed.track()->pieces()[3].turn == 1);
   CHECK(feed.state()["track"]["source"] == "scan");
-  CHECK(error(L, "pitwall.view.track{pieces = {{id = 300}}}").find("id 300") != std::string::npos);
+  CHECK(error(L, "pitwall.view.track{pieces = {{id = 300}}}").find("not 300") != std::string::npos);
+  CHECK(error(L, "pitwall.view.track{pieces = {{id = 'x'}}}").find("piece 1 needs an id") !=
+        std::string::npos);
+  CHECK(error(L, "pitwall.view.track{pieces = {{id = 3.5}}}").find("piece 1 needs an id") !=
+        std::string::npos);
+  // a metamethod of the script's is never run inside (raw reads): no "boom", the id is missing
+  CHECK(error(L,
+              "pitwall.view.track{pieces = {setmetatable({}, {__index = function() "
+              "error('boom') end})}}")
+            .find("piece 1 needs an id") != std::string::npos);
+  CHECK(error(L, "pitwall.view.race{title = 5, phase = 'grid'}") == "");  // odd, but data
+  CHECK(feed.state()["events"].back()["text"] == "race: grid");
 }
 
 TEST_CASE("pitwall.view without a view: nothing happens, nothing fails") {

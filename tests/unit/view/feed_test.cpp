@@ -171,3 +171,36 @@ TEST_CASE("view feed: a car lifted off the track is shown as such, and placed ag
   CHECK(back["delocalized"] == false);
   CHECK_FALSE(back["x"].is_null());
 }
+
+TEST_CASE("view feed: a long session's updates carry the latest laps, not all of them") {
+  Race r;
+  r.feed = std::make_unique<view::Feed>(r.loop, r.fleet, "simulator");
+  r.feed->setTrack(r.world.track(), "layout");
+  auto& car = r.fleet.addSimulated(r.world, sim::CarSpec{.name = "skull"});
+  r.run(0.5);
+  REQUIRE(car.sdkMode(true));
+  REQUIRE(car.setSpeed(1400, 5000));
+  r.run(500);  // ≈ 170 laps
+  const auto* tracker = r.feed->tracker(1);
+  REQUIRE(tracker);
+  const int laps = tracker->laps();
+  REQUIRE(laps > 120);
+  std::uint64_t cursor = 0, seen = 0;
+  auto update = r.feed->update(cursor, seen)["cars"][0];
+  CHECK(update["lap"] == laps);
+  CHECK(update["lapTimes"].size() == 100);
+  CHECK(update["lapTimesFrom"] == laps - 99);
+  CHECK(update["lapTimes"].back().get<double>() ==
+        doctest::Approx(tracker->lapTimes().back()).epsilon(1e-6));
+  CHECK(update["bestLap"].get<double>() == doctest::Approx(*tracker->bestLap()).epsilon(1e-6));
+  auto state = r.feed->state()["cars"][0];
+  CHECK(state["lapTimes"].size() == static_cast<std::size_t>(laps));  // ≤ 1000: all of them
+  CHECK(state["lapTimesFrom"] == 1);
+  // the text the server sends is the same update
+  cursor = 0, seen = 0;
+  auto text = nlohmann::json::parse(r.feed->updateText(cursor, seen));
+  CHECK(text["type"] == "update");
+  CHECK(text["cars"][0]["lapTimes"] == update["lapTimes"]);
+  CHECK(text.contains("track"));
+  CHECK_FALSE(nlohmann::json::parse(r.feed->updateText(cursor, seen)).contains("track"));
+}

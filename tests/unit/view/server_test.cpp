@@ -305,6 +305,98 @@ TEST_CASE("view server: hostile messages from a page are refused and the others 
   CHECK(lastControl.find("12.5") != std::string::npos);
 }
 
+TEST_CASE("view server: a message whose type is no string, or a control that throws: no crash") {
+  Rig rig(30);
+  rig.feed.onControl = [](const nlohmann::json& m) {
+    (void)m.at("seek").get<double>();  // throws for {"seek":"x"}: the server must not pass it on
+  };
+  rig.with([&](std::uint16_t port) {
+    WsClient c(port);
+    (void)c.read();
+    c.ws.text(true);
+    for (const char* m :
+         {R"({"type":5})", R"({"type":null})", R"({"type":[]})", R"({"type":{"a":1}})",
+          R"([{"type":"control"}])", R"("control")", R"({"type":"control","seek":"x"})"})
+      c.ws.write(asio::buffer(std::string(m)));
+    bool refused = false;
+    for (int i = 0; i < 100 && !refused; ++i) {
+      auto m = c.read();
+      refused = m["type"] == "error" &&
+                m["message"].get<std::string>().find("control refused") != std::string::npos;
+    }
+    CHECK(refused);
+    WsClient again(port);  // the server (and the process) goes on
+    CHECK(again.read()["type"] == "state");
+  });
+}
+
+TEST_CASE("view server: another site's page may not connect; HEAD has no body; limits answered") {
+  Rig rig;
+  rig.with([&](std::uint16_t port) {
+    auto upgrade = [&](const std::string& origin) {
+      asio::io_context io;
+      websocket::stream<tcp::socket> ws(io);
+      ws.next_layer().connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
+      ws.set_option(websocket::stream_base::decorator([&](websocket::request_type& req) {
+        if (!origin.empty()) req.set(http::field::origin, origin);
+      }));
+      beast::error_code ec;
+      ws.handshake("127.0.0.1:" + std::to_string(port), "/ws", ec);
+      return !ec;
+    };
+    CHECK_FALSE(upgrade("https://evil.example"));
+    CHECK_FALSE(upgrade("http://127.0.0.1:1"));
+    CHECK(upgrade("http://127.0.0.1:" + std::to_string(port)));  // the view's own page
+    CHECK(upgrade(""));                                          // a tool: no Origin
+
+    {  // HEAD: the headers (with the length of the body a GET would get), and nothing after them
+      asio::io_context io;
+      tcp::socket s(io);
+      s.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
+      asio::write(s, asio::buffer(std::string(
+                         "HEAD /api/state HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n")));
+      std::string all;
+      beast::error_code ec;
+      char buf[4096];
+      for (std::size_t n; (n = s.read_some(asio::buffer(buf), ec)) > 0 || !ec;) all.append(buf, n);
+      CHECK(all.starts_with("HTTP/1.1 200"));
+      CHECK(all.find("Content-Length: ") != std::string::npos);
+      CHECK(all.ends_with("\r\n\r\n"));
+    }
+    auto big = get(port, "/", http::verb::get, std::string(20 * 1024, 'x'));
+    CHECK(big.result() == http::status::request_header_fields_too_large);
+  });
+}
+
+TEST_CASE("view server: at most 64 browsers; the next is told so, and the server goes on") {
+  Rig rig;
+  rig.with(
+      [&](std::uint16_t port) {
+        std::vector<std::unique_ptr<WsClient>> clients;
+        for (int i = 0; i < 64; ++i) clients.push_back(std::make_unique<WsClient>(port));
+        bool refused = false;
+        try {
+          WsClient one(port);
+        } catch (const std::exception& e) {
+          refused = true;
+        }
+        CHECK(refused);
+        clients.pop_back();
+        // one closed: room again (the server notices the close first)
+        bool connected = false;
+        for (int attempt = 0; attempt < 50 && !connected; ++attempt) {
+          try {
+            WsClient one(port);
+            connected = one.read()["type"] == "state";
+          } catch (const std::exception&) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+          }
+        }
+        CHECK(connected);
+      },
+      std::chrono::seconds(60));
+}
+
 TEST_CASE("view server: stop() closes every browser (the page says the engine is gone)") {
   Rig rig;
   bool closed = false;
