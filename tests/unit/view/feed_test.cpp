@@ -26,6 +26,16 @@ struct Race {
     loop.at(loop.now() + fromSeconds(seconds), [this] { loop.stop(); });
     loop.run();
   }
+  // A feed on the layout and one car, "skull", driving at `speed`.
+  AnkiCar& driving(int speed, int accel) {
+    feed = std::make_unique<view::Feed>(loop, fleet, "simulator");
+    feed->setTrack(world.track(), "layout");
+    auto& car = fleet.addSimulated(world, sim::CarSpec{.name = "skull"});
+    run(0.5);
+    REQUIRE(car.sdkMode(true));
+    REQUIRE(car.setSpeed(speed, accel));
+    return car;
+  }
 };
 
 }  // namespace
@@ -148,12 +158,7 @@ TEST_CASE("view feed: the race as reported; phases are logged; the track only wh
 
 TEST_CASE("view feed: a car lifted off the track is shown as such, and placed again when back") {
   Race r;
-  r.feed = std::make_unique<view::Feed>(r.loop, r.fleet, "simulator");
-  r.feed->setTrack(r.world.track(), "layout");
-  auto& car = r.fleet.addSimulated(r.world, sim::CarSpec{.name = "skull"});
-  r.run(0.5);
-  REQUIRE(car.sdkMode(true));
-  REQUIRE(car.setSpeed(600, 2000));
+  auto& car = r.driving(600, 2000);
   r.run(3);
   auto placed = r.feed->state()["cars"][0];
   CHECK_FALSE(placed["x"].is_null());
@@ -174,12 +179,7 @@ TEST_CASE("view feed: a car lifted off the track is shown as such, and placed ag
 
 TEST_CASE("view feed: a long session's updates carry the latest laps, not all of them") {
   Race r;
-  r.feed = std::make_unique<view::Feed>(r.loop, r.fleet, "simulator");
-  r.feed->setTrack(r.world.track(), "layout");
-  auto& car = r.fleet.addSimulated(r.world, sim::CarSpec{.name = "skull"});
-  r.run(0.5);
-  REQUIRE(car.sdkMode(true));
-  REQUIRE(car.setSpeed(1400, 5000));
+  r.driving(1400, 5000);
   r.run(500);  // ≈ 170 laps
   const auto* tracker = r.feed->tracker(1);
   REQUIRE(tracker);
