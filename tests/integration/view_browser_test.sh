@@ -41,7 +41,8 @@ rm -f "$ART"/view-*.png
 
 # in_browser NAME BROWSER-OPTION PATH: a long race (it must not end by itself before the check is
 # done), real time, any free port; the page checked in that browser, then SIGINT to pitwall and
-# the open page says "engine gone". Screenshots $ART/view-NAME.png and view-NAME-gone.png.
+# the open page says "engine gone"; an engine started again on the same address, and the page
+# says "live" by itself with the cars back. Screenshots $ART/view-NAME.png and view-NAME-gone.png.
 in_browser() {
   local name=$1 option=$2 path=$3
   LAPS=50 "$PITWALL" run "$SRC/examples/grand_prix.lua" --view 127.0.0.1:0 \
@@ -54,6 +55,8 @@ in_browser() {
   fi
   url=$(grep -oE '^view: http://127\.0\.0\.1:[0-9]+/' "$TMP/err" | head -1 | sed 's/^view: //')
   echo "ok: view at $url ($name)"
+  local addr=${url#http://}
+  addr=${addr%/}
 
   # /api/state answers the whole state as JSON (the page itself uses /ws).
   state=$(timeout 20 node -e '
@@ -63,7 +66,8 @@ in_browser() {
   check "/api/state is the whole state" "state track=oval cars=4" "$state"
 
   timeout -k 5 180 node "$CHECK/browser_check.mjs" "$url" "$ART/view-$name.png" \
-    --expect-cars 4 --kill "$pid" --timeout 40 "$option" "$path"
+    --expect-cars 4 --kill "$pid" --timeout 40 "$option" "$path" \
+    --restart "$(printf '%q ' "$PITWALL" run "$SRC/examples/grand_prix.lua" --view "$addr")"
   check "$name: browser check exit status" 0 "$?"
 
   # pitwall ends on Ctrl-C, as without a browser (exit status 130), within 10 s.

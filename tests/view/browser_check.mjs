@@ -5,6 +5,9 @@
 //                          [--timeout SECONDS] [--chromium PATH] [--firefox PATH]
 //
 // --firefox PATH drives Debian's firefox-esr through WebDriver BiDi instead of Chromium.
+// --restart "COMMAND" (with --kill): once the page says "engine gone", COMMAND starts an engine
+// on the same address (sh -c) and the page must say "live" again by itself, with the cars back;
+// that engine gets SIGINT at the end.
 //
 // Checks: the page loads without script errors or failed requests; "live"; the track is drawn
 // (path.road with a path, lanes, the finish line); N car markers, each with a name; N rows in the
@@ -13,6 +16,7 @@
 // and checks that the open page says "engine gone" (and writes SCREENSHOT-gone.png).
 // Prints one PASS/FAIL line per check; exit status 1 when a check failed, 2 on bad arguments.
 // Every wait is bounded by --timeout (default 30 s); no fixed sleeps.
+import { spawn } from "node:child_process";
 import puppeteer from "puppeteer-core";
 
 function usage(message) {
@@ -34,6 +38,7 @@ for (let i = 0; i < args.length; i++) {
   else if (a === "--timeout") opts.timeout = Number(value());
   else if (a === "--chromium") opts.chromium = value();
   else if (a === "--firefox") opts.firefox = value();
+  else if (a === "--restart") opts.restart = value();
   else if (a.startsWith("--")) usage(`unknown option ${a}`);
   else positional.push(a);
 }
@@ -185,6 +190,20 @@ try {
       const gone = screenshot.replace(/(\.png)?$/i, "-gone.png");
       await page.screenshot({ path: gone, fullPage: true });
       pass("screenshot written", gone);
+      if (opts.restart) {
+        const engine = spawn("sh", ["-c", `exec ${opts.restart}`], { stdio: "ignore" });
+        try {
+          if (await waitFor(page, "live again after the engine restarted",
+              () => document.querySelector("#connection")?.textContent === "live"))
+            pass("live again after the engine restarted");
+          if (opts.cars != null && await waitFor(page, "the cars back",
+              (k) => document.querySelectorAll("#track g.car-marker").length === k &&
+                document.querySelectorAll("#leaderboard tbody tr").length === k, opts.cars))
+            pass("the cars back", `${opts.cars} markers and rows`);
+        } finally {
+          engine.kill("SIGINT");
+        }
+      }
     } catch (e) {
       fail(`SIGINT to ${opts.kill}`, e.message);
     }
