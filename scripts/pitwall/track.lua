@@ -383,6 +383,8 @@ function track.scan(car, options)
         .. "closed track turns a multiple of 4: a curve's direction may be wrong", turns))
     end
     if options.stop ~= false then car:stop() end
+    -- the race view draws what was learnt (a simulator's layout stays: pitwall.view.track)
+    if pitwall.view and pitwall.view.active then pcall(pitwall.view.track, map) end
     return map
   end)
   cancel()
