@@ -1,5 +1,6 @@
 #include "engine/vehicles/record_reader.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -150,6 +151,16 @@ std::variant<RecordedFrame, std::string> parseRecordLine(std::string_view line, 
   return frame;
 }
 
+namespace {
+// How far ahead of the next frame a frame must lie to be taken for the odd one out, not the
+// next for a frame that went back: a jump, not jitter.
+constexpr double kOddJump = 1.0;
+
+std::string timeText(double t) {
+  return shown(json(t));
+}
+}  // namespace
+
 Record readRecord(std::istream& in) {
   Record record;
   std::string buffer(kMaxLineBytes + 1, '\0');
@@ -174,9 +185,33 @@ Record readRecord(std::istream& in) {
       if (in.eof()) break;
       continue;
     }
-    auto parsed = parseRecordLine(line, lastTime);
+    auto parsed = parseRecordLine(line, 0);  // the time's order is checked here, below
     if (auto* frame = std::get_if<RecordedFrame>(&parsed)) {
       frame->line = number;
+      if (frame->t < lastTime - kBackwardsSlack) {
+        // One frame from far ahead (an edited or damaged time) must not take every frame after
+        // it: when this one follows the frame before that one, that one is the odd one out.
+        auto& frames = record.frames;
+        const double before = frames.size() >= 2 ? frames[frames.size() - 2].t : 0;
+        if (!frames.empty() && frame->t >= before - kBackwardsSlack &&
+            frames.back().t - frame->t > kOddJump) {
+          BadLine odd{frames.back().line, "\"t\" " + timeText(frames.back().t) +
+                                              " lies ahead of the frames around it (the next is "
+                                              "at " +
+                                              timeText(frame->t) + ")"};
+          auto at = std::upper_bound(record.bad.begin(), record.bad.end(), odd.line,
+                                     [](std::size_t l, const BadLine& b) { return l < b.line; });
+          record.bad.insert(at, std::move(odd));
+          frames.pop_back();
+          lastTime = frames.empty() ? 0 : std::max(before, frames.back().t);
+        } else {
+          record.bad.push_back({number, "\"t\" " + timeText(frame->t) +
+                                            " goes back in time (the frame before was at " +
+                                            timeText(lastTime) + ")"});
+          if (in.eof()) break;
+          continue;
+        }
+      }
       lastTime = std::max(lastTime, frame->t);
       record.frames.push_back(std::move(*frame));
     } else {

@@ -167,3 +167,22 @@ TEST_CASE("an empty record has no frames and no bad lines") {
   CHECK(r.bad.empty());
   CHECK(read("\n\n  \n").frames.empty());
 }
+
+TEST_CASE("record reader: one frame from far ahead does not take every frame after it") {
+  auto line = [](double t) {
+    return R"({"t":)" + std::to_string(t) + R"(,"car":1,"dir":"rx","hex":"01 17"})" + "\n";
+  };
+  std::istringstream in(line(1.0) + line(1.1) + line(900.0) + "junk\n" + line(1.2) + line(1.3) +
+                        line(1.25) + line(1.4));
+  Record r = readRecord(in);
+  std::vector<std::size_t> kept;
+  for (const auto& f : r.frames) kept.push_back(f.line);
+  // 900 (line 3) is the odd one out; 1.25 after 1.3 is jitter gone back: refused itself
+  CHECK(kept == std::vector<std::size_t>{1, 2, 5, 6, 8});
+  REQUIRE(r.bad.size() == 3);
+  CHECK(r.bad[0].line == 3);
+  CHECK(r.bad[0].why.find("lies ahead of the frames around it") != std::string::npos);
+  CHECK(r.bad[1].line == 4);
+  CHECK(r.bad[2].line == 7);
+  CHECK(r.bad[2].why.find("goes back in time") != std::string::npos);
+}
