@@ -241,19 +241,7 @@ nlohmann::json Feed::state() const {
 }
 
 nlohmann::json Feed::update(std::uint64_t& cursor, std::uint64_t& trackSeen) const {
-  nlohmann::json events = eventsJson(cursor);
-  cursor = nextEvent_;
-  nlohmann::json j = {{"type", "update"},
-                      {"time", round3(now())},
-                      {"cars", carsJson(false)},
-                      {"race", race_.is_null() ? nlohmann::json(nullptr) : race_},
-                      {"replay", replay_.is_null() ? nlohmann::json(nullptr) : replay_},
-                      {"events", std::move(events)}};
-  if (trackSeen != trackVersion_) {
-    j["track"] = track_ ? trackJson(*track_, trackSource_) : nlohmann::json(nullptr);
-    trackSeen = trackVersion_;
-  }
-  return j;
+  return nlohmann::json::parse(updateText(cursor, trackSeen));  // the one way an update is made
 }
 
 std::string Feed::updateText(std::uint64_t& cursor, std::uint64_t& trackSeen) const {
