@@ -114,7 +114,9 @@ struct ReplayOptions {
   bool json = false;     // --json: the summary as one JSON object per car per line
   std::optional<std::string> view;  // --view [[HOST:]PORT]: play it in the race view, real time
   double speed = 1;                 // --speed X with --view: 0.1..100
-  std::string track = "oval";       // --track: the layout the view draws (a record does not say)
+  // --track: the layout the view draws; none: the record's own ("layout" on its first line),
+  // else oval (a record written before records kept their layout)
+  std::optional<std::string> track;
   std::string script;               // --script S.lua: the recorded events reach its handlers
   std::uint64_t seed = 1;           // the script's math.random
 };

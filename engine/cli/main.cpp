@@ -248,8 +248,8 @@ int main(int argc, char** argv) {
       ->needs(replayView);
   replayCmd
       ->add_option("--track", replay.track,
-                   "With --view: the layout drawn, a name or a file (a record does not say which; "
-                   "default oval)")
+                   "With --view: the layout drawn, a name or a file (default: the record's own; "
+                   "oval for a record that keeps none)")
       ->needs(replayView);
   auto* replayScript = replayCmd->add_option(
       "--script", replay.script,

@@ -131,11 +131,15 @@ int replay(const ReplayOptions& options) {
                             " left out; replaying the " + std::to_string(record.frames.size()) +
                             " frames that are whole");
 
+  // The track drawn: --track, else the record's own layout, else the default oval.
   std::optional<sim::Track> track;
   if (options.view) {
-    auto layout = sim::loadLayout(options.track);
+    auto layout = options.track           ? sim::loadLayout(*options.track)
+                  : record.layout.empty() ? sim::loadLayout("oval")
+                                          : sim::parseLayout(record.layout, "recorded");
     if (!layout) {
-      std::cerr << "pitwall replay: " << layout.error() << "\n";
+      std::cerr << "pitwall replay: " << (options.track ? "" : "the record's layout: ")
+                << layout.error() << "\n";
       return 2;
     }
     track = std::move(*layout);

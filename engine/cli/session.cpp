@@ -7,6 +7,8 @@
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
+#include <nlohmann/json.hpp>
+#include <set>
 
 #include "bindings/interrupt.hpp"
 #include "bindings/sandbox.hpp"
@@ -325,9 +327,21 @@ int Session::connectLocalCars(const char* command) {
 void Session::record(const std::string& path) {
   recorder_ = std::make_unique<Recorder>(path);
   flushRecordPeriodically();
-  fleet_.onFrame = [this](AnkiCar& car, AnkiCar::Direction d, std::span<const std::uint8_t> f,
-                          const anki::Message& m) {
-    recorder_->write(loop_.seconds(), car.identity().number, d == AnkiCar::Direction::Tx, f, m);
+  // What a replay needs beside the frames (docs/cli.md "Record format"): the layout on the
+  // record's first line, each car's "carName" on its first line.
+  auto named = std::make_shared<std::set<int>>();
+  auto layout = std::make_shared<std::string>(
+      sim_.world ? ",\"layout\":" + nlohmann::json(sim::layoutText(sim_.world->track())).dump()
+                 : "");
+  fleet_.onFrame = [this, named, layout](AnkiCar& car, AnkiCar::Direction d,
+                                         std::span<const std::uint8_t> f, const anki::Message& m) {
+    std::string extra = std::exchange(*layout, {});
+    if (named->insert(car.identity().number).second)
+      extra +=
+          ",\"carName\":" + nlohmann::json(car.identity().name)
+                                .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+    recorder_->write(loop_.seconds(), car.identity().number, d == AnkiCar::Direction::Tx, f, m,
+                     extra);
   };
 }
 

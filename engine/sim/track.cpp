@@ -91,6 +91,23 @@ std::size_t Track::finishIndex() const {
   return 0;
 }
 
+std::string layoutText(const Track& track) {
+  std::string out;
+  const auto& pieces = track.pieces();
+  for (std::size_t i = 0; i < pieces.size(); ++i) {
+    const Piece& p = pieces[i];
+    if (p.type == anki::PieceType::StartLong && i + 1 < pieces.size() &&
+        pieces[i + 1].type == anki::PieceType::StartShort) {
+      out += out.empty() ? "start" : " start";
+      ++i;  // the pair is one token
+      continue;
+    }
+    const char* kind = p.turn > 0 ? "L" : p.turn < 0 ? "R" : "S";
+    out += (out.empty() ? "" : " ") + std::string(kind) + ":" + std::to_string(p.id);
+  }
+  return out;
+}
+
 double Track::lapLength(double offset_mm) const {
   double sum = 0;
   for (const Piece& p : pieces_) sum += p.length(offset_mm);

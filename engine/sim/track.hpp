@@ -47,6 +47,9 @@ class Track {
 };
 
 Result<Track, std::string> parseLayout(std::string_view text, std::string name = "custom");
+// The layout text of a track, every piece with its id ("start S:36 L:17 …"): parseLayout reads
+// it back to the same pieces (a record keeps the track it was made on this way).
+std::string layoutText(const Track& track);
 // Named layouts: "oval" (the default: start S L L S S L L, ≈4.0 m), and others listed by
 // layoutNames(). loadLayout takes a name or a path to a layout file.
 Result<Track, std::string> namedLayout(std::string_view name);

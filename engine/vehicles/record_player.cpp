@@ -19,12 +19,16 @@ RecordPlayer::RecordPlayer(Loop& loop, Fleet& fleet, std::vector<RecordedFrame> 
     times_.push_back(last);
     cars_[f.car];
   }
+  std::map<int, std::string> names;  // as the record keeps them (a car's first line)
+  for (const auto& f : frames_)
+    if (!f.name.empty()) names.emplace(f.car, f.name);
   for (auto& [number, c] : cars_) {
     numbers_.push_back(number);
     auto link = std::make_unique<ReplayLink>("car " + std::to_string(number));
     c.link = link.get();
     CarIdentity identity;
-    identity.name = "car" + std::to_string(number);
+    auto named = names.find(number);
+    identity.name = named != names.end() ? named->second : "car" + std::to_string(number);
     c.car = &fleet_.add(std::move(link), identity);
   }
   for (const auto& f : frames_)

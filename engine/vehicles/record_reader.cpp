@@ -148,6 +148,20 @@ std::variant<RecordedFrame, std::string> parseRecordLine(std::string_view line, 
   auto bytes = hexBytes(hex->get_ref<const std::string&>());
   if (auto* why = std::get_if<std::string>(&bytes)) return *why;
   frame.bytes = std::move(std::get<std::vector<std::uint8_t>>(bytes));
+  // what a replay is told beside the frames; anything else in them is not a frame's business
+  auto plain = [](const std::string& s) {  // no control character reaches a log or terminal
+    return std::none_of(s.begin(), s.end(),
+                        [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; });
+  };
+  if (auto name = j.find("carName");
+      name != j.end() && name->is_string() &&
+      name->get_ref<const std::string&>().size() <= kMaxRecordedName &&
+      plain(name->get_ref<const std::string&>()))
+    frame.name = name->get<std::string>();
+  if (auto layout = j.find("layout");
+      layout != j.end() && layout->is_string() &&
+      layout->get_ref<const std::string&>().size() <= kMaxRecordedLayout)
+    frame.layout = layout->get<std::string>();
   return frame;
 }
 
@@ -213,6 +227,8 @@ Record readRecord(std::istream& in) {
         }
       }
       lastTime = std::max(lastTime, frame->t);
+      if (!frame->name.empty()) record.names.emplace(frame->car, frame->name);
+      if (record.layout.empty()) record.layout = frame->layout;
       record.frames.push_back(std::move(*frame));
     } else {
       record.bad.push_back({number, std::move(std::get<std::string>(parsed))});

@@ -9,6 +9,7 @@
 // checked before a document is built, numbers are range-checked before they are narrowed.
 #include <cstdint>
 #include <istream>
+#include <map>
 #include <string>
 #include <string_view>
 #include <variant>
@@ -22,6 +23,10 @@ struct RecordedFrame {
   bool tx = false;
   std::vector<std::uint8_t> bytes;
   std::size_t line = 0;  // 1-based line number in the file
+  // A car's first line carries its "carName", the record's first line the simulator's "layout"
+  // (empty when the line has none, or one that is no string of a sensible length).
+  std::string name;
+  std::string layout;
 };
 
 struct BadLine {
@@ -33,6 +38,8 @@ struct Record {
   std::vector<RecordedFrame> frames;  // in file order; times never go backwards by more than
                                       // kBackwardsSlack
   std::vector<BadLine> bad;
+  std::map<int, std::string> names;  // the cars' names, where the record keeps them
+  std::string layout;                // the track's layout text; empty: the record keeps none
 };
 
 inline constexpr std::size_t kMaxLineBytes = 64 * 1024;
@@ -40,6 +47,8 @@ inline constexpr int kMaxRecordedCar = 64;        // as --cars
 inline constexpr double kMaxRecordedTime = 1e7;   // seconds (116 days): any real run is shorter
 inline constexpr double kBackwardsSlack = 0.001;  // seconds a line's t may lie before the last
 inline constexpr int kMaxJsonDepth = 16;          // a frame's line nests 2 deep ("msg")
+inline constexpr std::size_t kMaxRecordedName = 64;      // bytes of a car's name
+inline constexpr std::size_t kMaxRecordedLayout = 8192;  // bytes of a layout's text
 
 // One line (without its newline) against the time of the last good frame; the frame, or why not.
 std::variant<RecordedFrame, std::string> parseRecordLine(std::string_view line, double lastTime);

@@ -99,7 +99,7 @@ void Recorder::flush() {
 }
 
 void Recorder::write(double t, int car, bool tx, std::span<const std::uint8_t> frame,
-                     const anki::Message& message) {
+                     const anki::Message& message, std::string_view extra) {
   char stamp[32];
   std::snprintf(stamp, sizeof stamp, "%.6f", t);
   std::string line;
@@ -107,7 +107,7 @@ void Recorder::write(double t, int car, bool tx, std::span<const std::uint8_t> f
   line.append("{\"t\":").append(stamp).append(",\"car\":").append(std::to_string(car));
   line.append(",\"dir\":\"").append(tx ? "tx" : "rx").append("\",\"hex\":\"");
   line.append(toHex(frame)).append("\",\"msg\":").append(anki::toJson(message).dump());
-  line.append("}\n");
+  line.append(extra).append("}\n");
   ++lines_;
   if (used_ + line.size() > kCapacity) flush();
   if (line.size() > kCapacity) {  // never: a frame is at most 20 bytes

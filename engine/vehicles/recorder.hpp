@@ -24,8 +24,10 @@ class Recorder {
   Recorder(const Recorder&) = delete;
   Recorder& operator=(const Recorder&) = delete;
 
+  // `extra`: more members for this line, each `,"key":value` (a car's first line carries its
+  // "carName", the record's first line the "layout": docs/cli.md "Record format").
   void write(double t, int car, bool tx, std::span<const std::uint8_t> frame,
-             const anki::Message& message);
+             const anki::Message& message, std::string_view extra = {});
   // Everything written so far reaches the file.
   void flush();
   std::size_t lines() const { return lines_; }

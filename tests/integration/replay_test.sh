@@ -109,8 +109,15 @@ pitwall.every(5, function() print("positions " .. seen) end)
 EOF
 out=$($PITWALL replay "$TMP/r.jsonl" --script "$TMP/post.lua" 2>"$TMP/post.err")
 check "--script: exit status" 0 "$?"
-first=$(grep -m1 '"dir":"rx","hex":"[0-9a-f ]*","msg":{[^}]*"name":"position-update"' "$TMP/r.jsonl" |
-  $PY -c 'import json,sys; l=json.loads(sys.stdin.readline()); print("first position: car%d piece %d at %.3f" % (l["car"], l["msg"]["piece_id"], l["t"]))')
+# (the car by the name its first line in the record carries)
+first=$($PY -c '
+import json, sys
+lines = [json.loads(l) for l in open(sys.argv[1])]
+names = {}
+for l in lines:
+    names.setdefault(l["car"], l.get("carName"))
+l = next(l for l in lines if l["dir"] == "rx" and l["msg"]["name"] == "position-update")
+print("first position: %s piece %d at %.3f" % (names[l["car"]], l["msg"]["piece_id"], l["t"]))' "$TMP/r.jsonl")
 contains "--script: onPosition sees the first recorded position, at its time" "$first" "$out"
 contains "--script: timers run in the record's time" "positions " "$out"
 contains "--script: setSpeed is logged, not sent" "set-speed {\"accel_mm_s2\":1000,\"respect_limit\":false,\"speed_mm_s\":300} not sent: a replay" "$(cat "$TMP/post.err")"
@@ -153,7 +160,10 @@ while True:  # the state of another process: polled, bounded
         break
     assert time.time() < deadline, ("no car placed", s["cars"])
     time.sleep(0.05)
-assert s["source"] == "replay" and s["track"]["name"] == "oval" and len(s["cars"]) == 4, s
+# the record keeps its layout and the cars' names: the view draws that track, with those names
+assert s["source"] == "replay" and s["track"]["name"] == "recorded" and len(s["cars"]) == 4, s
+assert len(s["track"]["pieces"]) == 9, s["track"]
+assert [c["name"] for c in s["cars"]] == ["groundshock", "skull", "thermo", "nuke"], s["cars"]
 ws = websocket.create_connection(base.replace("http://", "ws://") + "ws", timeout=10)
 assert json.loads(ws.recv())["type"] == "state"
 def until(pred, what):

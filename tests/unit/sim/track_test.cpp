@@ -156,3 +156,18 @@ TEST_CASE("an unknown piece id is refused with the ids that fit") {
                  "piece id 200 at position 2 is not a known piece; straight ids are 36, 39, 40, "
                  "48, 51"));
 }
+
+TEST_CASE("layoutText: every layout reads back to the same pieces (what a record keeps)") {
+  for (const auto& name : layoutNames()) {
+    CAPTURE(name);
+    auto track = namedLayout(name).value();
+    auto again = parseLayout(layoutText(track), "again");
+    REQUIRE(again);
+    REQUIRE(again->size() == track.size());
+    for (std::size_t i = 0; i < track.size(); ++i) {
+      CHECK(again->pieces()[i].id == track.pieces()[i].id);
+      CHECK(again->pieces()[i].turn == track.pieces()[i].turn);
+    }
+  }
+  CHECK(layoutText(namedLayout("kidney").value()).starts_with("start S:36 L:17"));
+}

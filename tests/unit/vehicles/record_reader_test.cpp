@@ -186,3 +186,21 @@ TEST_CASE("record reader: one frame from far ahead does not take every frame aft
   CHECK(r.bad[2].line == 7);
   CHECK(r.bad[2].why.find("goes back in time") != std::string::npos);
 }
+
+TEST_CASE("record reader: the cars' names and the layout a record keeps; odd ones are not taken") {
+  std::istringstream in(
+      R"({"t":0,"car":1,"dir":"tx","hex":"01 17","layout":"start S L L S S L L","carName":"skull"})"
+      "\n"
+      R"({"t":0,"car":2,"dir":"tx","hex":"01 17","carName":"bad\u0007bell"})"
+      "\n"
+      R"({"t":0,"car":3,"dir":"tx","hex":"01 17","carName":42,"layout":["S"]})"
+      "\n" +
+      std::string(R"({"t":0,"car":4,"dir":"tx","hex":"01 17","carName":")") + std::string(65, 'x') +
+      "\"}\n" + R"({"t":1,"car":1,"dir":"rx","hex":"01 17","carName":"later"})" + "\n");
+  Record r = readRecord(in);
+  CHECK(r.bad.empty());  // still frames: only the extra is not taken
+  REQUIRE(r.frames.size() == 5);
+  CHECK(r.layout == "start S L L S S L L");
+  CHECK(r.names.size() == 1);
+  CHECK(r.names.at(1) == "skull");  // a car's first name stays
+}
