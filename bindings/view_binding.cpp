@@ -114,7 +114,7 @@ int track(lua_State* L) {
   view::Feed* feed = feedOf(L);
   if (!feed) return 0;
   luaL_checktype(L, 1, LUA_TTABLE);
-  if (feed->track() && feed->trackSourceIsLayout()) return 0;
+  if (feed->trackSourceIsLayout()) return 0;
   // Raw reads only: no metamethod of the script's runs here (a Lua error would jump over the
   // C++ objects below).
   lua_pushliteral(L, "pieces");

@@ -139,7 +139,8 @@ int replay(const ReplayOptions& options) {
                                           : sim::parseLayout(record.layout, "recorded");
     if (!layout) {
       std::cerr << "pitwall replay: " << (options.track ? "" : "the record's layout: ")
-                << layout.error() << "\n";
+                << layout.error() << (options.track ? "" : "; draw another with --track LAYOUT")
+                << "\n";
       return 2;
     }
     track = std::move(*layout);

@@ -71,7 +71,6 @@ class Session {
   // A spectator (pitwall view): remote cars are read-only, and the end of the run sends them
   // nothing (they are their bridges' cars, not ours).
   void spectate() { spectator_ = true; }
-  view::Server* viewServer() { return server_.get(); }
   // The one stop path (docs/safety.md): the script is shut down first (nothing of it runs or
   // commands again), then every car gets its stop as its last command, the record is flushed,
   // the stop frames are given time to reach the cars, real cars are disconnected, and

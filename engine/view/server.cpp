@@ -81,7 +81,6 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   std::list<std::weak_ptr<Http>> https;
   std::list<std::weak_ptr<Socket>> sockets;
   std::size_t open = 0;
-  std::uint64_t sent = 0;
 
   void accept();
   void closeAll();
@@ -176,7 +175,6 @@ struct Server::Impl::Socket : std::enable_shared_from_this<Socket> {
                      self->writing = false;
                      self->stall.cancel();
                      if (ec) return self->close();
-                     self->server->sent++;
                      self->next();
                    });
   }
@@ -430,10 +428,6 @@ std::string Server::url() const {
 
 std::size_t Server::clients() const {
   return impl_->open;
-}
-
-std::uint64_t Server::updatesSent() const {
-  return impl_->sent;
 }
 
 Result<ServerOptions, std::string> parseEndpoint(const std::string& text) {

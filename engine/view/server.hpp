@@ -45,7 +45,6 @@ class Server {
   std::uint16_t port() const;
   std::string url() const;
   std::size_t clients() const;  // open WebSockets
-  std::uint64_t updatesSent() const;
 
  private:
   struct Impl;

@@ -27,7 +27,6 @@ class CarTracker {
 
   int laps() const { return static_cast<int>(lapTimes_.size()); }
   const std::vector<double>& lapTimes() const { return lapTimes_; }
-  std::optional<double> lastCrossing() const { return lastCrossing_; }
   std::optional<double> bestLap() const { return best_; }
 
  private:

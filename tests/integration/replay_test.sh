@@ -140,6 +140,14 @@ $PITWALL track show "$TMP/bad.layout" 2>"$TMP/t.err"
 check "track show, a bad layout: exit status 2" 2 "$?"
 contains "track show, a bad layout: the parser's sentence" "the layout does not close" "$(cat "$TMP/t.err")"
 
+# A record whose layout does not parse: --view says so, with the parser's sentence, and how to go
+# on (--track); nothing is served.
+{ printf '{"t":0,"car":1,"dir":"rx","hex":"01 17","layout":"start S L"}\n'; } >"$TMP/badlayout.jsonl"
+$PITWALL replay "$TMP/badlayout.jsonl" --view 127.0.0.1:0 >/dev/null 2>"$TMP/badlayout.err"
+check "a record's broken layout: exit status 2" 2 "$?"
+contains "a record's broken layout: said" "the record's layout: " "$(cat "$TMP/badlayout.err")"
+contains "a record's broken layout: what to do" "--track" "$(cat "$TMP/badlayout.err")"
+
 # The race view: the record played at 5× speed; /api/state has the replay object and the cars
 # placed on the drawn track; a pause and seeks over the WebSocket move the position (and the laps
 # with it, backwards as well as forwards); Ctrl-C ends it.

@@ -417,3 +417,20 @@ TEST_CASE("view server: stop() closes every browser (the page says the engine is
   t.join();
   CHECK(closed);
 }
+
+TEST_CASE(
+    "view server: the page's folder is $PITWALL_VIEW_DIR first; one without a page is passed") {
+  Assets assets;
+  setenv("PITWALL_VIEW_DIR", assets.dir.c_str(), 1);
+  auto found = view::findAssets();
+  REQUIRE(found);
+  CHECK(*found == std::filesystem::weakly_canonical(assets.dir));
+  // a folder without index.html is not taken: the next place is (the build tree's page)
+  setenv("PITWALL_VIEW_DIR", (assets.dir / "vendor").c_str(), 1);
+  auto next = view::findAssets();
+  if (next)
+    CHECK(*next != std::filesystem::weakly_canonical(assets.dir / "vendor"));
+  else
+    CHECK(next.error().find("PITWALL_VIEW_DIR") != std::string::npos);
+  unsetenv("PITWALL_VIEW_DIR");
+}
