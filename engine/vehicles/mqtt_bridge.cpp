@@ -15,7 +15,7 @@ constexpr std::size_t kMaxOtherHosts = 1024;
 namespace {
 constexpr const char* kLog = "mqtt bridge";
 // The bucket of the host's connection intents (car ids never hold a space).
-const std::string kConnection = "connection intents";
+const std::string kConnection = "host intents";
 
 std::string perSecond(const RateLimit& r) {
   std::ostringstream out;
@@ -158,26 +158,37 @@ void MqttBridge::joined(AnkiCar& car) {
   else
     undelivered_.push_back(std::move(discovered));
   emit(topics::carJoined(info, car.state(), t));
+  if (car.state().connected) emit(topics::carConnected(host_, id, t));
   publishCars();
+}
+
+void MqttBridge::publishInformation() {
+  for (const auto& [car, id] : ids_) {
+    auto it = retained_.find("Anki/Car/" + id + "/S/Information");
+    if (it != retained_.end()) emit(it->second);
+  }
 }
 
 void MqttBridge::connectionChanged(AnkiCar& car, bool up) {
   auto it = ids_.find(&car);
   if (it == ids_.end()) return;  // not joined yet: joined() publishes it
-  emit(up ? topics::carOnline(it->second, car.state(), now())
-          : topics::carLeft(it->second, car.state(), now()));
+  auto t = now();
+  emit(up ? topics::carOnline(it->second, car.state(), t)
+          : topics::carLeft(it->second, car.state(), t));
+  emit(up ? topics::carConnected(host_, it->second, t)
+          : topics::carDisconnected(host_, it->second, t));
   publishCars();
 }
 
-void MqttBridge::publishCars() {
+void MqttBridge::publishCars(bool always) {
   std::vector<std::string> cars;
   for (const auto& [car, id] : ids_)
     if (car->state().connected) cars.push_back(id);
   std::sort(cars.begin(), cars.end());
-  if (haveCars_ && cars == lastCars_) return;
+  if (!always && haveCars_ && cars == lastCars_) return;
   haveCars_ = true;
   lastCars_ = cars;
-  emit(topics::hostCars(host_, cars, now()));
+  emit(topics::hostCars(host_, cars));
 }
 
 void MqttBridge::frame(AnkiCar& car, AnkiCar::Direction d, std::span<const std::uint8_t> bytes,
@@ -242,8 +253,8 @@ void MqttBridge::handle(std::string_view topic, std::string_view payload, bool r
       parts->rest.starts_with("S/"))
     return;  // our own status, echoed back by the broker
   std::string t(topic);
-  if (parts && parts->kind == topics::TopicParts::Kind::Car && parts->rest == "I" &&
-      parts->id != "all") {
+  if (parts && parts->kind == topics::TopicParts::Kind::Car &&
+      (parts->rest == "I" || parts->rest.starts_with("I/")) && parts->id != "all") {
     auto own = ownCars();
     if (!std::binary_search(own.begin(), own.end(), parts->id) && ownedElsewhere(parts->id))
       return;  // another bridge's car: its bridge answers
@@ -344,7 +355,10 @@ AnkiCar::Sent MqttBridge::apply(AnkiCar& car, const topics::Action& action) {
               return car.cancelLaneChange();
             return car.send(a.message);
           },
+          // host intents: execute() carries them out, they never reach a car
           [&](const ConnectIntent&) -> AnkiCar::Sent { return true; },
+          [&](const CarsIntent&) -> AnkiCar::Sent { return true; },
+          [&](const CarStatusIntent&) -> AnkiCar::Sent { return true; },
       },
       action);
 }
@@ -373,6 +387,24 @@ void MqttBridge::execute(const topics::Intent& intent, const std::string& topic)
                                   : "connection intent: disconnecting every car");
     auto& f = c->connecting ? connections_.connectAll : connections_.disconnectAll;
     if (f) f();
+    // The seed's controller answers a connection intent with S/Cars: its clients wait for that
+    // publication (they skip a retained one), so it comes even when the list is unchanged; cars
+    // that connect later publish it again.
+    publishCars(true);
+    if (onIntentHandled) onIntentHandled(topic, true);
+    return;
+  }
+  if (std::holds_alternative<topics::CarsIntent>(intent.action) ||
+      std::holds_alternative<topics::CarStatusIntent>(intent.action)) {
+    if (!admit(kConnection, topic)) {
+      if (onIntentHandled) onIntentHandled(topic, false);
+      return;
+    }
+    ++stats_.intents;
+    if (std::holds_alternative<topics::CarsIntent>(intent.action))
+      publishCars(true);
+    else
+      publishInformation();
     if (onIntentHandled) onIntentHandled(topic, true);
     return;
   }
@@ -406,7 +438,7 @@ void MqttBridge::goOffline() {
   for (const auto& [car, id] : ids_) emit(topics::carLeft(id, car->state(), t));
   lastCars_.clear();
   haveCars_ = true;
-  emit(topics::hostCars(host_, {}, t));
+  emit(topics::hostCars(host_, {}));
   emit(topics::hostWill(host_));
   offline_ = true;
 }

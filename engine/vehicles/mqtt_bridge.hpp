@@ -4,7 +4,10 @@
 //
 //  - Every frame a car sends becomes its events and status (topics::fromMessage) plus pitwall's
 //    E/frame; every command sent becomes S/Speed/Desired or S/Lane/Desired; joins and drops become
-//    S/CarStatus, S/Cars, S/Information, S/DiscoveryTime and E/CarDiscovered.
+//    S/CarStatus, S/Cars, S/Information, S/DiscoveryTime, E/CarDiscovered, E/CarConnected and
+//    E/CarDisconnected.
+//  - Intents come in both forms: the seed's controller's (the key names the command, on its
+//    topics Anki/Host/<host>/I/#, Anki/Car/+/I/#, Anki/Car/I) and pitwall's "type" forms.
 //  - Retained status is kept in a cache and republished whole after every (re)connection to the
 //    broker, HostStatus true first; events that happen while the broker is away are dropped, not
 //    queued, so a reconnection brings no flood of stale events.
@@ -92,7 +95,10 @@ class MqttBridge {
   void connected();
   void joined(AnkiCar& car);
   void connectionChanged(AnkiCar& car, bool up);
-  void publishCars();
+  // S/Cars when the list changed, or `always` (the answer to a connection or cars intent).
+  void publishCars(bool always = false);
+  // Every car's S/Information again (a car_status intent).
+  void publishInformation();
   void frame(AnkiCar& car, AnkiCar::Direction d, std::span<const std::uint8_t> bytes,
              const anki::Message& m);
   void message(std::string_view topic, std::string_view payload, bool retained);

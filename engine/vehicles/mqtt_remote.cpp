@@ -51,6 +51,8 @@ RemoteCars::RemoteCars(Loop& loop, Fleet& fleet, MqttClient& client, topics::Pay
   client_.subscribe("Anki/Host/+/S/#", 1);
   client_.subscribe("Anki/Car/+/S/#", 1);
   client_.subscribe("Anki/Car/+/E/frame", 0);
+  // A car of the seed's controller has no E/frame: its whole-message events stand in for it.
+  client_.subscribe("Anki/Car/+/E/Messages/#", 0);
   client_.subscribe(syncTopic_, 1);
   client_.onConnected = [this] {
     brokerUp_ = true;
@@ -175,8 +177,18 @@ void RemoteCars::handle(std::string_view topic, std::string_view payload) {
     } else if (parts->rest == "S/Cars") {
       auto list = topics::readHostCars(payload, limits_);
       if (!list) return complain(list.error());
+      std::set<std::string> named;
       for (const auto& id : *list)
-        if (Car* car = track(id, topic)) car->host = parts->id;
+        if (Car* car = track(id, topic)) {
+          car->host = parts->id;
+          car->listed = car->everListed = true;
+          named.insert(id);
+        }
+      for (auto& [id, car] : cars_) {
+        if (car.host != parts->id) continue;
+        if (!named.count(id)) car.listed = false;
+        update(id, car);
+      }
     } else if (parts->rest == "S/IntentError") {
       // Only errors about intents we might have sent: single-car intents to remote cars.
       for (const auto& [id, car] : cars_)
@@ -192,13 +204,26 @@ void RemoteCars::handle(std::string_view topic, std::string_view payload) {
     if (it == cars_.end() || !it->second.link) return;
     auto bytes = topics::readFrameEvent(payload, limits_);
     if (!bytes) return complain(bytes.error());
+    it->second.frames = true;  // a pitwall bridge: its E/Messages say the same again
     it->second.link->frame(*bytes);
+  } else if (parts->rest.starts_with("E/Messages/")) {
+    auto it = cars_.find(id);
+    if (it == cars_.end() || !it->second.link || it->second.frames) return;
+    auto message =
+        topics::readMessageEvent(std::string_view(parts->rest).substr(11), payload, limits_);
+    if (!message) return complain(message.error());
+    if (!*message) return;  // a message without a counterpart here
+    auto frame = anki::encode(**message);
+    it->second.link->frame(frame.span());
   } else if (parts->rest == "S/Information") {
     auto info = topics::readInformation(id, payload, limits_);
     if (!info) return complain(info.error());
     Car* car = track(id, topic);
     if (!car) return;
-    car->info = *info;
+    if (info->address.empty())
+      car->info.reset();  // the seed's controller blanks it when it drops the car
+    else
+      car->info = *info;
     update(id, *car);
   } else if (parts->rest == "S/CarStatus") {
     auto status = topics::readCarStatus(payload, limits_);
@@ -223,8 +248,16 @@ std::string RemoteCars::uniqueName(const topics::CarInfo& info) const {
   return name;
 }
 
+bool RemoteCars::Car::present() const {
+  // A host's S/Cars, once it named the car, decides (the seed's controller publishes no
+  // S/CarStatus when it drops a car, and the one it published may still say online); a car no
+  // S/Cars named yet is as its S/CarStatus says.
+  if (everListed) return listed && online.value_or(true);
+  return online.value_or(false);
+}
+
 void RemoteCars::update(const std::string& id, Car& car) {
-  bool up = brokerUp_ && car.online && car.info && hostUp(car.host);
+  bool up = brokerUp_ && car.present() && car.info && hostUp(car.host);
   if (!car.link) {
     if (!up) return;
     if (linkedCount() >= kMaxRemoteCars)
@@ -239,7 +272,8 @@ void RemoteCars::update(const std::string& id, Car& car) {
     auto& added = fleet_.add(std::move(link), std::move(identity));
     log::info(kLog, added.label() + " is " + id + (car.host.empty() ? "" : " on host " + car.host));
   }
-  std::string reason = !car.online         ? "its bridge reports it offline"
+  std::string reason = !car.present()      ? "its bridge reports it offline"
+                       : !car.info         ? "its bridge has no information on it"
                        : !hostUp(car.host) ? "host " + car.host + " is offline"
                        : !brokerUp_        ? "lost the MQTT broker"
                                            : "connected through the MQTT broker";

@@ -2,13 +2,17 @@
 // Remote cars (docs/mqtt.md "Remote cars"): the cars that bridges on other hosts publish, put in
 // the local fleet as ordinary AnkiCars. Each has a RemoteLink:
 //
-//  - up while its S/CarStatus says online and its host's S/HostStatus (when known) says true;
-//    down, with the reason, when either turns false or this client loses the broker;
+//  - up while its bridge has it (its host's S/Cars lists it, or before any S/Cars named it, its
+//    S/CarStatus says online) and its host's S/HostStatus (when known) says true; down, with the
+//    reason, when either turns false or this client loses the broker;
 //  - its frames are the bridge's Anki/Car/<car>/E/frame events, fed to AnkiCar::receive, so the
-//    car's state and its Lua events are exactly those of a local car;
-//  - a command becomes an intent on Anki/Car/<car>/I (topics::intentPayload), QoS 1, which the
-//    owning bridge validates again and executes. sdk-mode is the bridge's business (it keeps its
-//    cars in SDK mode) and is accepted without sending anything.
+//    car's state and its Lua events are exactly those of a local car. A car of the seed's
+//    controller has no E/frame: its E/Messages/ANKI_VEHICLE_MSG_V2C_… events are turned back
+//    into the messages they were made from (topics::readMessageEvent);
+//  - a command becomes an intent on Anki/Car/<car>/I (topics::intentPayload, the controller's
+//    form where it has one), QoS 1, which the owning bridge validates again and executes.
+//    sdk-mode is the bridge's business (it keeps its cars in SDK mode) and is accepted without
+//    sending anything.
 //
 // Hostile publications on the tree (docs/mqtt.md "Hostile input") are ignored with a warning:
 // a payload beyond the limits is refused before it is parsed, an exception from any message is
@@ -62,8 +66,12 @@ class RemoteCars {
   struct Car {
     RemoteLink* link = nullptr;  // owned by the fleet once added
     std::optional<topics::CarInfo> info;
-    bool online = false;
-    std::string host;  // from the hosts' S/Cars; empty while unknown
+    std::optional<bool> online;  // its S/CarStatus, once one came
+    std::string host;            // from the hosts' S/Cars; empty while unknown
+    bool listed = false;         // in its host's S/Cars now
+    bool everListed = false;     // some S/Cars named it
+    bool frames = false;         // E/frame seen: its E/Messages are not needed
+    bool present() const;        // its bridge has it connected
   };
   void message(std::string_view topic, std::string_view payload);
   void handle(std::string_view topic, std::string_view payload);

@@ -3,7 +3,9 @@
 #include "engine/vehicles/mqtt_topics.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
+#include <charconv>
 #include <cmath>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -204,6 +206,94 @@ std::string hostId(std::string_view host) {
 
 // ---- car → broker ----
 
+std::string_view messageEventName(const anki::Message& message) {
+  // The names of drive-sdk's protocol.h, as the seed's controller publishes them
+  return std::visit(
+      Overload{
+          [](const anki::PingResponse&) { return "ANKI_VEHICLE_MSG_V2C_PING_RESPONSE"; },
+          [](const anki::VersionResponse&) { return "ANKI_VEHICLE_MSG_V2C_VERSION_RESPONSE"; },
+          [](const anki::BatteryResponse&) {
+            return "ANKI_VEHICLE_MSG_V2C_BATTERY_LEVEL_RESPONSE";
+          },
+          [](const anki::PositionUpdate&) {
+            return "ANKI_VEHICLE_MSG_V2C_LOCALIZATION_POSITION_UPDATE";
+          },
+          [](const anki::TransitionUpdate&) {
+            return "ANKI_VEHICLE_MSG_V2C_LOCALIZATION_TRANSITION_UPDATE";
+          },
+          [](const anki::IntersectionUpdate&) {
+            return "ANKI_VEHICLE_MSG_V2C_LOCALIZATION_INTERSECTION_UPDATE";
+          },
+          [](const anki::Delocalized&) { return "ANKI_VEHICLE_MSG_V2C_VEHICLE_DELOCALIZED"; },
+          [](const anki::CarStatus&) { return "ANKI_VEHICLE_MSG_V2C_VEHICLE_STATUS"; },
+          [](const auto&) { return ""; },
+      },
+      message);
+}
+
+namespace {
+
+// The whole message as the seed's controller publishes it on E/Messages/<name>: its id, the
+// time, then its fields under the controller's keys (ReturnMsgHandler.js). Empty when the
+// controller has no such event.
+Json messageFields(const anki::Message& message) {
+  Json j;
+  std::visit(Overload{
+                 [&](const anki::PositionUpdate& m) {
+                   j = Json{{"offset", mm(m.offset_mm)},
+                            {"speed", m.speed_mm_s},
+                            {"flag", m.parsing_flags},
+                            {"pieceId", m.piece_id},
+                            {"pieceLocation", m.location_id},
+                            // the controller means reverse parsing (its own test of the bit
+                            // never matches: it compares the hex text with "0x40")
+                            {"isReverse", (m.parsing_flags & 0x40) != 0},
+                            {"last_des_speed", m.last_desired_speed_mm_s},
+                            {"last_rec_lane_change_cmd", m.last_recv_lane_change_id},
+                            {"last_exe_lane_change_cmd", m.last_exec_lane_change_id},
+                            {"last_des_lane_change_speed", m.last_desired_lane_change_speed_mm_s}};
+                 },
+                 [&](const anki::TransitionUpdate& m) {
+                   j = Json{{"offset", mm(m.offset_mm)},
+                            {"last_recv_lane_change_id", m.last_recv_lane_change_id},
+                            {"last_exec_lane_change_id", m.last_exec_lane_change_id},
+                            {"last_desired_lane_change_speed_mm_per_sec",
+                             m.last_desired_lane_change_speed_mm_s},
+                            {"ave_follow_line_drift_pixels", m.average_follow_line_drift_px},
+                            {"had_lane_change_activity", m.had_lane_change_activity},
+                            {"uphill_counter", m.uphill_counter},
+                            {"downhill_counter", m.downhill_counter},
+                            {"left_wheel_dist_cm", m.left_wheel_distance_cm},
+                            {"right_wheel_dist_cm", m.right_wheel_distance_cm}};
+                 },
+                 [&](const anki::IntersectionUpdate& m) {
+                   j = Json{{"offset", mm(m.offset_mm)},
+                            {"intersection_code", m.intersection_code},
+                            {"is_exiting", m.is_exiting},
+                            {"mm_since_last_transition_bar", m.mm_since_last_transition_bar}};
+                   if (m.mm_since_last_intersection_code)
+                     j["mm_since_last_intersection_code"] = *m.mm_since_last_intersection_code;
+                 },
+                 [&](const anki::VersionResponse& m) {
+                   j = Json{{"value", m.version}};
+                 },
+                 [&](const anki::BatteryResponse& m) {
+                   j = Json{{"value", m.millivolts}};
+                 },
+                 [&](const anki::CarStatus& m) {
+                   // 0/1 as the controller reads them (readUInt8)
+                   j = Json{{"online", true},
+                            {"charging", m.on_charger ? 1 : 0},
+                            {"onTrack", m.on_track ? 1 : 0}};
+                 },
+                 [&](const auto&) { j = Json::object(); },
+             },
+             message);
+  return j;
+}
+
+}  // namespace
+
 std::vector<Publication> fromMessage(std::string_view car, const anki::Message& message,
                                      std::optional<double> pingRttSeconds, Millis now) {
   std::vector<Publication> out;
@@ -236,6 +326,7 @@ std::vector<Publication> fromMessage(std::string_view car, const anki::Message& 
                    st("Lane/Actual", mm(m.offset_mm));
                  },
                  [&](const anki::IntersectionUpdate& m) {
+                   ev("lane/offset/actual", mm(m.offset_mm));
                    ev("intersection_code", m.intersection_code);
                    ev("mm_since_last_transition_bar", m.mm_since_last_transition_bar);
                    // absent in the older layout: nothing to report then
@@ -250,11 +341,14 @@ std::vector<Publication> fromMessage(std::string_view car, const anki::Message& 
                  [&](const anki::OffsetUpdate& m) { st("Lane/Actual", mm(m.offset_mm)); },
                  [&](const anki::SpeedUpdate& m) { st("Speed/Actual", m.actual_mm_s); },
                  [&](const anki::PingResponse&) {
-                   // round-trip time in ms (µs precision); null when no ping of ours was waiting
+                   // round-trip time in ms (µs precision); null when no ping of ours was waiting.
+                   // S/PingResp is where the seed's controller's clients read it; S/PingResponse
+                   // is pitwall's earlier name, kept for the tools written against it.
                    Json rtt = nullptr;
                    if (pingRttSeconds) rtt = std::round(*pingRttSeconds * 1e6) / 1e3;
-                   out.push_back(status(carTopic(car, "S/PingResponse"),
-                                        Json{{"timestamp", now}, {"rtt_ms", rtt}}));
+                   Json payload{{"timestamp", now}, {"rtt_ms", rtt}};
+                   out.push_back(status(carTopic(car, "S/PingResp"), payload));
+                   out.push_back(status(carTopic(car, "S/PingResponse"), payload));
                  },
                  [&](const anki::VersionResponse& m) { st("Version", m.version); },
                  [&](const anki::BatteryResponse& m) { st("BatteryLevel", m.millivolts); },
@@ -264,6 +358,12 @@ std::vector<Publication> fromMessage(std::string_view car, const anki::Message& 
                  [&](const auto&) {},
              },
              message);
+  if (auto name = messageEventName(message); !name.empty()) {
+    Json j{{"message_id", anki::messageId(message)}, {"timestamp", now}};
+    Json fields = messageFields(message);  // items() refers to it: it must outlive the loop
+    for (auto& [key, value] : fields.items()) j[key] = value;
+    out.push_back({carTopic(car, "E/Messages/" + std::string(name)), j.dump(), kEventQos, false});
+  }
   return out;
 }
 
@@ -318,22 +418,38 @@ Publication hostWill(std::string_view host) {
   return status(hostTopic(host, "S/HostStatus"), Json{{"value", false}});
 }
 
-Publication hostCars(std::string_view host, std::span<const std::string> cars, Millis now) {
+Publication hostCars(std::string_view host, std::span<const std::string> cars) {
   Json list = Json::array();
   for (const auto& c : cars) list.push_back(c);
-  return status(hostTopic(host, "S/Cars"), Json{{"timestamp", now}, {"value", list}});
+  return status(hostTopic(host, "S/Cars"), list);
+}
+
+namespace {
+Publication hostEvent(std::string_view host, std::string_view name, std::string_view car,
+                      Millis now) {
+  return {hostTopic(host, "E/" + std::string(name)),
+          Json{{"timestamp", now}, {"Car", std::string(car)}}.dump(), kEventQos, false};
+}
+}  // namespace
+
+Publication carConnected(std::string_view host, std::string_view car, Millis now) {
+  return hostEvent(host, "CarConnected", car, now);
+}
+
+Publication carDisconnected(std::string_view host, std::string_view car, Millis now) {
+  return hostEvent(host, "CarDisconnected", car, now);
 }
 
 Publication carDiscovered(std::string_view host, std::string_view car, Millis now) {
   // seed 000 §4.4.2.17: an event, so not retained
-  return {hostTopic(host, "E/CarDiscovered"),
-          Json{{"timestamp", now}, {"Car", std::string(car)}}.dump(), kEventQos, false};
+  return hostEvent(host, "CarDiscovered", car, now);
 }
 
 // ---- broker → intents ----
 
 std::vector<std::string> intentSubscriptions(std::string_view host) {
-  return {hostTopic(host, "I/connection"), hostTopic(host, "I"), "Anki/Car/+/I"};
+  // As the seed's controller subscribes: "a/I/#" matches "a/I" itself too
+  return {hostTopic(host, "I/#"), "Anki/Car/+/I/#", "Anki/Car/I"};
 }
 
 namespace {
@@ -371,6 +487,57 @@ Result<int, std::string> integer(const Json& j, const char* key, int lo, int hi,
   return static_cast<int>(d);
 }
 
+// ---- the seed's controller's forms: the key names the command ----
+//
+// {"speed":600,"acceleration":1000}, {"lane":-23} (or {"lane":…,"offset":-23}),
+// {"turn":{"type":3,"time":0}}, {"battery":true}, {"version":true}, {"ping":true}
+// (../shared/protocols/mqtt-topics.md). The controller hands the values to Node's Buffer
+// writers, which take a number or a string holding one: so do these.
+
+// A number, or a string holding one ("600", as a form field gives it); nullopt with the
+// sentence when neither.
+Result<double, std::string> looseNumber(const Json& v, std::string_view key) {
+  if (v.is_number()) return v.get<double>();
+  if (v.is_string()) {
+    const auto& text = v.get_ref<const std::string&>();
+    auto first = text.find_first_not_of(" \t");
+    auto last = text.find_last_not_of(" \t");
+    if (first != std::string::npos) {
+      std::string_view digits(text.data() + first, last - first + 1);
+      double d = 0;
+      auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), d);
+      if (ec == std::errc{} && end == digits.data() + digits.size() && std::isfinite(d)) return d;
+    }
+  }
+  return Unexpected{"\"" + std::string(key) + "\" must be a number, not " + typeName(v) + " (" +
+                    excerpt(v) + ")"};
+}
+
+// The number at `key` rounded to an integer within [lo, hi].
+Result<int, std::string> looseInteger(const Json& v, std::string_view key, int lo, int hi,
+                                      std::string_view unit) {
+  auto d = looseNumber(v, key);
+  if (!d) return Unexpected{d.error()};
+  double r = std::round(*d);
+  std::string u = unit.empty() ? "" : " " + std::string(unit);
+  if (!(r >= lo && r <= hi))
+    return Unexpected{std::string(key) + " " + excerpt(v) + u + " is out of range " +
+                      std::to_string(lo) + ".." + std::to_string(hi) + u};
+  return static_cast<int>(r);
+}
+
+Result<double, std::string> offsetValue(const Json& v, std::string_view key) {
+  namespace L = anki::limits;
+  auto d = looseNumber(v, key);
+  if (!d) return Unexpected{d.error()};
+  if (!(*d >= L::kOffsetMin && *d <= L::kOffsetMax))
+    return Unexpected{std::string(key) + " " + excerpt(v) + " mm is out of range " +
+                      std::to_string(static_cast<int>(L::kOffsetMin)) + ".." +
+                      std::to_string(static_cast<int>(L::kOffsetMax)) +
+                      " mm (beyond it the car leaves the road)"};
+  return *d;
+}
+
 Parsed speedIntent(const Json& j) {
   namespace L = anki::limits;
   auto speed = integer(j, "speed", L::kSpeedMin, L::kSpeedMax, "mm/s");
@@ -387,13 +554,10 @@ Parsed laneIntent(const Json& j) {
   const Json& v = **f;
   if (!v.is_number())
     return Unexpected{"\"offset\" must be a number, not " + typeName(v) + " (" + excerpt(v) + ")"};
-  double d = v.get<double>();
-  if (!(d >= L::kOffsetMin && d <= L::kOffsetMax))
-    return Unexpected{"offset " + v.dump() + " mm is out of range " +
-                      std::to_string(static_cast<int>(L::kOffsetMin)) + ".." +
-                      std::to_string(static_cast<int>(L::kOffsetMax)) + " mm"};
+  auto d = offsetValue(v, "offset");
+  if (!d) return Unexpected{d.error()};
   LaneIntent lane;
-  lane.offset_mm = d;
+  lane.offset_mm = *d;
   if (j.contains("horizontalSpeed")) {
     auto v = integer(j, "horizontalSpeed", L::kLaneSpeedMin, L::kLaneSpeedMax, "mm/s");
     if (!v) return Unexpected{v.error()};
@@ -453,10 +617,136 @@ Parsed commandIntent(const Json& j) {
                     "; expected one of speed, lane, turn, battery, version, ping, message"};
 }
 
-Parsed connectionIntent(const Json& j) {
-  auto f = field(j, "connecting", "true or false");
-  if (!f) return Unexpected{f.error()};
-  const Json& v = **f;
+// The command keys of the controller's forms, in the order error sentences list them.
+constexpr std::array<const char*, 6> kCommandKeys{"speed",   "lane",    "turn",
+                                                  "battery", "version", "ping"};
+constexpr const char* kCommandKeyList = "speed, lane, turn, battery, version or ping";
+
+Parsed keyedSpeed(const Json& j) {
+  namespace L = anki::limits;
+  auto it = j.find("speed");
+  if (it == j.end())
+    return Unexpected{
+        std::string("missing key \"speed\" (a number, mm/s) beside \"acceleration\"")};
+  auto speed = looseInteger(*it, "speed", L::kSpeedMin, L::kSpeedMax, "mm/s");
+  if (!speed) return Unexpected{speed.error()};
+  int accel = kDefaultAccel;  // what the controller's clients send (their STANDARD_ACCELERATION)
+  if (auto a = j.find("acceleration"); a != j.end()) {
+    auto v = looseInteger(*a, "acceleration", L::kAccelMin, L::kAccelMax, "mm/s²");
+    if (!v) return Unexpected{v.error()};
+    accel = *v;
+  }
+  return Action{SpeedIntent{*speed, accel}};
+}
+
+Parsed keyedLane(const Json& j) {
+  namespace L = anki::limits;
+  // The controller reads "offset"; its clients send the offset as "lane" itself, or both.
+  auto it = j.find("offset");
+  const char* key = "offset";
+  if (it == j.end()) {
+    it = j.find("lane");
+    key = "lane";
+  }
+  auto offset = offsetValue(*it, key);
+  if (!offset) return Unexpected{offset.error()};
+  LaneIntent lane;
+  lane.offset_mm = *offset;
+  for (auto [name, out, lo, hi, unit] : {std::tuple{"horizontalSpeed", &lane.h_speed_mm_s,
+                                                    L::kLaneSpeedMin, L::kLaneSpeedMax, "mm/s"},
+                                         std::tuple{"horizontalAcceleration", &lane.h_accel_mm_s2,
+                                                    L::kLaneAccelMin, L::kLaneAccelMax, "mm/s²"}}) {
+    if (auto v = j.find(name); v != j.end()) {
+      auto n = looseInteger(*v, name, lo, hi, unit);
+      if (!n) return Unexpected{n.error()};
+      *out = *n;
+    }
+  }
+  return Action{lane};
+}
+
+Parsed keyedTurn(const Json& j) {
+  const Json& t = j.at("turn");
+  if (!t.is_object())
+    return Unexpected{"\"turn\" must be an object {\"type\":0..4,\"time\":0..1}, not " +
+                      typeName(t) + " (" + excerpt(t) + ")"};
+  auto type = t.find("type");
+  if (type == t.end())
+    return Unexpected{
+        std::string("missing key \"type\" in \"turn\" (0 none, 1 left, 2 right, 3 "
+                    "U-turn, 4 U-turn jump)")};
+  auto kind = looseInteger(*type, "turn type", 0, static_cast<int>(anki::TurnType::UTurnJump), "");
+  if (!kind) return Unexpected{kind.error()};
+  int trigger = 0;  // the controller writes a missing "time" as 0: now
+  if (auto time = t.find("time"); time != t.end()) {
+    auto v =
+        looseInteger(*time, "turn time", 0, static_cast<int>(anki::TurnTrigger::Intersection), "");
+    if (!v) return Unexpected{v.error()};
+    trigger = *v;
+  }
+  return Action{
+      TurnIntent{static_cast<anki::TurnType>(*kind), static_cast<anki::TurnTrigger>(trigger)}};
+}
+
+// A command in the controller's form; `also` is what else the topic takes, for the sentence
+// when the payload names no command.
+Parsed keyedCommand(const Json& j, std::string_view also) {
+  std::vector<std::string> named;
+  for (const char* key : kCommandKeys)
+    if (j.contains(key)) named.emplace_back(key);
+  if (named.empty() && j.contains("acceleration")) named.emplace_back("speed");
+  if (named.empty()) {
+    std::string keys;
+    for (const auto& [key, value] : j.items()) {
+      if (keys.size() > 60) {
+        keys += ", …";
+        break;
+      }
+      keys += (keys.empty() ? "" : ", ") + quote(key, 32);
+    }
+    return Unexpected{"no command in the payload" +
+                      (keys.empty() ? std::string(" (it is empty)") : " (its keys: " + keys + ")") +
+                      "; name one with a key, as the seed's controller takes it — " +
+                      kCommandKeyList +
+                      ", e.g. {\"speed\":600,\"acceleration\":1000} — or with pitwall's \"type\"" +
+                      std::string(also)};
+  }
+  if (named.size() > 1) {
+    std::string list;
+    for (const auto& n : named) list += (list.empty() ? "" : " and ") + n;
+    return Unexpected{"the payload names " + std::to_string(named.size()) + " commands (" + list +
+                      "); send one command per message"};
+  }
+  const std::string& command = named.front();
+  if (command == "speed") return keyedSpeed(j);
+  if (command == "lane") return keyedLane(j);
+  if (command == "turn") return keyedTurn(j);
+  // the controller sends these whatever the value is
+  if (command == "battery") return Action{BatteryIntent{}};
+  if (command == "version") return Action{VersionIntent{}};
+  return Action{PingIntent{}};
+}
+
+Parsed carCommand(const Json& j, std::string_view also = "") {
+  if (j.contains("type")) return commandIntent(j);
+  return keyedCommand(j, also);
+}
+
+// On Anki/Host/<host>/I…: a host intent, or else a command for every car of the host.
+Parsed hostIntent(const Json& j) {
+  std::vector<std::string> named;
+  for (const char* key : {"connecting", "cars", "car_status"})
+    if (j.contains(key)) named.emplace_back(key);
+  if (named.size() > 1)
+    return Unexpected{"the payload names " + std::to_string(named.size()) + " host intents (" +
+                      named[0] + " and " + named[1] + "); send one per message"};
+  if (named.empty()) {
+    if (j.contains("type")) return commandIntent(j);
+    return keyedCommand(j, ", or a host intent: connecting, cars or car_status");
+  }
+  if (named[0] == "cars") return Action{CarsIntent{}};
+  if (named[0] == "car_status") return Action{CarStatusIntent{}};
+  const Json& v = j.at("connecting");
   if (!v.is_boolean())
     return Unexpected{"\"connecting\" must be true or false, not " + typeName(v) + " (" +
                       excerpt(v) + ")"};
@@ -482,23 +772,21 @@ Result<Intent, IntentError> parseIntent(std::string_view host, std::string_view 
   auto fail = [&](std::string message) {
     return Unexpected{IntentError{std::string(topic), std::move(message)}};
   };
-  // Which intent the topic names.
+  // Which intent the topic names: the seed's controller's filters Anki/Host/<host>/I/#,
+  // Anki/Car/+/I/# and Anki/Car/I.
   auto parts = split(topic);
+  const bool anki = parts.size() >= 3 && parts[0] == "Anki";
   Target target;
-  bool connection = false;
-  if (parts.size() >= 3 && parts[0] == "Anki" && parts[1] == "Host" && parts[2] != host &&
-      (parts.size() == 4 || parts.size() == 5) && parts[3] == "I") {
-    return fail("intent addressed to host \"" + quote(parts[2]) + "\", this host is \"" +
-                std::string(host) + "\"");
-  }
-  if (parts.size() == 5 && parts[0] == "Anki" && parts[1] == "Host" && parts[2] == host &&
-      parts[3] == "I" && parts[4] == "connection") {
-    target.kind = Target::Kind::Host;
-    connection = true;
-  } else if (parts.size() == 4 && parts[0] == "Anki" && parts[1] == "Host" && parts[2] == host &&
-             parts[3] == "I") {
-    target.kind = Target::Kind::AllCars;
-  } else if (parts.size() == 4 && parts[0] == "Anki" && parts[1] == "Car" && parts[3] == "I") {
+  bool onHost = false;
+  if (anki && parts[1] == "Host" && parts.size() >= 4 && parts[3] == "I") {
+    if (parts[2] != host)
+      return fail("intent addressed to host \"" + quote(parts[2]) + "\", this host is \"" +
+                  std::string(host) + "\"");
+    onHost = true;
+    target.kind = Target::Kind::AllCars;  // a command there is for every car of this host
+  } else if (anki && parts.size() == 3 && parts[1] == "Car" && parts[2] == "I") {
+    target.kind = Target::Kind::AllCars;  // the controller's global commands
+  } else if (anki && parts[1] == "Car" && parts.size() >= 4 && parts[3] == "I") {
     if (parts[2] == "all") {
       target.kind = Target::Kind::AllCars;
     } else {
@@ -512,8 +800,7 @@ Result<Intent, IntentError> parseIntent(std::string_view host, std::string_view 
     }
   } else {
     return fail("not an intent topic; intents go to Anki/Host/" + std::string(host) +
-                "/I/connection, Anki/Host/" + std::string(host) +
-                "/I, Anki/Car/all/I or Anki/Car/<car>/I");
+                "/I (or below it), Anki/Car/I, Anki/Car/all/I or Anki/Car/<car>/I (or below it)");
   }
 
   auto j = parse(payload, limits);
@@ -521,8 +808,12 @@ Result<Intent, IntentError> parseIntent(std::string_view host, std::string_view 
   if (!j->is_object())
     return fail("payload must be a JSON object, not " + typeName(*j) + " (" + excerpt(*j) + ")");
 
-  Parsed action = connection ? connectionIntent(*j) : commandIntent(*j);
+  Parsed action = onHost ? hostIntent(*j) : carCommand(*j);
   if (!action) return fail(action.error());
+  if (std::holds_alternative<ConnectIntent>(*action) ||
+      std::holds_alternative<CarsIntent>(*action) ||
+      std::holds_alternative<CarStatusIntent>(*action))
+    target.kind = Target::Kind::Host;
   return Intent{std::move(target), std::move(*action)};
 }
 
@@ -546,36 +837,36 @@ Publication intentError(std::string_view host, const IntentError& error, Millis 
 std::optional<std::string> intentPayload(const anki::Message& command) {
   if (!isCommand(command)) return std::nullopt;
   Json j;
-  std::visit(
-      Overload{
-          [&](const anki::SetSpeed& m) {
-            if (m.respect_limit) return;  // no key for it in the seed's intent
-            j = Json{{"type", "speed"}, {"speed", m.speed_mm_s}, {"acceleration", m.accel_mm_s2}};
-          },
-          [&](const anki::ChangeLane& m) {
-            if (m.hop_intent != 0 || m.tag != 0) return;
-            j = Json{{"type", "lane"},
-                     {"offset", mm(m.offset_mm)},
-                     {"horizontalSpeed", m.h_speed_mm_s},
-                     {"horizontalAcceleration", m.h_accel_mm_s2}};
-          },
-          [&](const anki::Turn& m) {
-            j = Json{{"type", "turn"},
-                     {"turnType", static_cast<int>(m.type)},
-                     {"trigger", static_cast<int>(m.trigger)}};
-          },
-          [&](const anki::BatteryRequest&) {
-            j = Json{{"type", "battery"}};
-          },
-          [&](const anki::VersionRequest&) {
-            j = Json{{"type", "version"}};
-          },
-          [&](const anki::PingRequest&) {
-            j = Json{{"type", "ping"}};
-          },
-          [&](const auto&) {},
-      },
-      command);
+  std::visit(Overload{
+                 [&](const anki::SetSpeed& m) {
+                   if (m.respect_limit) return;  // no key for it in the controller's form
+                   j = Json{{"speed", m.speed_mm_s}, {"acceleration", m.accel_mm_s2}};
+                 },
+                 [&](const anki::ChangeLane& m) {
+                   if (m.hop_intent != 0 || m.tag != 0) return;
+                   // "lane" names the command, "offset" is what the controller reads; the
+                   // sideways speed is pitwall's (the controller uses its own)
+                   j = Json{{"lane", mm(m.offset_mm)},
+                            {"offset", mm(m.offset_mm)},
+                            {"horizontalSpeed", m.h_speed_mm_s},
+                            {"horizontalAcceleration", m.h_accel_mm_s2}};
+                 },
+                 [&](const anki::Turn& m) {
+                   j = Json{{"turn", Json{{"type", static_cast<int>(m.type)},
+                                          {"time", static_cast<int>(m.trigger)}}}};
+                 },
+                 [&](const anki::BatteryRequest&) {
+                   j = Json{{"battery", true}};
+                 },
+                 [&](const anki::VersionRequest&) {
+                   j = Json{{"version", true}};
+                 },
+                 [&](const anki::PingRequest&) {
+                   j = Json{{"ping", true}};
+                 },
+                 [&](const auto&) {},
+             },
+             command);
   if (j.is_null()) {
     auto frame = anki::encode(command);
     j = Json{{"type", "message"}, {"frame", toHex(frame.span(), "")}};
@@ -641,6 +932,9 @@ Result<CarInfo, std::string> readInformation(std::string_view car, std::string_v
   auto address = key<std::string>(*j, "address");
   if (!address) return Unexpected{address.error()};
   info.address = *address;
+  // The seed's controller blanks every key when it disconnects the car: an empty address, the
+  // rest not read.
+  if (info.address.empty()) return info;
   auto identifier = unsignedKey<std::uint32_t>(*j, "identifier");
   if (!identifier) return Unexpected{identifier.error()};
   info.identifier = *identifier;
@@ -674,9 +968,27 @@ Result<bool, std::string> readHostStatus(std::string_view payload, const Payload
 
 Result<std::vector<std::string>, std::string> readHostCars(std::string_view payload,
                                                            const PayloadLimits& limits) {
-  auto j = object(payload, limits);
+  auto j = parse(payload, limits);
   if (!j) return Unexpected{j.error()};
-  return key<std::vector<std::string>>(*j, "value");
+  const Json* list = &*j;
+  if (j->is_object()) {
+    if (j->empty()) return std::vector<std::string>{};  // the seed's controller's "none"
+    auto it = j->find("value");                         // earlier pitwall bridges
+    if (it == j->end())
+      return Unexpected{std::string("must be an array of car ids, not an object")};
+    list = &*it;
+  }
+  if (!list->is_array())
+    return Unexpected{"must be an array of car ids, not " + typeName(*list) + " (" +
+                      excerpt(*list) + ")"};
+  std::vector<std::string> out;
+  for (const auto& id : *list) {
+    if (!id.is_string())
+      return Unexpected{"a car id must be a string, not " + typeName(id) + " (" + excerpt(id) +
+                        ")"};
+    out.push_back(id.get<std::string>());
+  }
+  return out;
 }
 
 Result<std::vector<std::uint8_t>, std::string> readFrameEvent(std::string_view payload,
@@ -688,6 +1000,112 @@ Result<std::vector<std::uint8_t>, std::string> readFrameEvent(std::string_view p
   auto bytes = fromHex(*text);
   if (!bytes) return Unexpected{quote(bytes.error())};  // a pair may cut a character in two
   return bytes;
+}
+
+namespace {
+
+// A field of an E/Messages payload: absent is 0 (the controller always sends every key it has);
+// present, it must be a number within the field's type.
+template <typename T>
+Result<T, std::string> wireField(const Json& j, const char* name) {
+  auto it = j.find(name);
+  if (it == j.end()) return T{};
+  if (it->is_boolean()) return static_cast<T>(it->get<bool>());
+  if (!it->is_number())
+    return Unexpected{std::string("\"") + name + "\" must be a number, not " + typeName(*it) +
+                      " (" + excerpt(*it) + ")"};
+  double d = it->get<double>();
+  if constexpr (std::is_floating_point_v<T>) {
+    if (!(std::abs(d) <= std::numeric_limits<T>::max()))
+      return Unexpected{std::string("\"") + name + "\" " + excerpt(*it) + " is beyond a float"};
+    return static_cast<T>(d);
+  } else {
+    constexpr double lo = std::numeric_limits<T>::min(), hi = std::numeric_limits<T>::max();
+    if (!(d >= lo && d <= hi) || d != std::floor(d))
+      return Unexpected{std::string("\"") + name + "\" must be an integer " +
+                        std::to_string(static_cast<long long>(lo)) + ".." +
+                        std::to_string(static_cast<long long>(hi)) + ", not " + excerpt(*it)};
+    return static_cast<T>(d);
+  }
+}
+
+}  // namespace
+
+Result<std::optional<anki::Message>, std::string> readMessageEvent(std::string_view name,
+                                                                   std::string_view payload,
+                                                                   const PayloadLimits& limits) {
+  using Out = Result<std::optional<anki::Message>, std::string>;
+  // Which message the name is, from the one list of names (messageEventName).
+  static const std::vector<anki::Message> kMessages{
+      anki::PingResponse{},   anki::VersionResponse{},  anki::BatteryResponse{},
+      anki::PositionUpdate{}, anki::TransitionUpdate{}, anki::IntersectionUpdate{},
+      anki::Delocalized{},    anki::CarStatus{}};
+  auto kind = std::find_if(kMessages.begin(), kMessages.end(),
+                           [&](const anki::Message& m) { return messageEventName(m) == name; });
+  if (kind == kMessages.end()) return std::optional<anki::Message>{};
+  auto j = object(payload, limits);
+  if (!j) return Unexpected{j.error()};
+  std::string error;
+  // Reads each field into its member; the first bad one is the error.
+  auto read = [&]<typename T>(T& member, const char* key) {
+    if (!error.empty()) return;
+    auto v = wireField<T>(*j, key);
+    if (v)
+      member = *v;
+    else
+      error = v.error();
+  };
+  anki::Message message = *kind;
+  std::visit(Overload{
+                 [&](anki::PositionUpdate& m) {
+                   read(m.offset_mm, "offset");
+                   read(m.speed_mm_s, "speed");
+                   read(m.parsing_flags, "flag");
+                   read(m.piece_id, "pieceId");
+                   read(m.location_id, "pieceLocation");
+                   read(m.last_desired_speed_mm_s, "last_des_speed");
+                   read(m.last_recv_lane_change_id, "last_rec_lane_change_cmd");
+                   read(m.last_exec_lane_change_id, "last_exe_lane_change_cmd");
+                   read(m.last_desired_lane_change_speed_mm_s, "last_des_lane_change_speed");
+                 },
+                 [&](anki::TransitionUpdate& m) {
+                   read(m.offset_mm, "offset");
+                   read(m.last_recv_lane_change_id, "last_recv_lane_change_id");
+                   read(m.last_exec_lane_change_id, "last_exec_lane_change_id");
+                   read(m.last_desired_lane_change_speed_mm_s,
+                        "last_desired_lane_change_speed_mm_per_sec");
+                   read(m.average_follow_line_drift_px, "ave_follow_line_drift_pixels");
+                   read(m.had_lane_change_activity, "had_lane_change_activity");
+                   read(m.uphill_counter, "uphill_counter");
+                   read(m.downhill_counter, "downhill_counter");
+                   read(m.left_wheel_distance_cm, "left_wheel_dist_cm");
+                   read(m.right_wheel_distance_cm, "right_wheel_dist_cm");
+                 },
+                 [&](anki::IntersectionUpdate& m) {
+                   read(m.offset_mm, "offset");
+                   read(m.intersection_code, "intersection_code");
+                   read(m.is_exiting, "is_exiting");
+                   read(m.mm_since_last_transition_bar, "mm_since_last_transition_bar");
+                   if (j->contains("mm_since_last_intersection_code")) {
+                     std::uint16_t v = 0;
+                     read(v, "mm_since_last_intersection_code");
+                     m.mm_since_last_intersection_code = v;
+                   }
+                 },
+                 [&](anki::VersionResponse& m) { read(m.version, "value"); },
+                 [&](anki::BatteryResponse& m) { read(m.millivolts, "value"); },
+                 [&](anki::CarStatus& m) {
+                   std::uint8_t charging = 0, onTrack = 0;
+                   read(charging, "charging");
+                   read(onTrack, "onTrack");
+                   m.on_charger = charging != 0;
+                   m.on_track = onTrack != 0;
+                 },
+                 [&](auto&) {},
+             },
+             message);
+  if (!error.empty()) return Unexpected{error};
+  return Out{std::optional<anki::Message>{std::move(message)}};
 }
 
 }  // namespace pitwall::topics

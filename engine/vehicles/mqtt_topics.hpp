@@ -71,7 +71,9 @@ struct CarInfo {
 
 // ---- car → broker ----
 
-// Events (QoS 0, not retained) and status (QoS 1, retained) for one decoded vehicle message.
+// Events (QoS 0, not retained) and status (QoS 1, retained) for one decoded vehicle message:
+// the seed's events (E/speed, …), the seed's controller's whole-message events
+// (E/Messages/ANKI_VEHICLE_MSG_V2C_…, see messageEventName) and its status topics.
 // `pingRttSeconds` is AnkiCar::lastPingRtt() when `message` is a ping response. Messages with
 // nothing in the tree (controller→vehicle ones, collisions, …) give no publication.
 std::vector<Publication> fromMessage(std::string_view car, const anki::Message& message,
@@ -89,6 +91,10 @@ std::vector<Publication> commandStatus(std::string_view car, const anki::Message
 // A car joined: S/Information, S/DiscoveryTime and S/CarStatus online (charging and onTrack
 // from `state`).
 std::vector<Publication> carJoined(const CarInfo& info, const CarState& state, Millis now);
+// The seed's controller's host events when a car's connection comes up or goes down:
+// Anki/Host/<host>/E/CarConnected and E/CarDisconnected {"timestamp":…,"Car":"<car>"}.
+Publication carConnected(std::string_view host, std::string_view car, Millis now);
+Publication carDisconnected(std::string_view host, std::string_view car, Millis now);
 // A car (re)connected: S/CarStatus with online true.
 Publication carOnline(std::string_view car, const CarState& state, Millis now);
 // A car left: S/CarStatus with online false.
@@ -97,7 +103,9 @@ Publication carLeft(std::string_view car, const CarState& state, Millis now);
 // Host status and events.
 Publication hostOnline(std::string_view host);  // S/HostStatus {"value":true}
 Publication hostWill(std::string_view host);    // the same topic with {"value":false}
-Publication hostCars(std::string_view host, std::span<const std::string> cars, Millis now);
+// S/Cars: a bare JSON array of car ids, as the seed's controller publishes it and its clients
+// iterate it (`[]` when there are none; the controller's `{}` makes a client's forEach throw).
+Publication hostCars(std::string_view host, std::span<const std::string> cars);
 Publication carDiscovered(std::string_view host, std::string_view car, Millis now);
 
 // ---- broker → intents ----
@@ -112,9 +120,16 @@ struct Target {
   bool operator==(const Target&) const = default;
 };
 
-struct ConnectIntent {  // Anki/Host/<host>/I/connection {"connecting":…}
+// Host intents, on Anki/Host/<host>/I or any topic below it (the seed's controller matches both).
+struct ConnectIntent {  // {"connecting":true|false}: scan and connect, or drop every car
   bool connecting = false;
   bool operator==(const ConnectIntent&) const = default;
+};
+struct CarsIntent {  // {"cars":true}: publish S/Cars again
+  bool operator==(const CarsIntent&) const = default;
+};
+struct CarStatusIntent {  // {"car_status":true}: publish every car's S/Information again
+  bool operator==(const CarStatusIntent&) const = default;
 };
 struct SpeedIntent {
   int speed_mm_s = 0;
@@ -150,8 +165,8 @@ struct MessageIntent {
   bool operator==(const MessageIntent&) const = default;
 };
 
-using Action = std::variant<ConnectIntent, SpeedIntent, LaneIntent, TurnIntent, BatteryIntent,
-                            VersionIntent, PingIntent, MessageIntent>;
+using Action = std::variant<ConnectIntent, CarsIntent, CarStatusIntent, SpeedIntent, LaneIntent,
+                            TurnIntent, BatteryIntent, VersionIntent, PingIntent, MessageIntent>;
 
 struct Intent {
   Target target;
@@ -183,8 +198,10 @@ Publication intentError(std::string_view host, const IntentError& error, Millis 
 // ---- the reading side: a remote pitwall's view of the tree ----
 
 // The intent payload that asks a bridge to send `command` (a controller→vehicle message) to a car:
-// the seed's types where one fits (speed, lane, turn, battery, version, ping), else "message".
-// nullopt for a vehicle→controller message.
+// the seed's controller's key-named form where one fits ({"speed":…,"acceleration":…},
+// {"lane":…,"offset":…}, {"turn":{…}}, {"battery":true}, …), which a pitwall bridge and the
+// seed's controller both execute; else pitwall's {"type":"message","frame":…}, which only a
+// pitwall bridge executes. nullopt for a vehicle→controller message.
 std::optional<std::string> intentPayload(const anki::Message& command);
 
 // What a topic of the tree is about: Anki/Car/<car>/<rest> or Anki/Host/<host>/<rest>.
@@ -206,9 +223,20 @@ Result<CarOnline, std::string> readCarStatus(std::string_view payload,
                                              const PayloadLimits& limits = {});
 Result<bool, std::string> readHostStatus(std::string_view payload,
                                          const PayloadLimits& limits = {});
+// S/Cars: the bare array (the seed's controller's `{}` reads as none; the object
+// {"timestamp":…,"value":[…]} of earlier pitwall bridges is read too).
 Result<std::vector<std::string>, std::string> readHostCars(std::string_view payload,
                                                            const PayloadLimits& limits = {});
 Result<std::vector<std::uint8_t>, std::string> readFrameEvent(std::string_view payload,
                                                               const PayloadLimits& limits = {});
+
+// The seed's controller's whole-message events: "ANKI_VEHICLE_MSG_V2C_LOCALIZATION_POSITION_UPDATE"
+// for a position update, …; empty for a message without one.
+std::string_view messageEventName(const anki::Message& message);
+// E/Messages/<name> back into the vehicle message it was made from (a car of the seed's
+// controller has no E/frame): the fields its payload carries, the rest zero. nullopt for a name
+// without a message of its own (the payload is not read then); an error names the bad key.
+Result<std::optional<anki::Message>, std::string> readMessageEvent(
+    std::string_view name, std::string_view payload, const PayloadLimits& limits = {});
 
 }  // namespace pitwall::topics

@@ -194,10 +194,9 @@ inline std::vector<std::string> sorted(std::vector<std::string> v) {
 inline void waitForCars(Loop& loop, Observer& o, Host& h) {
   REQUIRE(runUntil(loop, [&] {
     auto cars = o.json(kCars);
-    return o.json(kHostStatus) == Json{{"value", true}} && cars.is_object() &&
-           cars["value"].size() == 2;
+    return o.json(kHostStatus) == Json{{"value", true}} && cars.is_array() && cars.size() == 2;
   }));
-  CHECK(o.json(kCars)["value"].get<std::vector<std::string>>() == sorted({h.id(0), h.id(1)}));
+  CHECK(o.json(kCars).get<std::vector<std::string>>() == sorted({h.id(0), h.id(1)}));
 }
 
 // The usual set-up: a private broker, an observer subscribed to the whole tree, and a bridge of

@@ -24,6 +24,11 @@ Publication st(const std::string& suffix, const std::string& value) {
           "{\"timestamp\":1700000000123,\"value\":" + value + "}", 1, true};
 }
 
+// The seed's controller's whole-message event: E/Messages/ANKI_VEHICLE_MSG_V2C_<name>.
+Publication whole(const std::string& name, const std::string& fields) {
+  return {"Anki/Car/" + kCar + "/E/Messages/ANKI_VEHICLE_MSG_V2C_" + name, fields, 0, false};
+}
+
 Result<Intent, IntentError> parse(std::string_view topic, std::string_view payload) {
   return parseIntent("pit1", topic, payload, kCars);
 }
@@ -76,6 +81,11 @@ TEST_CASE("mqtt topics: a position update gives the six seed events and speed an
                   ev("lane/desired_lane_change_speed", "300"),
                   st("Speed/Actual", "612"),
                   st("Lane/Actual", "-23.1"),
+                  whole("LOCALIZATION_POSITION_UPDATE",
+                        R"({"message_id":39,"timestamp":1700000000123,"offset":-23.1,"speed":612,)"
+                        R"("flag":0,"pieceId":33,"pieceLocation":7,"isReverse":false,)"
+                        R"("last_des_speed":600,"last_rec_lane_change_cmd":0,)"
+                        R"("last_exe_lane_change_cmd":0,"last_des_lane_change_speed":300})"),
               });
 }
 
@@ -100,6 +110,13 @@ TEST_CASE("mqtt topics: a transition update gives its fields as events and the l
                   ev("left_wheel_dist_cm", "21"),
                   ev("right_wheel_dist_cm", "22"),
                   st("Lane/Actual", "44.5"),
+                  whole("LOCALIZATION_TRANSITION_UPDATE",
+                        R"({"message_id":41,"timestamp":1700000000123,"offset":44.5,)"
+                        R"("last_recv_lane_change_id":0,"last_exec_lane_change_id":0,)"
+                        R"("last_desired_lane_change_speed_mm_per_sec":250,)"
+                        R"("ave_follow_line_drift_pixels":-3,"had_lane_change_activity":1,)"
+                        R"("uphill_counter":2,"downhill_counter":4,"left_wheel_dist_cm":21,)"
+                        R"("right_wheel_dist_cm":22})"),
               });
 }
 
@@ -108,27 +125,42 @@ TEST_CASE("mqtt topics: an intersection update gives its code and distances") {
   m.intersection_code = 3;
   m.mm_since_last_transition_bar = 120;
   m.mm_since_last_intersection_code = 450;
+  m.offset_mm = 23;
+  m.is_exiting = 1;
   CHECK(fromMessage(kCar, m, std::nullopt, kNow) ==
-        std::vector<Publication>{ev("intersection_code", "3"),
-                                 ev("mm_since_last_transition_bar", "120"),
-                                 ev("mm_since_last_intersection_code", "450")});
+        std::vector<Publication>{
+            ev("lane/offset/actual", "23.0"), ev("intersection_code", "3"),
+            ev("mm_since_last_transition_bar", "120"), ev("mm_since_last_intersection_code", "450"),
+            whole("LOCALIZATION_INTERSECTION_UPDATE",
+                  R"({"message_id":42,"timestamp":1700000000123,"offset":23.0,)"
+                  R"("intersection_code":3,"is_exiting":1,"mm_since_last_transition_bar":120,)"
+                  R"("mm_since_last_intersection_code":450})")});
   SUBCASE("the older layout has no distance since the last code, so none is published") {
     m.mm_since_last_intersection_code.reset();
-    CHECK(fromMessage(kCar, m, std::nullopt, kNow).size() == 2);
+    auto ps = fromMessage(kCar, m, std::nullopt, kNow);
+    CHECK(ps.size() == 4);
+    CHECK(ps.back().payload.find("mm_since_last_intersection_code") == std::string::npos);
   }
 }
 
 TEST_CASE("mqtt topics: delocalized is an event with the timestamp only") {
   CHECK(fromMessage(kCar, anki::Delocalized{}, std::nullopt, kNow) ==
         std::vector<Publication>{
-            {"Anki/Car/" + kCar + "/E/Delocalized", "{\"timestamp\":1700000000123}", 0, false}});
+            {"Anki/Car/" + kCar + "/E/Delocalized", "{\"timestamp\":1700000000123}", 0, false},
+            whole("VEHICLE_DELOCALIZED", R"({"message_id":43,"timestamp":1700000000123})")});
 }
 
 TEST_CASE("mqtt topics: replies and reports become retained status") {
   CHECK(fromMessage(kCar, anki::VersionResponse{0x2b6e}, std::nullopt, kNow) ==
-        std::vector<Publication>{st("Version", "11118")});
+        std::vector<Publication>{
+            st("Version", "11118"),
+            whole("VERSION_RESPONSE",
+                  R"({"message_id":25,"timestamp":1700000000123,"value":11118})")});
   CHECK(fromMessage(kCar, anki::BatteryResponse{3912}, std::nullopt, kNow) ==
-        std::vector<Publication>{st("BatteryLevel", "3912")});
+        std::vector<Publication>{
+            st("BatteryLevel", "3912"),
+            whole("BATTERY_LEVEL_RESPONSE",
+                  R"({"message_id":27,"timestamp":1700000000123,"value":3912})")});
   CHECK(fromMessage(kCar, anki::OffsetUpdate{-68.0f, 1}, std::nullopt, kNow) ==
         std::vector<Publication>{st("Lane/Actual", "-68.0")});
   CHECK(fromMessage(kCar, anki::SpeedUpdate{600, 1000, 598}, std::nullopt, kNow) ==
@@ -136,17 +168,24 @@ TEST_CASE("mqtt topics: replies and reports become retained status") {
   anki::CarStatus status;
   status.on_track = true;
   status.on_charger = false;
-  CHECK(fromMessage(kCar, status, std::nullopt, kNow) ==
-        std::vector<Publication>{
-            {"Anki/Car/" + kCar + "/S/CarStatus",
-             R"({"timestamp":1700000000123,"online":true,"charging":false,"onTrack":true})", 1,
-             true}});
+  CHECK(
+      fromMessage(kCar, status, std::nullopt, kNow) ==
+      std::vector<Publication>{
+          {"Anki/Car/" + kCar + "/S/CarStatus",
+           R"({"timestamp":1700000000123,"online":true,"charging":false,"onTrack":true})", 1, true},
+          whole("VEHICLE_STATUS", R"({"message_id":63,"timestamp":1700000000123,"online":true,)"
+                                  R"("charging":0,"onTrack":1})")});
 }
 
 TEST_CASE("mqtt topics: a ping response carries the round-trip time in ms, or null") {
+  // S/PingResp where the controller's clients read it, S/PingResponse as pitwall published it
   CHECK(fromMessage(kCar, anki::PingResponse{}, 0.0125, kNow) ==
-        std::vector<Publication>{{"Anki/Car/" + kCar + "/S/PingResponse",
-                                  R"({"timestamp":1700000000123,"rtt_ms":12.5})", 1, true}});
+        std::vector<Publication>{
+            {"Anki/Car/" + kCar + "/S/PingResp", R"({"timestamp":1700000000123,"rtt_ms":12.5})", 1,
+             true},
+            {"Anki/Car/" + kCar + "/S/PingResponse", R"({"timestamp":1700000000123,"rtt_ms":12.5})",
+             1, true},
+            whole("PING_RESPONSE", R"({"message_id":23,"timestamp":1700000000123})")});
   CHECK(fromMessage(kCar, anki::PingResponse{}, std::nullopt, kNow).at(0).payload ==
         R"({"timestamp":1700000000123,"rtt_ms":null})");
 }
@@ -194,20 +233,25 @@ TEST_CASE("mqtt topics: host status, will, car list and discovery event") {
         Publication{"Anki/Host/pit1/S/HostStatus", R"({"value":true})", 1, true});
   CHECK(hostWill("pit1") ==
         Publication{"Anki/Host/pit1/S/HostStatus", R"({"value":false})", 1, true});
-  CHECK(hostCars("pit1", kCars, kNow) ==
-        Publication{"Anki/Host/pit1/S/Cars",
-                    R"({"timestamp":1700000000123,"value":["e85a0f112233","sim-0000002a"]})", 1,
-                    true});
-  CHECK(hostCars("pit1", {}, kNow).payload == R"({"timestamp":1700000000123,"value":[]})");
+  // a bare array, as the seed's controller publishes it and its clients iterate it
+  CHECK(hostCars("pit1", kCars) ==
+        Publication{"Anki/Host/pit1/S/Cars", R"(["e85a0f112233","sim-0000002a"])", 1, true});
+  CHECK(hostCars("pit1", {}).payload == "[]");
+  CHECK(carConnected("pit1", kCar, kNow) ==
+        Publication{"Anki/Host/pit1/E/CarConnected",
+                    R"({"timestamp":1700000000123,"Car":"e85a0f112233"})", 0, false});
+  CHECK(carDisconnected("pit1", kCar, kNow) ==
+        Publication{"Anki/Host/pit1/E/CarDisconnected",
+                    R"({"timestamp":1700000000123,"Car":"e85a0f112233"})", 0, false});
   CHECK(carDiscovered("pit1", kCar, kNow) ==
         Publication{"Anki/Host/pit1/E/CarDiscovered",
                     R"({"timestamp":1700000000123,"Car":"e85a0f112233"})", 0, false});
 }
 
 TEST_CASE("mqtt intents: the bridge subscribes to the host's and every car's intent topics") {
-  CHECK(intentSubscriptions("pit1") == std::vector<std::string>{"Anki/Host/pit1/I/connection",
-                                                                "Anki/Host/pit1/I",
-                                                                "Anki/Car/+/I"});
+  // the seed's controller's filters; "…/I/#" takes "…/I" itself too
+  CHECK(intentSubscriptions("pit1") ==
+        std::vector<std::string>{"Anki/Host/pit1/I/#", "Anki/Car/+/I/#", "Anki/Car/I"});
 }
 
 TEST_CASE("mqtt intents: every intent type is parsed with its target") {
@@ -247,7 +291,9 @@ TEST_CASE("mqtt intents: bad JSON is rejected with the parser's message") {
 
 TEST_CASE("mqtt intents: a missing or unknown type is rejected with the accepted types") {
   CHECK(rejected("Anki/Car/all/I", "{}") ==
-        "missing key \"type\" (one of speed, lane, turn, battery, version, ping, message)");
+        "no command in the payload (it is empty); name one with a key, as the seed's controller "
+        "takes it — speed, lane, turn, battery, version or ping, e.g. "
+        "{\"speed\":600,\"acceleration\":1000} — or with pitwall's \"type\"");
   CHECK(rejected("Anki/Car/all/I", R"({"type":"fly"})") ==
         "unknown intent type \"fly\"; expected one of speed, lane, turn, battery, version, ping, "
         "message");
@@ -255,11 +301,31 @@ TEST_CASE("mqtt intents: a missing or unknown type is rejected with the accepted
         "\"type\" must be a string, not an integer (7)");
 }
 
-TEST_CASE("mqtt intents: a connection intent is only accepted on the host's connection topic") {
-  CHECK(rejected("Anki/Host/pit1/I", R"({"connecting":true})") ==
-        "missing key \"type\" (one of speed, lane, turn, battery, version, ping, message)");
-  CHECK(rejected("Anki/Host/pit1/I/connection", R"({"type":"ping"})") ==
-        "missing key \"connecting\" (true or false)");
+TEST_CASE("mqtt intents: host intents on the host's topic and below it, commands elsewhere") {
+  const Target host{Target::Kind::Host, ""};
+  for (std::string topic :
+       {"Anki/Host/pit1/I", "Anki/Host/pit1/I/connection", "Anki/Host/pit1/I/anything/below"}) {
+    CAPTURE(topic);
+    CHECK(accepted(topic, R"({"connecting":true})") == Intent{host, ConnectIntent{true}});
+    CHECK(accepted(topic, R"({"connecting":false})") == Intent{host, ConnectIntent{false}});
+    CHECK(accepted(topic, R"({"cars":true})") == Intent{host, CarsIntent{}});
+    CHECK(accepted(topic, R"({"car_status":true})") == Intent{host, CarStatusIntent{}});
+    // anything else there is a command for every car of the host
+    CHECK(accepted(topic, R"({"type":"ping"})") ==
+          Intent{{Target::Kind::AllCars, ""}, PingIntent{}});
+    CHECK(accepted(topic, R"({"ping":true})") == Intent{{Target::Kind::AllCars, ""}, PingIntent{}});
+  }
+  // a host intent on a car's topic is no command
+  CHECK(rejected("Anki/Car/all/I", R"({"connecting":true})")
+            .starts_with("no command in the payload (its keys: connecting)"));
+  CHECK(rejected("Anki/Host/pit1/I", R"({"cars":true,"car_status":true})") ==
+        "the payload names 2 host intents (cars and car_status); send one per message");
+  // the track editor's bridge command: nothing pitwall does
+  CHECK(rejected("Anki/Host/pit1/I", R"({"bridge":true,"host":"h","port":"1883"})") ==
+        "no command in the payload (its keys: bridge, host, port); name one with a key, as the "
+        "seed's controller takes it — speed, lane, turn, battery, version or ping, e.g. "
+        "{\"speed\":600,\"acceleration\":1000} — or with pitwall's \"type\", or a host intent: "
+        "connecting, cars or car_status");
 }
 
 TEST_CASE("mqtt intents: an intent for a car this host does not have is rejected") {
@@ -278,10 +344,10 @@ TEST_CASE("mqtt intents: every out-of-range value is rejected with the car model
   CHECK(rejected("Anki/Car/all/I",
                  R"({"type":"speed","speed":600,"acceleration":18446744073709551615})") ==
         "acceleration 18446744073709551615 mm/s² is out of range 0..25000 mm/s²");
-  CHECK(rejected("Anki/Car/all/I", R"({"type":"lane","offset":-100.5})") ==
-        "offset -100.5 mm is out of range -100..100 mm");
+  CHECK(rejected("Anki/Car/all/I", R"({"type":"lane","offset":-70.5})") ==
+        "offset -70.5 mm is out of range -70..70 mm (beyond it the car leaves the road)");
   CHECK(rejected("Anki/Car/all/I", R"({"type":"lane","offset":1e300})") ==
-        "offset 1e+300 mm is out of range -100..100 mm");
+        "offset 1e+300 mm is out of range -70..70 mm (beyond it the car leaves the road)");
   CHECK(rejected("Anki/Car/all/I", R"({"type":"turn","turnType":5,"trigger":0})") ==
         "turnType 5 is out of range 0..4");
   CHECK(rejected("Anki/Car/all/I", R"({"type":"turn","turnType":1,"trigger":2})") ==
@@ -289,8 +355,8 @@ TEST_CASE("mqtt intents: every out-of-range value is rejected with the car model
   // the ranges are the car model's (engine/protocol/anki/limits.hpp)
   CHECK(accepted("Anki/Car/all/I", R"({"type":"speed","speed":1500,"acceleration":25000})") ==
         Intent{{Target::Kind::AllCars, ""}, SpeedIntent{1500, 25000}});
-  CHECK(accepted("Anki/Car/all/I", R"({"type":"lane","offset":100})") ==
-        Intent{{Target::Kind::AllCars, ""}, LaneIntent{100, {}, {}}});
+  CHECK(accepted("Anki/Car/all/I", R"({"type":"lane","offset":70})") ==
+        Intent{{Target::Kind::AllCars, ""}, LaneIntent{70, {}, {}}});
   CHECK(accepted("Anki/Car/all/I", R"({"type":"turn","turnType":4,"trigger":1})") ==
         Intent{{Target::Kind::AllCars, ""},
                TurnIntent{anki::TurnType::UTurnJump, anki::TurnTrigger::Intersection}});
@@ -313,8 +379,6 @@ TEST_CASE("mqtt intents: missing and wrong-typed keys are named") {
         "missing key \"turnType\" (an integer)");
   CHECK(rejected("Anki/Car/all/I", R"({"type":"turn","turnType":true,"trigger":0})") ==
         "\"turnType\" must be an integer, not a boolean (true)");
-  CHECK(rejected("Anki/Host/pit1/I/connection", "{}") ==
-        "missing key \"connecting\" (true or false)");
   CHECK(rejected("Anki/Host/pit1/I/connection", R"({"connecting":"yes"})") ==
         "\"connecting\" must be true or false, not a string (\"yes\")");
   CHECK(rejected("Anki/Host/pit1/I/connection", R"({"connecting":1})") ==
@@ -323,12 +387,13 @@ TEST_CASE("mqtt intents: missing and wrong-typed keys are named") {
 
 TEST_CASE("mqtt intents: a topic outside the intent tree is rejected") {
   const std::string where =
-      "not an intent topic; intents go to Anki/Host/pit1/I/connection, Anki/Host/pit1/I, "
-      "Anki/Car/all/I or Anki/Car/<car>/I";
+      "not an intent topic; intents go to Anki/Host/pit1/I (or below it), Anki/Car/I, "
+      "Anki/Car/all/I or Anki/Car/<car>/I (or below it)";
   CHECK(rejected("Anki/Car/" + kCar + "/E/speed", R"({"type":"ping"})") == where);
-  CHECK(rejected("Anki/Car/" + kCar + "/I/extra", R"({"type":"ping"})") == where);
-  CHECK(rejected("Anki/Host/pit1/I/other", R"({"connecting":true})") == where);
+  CHECK(rejected("Anki/Car/" + kCar + "/S/I", R"({"type":"ping"})") == where);
+  CHECK(rejected("Anki/Host/pit1/S/Cars", R"({"connecting":true})") == where);
   CHECK(rejected("anki/car/all/i", R"({"type":"ping"})") == where);
+  CHECK(rejected("Anki/Car", R"({"type":"ping"})") == where);
   CHECK(rejected("", "{}") == where);
   CHECK(rejected("Anki/Host/pit2/I", R"({"type":"ping"})") ==
         "intent addressed to host \"pit2\", this host is \"pit1\"");
@@ -418,13 +483,23 @@ TEST_CASE("mqtt intents: a remote command becomes the intent that parses back to
       anki::CancelLaneChange{},
       anki::SetSpeed{600, 1000, true},  // respect_limit has no key in the seed's speed intent
   };
-  std::vector<std::string> types{"speed", "lane",    "turn",    "battery", "version",
-                                 "ping",  "message", "message", "message", "message"};
+  // the seed's controller's forms where it has one, so its bridge executes them too
+  std::vector<std::string> forms{
+      R"({"speed":600,"acceleration":1000})",
+      R"({"lane":-23.5,"offset":-23.5,"horizontalSpeed":400,"horizontalAcceleration":4000})",
+      R"({"turn":{"type":3,"time":1}})",
+      R"({"battery":true})",
+      R"({"version":true})",
+      R"({"ping":true})",
+      R"({"type":"message","frame":"021d44"})",
+      R"({"type":"message","frame":"052c00004041"})",
+      R"({"type":"message","frame":"0126"})",
+      R"({"type":"message","frame":"06245802e80301"})"};
   for (std::size_t i = 0; i < commands.size(); ++i) {
     auto payload = intentPayload(commands[i]);
     REQUIRE(payload);
     INFO(*payload);
-    CHECK(payload->find("\"type\":\"" + types[i] + "\"") != std::string::npos);
+    CHECK(*payload == forms[i]);
     auto intent = accepted("Anki/Car/" + kCar + "/I", *payload);
     // executed as the bridge does: the action must describe the same command
     std::visit(
@@ -501,8 +576,19 @@ TEST_CASE("mqtt topics: the reading side splits topics and reads status payloads
   CHECK(*readHostStatus(hostOnline("pit1").payload));
   CHECK_FALSE(*readHostStatus(hostWill("pit1").payload));
   std::vector<std::string> cars{"a", "b"};
-  CHECK(*readHostCars(hostCars("pit1", cars, kNow).payload) == cars);
-  CHECK(readHostCars(R"({"value":[1]})").error() == "\"value\" has the wrong type ([1])");
+  CHECK(*readHostCars(hostCars("pit1", cars).payload) == cars);
+  CHECK(readHostCars("{}")->empty());                                    // the controller's none
+  CHECK(*readHostCars(R"({"timestamp":1,"value":["a","b"]})") == cars);  // earlier pitwall
+  CHECK(readHostCars("[1]").error() == "a car id must be a string, not an integer (1)");
+  CHECK(readHostCars(R"({"value":[1]})").error() ==
+        "a car id must be a string, not an integer (1)");
+  CHECK(readHostCars(R"({"x":1})").error() == "must be an array of car ids, not an object");
+  CHECK(readHostCars("7").error() == "must be an array of car ids, not an integer (7)");
+  // the controller blanks S/Information when it drops a car
+  auto blank = readInformation(
+      kCar, R"({"address":"","identifier":"","model":"","modelId":"","productId":""})");
+  REQUIRE(blank);
+  CHECK(blank->address.empty());
 }
 
 TEST_CASE("mqtt topics: quote() shows at most so many bytes, printable, invalid bytes as \\xNN") {
@@ -590,4 +676,146 @@ TEST_CASE("mqtt topics: the readers refuse hostile payloads with an error, never
   CHECK(readCarStatus(pitwall::testing::nested(3, ""), PayloadLimits{100, 2})
             .error()
             .starts_with("payload nests objects and arrays more than 2 deep"));
+}
+
+TEST_CASE("mqtt intents: the seed's controller's forms, the key naming the command") {
+  const auto one = Target{Target::Kind::Car, kCar};
+  const auto all = Target{Target::Kind::AllCars, ""};
+  const std::string car = "Anki/Car/" + kCar + "/I";
+  // as its clients send them (hofdo/nodejsankisdk CmdHandler.js, the track editor's mqtt.js)
+  CHECK(accepted(car, R"({"speed":600,"acceleration":1000})") ==
+        Intent{one, SpeedIntent{600, 1000}});
+  CHECK(accepted(car, R"({"acceleration":5000,"speed":600})") ==
+        Intent{one, SpeedIntent{600, 5000}});
+  CHECK(accepted(car, R"({"speed":600})") == Intent{one, SpeedIntent{600, 1000}});
+  CHECK(accepted(car, R"({"lane":-23})") == Intent{one, LaneIntent{-23, {}, {}}});
+  CHECK(accepted(car, R"({"lane":1,"offset":44.5})") == Intent{one, LaneIntent{44.5, {}, {}}});
+  CHECK(accepted(car, R"({"turn":{"type":3,"time":0}})") ==
+        Intent{one, TurnIntent{anki::TurnType::UTurn, anki::TurnTrigger::Immediate}});
+  CHECK(accepted(car, R"({"turn":{"type":1}})") ==
+        Intent{one, TurnIntent{anki::TurnType::Left, anki::TurnTrigger::Immediate}});
+  CHECK(accepted(car, R"({"battery":true})") == Intent{one, BatteryIntent{}});
+  CHECK(accepted(car, R"({"version":true})") == Intent{one, VersionIntent{}});
+  CHECK(accepted(car, R"({"ping":true})") == Intent{one, PingIntent{}});
+  // the values as Node's Buffer writers take them: a string holding a number, a fraction
+  CHECK(accepted(car, R"({"speed":"600","acceleration":" 1000 "})") ==
+        Intent{one, SpeedIntent{600, 1000}});
+  CHECK(accepted(car, R"({"lane":"-23.5"})") == Intent{one, LaneIntent{-23.5, {}, {}}});
+  CHECK(accepted(car, R"({"speed":600.4})") == Intent{one, SpeedIntent{600, 1000}});
+  // the topics the controller subscribes: below a car's I, and the global Anki/Car/I
+  CHECK(accepted(car + "/speed", R"({"speed":300})") == Intent{one, SpeedIntent{300, 1000}});
+  CHECK(accepted("Anki/Car/I", R"({"speed":0,"acceleration":12500})") ==
+        Intent{all, SpeedIntent{0, 12500}});
+  CHECK(accepted("Anki/Car/all/I", R"({"lane":23})") == Intent{all, LaneIntent{23, {}, {}}});
+  CHECK(accepted("Anki/Host/pit1/I", R"({"speed":500})") == Intent{all, SpeedIntent{500, 1000}});
+}
+
+TEST_CASE("mqtt intents: a bad command in the controller's form names the key, value and range") {
+  const std::string car = "Anki/Car/all/I";
+  CHECK(rejected(car, R"({"speed":2000})") == "speed 2000 mm/s is out of range 0..1500 mm/s");
+  CHECK(rejected(car, R"({"speed":"fast"})") ==
+        "\"speed\" must be a number, not a string (\"fast\")");
+  CHECK(rejected(car, R"({"speed":""})") == "\"speed\" must be a number, not a string (\"\")");
+  CHECK(rejected(car, R"({"speed":"1e999"})") ==
+        "\"speed\" must be a number, not a string (\"1e999\")");
+  CHECK(rejected(car, R"({"speed":600,"acceleration":-5})") ==
+        "acceleration -5 mm/s² is out of range 0..25000 mm/s²");
+  CHECK(rejected(car, R"({"acceleration":1000})") ==
+        "missing key \"speed\" (a number, mm/s) beside \"acceleration\"");
+  CHECK(rejected(car, R"({"lane":-71})") ==
+        "lane -71 mm is out of range -70..70 mm (beyond it the car leaves the road)");
+  CHECK(rejected(car, R"({"lane":0,"offset":"x"})") ==
+        "\"offset\" must be a number, not a string (\"x\")");
+  CHECK(rejected(car, R"({"lane":null})") == "\"lane\" must be a number, not a null (null)");
+  CHECK(rejected(car, R"({"turn":3})") ==
+        "\"turn\" must be an object {\"type\":0..4,\"time\":0..1}, not an integer (3)");
+  CHECK(rejected(car, R"({"turn":{"time":0}})") ==
+        "missing key \"type\" in \"turn\" (0 none, 1 left, 2 right, 3 U-turn, 4 U-turn jump)");
+  CHECK(rejected(car, R"({"turn":{"type":5}})") == "turn type 5 is out of range 0..4");
+  CHECK(rejected(car, R"({"turn":{"type":1,"time":2}})") == "turn time 2 is out of range 0..1");
+  CHECK(rejected(car, R"({"speed":600,"lane":23})") ==
+        "the payload names 2 commands (speed and lane); send one command per message");
+  CHECK(rejected(car, R"({"fly":true})") ==
+        "no command in the payload (its keys: fly); name one with a key, as the seed's "
+        "controller takes it — speed, lane, turn, battery, version or ping, e.g. "
+        "{\"speed\":600,\"acceleration\":1000} — or with pitwall's \"type\"");
+  // pitwall's "type" forms stay strict: integers are integers there
+  CHECK(rejected(car, R"({"type":"speed","speed":"600","acceleration":1000})") ==
+        "\"speed\" must be an integer, not a string (\"600\")");
+}
+
+TEST_CASE("mqtt intents: hostile values in the controller's forms are errors, never a crash") {
+  for (const auto& bad : testing::hostilePayloads()) {
+    for (std::string key : {"speed", "lane", "turn", "battery"}) {
+      for (const auto& payload : {"{\"" + key + "\":" + bad.payload + "}",
+                                  "{\"" + key + "\":{\"type\":" + bad.payload + "}}"}) {
+        auto r = parseIntent("pit1", "Anki/Car/I", payload, kCars);
+        if (!r) CHECK(r.error().message.size() < 2000);
+      }
+    }
+  }
+}
+
+TEST_CASE("mqtt topics: E/Messages reads back to the message it was made from") {
+  anki::PositionUpdate position{7, 33, -23.5f, 612, 0x47, 2, 1, 300, 600};
+  anki::TransitionUpdate transition;
+  transition.offset_mm = 44.5f;
+  transition.last_desired_lane_change_speed_mm_s = 250;
+  transition.average_follow_line_drift_px = -3;
+  transition.uphill_counter = 2;
+  transition.right_wheel_distance_cm = 22;
+  anki::IntersectionUpdate intersection;
+  intersection.offset_mm = 23;
+  intersection.intersection_code = 3;
+  intersection.mm_since_last_transition_bar = 120;
+  intersection.mm_since_last_intersection_code = 450;
+  anki::CarStatus status;
+  status.on_track = true;
+  std::vector<anki::Message> messages{position,
+                                      transition,
+                                      intersection,
+                                      anki::Delocalized{},
+                                      anki::PingResponse{},
+                                      anki::VersionResponse{0x2b6e},
+                                      anki::BatteryResponse{3912},
+                                      status};
+  for (const auto& m : messages) {
+    auto ps = fromMessage(kCar, m, std::nullopt, kNow);
+    const auto& event = ps.back();
+    const std::string prefix = "Anki/Car/" + kCar + "/E/Messages/";
+    REQUIRE(event.topic.starts_with(prefix));
+    auto name = event.topic.substr(prefix.size());
+    CHECK(name == messageEventName(m));
+    auto back = readMessageEvent(name, event.payload);
+    REQUIRE(back);
+    REQUIRE(*back);
+    CHECK(**back == m);
+  }
+  // a name without a message of its own is not read at all
+  auto other = readMessageEvent("ANKI_VEHICLE_MSG_V2C_SOMETHING_NEW", "not json");
+  REQUIRE(other);
+  CHECK_FALSE(*other);
+  // the controller's payload as it publishes it: "timestamp":Date.now is dropped by
+  // JSON.stringify, the rest is there
+  auto controller = readMessageEvent(
+      "ANKI_VEHICLE_MSG_V2C_LOCALIZATION_POSITION_UPDATE",
+      R"({"message_id":39,"offset":-68,"speed":500,"flag":71,"pieceId":36,"pieceLocation":12,)"
+      R"("isReverse":false,"last_des_speed":500,"last_rec_lane_change_cmd":0,)"
+      R"("last_exe_lane_change_cmd":0,"last_des_lane_change_speed":0})");
+  REQUIRE(controller);
+  auto* p = std::get_if<anki::PositionUpdate>(&**controller);
+  REQUIRE(p);
+  CHECK(p->piece_id == 36);
+  CHECK(p->speed_mm_s == 500);
+  CHECK(p->offset_mm == -68.0f);
+  // bad values are named
+  CHECK(readMessageEvent("ANKI_VEHICLE_MSG_V2C_LOCALIZATION_POSITION_UPDATE", R"({"speed":-1})")
+            .error() == "\"speed\" must be an integer 0..65535, not -1");
+  CHECK(readMessageEvent("ANKI_VEHICLE_MSG_V2C_LOCALIZATION_POSITION_UPDATE", R"({"pieceId":"36"})")
+            .error() == "\"pieceId\" must be a number, not a string (\"36\")");
+  CHECK(readMessageEvent("ANKI_VEHICLE_MSG_V2C_VERSION_RESPONSE", "[]").error() ==
+        "payload must be a JSON object, not an array");
+  for (const auto& bad : testing::hostilePayloads())
+    CHECK_NOTHROW(
+        (void)readMessageEvent("ANKI_VEHICLE_MSG_V2C_LOCALIZATION_POSITION_UPDATE", bad.payload));
 }
