@@ -175,6 +175,8 @@ void MqttBridge::connectionChanged(AnkiCar& car, bool up) {
   auto t = now();
   emit(up ? topics::carOnline(it->second, car.state(), t)
           : topics::carLeft(it->second, car.state(), t));
+  // A car that comes back was found again, as the seed's controller's scan reports it.
+  if (up) emit(topics::carDiscovered(host_, it->second, t));
   emit(up ? topics::carConnected(host_, it->second, t)
           : topics::carDisconnected(host_, it->second, t));
   publishCars();

@@ -32,7 +32,7 @@ spawn bridge "$PITWALL" bridge --ble --scan-timeout 0.5 --mqtt "$MQTT_URL" --hos
 BRIDGE=$LAST_PID
 wait_for "$TMP/bridge.err" "bridging 2 cars as host blue" 15 ||
   { fail "the bridge did not start: $(cat "$TMP/bridge.err")"; finish; }
-wait_for "$ALL" "^Anki/Host/blue/S/Cars .*\"value\":\[\"$C1\",\"$C2\"\]" 5 &&
+wait_for "$ALL" "^Anki/Host/blue/S/Cars \[\"$C1\",\"$C2\"\]" 5 &&
   echo "ok: the cars are published under their Bluetooth ids" ||
   fail "no S/Cars with $C1 and $C2: $(grep '/S/Cars' "$ALL")"
 contains "S/Information has the car's address" "\"address\":\"E0:00:00:00:00:01\"" \
@@ -52,9 +52,9 @@ for c in $C1 $C2; do
   wait_for "$ALL" "^Anki/Car/$c/S/CarStatus .*\"online\":false" 10 &&
     echo "ok: connection false: $c offline" || fail "connection false: $c still online"
 done
-wait_for "$ALL" '^Anki/Host/blue/S/Cars .*"value":\[\]}' 5 &&
+wait_for "$ALL" '^Anki/Host/blue/S/Cars \[\]$' 5 &&
   echo "ok: connection false: no cars listed" || fail "connection false: S/Cars not emptied"
-both="^Anki/Host/blue/S/Cars .*\"value\":\[\"$C1\",\"$C2\"\]}"
+both="^Anki/Host/blue/S/Cars \[\"$C1\",\"$C2\"\]$"
 listed=$(count "$ALL" "$both")
 pub "Anki/Host/blue/I/connection" '{"connecting":true}'
 wait_count "$ALL" "$both" $((listed + 1)) 15 &&

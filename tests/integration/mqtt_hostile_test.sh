@@ -11,7 +11,7 @@ start_broker
 subscribe all 'Anki/#'
 spawn bridge $PITWALL bridge --mqtt "$MQTT_URL" --host-id pit1 --cars 2
 BRIDGE=$LAST_PID
-wait_for "$ALL" '^Anki/Host/pit1/S/Cars .*"value":\["pit1-sim-[0-9a-f]+","pit1-sim-[0-9a-f]+"\]' 10 ||
+wait_for "$ALL" '^Anki/Host/pit1/S/Cars \["pit1-sim-[0-9a-f]+","pit1-sim-[0-9a-f]+"\]' 10 ||
   { fail "the bridge did not publish its cars: $(cat "$TMP/bridge.err")"; finish; }
 CARS=($(grep -m1 '^Anki/Host/pit1/S/Cars ' "$ALL" | grep -oE 'pit1-sim-[0-9a-f]+'))
 C1=${CARS[0]}
