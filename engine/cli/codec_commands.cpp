@@ -65,12 +65,16 @@ int decode(const std::string& protocol, const std::vector<std::string>& hex) {
   }
   if (protocol == "mindroad") return decodeMindroad(*bytes);
   if (protocol == "alphabot" || alphabotBle) return decodeAlphabot(*bytes, side);
-  auto message = anki::decode(*bytes);
+  // As the receiver reads it: a car takes the short command forms too (decodeCommand), and bytes
+  // past a layout are shown, not dropped (anki-overdrive.md **Decision**).
+  auto message = anki::decodeCommand(*bytes);
   if (!message) {
     std::cerr << "pitwall decode: " << message.error().message() << "\n";
     return 2;
   }
-  std::cout << anki::toJson(*message).dump() << "\n";
+  nlohmann::json json = anki::toJson(*message);
+  if (auto extra = anki::extraBytes(*bytes); !extra.empty()) json["extra_bytes"] = toHex(extra);
+  std::cout << json.dump() << "\n";
   return 0;
 }
 

@@ -32,6 +32,16 @@ contains "decode position speed" '"speed_mm_s":600' "$out"
 contains "decode position offset" '"offset_mm":23.0' "$out"
 out=$($PITWALL decode anki 03 ee 01 02)
 contains "unknown id decodes" '"name":"unknown"' "$out"
+# A frame longer than its layout is read by it, the extra bytes shown (anki-overdrive.md).
+out=$($PITWALL decode anki 11 27 05 11 00 00 b8 41 58 02 00 00 00 00 00 00 00 aa); rc=$?
+check "longer frame exit status" 0 "$rc"
+contains "longer frame read by its layout" '"speed_mm_s":600' "$out"
+contains "longer frame shows its extra bytes" '"extra_bytes":"aa"' "$out"
+# py-drivesdk's set speed without its last byte: what a car reads.
+out=$($PITWALL decode anki 05 24 f4 01 f4 01)
+contains "short set-speed decodes" '"name":"set-speed"' "$out"
+contains "short set-speed speed" '"speed_mm_s":500' "$out"
+contains "short set-speed respect limit" '"respect_limit":false' "$out"
 
 err=$($PITWALL decode anki 05 27 01 2>&1 >/dev/null); rc=$?
 check "malformed exit status" 2 "$rc"

@@ -1,6 +1,8 @@
 #pragma once
 // bytes ⇄ messages for the Anki Overdrive protocol. Pure: no I/O, no allocation on the hot path.
-// Decoding is total: every byte string gives a Message (possibly Unknown) or a DecodeError.
+// Decoding is total: every byte string gives a Message (possibly Unknown) or a DecodeError. A
+// frame longer than its layout is no error: it is read by its longest layout and the bytes past
+// it are left to extraBytes() (anki-overdrive.md **Decision**).
 #include <cstdint>
 #include <span>
 #include <string>
@@ -16,7 +18,6 @@ struct DecodeError {
     Empty,         // no bytes at all
     SizeMismatch,  // size byte disagrees with the number of bytes received
     TooShort,      // fewer payload bytes than the message's layout needs
-    TooLong,       // more payload bytes than any known layout of that id
     TooBig,        // more than 20 bytes
   };
   Kind kind = Kind::Empty;
@@ -28,6 +29,17 @@ struct DecodeError {
 
 Result<Message, DecodeError> decode(std::span<const std::uint8_t> bytes);
 Frame encode(const Message& message);
+
+// The bytes of a frame past the longest layout of its id: what decode() read the frame without.
+// Empty when the frame fits its layout, for an unknown id (kept whole in Unknown::raw) and for a
+// frame decode() refuses. A firmware that appends a field to a message sends these.
+std::span<const std::uint8_t> extraBytes(std::span<const std::uint8_t> frame);
+
+// What a car makes of a frame written to it (the vehicle side: simulated and emulated cars):
+// decode(), and also the short command forms real firmware accepts, read with the missing
+// trailing fields at their defaults (anki-overdrive.md **Decision**): set speed without its last
+// byte, `05 24 <speed i16> <accel i16>` (sent by py-drivesdk), is set speed with respect-limit 0.
+Result<Message, DecodeError> decodeCommand(std::span<const std::uint8_t> bytes);
 
 // Stable kebab-case name: "set-speed", "position-update", "unknown", …
 std::string_view name(const Message& message);

@@ -20,8 +20,12 @@
 namespace pitwall::anki::fields {
 
 // The size bytes (= frame length − 1) a message may have. Most have one. A few have a shorter
-// and a longer form told apart by the size byte alone: optional fields are in the longer one;
-// bytes past the last field (newer firmware's extras) are accepted and not kept.
+// and a longer form told apart by the size byte alone: optional fields are in the longer one; a
+// documented form may end in bytes no field carries (set speed's size 7, the version response's
+// 4-byte form), accepted and not kept. A frame longer than the longer form is read by it and the
+// bytes past it are the codec's extraBytes(), kept by whoever receives the frame
+// (anki-overdrive.md **Decision**). A frame shorter than the shorter form is refused, except the
+// short command forms cars obey, which decodeCommand() takes (codec.cpp, kShortForms).
 struct Sizes {
   std::uint8_t shorter;
   std::uint8_t longer;
@@ -91,8 +95,10 @@ struct Spec<SetLights> {
   static constexpr Layout layout{id::kSetLights, "set-lights", {2, 2}};
   static constexpr std::tuple fields{Field{"mask", &M::mask}};
 };
-// seed 000 §4.3.4.3: i16 speed, i16 accel; anki-overdrive.md: + u8 respect limit (size 6); newer
-// firmware takes a trailing byte (size 7) that we accept and do not model.
+// seed 000 §4.3.4.3: i16 speed, i16 accel; anki-overdrive.md: + u8 respect limit (size 6, as in
+// drive-sdk's golden vector 06 24 e8 03 a8 61 00); newer firmware takes a trailing byte (size 7)
+// that we accept and do not model. Cars also obey it without the respect-limit byte (size 5,
+// py-drivesdk): decodeCommand() reads that form, decode() does not.
 template <>
 struct Spec<SetSpeed> {
   using M = SetSpeed;

@@ -1,5 +1,6 @@
 // The Anki codec against golden bytes (anki-overdrive.md, drive-sdk's own test vectors), both
-// firmware layouts, every decode error, and a brute-force check that decoding is total.
+// firmware layouts, frames longer than their layout, the short command forms cars obey, every
+// decode error, and a brute-force check that decoding is total.
 #include "engine/protocol/anki/codec.hpp"
 
 #include <doctest/doctest.h>
@@ -361,18 +362,91 @@ TEST_CASE("a length between an old and a new layout is a cut-short new layout") 
   CHECK(status.message().find("0x3f") != std::string::npos);
 }
 
-TEST_CASE("more payload than any layout of the id is a too-long error") {
-  const auto e = errorOf("02 16 00");
-  CHECK(e.kind == DecodeError::Kind::TooLong);
-  CHECK(e.id == 0x16);
-  CHECK(e.expected == 2);
-  CHECK(e.received == 3);
-  CHECK(e.message().find("0x16") != std::string::npos);
-  CHECK(e.message().find("3 bytes") != std::string::npos);
-  CHECK(e.message().find("2 bytes") != std::string::npos);
-  const auto transition = errorOf("13 29 00 00 00 00 b8 41 01 03 03 fa 00 fe 01 00 01 38 39 00");
-  CHECK(transition.kind == DecodeError::Kind::TooLong);
-  CHECK(transition.expected == 19);
+// anki-overdrive.md **Decision**: a firmware that appends a field must not lose its frames.
+TEST_CASE("a position update with a byte appended is read by its layout and the byte kept") {
+  const auto plain = bytes("10 27 0e 24 00 00 88 c2 58 02 47 02 02 2c 01 58 02");
+  const auto longer = bytes("11 27 0e 24 00 00 88 c2 58 02 47 02 02 2c 01 58 02 aa");
+  const auto r = decode(longer);
+  REQUIRE(r.ok());
+  CHECK(*r == *decode(plain));
+  CHECK(std::get<PositionUpdate>(*r).speed_mm_s == 600);
+  CHECK(hex(extraBytes(longer)) == "aa");
+  CHECK(extraBytes(plain).empty());
+}
+
+TEST_CASE("every known id takes extra bytes up to the 20 a frame may have") {
+  const auto ping = bytes("13 16 01 02 03 04 05 06 07 08 09 0a 0b 0c 0d 0e 0f 10 11 12");
+  const auto r = decode(ping);
+  REQUIRE(r.ok());
+  CHECK(std::holds_alternative<PingRequest>(*r));
+  CHECK(extraBytes(ping).size() == 18);
+  CHECK(hex(extraBytes(bytes("02 16 00"))) == "00");
+  CHECK(hex(extraBytes(bytes("04 2d 00 00 b8"))).empty());  // too short: no extras, an error
+}
+
+TEST_CASE("a message with two layouts is read by the longer one when the frame is longer still") {
+  // 0x29 is 18 or 19 bytes; 20 is the old-firmware layout (with the driving direction) + 1 byte.
+  const auto frame = bytes("13 29 00 00 00 00 b8 41 01 03 03 fa 00 fe 01 00 01 38 39 5a");
+  const auto r = decode(frame);
+  REQUIRE(r.ok());
+  const auto& t = std::get<TransitionUpdate>(*r);
+  CHECK(t.driving_direction == std::optional<std::uint8_t>(1));
+  CHECK(t.right_wheel_distance_cm == 57);
+  CHECK(hex(extraBytes(frame)) == "5a");
+  // A car status past its newer form keeps both newer fields.
+  const auto status = bytes("06 3f 01 00 01 00 07");
+  REQUIRE(decode(status).ok());
+  CHECK(std::get<CarStatus>(*decode(status)).low_battery == std::optional<bool>(true));
+  CHECK(hex(extraBytes(status)) == "07");
+}
+
+TEST_CASE("a frame that fits its layout, an unknown id and a refused frame have no extra bytes") {
+  CHECK(extraBytes(bytes("07 24 e8 03 a8 61 00 01")).empty());  // set speed's documented size 7
+  CHECK(extraBytes(bytes("05 19 6e 2b 01 02")).empty());        // the version's 4-byte form
+  CHECK(extraBytes(bytes("04 99 01 02 03")).empty());           // all of it is Unknown::raw
+  CHECK(extraBytes(bytes("05 16 00")).empty());                 // size mismatch
+  CHECK(extraBytes({}).empty());
+  std::vector<std::uint8_t> big(21, 0);
+  big[0] = 20;
+  big[1] = 0x16;
+  CHECK(extraBytes(big).empty());  // too big
+}
+
+TEST_CASE("encoding a message read from a longer frame gives the frame without the extra bytes") {
+  const auto r = decode(bytes("11 27 0e 24 00 00 88 c2 58 02 47 02 02 2c 01 58 02 aa"));
+  REQUIRE(r.ok());
+  CHECK(hex(encode(*r).span()) == "10 27 0e 24 00 00 88 c2 58 02 47 02 02 2c 01 58 02");
+}
+
+// anki-overdrive.md **Decision**: py-drivesdk's set_speed and stop leave out the last byte.
+TEST_CASE("the vehicle side reads a set speed without its last byte as respect-limit 0") {
+  const auto shortForm = bytes("05 24 f4 01 f4 01");
+  const auto e = decode(shortForm);
+  REQUIRE_FALSE(e.ok());  // the controller side's decode stays strict
+  CHECK(e.error().kind == DecodeError::Kind::TooShort);
+  const auto r = decodeCommand(shortForm);
+  REQUIRE(r.ok());
+  CHECK(std::get<SetSpeed>(*r) ==
+        SetSpeed{.speed_mm_s = 500, .accel_mm_s2 = 500, .respect_limit = false});
+  const auto stop = decodeCommand(bytes("05 24 00 00 f4 01"));
+  REQUIRE(stop.ok());
+  CHECK(std::get<SetSpeed>(*stop).speed_mm_s == 0);
+}
+
+TEST_CASE("the vehicle side reads whole frames as decode() does and refuses other short forms") {
+  for (const auto& g : goldens()) {
+    INFO(g.hex);
+    const auto r = decodeCommand(bytes(g.hex));
+    REQUIRE(r.ok());
+    CHECK(*r == g.message);
+  }
+  CHECK(decodeCommand(bytes("04 24 f4 01 f4")).error().kind == DecodeError::Kind::TooShort);
+  CHECK(decodeCommand(bytes("03 24 f4 01")).error().kind == DecodeError::Kind::TooShort);
+  CHECK(decodeCommand(bytes("05 24 f4 01 f4")).error().kind == DecodeError::Kind::SizeMismatch);
+  CHECK(decodeCommand(bytes("0a 25 e8 03 10 27 00 00 a0 41 00")).error().kind ==
+        DecodeError::Kind::TooShort);
+  CHECK(decodeCommand(bytes("00")).error().kind == DecodeError::Kind::TooShort);
+  CHECK(decodeCommand({}).error().kind == DecodeError::Kind::Empty);
 }
 
 TEST_CASE("a lone size byte is an error that says the id is missing") {
@@ -388,8 +462,10 @@ namespace {
 
 // Whether encode(decode(x)) must give x back. Decoding forgets exactly these things: booleans
 // sent as bytes other than 0/1, the trailing byte of a size-7 set-speed, the two extra bytes of
-// a long version response, and the last byte of a lane-change update.
+// a long version response, the last byte of a lane-change update, and the bytes past the longest
+// layout (those are extraBytes(x)).
 bool canonical(std::span<const std::uint8_t> x) {
+  if (!extraBytes(x).empty()) return false;
   const auto is01 = [&](std::size_t at) { return x[at] <= 1; };
   switch (x[1]) {
     case id::kSetSpeed:
@@ -414,7 +490,7 @@ bool canonical(std::span<const std::uint8_t> x) {
 
 TEST_CASE("decoding is total: every length and id decodes or fails cleanly, and re-encodes") {
   std::mt19937 rng(20240611);
-  std::size_t decoded = 0, exact = 0;
+  std::size_t decoded = 0, exact = 0, withExtra = 0;
   for (std::size_t length = 0; length <= 24; ++length) {
     for (int id = 0; id < 256; ++id) {
       for (int shape = 0; shape < 3; ++shape) {
@@ -434,6 +510,16 @@ TEST_CASE("decoding is total: every length and id decodes or fails cleanly, and 
           continue;
         }
         ++decoded;
+        const auto extra = extraBytes(x);
+        if (!extra.empty()) {
+          // The same message as the frame cut to its layout, with the size byte to match.
+          ++withExtra;
+          std::vector<std::uint8_t> cut(x.begin(), x.end() - static_cast<long>(extra.size()));
+          cut[0] = static_cast<std::uint8_t>(cut.size() - 1);
+          const auto plain = decode(cut);
+          if (!plain.ok() || !(encode(*plain) == encode(*r)))
+            FAIL_CHECK(hex(x) << " does not read as " << hex(cut) << " does");
+        }
         const Frame again = encode(*r);
         if (again.length < 2 || again.bytes[0] != again.length - 1) {
           FAIL_CHECK("malformed re-encoding of " << hex(x) << ": " << hex(again.span()));
@@ -453,4 +539,5 @@ TEST_CASE("decoding is total: every length and id decodes or fails cleanly, and 
   }
   CHECK(decoded > 0);
   CHECK(exact > 0);
+  CHECK(withExtra > 0);
 }
