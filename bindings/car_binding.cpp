@@ -12,6 +12,7 @@
 
 #include "bindings/lua_support.hpp"
 #include "bindings/script_host.hpp"
+#include "engine/core/hex.hpp"
 #include "engine/core/log.hpp"
 #include "engine/protocol/anki/advertisement.hpp"
 #include "engine/protocol/anki/message_json.hpp"
@@ -288,13 +289,13 @@ bool pushField(lua_State* L, const AnkiCar& car, std::string_view key) {
   return false;
 }
 
-constexpr std::array<const char*, 27> kFieldNames = {
+constexpr std::array<const char*, 28> kFieldNames = {
     "speed",       "piece",       "location",     "offset",       "name",
     "number",      "model",       "modelId",      "identifier",   "address",
     "connected",   "onTrack",     "onCharger",    "delocalized",  "reverse",
     "targetSpeed", "prevPiece",   "laneChanging", "targetOffset", "batteryLevel",
     "batteryLow",  "batteryFull", "firmware",     "lastPing",     "lastPositionTime",
-    "frames",      "malformed"};
+    "frames",      "malformed",   "extraBytes"};
 
 int index(lua_State* L) {
   // 1: car, 2: key. Methods first, then state, then the car's own fields.
@@ -307,6 +308,16 @@ int index(lua_State* L) {
     }
     if (key == "malformed") {
       lua_pushinteger(L, static_cast<lua_Integer>(s.malformed));
+      return true;
+    }
+    if (key == "extraBytes") {  // {["position-update"] = {frames = 3, last = "aa"}, …}, fresh
+      lua_createtable(L, 0, static_cast<int>(s.extra_bytes.size()));
+      for (const auto& [name, extra] : s.extra_bytes) {
+        lua_createtable(L, 0, 2);
+        lua::setInteger(L, "frames", static_cast<lua_Integer>(extra.frames));
+        lua::setString(L, "last", toHex(extra.last));
+        lua_setfield(L, -2, name.c_str());
+      }
       return true;
     }
     return pushField(L, *p.car, key);

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "engine/core/hex.hpp"
 #include "engine/core/log.hpp"
 #include "engine/protocol/anki/advertisement.hpp"
 #include "engine/protocol/anki/limits.hpp"
@@ -152,9 +153,26 @@ void AnkiCar::receive(std::span<const std::uint8_t> frame) {
     return;
   }
   ++state_.frames_in;
+  if (auto extra = extraBytes(frame); !extra.empty()) keepExtra(*decoded, extra);
   apply(*decoded);
   if (onFrame) onFrame(Direction::Rx, frame, *decoded);
   if (onMessage) onMessage(*decoded);
+}
+
+// A frame longer than its layout is no error (anki-overdrive.md **Decision**): counted per message,
+// its extra bytes kept, and the first of each message told once.
+void AnkiCar::keepExtra(const Message& message, std::span<const std::uint8_t> extra) {
+  const std::string_view what = name(message);
+  auto it = state_.extra_bytes.find(what);
+  if (it == state_.extra_bytes.end()) {
+    it = state_.extra_bytes.emplace(std::string(what), ExtraBytes{}).first;
+    log::warn(label(), std::string(what) + " came " + std::to_string(extra.size()) +
+                           (extra.size() == 1 ? " byte" : " bytes") + " longer than its layout (" +
+                           toHex(extra) +
+                           "): read by the layout, the extra bytes counted and kept");
+  }
+  ++it->second.frames;
+  it->second.last.assign(extra.begin(), extra.end());
 }
 
 // The offset update (0x2d) that ends a lane change may be lost on the radio: a car that reports

@@ -4,9 +4,11 @@
 // code serves simulated and real cars: only the Link differs.
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <optional>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "engine/core/loop.hpp"
 #include "engine/core/result.hpp"
@@ -20,6 +22,14 @@ struct CarIdentity {
   std::string name;  // user name from the advertisement, or "car<n>"
   std::uint8_t model_id = 0;
   std::uint32_t identifier = 0;
+};
+
+// Frames of one message that came longer than its layout (anki-overdrive.md **Decision**): read by
+// the layout all the same; the bytes past it are kept so that a user can see what a firmware
+// appends.
+struct ExtraBytes {
+  std::uint64_t frames = 0;        // frames of that message with bytes past its layout
+  std::vector<std::uint8_t> last;  // those bytes of the latest one
 };
 
 struct CarState {
@@ -41,6 +51,7 @@ struct CarState {
   int version = 0;  // firmware version, 0 until known
   double last_position_time = -1;
   std::uint64_t frames_in = 0, frames_out = 0, malformed = 0;
+  std::map<std::string, ExtraBytes, std::less<>> extra_bytes;  // by message name
 };
 
 // Command defaults (docs/lua-api.md)
@@ -104,6 +115,7 @@ class AnkiCar {
 
  private:
   void apply(const anki::Message& message);
+  void keepExtra(const anki::Message& message, std::span<const std::uint8_t> extra);
   void connectionChanged(bool up, const std::string& reason);
   void laneChangeReached();
 

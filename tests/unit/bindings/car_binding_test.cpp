@@ -96,6 +96,27 @@ TEST_CASE_FIXTURE(LuaFixture, "onPosition receives the car and an event with the
   CHECK(run("assert(same == true); assert(pitwall.cars()[1].piece == 17)") == "");
 }
 
+// anki-overdrive.md **Decision**: frames longer than their layout are read, and what they carry
+// beyond it is there to see.
+TEST_CASE_FIXTURE(
+    LuaFixture,
+    "car.extraBytes counts frames longer than their layout per message, with the last "
+    "extra bytes") {
+  REQUIRE(run("local car = pitwall.cars()[1]\n"
+              "assert(next(car.extraBytes) == nil)\n"
+              "car.onPosition = function(c, ev) positions = (positions or 0) + 1 end") == "");
+  link->carSendsBytes({0x11, 0x27, 0x0e, 0x22, 0x00, 0x00, 0xb8, 0xc1, 0x58, 0x02, 0x47, 0x00, 0x00,
+                       0x00, 0x00, 0x58, 0x02, 0xaa});
+  link->carSendsBytes({0x12, 0x27, 0x0f, 0x22, 0x00, 0x00, 0xb8, 0xc1, 0x58, 0x02, 0x47, 0x00, 0x00,
+                       0x00, 0x00, 0x58, 0x02, 0xbb, 0xcc});
+  CHECK(number("positions") == 2);
+  CHECK(run("local car = pitwall.cars()[1]\n"
+            "local e = car.extraBytes['position-update']\n"
+            "assert(e.frames == 2, e.frames)\n"
+            "assert(e.last == 'bb cc', e.last)\n"
+            "assert(car.malformed == 0 and car.location == 15)") == "");
+}
+
 TEST_CASE_FIXTURE(LuaFixture, "state fields are read-only and unknown events are refused by name") {
   CHECK(run("pitwall.cars()[1].speed = 3").find("read-only") != std::string::npos);
   CHECK(run("pitwall.cars()[1].onPostion = function() end").find("not an event") !=

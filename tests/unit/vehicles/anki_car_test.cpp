@@ -2,6 +2,7 @@
 
 #include <doctest/doctest.h>
 
+#include "engine/core/log.hpp"
 #include "engine/vehicles/fleet.hpp"
 #include "tests/unit/capture_link.hpp"
 
@@ -86,6 +87,45 @@ TEST_CASE_FIXTURE(Fixture, "a malformed frame is counted and reported, and the c
   CHECK(reported.find("0x27") != std::string::npos);
   link.carSends(BatteryResponse{3900});
   CHECK(car.state().battery_mv == 3900);
+}
+
+// anki-overdrive.md **Decision**: a firmware that appends a field must not lose its frames.
+TEST_CASE_FIXTURE(Fixture,
+                  "frames longer than their layout are applied, counted per message, and their "
+                  "extra bytes kept") {
+  link.setConnected(true);
+  std::vector<std::string> logged;
+  log::setSink([&](log::Level, std::string_view line) { logged.emplace_back(line); });
+  int positions = 0;
+  car.onMessage = [&](const Message& m) { positions += std::holds_alternative<PositionUpdate>(m); };
+  // 0x27 (16) + 1 byte; 0x27 + 2 bytes; a battery response (3) + 1 byte.
+  link.carSendsBytes({0x11, 0x27, 0x0e, 0x22, 0x00, 0x00, 0xb8, 0xc1, 0x58, 0x02, 0x47, 0x00, 0x00,
+                      0x00, 0x00, 0x58, 0x02, 0xaa});
+  link.carSendsBytes({0x12, 0x27, 0x0f, 0x22, 0x00, 0x00, 0xb8, 0xc1, 0x5a, 0x02, 0x47, 0x00, 0x00,
+                      0x00, 0x00, 0x58, 0x02, 0xbb, 0xcc});
+  link.carSendsBytes({0x04, 0x1b, 0x4c, 0x0f, 0x01});
+  log::setSink(nullptr);
+
+  CHECK(positions == 2);
+  CHECK(car.state().piece == 34);
+  CHECK(car.state().location == 15);
+  CHECK(car.state().speed_mm_s == 602);
+  CHECK(car.state().offset_mm == doctest::Approx(-23.0));
+  CHECK(car.state().battery_mv == 3916);
+  CHECK(car.state().malformed == 0);
+  CHECK(car.state().frames_in == 3);
+  const auto& extra = car.state().extra_bytes;
+  REQUIRE(extra.size() == 2);
+  CHECK(extra.at("position-update").frames == 2);
+  CHECK(extra.at("position-update").last == std::vector<std::uint8_t>{0xbb, 0xcc});
+  CHECK(extra.at("battery-response").frames == 1);
+  CHECK(extra.at("battery-response").last == std::vector<std::uint8_t>{0x01});
+  // Told once per message: which one, how many bytes, which.
+  REQUIRE(logged.size() == 2);
+  CHECK(logged[0].find("position-update came 1 byte longer than its layout (aa)") !=
+        std::string::npos);
+  CHECK(logged[1].find("battery-response came 1 byte longer than its layout (01)") !=
+        std::string::npos);
 }
 
 TEST_CASE_FIXTURE(Fixture, "a ping's round trip is measured on the engine clock") {
