@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "engine/core/hex.hpp"
+#include "engine/core/log.hpp"
 #include "engine/core/overload.hpp"
 #include "engine/protocol/anki/codec.hpp"
 
@@ -115,10 +117,22 @@ void Car::stop() {
 
 void Car::receive(std::span<const std::uint8_t> frame) {
   if (!sink_) return;  // frames only arrive over a connection
-  auto decoded = anki::decode(frame);
-  if (!decoded) return;  // a real car ignores what it cannot parse
+  // As real firmware reads it, the short command forms too (anki-overdrive.md **Decision**).
+  auto decoded = anki::decodeCommand(frame);
+  if (!decoded) return refuse(frame, decoded.error().message());  // a real car ignores it
+  const std::string_view what = anki::name(*decoded);
   // Driving commands need SDK mode (anki-overdrive.md "GATT"); answers are always given.
   const bool sdk = sdk_;
+  auto driving = [&] {
+    if (!sdk)
+      refuse(frame, std::string(what) + " needs SDK mode, which is off (sdk-mode on: 03 90 01 01)");
+    return sdk;
+  };
+  auto finite = [&](float offset_mm) {
+    if (!std::isfinite(offset_mm))
+      refuse(frame, std::string(what) + " offset " + std::to_string(offset_mm) + " is no distance");
+    return std::isfinite(offset_mm);
+  };
   std::visit(
       Overload{
           [&](const anki::PingRequest&) { emit(anki::PingResponse{}); },
@@ -130,7 +144,7 @@ void Car::receive(std::span<const std::uint8_t> frame) {
           },
           [&](const anki::Disconnect&) { drop(true); },
           [&](const anki::SetSpeed& m) {
-            if (!sdk) return;
+            if (!driving()) return;
             ++speed_commands_;
             if (m.speed_mm_s <= 0) ++stop_commands_;
             target_ = std::clamp<double>(m.speed_mm_s, 0, kMaxSpeed);
@@ -140,7 +154,7 @@ void Car::receive(std::span<const std::uint8_t> frame) {
             if (target_ > 0) env_.wake();
           },
           [&](const anki::ChangeLane& m) {
-            if (!sdk || !std::isfinite(m.offset_mm)) return;
+            if (!driving() || !finite(m.offset_mm)) return;
             ++lane_recv_id_;
             lane_speed_asked_ = m.h_speed_mm_s;
             lane_speed_ = m.h_speed_mm_s > 0 ? m.h_speed_mm_s : kDefaultLaneSpeed;
@@ -152,26 +166,45 @@ void Car::receive(std::span<const std::uint8_t> frame) {
             env_.wake();
           },
           [&](const anki::CancelLaneChange&) {
-            if (!sdk) return;
+            if (!driving()) return;
             lane_active_ = false;
             lane_vel_ = 0;
           },
           [&](const anki::SetOffset& m) {
-            if (!sdk || !std::isfinite(m.offset_mm)) return;
+            if (!driving() || !finite(m.offset_mm)) return;
             bias_ = m.offset_mm - offset_ * dir_;
           },
           [&](const anki::Turn& m) {
-            if (!sdk || m.trigger != anki::TurnTrigger::Immediate) return;
-            if (m.type != anki::TurnType::UTurn && m.type != anki::TurnType::UTurnJump) return;
-            // Left/right turns need an intersection piece, which no simulated layout has.
+            if (!driving() || m.type == anki::TurnType::None) return;
+            // Left/right turns and turns at the next intersection need an intersection piece.
+            if (m.trigger != anki::TurnTrigger::Immediate ||
+                (m.type != anki::TurnType::UTurn && m.type != anki::TurnType::UTurnJump))
+              return refuse(frame,
+                            "this turn needs an intersection piece, and no simulated "
+                            "track has one (U-turns at once are taken)");
             dir_ = -dir_;
             bias_ = -bias_;  // what was believed right of the car is now left of it
             lane_active_ = false;
             lane_vel_ = 0;
           },
-          [&](const auto&) {},  // lights, config, and vehicle→controller ids: nothing to do
+          // Lights and config change nothing the simulator models: taken, nothing to do.
+          [&](const anki::SetLights&) {},
+          [&](const anki::LightsPattern&) {},
+          [&](const anki::SetConfig&) {},
+          [&](const anki::Unknown& u) {
+            refuse(frame, "message " + hexByte(u.id) + " is not one a car takes");
+          },
+          [&](const auto&) {  // the vehicle→controller ids
+            refuse(frame, std::string(what) + " is a message cars send, not one they take");
+          },
       },
       *decoded);
+}
+
+// What a real car ignores without a word is told here, so that a client's mistake shows.
+void Car::refuse(std::span<const std::uint8_t> frame, const std::string& why) const {
+  log::warn(spec_.name.empty() ? "sim car" : "sim car " + spec_.name,
+            "ignored " + toHex(frame) + ": " + why);
 }
 
 // ---- physics ----

@@ -7,6 +7,7 @@
 #include <functional>
 #include <random>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "engine/core/loop.hpp"
@@ -78,6 +79,7 @@ class Car final : public SimCar {
   void stop();
   void drop(bool notify);
 
+  void refuse(std::span<const std::uint8_t> frame, const std::string& why) const;
   void emit(const anki::Message& message);
   void flushOutbox();
   double uniform();  // [0, 1) from the world's generator, by our own arithmetic

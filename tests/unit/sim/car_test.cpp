@@ -2,8 +2,10 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <string>
 #include <vector>
 
+#include "engine/core/log.hpp"
 #include "engine/protocol/anki/codec.hpp"
 #include "engine/sim/world.hpp"
 
@@ -96,6 +98,68 @@ TEST_CASE("a car ignores driving commands until SDK mode is on") {
   rig.runUntil(4);
   CHECK(rig.car.truth().speed_mm_s == 600);
   CHECK_FALSE(rig.all<anki::PositionUpdate>().empty());
+}
+
+// anki-overdrive.md **Decision**: py-drivesdk's set_speed and stop leave out the respect-limit
+// byte, and real cars obey them.
+TEST_CASE("a car obeys set speed without its last byte: it drives at 500 mm/s, then stops") {
+  Rig rig;
+  rig.sdk();
+  rig.car.receive(std::vector<std::uint8_t>{0x05, 0x24, 0xf4, 0x01, 0xf4, 0x01});
+  auto ack = rig.all<anki::SpeedUpdate>();
+  REQUIRE(ack.size() == 1);
+  CHECK(ack[0].second.desired_mm_s == 500);
+  CHECK(ack[0].second.accel_mm_s2 == 500);
+  rig.runUntil(5);  // 1 s to reach 500 mm/s, then 4 s at it
+  CHECK(rig.car.truth().speed_mm_s == 500);
+  auto driving = rig.all<anki::PositionUpdate>();
+  REQUIRE(driving.size() > 5);
+  CHECK(driving.back().second.speed_mm_s == 500);
+  CHECK(driving.back().second.last_desired_speed_mm_s == 500);
+
+  rig.heard.clear();
+  rig.car.receive(std::vector<std::uint8_t>{0x05, 0x24, 0x00, 0x00, 0xf4, 0x01});
+  CHECK(rig.car.truth().target_speed_mm_s == 0);
+  CHECK(rig.car.truth().stop_commands == 1);
+  rig.runUntil(7);  // 500 mm/s at 500 mm/s² stops within 1 s
+  CHECK(rig.car.truth().speed_mm_s == 0);
+  auto braking = rig.all<anki::PositionUpdate>();
+  REQUIRE_FALSE(braking.empty());
+  CHECK(braking.back().second.speed_mm_s < 500);
+  CHECK(braking.back().second.last_desired_speed_mm_s == 0);
+
+  const double stoppedAt = rig.car.truth().lap_distance_mm;
+  rig.heard.clear();
+  rig.runUntil(12);
+  CHECK(rig.all<anki::PositionUpdate>().empty());
+  CHECK(rig.car.truth().lap_distance_mm == stoppedAt);
+}
+
+TEST_CASE("a car tells what it ignores: the bytes and why") {
+  Rig rig;
+  std::vector<std::string> logged;
+  log::setSink([&](log::Level, std::string_view line) { logged.emplace_back(line); });
+  rig.send(anki::SetSpeed{600, 1000});                                       // before SDK mode
+  rig.car.receive(std::vector<std::uint8_t>{0x04, 0x24, 0xf4, 0x01, 0xf4});  // too short even so
+  rig.car.receive(std::vector<std::uint8_t>{0x02, 0x99, 0x01});              // an unknown id
+  rig.sdk();
+  rig.send(anki::Turn{anki::TurnType::Left, anki::TurnTrigger::Immediate});
+  rig.send(anki::CarStatus{true, false, {}, {}});  // a message cars send
+  rig.send(anki::SetLights{0x44});                 // taken: nothing to say
+  log::setSink(nullptr);
+
+  REQUIRE(logged.size() == 5);
+  auto says = [&](std::size_t i, std::initializer_list<std::string_view> parts) {
+    INFO(logged[i]);
+    for (auto part : parts) CHECK(logged[i].find(part) != std::string::npos);
+  };
+  says(0, {"ignored 06 24 58 02 e8 03 00", "set-speed needs SDK mode"});
+  says(1, {"ignored 04 24 f4 01 f4", "0x24", "too short"});
+  says(2, {"ignored 02 99 01", "0x99"});
+  says(3, {"ignored 03 32 01 00", "intersection"});
+  says(4, {"ignored 03 3f 01 00", "car-status is a message cars send"});
+  CHECK(rig.car.truth().speed_mm_s == 0);
+  CHECK(rig.car.truth().speed_commands == 0);
 }
 
 TEST_CASE("a stopped car sends nothing but answers") {
