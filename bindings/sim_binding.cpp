@@ -8,6 +8,7 @@
 #include "bindings/pitwall_module.hpp"
 #include "bindings/script_host.hpp"
 #include "engine/protocol/anki/advertisement.hpp"
+#include "engine/protocol/anki/limits.hpp"
 #include "engine/sim/grid.hpp"
 #include "engine/transport/sim_link.hpp"
 
@@ -96,6 +97,17 @@ int layouts(lua_State* L) {
   return 1;
 }
 
+// A car is put on the road: within ±70 mm of its centre (seed 000 §4.3.4.4), the offsets car
+// commands take (limits.hpp). A car steered further, which only raw frames can do, drives on to
+// the simulator's road edge (docs/simulator.md "Delocalization").
+void checkOnRoad(double offset_mm) {
+  using anki::limits::kOffsetMax, anki::limits::kOffsetMin;
+  if (!(offset_mm >= kOffsetMin && offset_mm <= kOffsetMax))  // NaN too
+    throw LuaError("offset " + lua::show(offset_mm) + " mm is off the road (" +
+                   std::to_string(static_cast<int>(kOffsetMin)) + ".." +
+                   std::to_string(static_cast<int>(kOffsetMax)) + " mm)");
+}
+
 // sim._addCar{name=, model=, piece=, distance=, lane= | offset=, battery=, version=}
 int addCar(lua_State* L) {
   ScriptHost& host = ScriptHost::from(L);
@@ -137,8 +149,7 @@ int addCar(lua_State* L) {
   lua_pop(L, 1);
   if (lua_getfield(L, 1, "offset") != LUA_TNIL) {
     spec.offset_mm = lua::checkNumber(L, -1, "offset (mm)");
-    if (spec.offset_mm < -100 || spec.offset_mm > 100)
-      throw LuaError("offset " + lua::show(spec.offset_mm) + " mm is off the road (-100..100 mm)");
+    checkOnRoad(spec.offset_mm);
   }
   lua_pop(L, 1);
   if (lua_getfield(L, 1, "battery") != LUA_TNIL) {
@@ -206,8 +217,7 @@ int place(lua_State* L) {
     throw LuaError("piece " + std::to_string(piece) + " is out of range 1.." +
                    std::to_string(track.size()));
   double offset = lua::optNumber(L, 3, "offset (mm)", 0);
-  if (offset < -100 || offset > 100)
-    throw LuaError("offset " + lua::show(offset) + " mm is off the road (-100..100 mm)");
+  checkOnRoad(offset);
   car.place(static_cast<std::size_t>(piece - 1), offset);
   return 0;
 }

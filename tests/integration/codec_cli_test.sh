@@ -19,6 +19,10 @@ contains "config" "03 45" "$($PITWALL encode anki config 0 vinyl)"
 err=$($PITWALL encode anki set-speed 2000 2>&1 >/dev/null); rc=$?
 check "out-of-range exit status" 2 "$rc"
 contains "out-of-range names the range" "0..1500" "$err"
+err=$($PITWALL encode anki change-lane 300 3000 75 2>&1 >/dev/null); rc=$?
+check "offset beyond 70 mm exit status" 2 "$rc"
+contains "offset beyond 70 mm names the range" "offset 75 mm is out of range -70..70 mm" "$err"
+check "offset 70 mm is taken" "05 2c 00 00 8c 42" "$($PITWALL encode anki set-offset 70)"
 err=$($PITWALL encode anki warp 9 2>&1 >/dev/null); rc=$?
 check "unknown command exit status" 2 "$rc"
 contains "unknown command lists the known ones" "set-speed" "$err"

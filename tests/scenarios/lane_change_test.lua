@@ -24,7 +24,11 @@ sim.runUntil(function() return seen ~= nil end, 2)
 expect.near(seen, 68, 1, "offset in position updates")
 expect.near(car.offset, 68, 1, "car.offset")
 
--- Out of range is refused with the range named, and nothing is sent.
+-- Out of range is refused with the range named, and nothing is sent: beyond ±70 mm the car
+-- leaves the road (seed 000 §4.3.4.4).
 local before = car.frames
-expect.fails(function() car:changeLane(150) end, "-100..100")
+expect.fails(function() car:changeLane(150) end,
+  "offset 150 mm is out of range -70..70 mm (beyond it the car leaves the road)")
+expect.fails(function() car:changeLane(-70.5) end, "offset -70.5 mm is out of range -70..70 mm")
+expect.fails(function() car:setOffset(90) end, "offset 90 mm is out of range -70..70 mm")
 expect.eq(car.frames, before, "frames after a refused command")

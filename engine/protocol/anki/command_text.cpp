@@ -54,8 +54,9 @@ class Words {
     return T{};
   }
 
-  // A decimal number of millimetres in min..max (NaN and infinity are out of every range).
-  float millimetres(string_view what, double min, double max) {
+  // A decimal number of millimetres in min..max (NaN and infinity are out of every range); `why`
+  // the range is what it is, said after it when the number is out of it.
+  float millimetres(string_view what, double min, double max, string_view why = {}) {
     const auto word = take(what);
     if (!word) return 0;
     double value = 0;
@@ -64,7 +65,8 @@ class Words {
     if (word->empty() || end != word->data() + word->size() || ec == std::errc::invalid_argument) {
       fail(quoted(what, *word) + " is not a number; expected " + expected);
     } else if (ec != std::errc{} || !(value >= min && value <= max)) {
-      fail(std::string(what) + " " + std::string(*word) + " mm is out of range " + expected);
+      fail(std::string(what) + " " + std::string(*word) + " mm is out of range " + expected +
+           (why.empty() ? std::string() : " (" + std::string(why) + ")"));
     } else {
       return static_cast<float>(value);
     }
@@ -165,13 +167,16 @@ Message setSpeed(Words& w) {
   return m;
 }
 
+// seed 000 §4.3.4.4, as limits::validate says it.
+constexpr string_view kOffRoad = "beyond it the car leaves the road";
+
 Message changeLane(Words& w) {
   ChangeLane m;
   m.h_speed_mm_s = w.integer<std::uint16_t>("lane-change speed", limits::kLaneSpeedMin,
                                             limits::kLaneSpeedMax, "mm/s");
   m.h_accel_mm_s2 = w.integer<std::uint16_t>("lane-change accel", limits::kLaneAccelMin,
                                              limits::kLaneAccelMax, "mm/s²");
-  m.offset_mm = w.millimetres("offset", limits::kOffsetMin, limits::kOffsetMax);
+  m.offset_mm = w.millimetres("offset", limits::kOffsetMin, limits::kOffsetMax, kOffRoad);
   if (w.more()) {  // HOP and TAG come together
     m.hop_intent = w.integer<std::uint8_t>("hop intent", 0, kByte);
     m.tag = w.integer<std::uint8_t>("tag", 0, kByte);
@@ -180,7 +185,8 @@ Message changeLane(Words& w) {
 }
 
 Message setOffset(Words& w) {
-  return SetOffset{.offset_mm = w.millimetres("offset", limits::kOffsetMin, limits::kOffsetMax)};
+  return SetOffset{.offset_mm =
+                       w.millimetres("offset", limits::kOffsetMin, limits::kOffsetMax, kOffRoad)};
 }
 
 // Word order follows TurnType's values: none 0, left 1, right 2, uturn 3, uturn-jump 4.

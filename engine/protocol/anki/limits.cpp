@@ -33,6 +33,13 @@ Verdict range(std::string_view field, double value, double min, double max,
          ".." + withUnit(text(max), unit);
 }
 
+// seed 000 §4.3.4.4: the offset range is where the road is, which the sentence says.
+Verdict offset(double value) {
+  auto v = range("offset", value, kOffsetMin, kOffsetMax, "mm");
+  if (v) *v += " (beyond it the car leaves the road)";
+  return v;
+}
+
 Verdict firstOf(std::initializer_list<Verdict> verdicts) {
   for (const auto& v : verdicts) {
     if (v) return v;
@@ -49,11 +56,11 @@ Verdict check(const ChangeLane& m) {
   return firstOf(
       {range("lane-change speed", m.h_speed_mm_s, kLaneSpeedMin, kLaneSpeedMax, "mm/s"),
        range("lane-change accel", m.h_accel_mm_s2, kLaneAccelMin, kLaneAccelMax, "mm/s²"),
-       range("offset", m.offset_mm, kOffsetMin, kOffsetMax, "mm")});
+       offset(m.offset_mm)});
 }
 
 Verdict check(const SetOffset& m) {
-  return range("offset", m.offset_mm, kOffsetMin, kOffsetMax, "mm");
+  return offset(m.offset_mm);
 }
 
 // anki-overdrive.md: type 0 none … 4 U-turn jump; trigger 0 immediate, 1 at next intersection.

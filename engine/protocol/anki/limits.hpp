@@ -8,11 +8,12 @@
 
 namespace pitwall::anki::limits {
 
-inline constexpr int kSpeedMin = 0, kSpeedMax = 1500;            // mm/s
-inline constexpr int kAccelMin = 0, kAccelMax = 25000;           // mm/s²
-inline constexpr int kLaneSpeedMin = 0, kLaneSpeedMax = 1500;    // mm/s
-inline constexpr int kLaneAccelMin = 0, kLaneAccelMax = 25000;   // mm/s²
-inline constexpr double kOffsetMin = -100.0, kOffsetMax = 100.0;  // mm from road centre
+inline constexpr int kSpeedMin = 0, kSpeedMax = 1500;           // mm/s
+inline constexpr int kAccelMin = 0, kAccelMax = 25000;          // mm/s²
+inline constexpr int kLaneSpeedMin = 0, kLaneSpeedMax = 1500;   // mm/s
+inline constexpr int kLaneAccelMin = 0, kLaneAccelMax = 25000;  // mm/s²
+// mm from road centre: seed 000 §4.3.4.4, beyond ±70 mm the car leaves the road
+inline constexpr double kOffsetMin = -70.0, kOffsetMax = 70.0;
 inline constexpr int kLightChannelMax = 5, kLightEffectMax = 4, kLightIntensityMax = 14;
 inline constexpr int kTrackMaterialMax = 1;
 

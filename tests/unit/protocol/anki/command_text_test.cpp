@@ -101,7 +101,13 @@ TEST_CASE("an out-of-range number is refused with word, value and range") {
   CHECK(refusal("set-speed 2000") == "speed 2000 mm/s is out of range 0..1500 mm/s");
   CHECK(refusal("set-speed -5") == "speed -5 mm/s is out of range 0..1500 mm/s");
   CHECK(refusal("set-speed 500 30000") == "accel 30000 mm/s² is out of range 0..25000 mm/s²");
-  CHECK(refusal("change-lane 300 300 150") == "offset 150 mm is out of range -100..100 mm");
+  CHECK(refusal("change-lane 300 300 150") ==
+        "offset 150 mm is out of range -70..70 mm (beyond it the car leaves the road)");
+  CHECK(refusal("change-lane 300 300 -75") ==
+        "offset -75 mm is out of range -70..70 mm (beyond it the car leaves the road)");
+  CHECK(refusal("set-offset 70.5") ==
+        "offset 70.5 mm is out of range -70..70 mm (beyond it the car leaves the road)");
+  CHECK(encoded("set-offset -70") == "05 2c 00 00 8c c2");
   CHECK(mentions(refusal("lights-pattern 7 0 0 14 10"), {"slot 1 channel", "7", "0..5"}));
   CHECK(mentions(refusal("lights-pattern 0 0 0 15 10"), {"slot 1 end intensity", "15", "0..14"}));
   CHECK(mentions(refusal("change-lane 300 300 0 256 1"), {"hop intent", "256", "0..255"}));
@@ -112,18 +118,19 @@ TEST_CASE("a number too big for its field is refused before it is narrowed") {
   CHECK(mentions(refusal("set-speed 99999999999999999999999"), {"speed", "0..1500"}));
   CHECK(mentions(refusal("lights 256"), {"mask", "256", "0..255"}));
   CHECK(mentions(refusal("sdk-mode on 0x100"), {"flags", "0x100", "0..255"}));
-  CHECK(mentions(refusal("set-offset 1e300"), {"offset", "1e300", "-100..100 mm"}));
+  CHECK(mentions(refusal("set-offset 1e300"), {"offset", "1e300", "-70..70 mm"}));
 }
 
 TEST_CASE("offsets that are not finite are refused") {
-  CHECK(refusal("set-offset nan") == "offset nan mm is out of range -100..100 mm");
-  CHECK(mentions(refusal("change-lane 300 300 inf"), {"offset", "inf", "-100..100 mm"}));
+  CHECK(refusal("set-offset nan") ==
+        "offset nan mm is out of range -70..70 mm (beyond it the car leaves the road)");
+  CHECK(mentions(refusal("change-lane 300 300 inf"), {"offset", "inf", "-70..70 mm"}));
 }
 
 TEST_CASE("a word that is not a number is refused with the range it should be in") {
   CHECK(refusal("set-speed fast") == "speed 'fast' is not a whole number; expected 0..1500 mm/s");
   CHECK(mentions(refusal("set-speed 12.5"), {"speed", "12.5", "0..1500"}));
-  CHECK(mentions(refusal("set-offset left"), {"offset", "left", "-100..100 mm"}));
+  CHECK(mentions(refusal("set-offset left"), {"offset", "left", "-70..70 mm"}));
   CHECK(mentions(refusal("lights 0x"), {"mask", "0x", "0..255"}));
 }
 

@@ -19,8 +19,9 @@ TEST_CASE("commands inside their ranges are accepted") {
   CHECK_FALSE(limits::validate(SetSpeed{.speed_mm_s = 1500, .accel_mm_s2 = 25000}));
   CHECK_FALSE(limits::validate(SetSpeed{.speed_mm_s = 0, .accel_mm_s2 = 0}));
   CHECK_FALSE(
-      limits::validate(ChangeLane{.h_speed_mm_s = 300, .h_accel_mm_s2 = 300, .offset_mm = -100}));
-  CHECK_FALSE(limits::validate(SetOffset{.offset_mm = 100}));
+      limits::validate(ChangeLane{.h_speed_mm_s = 300, .h_accel_mm_s2 = 300, .offset_mm = -70}));
+  CHECK_FALSE(limits::validate(SetOffset{.offset_mm = 70}));
+  CHECK_FALSE(limits::validate(ChangeLane{.offset_mm = 68}));  // the outer lanes
   CHECK_FALSE(
       limits::validate(Turn{.type = TurnType::UTurnJump, .trigger = TurnTrigger::Intersection}));
   CHECK_FALSE(limits::validate(SetConfig{.super_code_parse_mask = 0xff, .track_material = 1}));
@@ -44,14 +45,29 @@ TEST_CASE("a lane change out of range is refused") {
   CHECK(refusal(ChangeLane{.h_speed_mm_s = 1501}) ==
         "lane-change speed 1501 mm/s is out of range 0..1500 mm/s");
   CHECK(refusal(ChangeLane{.h_accel_mm_s2 = 30000}).find("0..25000 mm/s²") != std::string::npos);
-  CHECK(refusal(ChangeLane{.offset_mm = 100.5f}) == "offset 100.5 mm is out of range -100..100 mm");
+  CHECK(refusal(ChangeLane{.offset_mm = 100.5f}) ==
+        "offset 100.5 mm is out of range -70..70 mm (beyond it the car leaves the road)");
+}
+
+// seed 000 §4.3.4.4: beyond ±70 mm the car leaves the road.
+TEST_CASE("an offset beyond 70 mm either side is refused for lane changes and set-offset alike") {
+  CHECK(refusal(ChangeLane{.offset_mm = 70.5f}) ==
+        "offset 70.5 mm is out of range -70..70 mm (beyond it the car leaves the road)");
+  CHECK(refusal(ChangeLane{.offset_mm = -71}) ==
+        "offset -71 mm is out of range -70..70 mm (beyond it the car leaves the road)");
+  CHECK(refusal(SetOffset{.offset_mm = 90}) ==
+        "offset 90 mm is out of range -70..70 mm (beyond it the car leaves the road)");
+  CHECK(refusal(SetOffset{.offset_mm = -100}) ==
+        "offset -100 mm is out of range -70..70 mm (beyond it the car leaves the road)");
 }
 
 TEST_CASE("offsets that are not finite numbers are refused") {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const float inf = std::numeric_limits<float>::infinity();
-  CHECK(refusal(SetOffset{.offset_mm = nan}) == "offset nan mm is out of range -100..100 mm");
-  CHECK(refusal(SetOffset{.offset_mm = -inf}) == "offset -inf mm is out of range -100..100 mm");
+  CHECK(refusal(SetOffset{.offset_mm = nan}) ==
+        "offset nan mm is out of range -70..70 mm (beyond it the car leaves the road)");
+  CHECK(refusal(SetOffset{.offset_mm = -inf}) ==
+        "offset -inf mm is out of range -70..70 mm (beyond it the car leaves the road)");
   CHECK(refusal(ChangeLane{.offset_mm = inf}).find("inf mm") != std::string::npos);
 }
 
