@@ -99,6 +99,9 @@ int view(const ViewOptions& options);
 struct EmulateOptions {
   std::string adapter = "hci0";
   std::string name = "pitwall";
+  // The advertised local name: false — laid out as a car's (state, version, filler, name;
+  // anki::localNameText), which clients that read the state byte need; true — the name alone.
+  bool plainName = false;
   std::uint8_t model = 8;  // Groundshock
   std::string track = "oval";
   std::uint64_t seed = 1;
@@ -117,8 +120,8 @@ struct ReplayOptions {
   // --track: the layout the view draws; none: the record's own ("layout" on its first line),
   // else oval (a record written before records kept their layout)
   std::optional<std::string> track;
-  std::string script;               // --script S.lua: the recorded events reach its handlers
-  std::uint64_t seed = 1;           // the script's math.random
+  std::string script;      // --script S.lua: the recorded events reach its handlers
+  std::uint64_t seed = 1;  // the script's math.random
 };
 int replay(const ReplayOptions& options);
 

@@ -22,6 +22,8 @@ constexpr const char* kComponent = "emulate-car";
 // How long a stop waits for BlueZ to confirm the unregistrations before leaving anyway (the
 // registrations also die with our bus connection).
 constexpr Duration kStopGrace = std::chrono::seconds(1);
+// The simulator's "fully charged" (engine/sim: at or above it, the state byte's 0x10 bit).
+constexpr std::uint16_t kFullBatteryMv = 4200;
 
 std::string hex32(std::uint32_t v) {
   char text[16];
@@ -32,6 +34,10 @@ std::string hex32(std::uint32_t v) {
 }  // namespace
 
 int emulateCar(const EmulateOptions& options) {
+  if (auto problem = anki::userNameProblem(options.name); !problem.empty()) {
+    std::cerr << "pitwall emulate-car: --name: " << problem << "\n";
+    return 2;
+  }
   auto track = sim::loadLayout(options.track);
   if (!track) {
     std::cerr << "pitwall emulate-car: " << track.error() << "\n";
@@ -53,6 +59,9 @@ int emulateCar(const EmulateOptions& options) {
   sim::CarSpec spec = sim::gridSpec(world.track(), 0);
   spec.name = options.name;
   spec.model_id = options.model;
+  // Fully charged, as a car just taken off its charger: its name's state byte is 0x10 "full
+  // battery". A battery neither full nor low is state 0, a NUL the text name cannot hold.
+  spec.battery_mv = kFullBatteryMv;
   sim::SimCar& car = world.addCar(spec);
 
   PeripheralSpec peripheralSpec;
@@ -65,7 +74,22 @@ int emulateCar(const EmulateOptions& options) {
   peripheralSpec.manufacturerKey = anki::kManufacturerKey;
   peripheralSpec.manufacturerData.assign(manufacturer.begin() + 2, manufacturer.end());
   peripheralSpec.localName = car.localName();
-  peripheralSpec.fallbackName = options.name;
+  if (options.plainName) {
+    peripheralSpec.localNameText = options.name;
+  } else {
+    // The car's own local name (state, version, user name) with filler for its zeros: clients
+    // such as py-drivesdk read byte 0 as the state and skip a car "on the charger" — which the
+    // plain name's first letter often is ('p' is 0x70).
+    anki::LocalName local = anki::parseLocalName(car.localName());
+    local.user_name = options.name;  // whole: the simulator's bytes keep 11 of its 12
+    auto text = anki::localNameText(local);
+    if (!text) {
+      std::cerr << "pitwall emulate-car: cannot advertise the car's local name: " << text.error()
+                << " (--plain-name advertises the name alone)\n";
+      return 2;
+    }
+    peripheralSpec.localNameText = *text;
+  }
 
   DbusPump pump(loop, *bus);
   BlePeripheral peripheral(pump, peripheralSpec);

@@ -190,7 +190,9 @@ int main(int argc, char** argv) {
   auto* emulateCmd = app.add_subcommand(
       "emulate-car", "Be an Anki car: a BLE peripheral driven by the simulator (needs BlueZ)");
   emulateCmd->add_option("--adapter", emulate.adapter, "The controller to advertise on (hci0)");
-  emulateCmd->add_option("--name", emulate.name, "The car's user name (pitwall)");
+  emulateCmd->add_option("--name", emulate.name, "The car's user name (pitwall, ≤ 12 bytes)");
+  emulateCmd->add_flag("--plain-name", emulate.plainName,
+                       "Advertise the user name alone, not laid out as a car's local name");
   emulateCmd->add_option("--model", emulate.model, "Model id (8: Groundshock)")
       ->check(CLI::Range(1, 255));
   emulateCmd->add_option("--track", emulate.track, "Track layout the car drives on (oval)");

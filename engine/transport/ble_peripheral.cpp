@@ -1,6 +1,7 @@
 #include "engine/transport/ble_peripheral.hpp"
 
 #include <chrono>
+#include <cstdio>
 #include <map>
 
 #include <sdbus-c++/sdbus-c++.h>
@@ -27,16 +28,31 @@ using Options = std::map<std::string, sdbus::Variant>;
 // names included (src/shared/ad.c, type_reject_list). The service UUID (18 bytes) and the
 // manufacturer data (10) already fill the 31-byte advertising data with the flags (3), and 5.66
 // has no ScanResponse* properties; what it does put in the scan response is `LocalName`, a
-// string: the user name alone. Centrals then see the name without the state/version bytes,
-// which pitwall's scanner reads as a plain name (anki-overdrive.md "Advertisement").
+// string (UTF-8, no NUL): emulate-car gives the name's layout with control characters for the
+// zeros (anki::localNameText), or the plain user name (anki-overdrive.md "Advertisement").
 enum class NameForm { RawData, LocalName, None };
+
+// The name for a log line: control characters as \xNN.
+std::string printable(const std::string& text) {
+  std::string out;
+  for (unsigned char c : text) {
+    if (c < 0x20 || c == 0x7f) {
+      char esc[8];
+      std::snprintf(esc, sizeof esc, "\\x%02x", c);
+      out += esc;
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  return out;
+}
 
 std::string formDescription(NameForm form, const PeripheralSpec& spec) {
   switch (form) {
     case NameForm::RawData:
       return "Data 0x09 (" + std::to_string(spec.localName.size()) + " raw bytes)";
     case NameForm::LocalName:
-      return "LocalName \"" + spec.fallbackName + "\" (scan response)";
+      return "LocalName \"" + printable(spec.localNameText) + "\" (scan response)";
     case NameForm::None:
       return "no local name";
   }
@@ -204,7 +220,7 @@ struct BlePeripheral::State {
       return data;
     });
     advert->registerProperty("LocalName").onInterface(api::kAdvertisement).withGetter([this] {
-      return form == NameForm::LocalName ? spec.fallbackName : std::string();
+      return form == NameForm::LocalName ? spec.localNameText : std::string();
     });
     advert->registerMethod("Release").onInterface(api::kAdvertisement).implementedAs([this] {
       log::info(kComponent, "BlueZ released the advertisement on " + spec.adapter);

@@ -27,7 +27,9 @@ struct PeripheralSpec {
   std::uint16_t manufacturerKey = 0;           // company id: the first 2 bytes, little-endian
   std::vector<std::uint8_t> manufacturerData;  // the bytes after the company id
   std::vector<std::uint8_t> localName;         // raw bytes (may hold NULs), tried first
-  std::string fallbackName;                    // LocalName string when the raw bytes are refused
+  // The LocalName string when the raw bytes are refused: UTF-8 without NUL (a D-Bus string),
+  // control characters allowed (emulate-car's Anki-shaped name, anki::localNameText).
+  std::string localNameText;
 };
 
 class BlePeripheral {
@@ -50,7 +52,8 @@ class BlePeripheral {
   void disconnectCentral();
 
   // How the local name went into the advertisement, once start() succeeded: e.g.
-  // "Data 0x09 (raw bytes)" or "LocalName \"pitwall\" (scan response)".
+  // `Data 0x09 (20 raw bytes)` or `LocalName "\x10p+\x01\x01\x01\x01\x01pitwall" (scan
+  // response)`, control characters written as \xNN.
   const std::string& advertisedName() const;
   bool connected() const;
 

@@ -51,11 +51,8 @@ bool stateByte(unsigned char b) {
   return (b & ~0x70u) == 0;
 }  // bits 0x10, 0x20, 0x40 only
 
-// The raw local name is Anki's: a state byte, the version, five reserved zero bytes (a plain
-// name, such as a car emulator's, has letters there).
-bool ankiLocalName(const std::vector<std::uint8_t>& raw) {
-  if (raw.size() < 8 || !stateByte(raw[0])) return false;
-  return std::all_of(raw.begin() + 3, raw.begin() + 8, [](std::uint8_t b) { return b == 0; });
+std::span<const std::uint8_t> bytesOf(const std::string& s) {
+  return {reinterpret_cast<const std::uint8_t*>(s.data()), s.size()};
 }
 
 // What BlueZ's Name keeps of an Anki local name: the bytes before the first reserved zero — a
@@ -68,13 +65,16 @@ bool cutAnkiName(const std::string& name) {
 
 anki::LocalName Device::localName() const {
   if (rawName) {
-    if (ankiLocalName(*rawName)) return anki::parseLocalName(*rawName);
+    if (anki::isAnkiLocalName(*rawName)) return anki::parseLocalName(*rawName);
     anki::LocalName n;  // a plain name
     n.user_name = std::string(rawName->begin(), std::find(rawName->begin(), rawName->end(), 0));
     return n;
   }
+  // A whole Anki-shaped name in Name: an emulated car's (pitwall emulate-car puts control
+  // characters where a real car's zeros would cut the string; anki::localNameText).
+  if (anki::isAnkiLocalName(bytesOf(name))) return anki::parseLocalName(bytesOf(name));
   if (cutAnkiName(name)) {
-    auto n = anki::parseLocalName(std::vector<std::uint8_t>(name.begin(), name.end()));
+    auto n = anki::parseLocalName(bytesOf(name));
     n.user_name.clear();
     if (name.size() < 3) n.version = 0;
     return n;
@@ -85,7 +85,8 @@ anki::LocalName Device::localName() const {
 }
 
 bool Device::stateKnown() const {
-  return rawName ? ankiLocalName(*rawName) : cutAnkiName(name);
+  return rawName ? anki::isAnkiLocalName(*rawName)
+                 : anki::isAnkiLocalName(bytesOf(name)) || cutAnkiName(name);
 }
 
 std::string describe(const sdbus::Error& error, const std::string& step) {

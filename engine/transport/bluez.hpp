@@ -59,8 +59,9 @@ struct Device {
   // The Anki local name: from the raw advertising data where BlueZ has it (only experimentally,
   // and not in 5.66), else from what BlueZ made of it in Name: the bytes up to the first NUL —
   // the state byte and the version when they contain no zero, never the user name (which comes
-  // after reserved NUL bytes). A Name that does not start with a state byte is taken as the
-  // user name (a car emulator that advertises a plain name).
+  // after reserved NUL bytes). A whole Anki-shaped Name, with control characters where a real
+  // car has the NULs (pitwall emulate-car, anki::localNameText), gives all of it. Any other Name
+  // is taken as the user name (a car emulator that advertises a plain name).
   anki::LocalName localName() const;
   bool stateKnown() const;  // the state byte and version were readable
 };

@@ -1,7 +1,8 @@
 // What an Anki car advertises (engine/protocol/anki/advertisement.hpp): the manufacturer data in
 // both shapes (8 raw bytes; BlueZ's key + value) and the local name. Never a crash or an exception;
 // parseLocalName never fails and gives valid UTF-8 (documented), and the two manufacturer-data
-// shapes agree: raw bytes [BE EF rest…] parse exactly as key 0xEFBE with value [rest…].
+// shapes agree: raw bytes [BE EF rest…] parse exactly as key 0xEFBE with value [rest…]; a name
+// that localNameText takes comes back from its text form unchanged.
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -44,5 +45,19 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // it (dump() throws on invalid UTF-8, which this would report as a crash).
   FUZZ_CHECK(name.user_name.size() <= 3 * in.size(), fuzz::bytesText("in", in));
   (void)nlohmann::json(name.user_name).dump();
+  // The text form (emulate-car's LocalName) holds no NUL and reads back as what it was made of.
+  if (auto text = anki::localNameText(name)) {
+    const std::span<const std::uint8_t> bytes(reinterpret_cast<const std::uint8_t*>(text->data()),
+                                              text->size());
+    FUZZ_CHECK(text->find('\0') == std::string::npos && anki::isAnkiLocalName(bytes),
+               fuzz::bytesText("in", in));
+    const anki::LocalName back = anki::parseLocalName(bytes);
+    FUZZ_CHECK(back.full_battery == name.full_battery && back.low_battery == name.low_battery &&
+                   back.on_charger == name.on_charger && back.version == name.version &&
+                   back.user_name == name.user_name,
+               fuzz::bytesText("in", in));
+  } else {
+    FUZZ_CHECK(!text.error().empty());
+  }
   return 0;
 }

@@ -121,6 +121,56 @@ LocalName parseLocalName(std::span<const std::uint8_t> raw) {
   return name;
 }
 
+bool isAnkiLocalName(std::span<const std::uint8_t> raw) {
+  if (raw.size() < 8 || (raw[0] & ~0x70u) != 0) return false;
+  return std::all_of(raw.begin() + 3, raw.begin() + 8, [](std::uint8_t b) { return b < 0x20; });
+}
+
+std::string userNameProblem(std::string_view name) {
+  if (name.empty()) return "a car's name cannot be empty";
+  if (name.size() > kMaxUserNameBytes) {
+    return "\"" + std::string(name) + "\" has " + std::to_string(name.size()) +
+           " bytes; a car's name has at most " + std::to_string(kMaxUserNameBytes) +
+           " (its local name is 20 bytes, 8 of them before the name)";
+  }
+  const std::span<const std::uint8_t> bytes(reinterpret_cast<const std::uint8_t*>(name.data()),
+                                            name.size());
+  for (std::size_t i = 0; i < bytes.size();) {
+    const std::size_t n = utf8Sequence(bytes, i);
+    if (n == 0) return "a car's name must be UTF-8: byte " + std::to_string(i) + " is not";
+    if (n == 1 && (bytes[i] < 0x20 || bytes[i] == 0x7f)) {
+      return "a car's name cannot hold control characters (byte " + std::to_string(i) + ")";
+    }
+    i += n;
+  }
+  return "";
+}
+
+Result<std::string, std::string> localNameText(const LocalName& name) {
+  const auto state =
+      static_cast<std::uint8_t>((name.full_battery ? 0x10 : 0) | (name.low_battery ? 0x20 : 0) |
+                                (name.on_charger ? 0x40 : 0));
+  if (state == 0) {
+    return Unexpected{std::string(
+        "a state byte with no bit set (battery neither full nor low, not on the charger) is a "
+        "NUL, which a text name cannot hold")};
+  }
+  const auto lo = static_cast<std::uint8_t>(name.version & 0xff);
+  const auto hi = static_cast<std::uint8_t>(name.version >> 8);
+  for (std::uint8_t b : {lo, hi}) {
+    if (b == 0 || b > 0x7f) {
+      return Unexpected{"version " + hex16(name.version) +
+                        " has a byte that is no character of its own in UTF-8 (0x01..0x7f)"};
+    }
+  }
+  if (auto problem = userNameProblem(name.user_name); !problem.empty()) {
+    return Unexpected{std::move(problem)};
+  }
+  std::string text{static_cast<char>(state), static_cast<char>(lo), static_cast<char>(hi)};
+  text.append(5, static_cast<char>(kNameFiller));
+  return text + name.user_name;
+}
+
 // anki-overdrive.md "Model ids" (majority of sources where they disagree); index = model id,
 // empty = no known model.
 std::string modelName(std::uint8_t model_id) {

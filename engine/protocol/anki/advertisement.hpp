@@ -36,6 +36,28 @@ struct LocalName {
 // Never fails: short input gives what could be read (a name cut short by BlueZ is common).
 LocalName parseLocalName(std::span<const std::uint8_t> raw);
 
+// Whether bytes have the shape of an Anki local name rather than a plain text name: at least 8
+// bytes, a state byte with no bits but 0x10/0x20/0x40, and the five reserved bytes 3..7 control
+// characters — zero on a real car, kNameFiller from an emulated one (localNameText). A text
+// name has letters there.
+bool isAnkiLocalName(std::span<const std::uint8_t> raw);
+
+// What an emulated car puts in the reserved bytes, which a real car leaves zero: a stack that
+// takes the local name as a string (BlueZ's LEAdvertisement1.LocalName is a D-Bus string: UTF-8,
+// no NUL) cannot carry zeros.
+inline constexpr std::uint8_t kNameFiller = 0x01;
+// A local name is at most 20 bytes: 8 before the user name, so 12 for it.
+inline constexpr std::size_t kMaxUserNameBytes = 12;
+// Why `name` cannot be advertised as a car's user name, "" when it can: UTF-8 without control
+// characters, 1..kMaxUserNameBytes bytes.
+std::string userNameProblem(std::string_view name);
+// The local name as text with the layout of the binary one — state byte, version little-endian,
+// kNameFiller × 5, user name — so that clients that read a car's state from the name's first
+// byte (py-drivesdk skips a car whose byte 0 has the on-charger bit) take it for a car. Refused
+// with the reason when a byte would be NUL or not a character on its own: a state with no bit
+// set, a version byte 0 or above 0x7f, a user name userNameProblem() refuses.
+Result<std::string, std::string> localNameText(const LocalName& name);
+
 // "Groundshock", …; unknown ids give "model-<n>".
 std::string modelName(std::uint8_t model_id);
 // A car's default name from its model: "groundshock", or "groundshock-2" when that is in `taken`

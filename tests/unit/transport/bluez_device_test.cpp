@@ -45,6 +45,19 @@ TEST_CASE("device: a plain name (a car emulator's) is the user name, state unkno
   CHECK(named.localName().user_name == "pitwall");
 }
 
+TEST_CASE("device: an emulated car's Anki-shaped Name gives state, version and a clean name") {
+  // pitwall emulate-car's LocalName (anki::localNameText): the zeros of a real car's name are
+  // 0x01, so BlueZ passes the whole name on in Name.
+  Device d;
+  d.name = std::string("\x10\x70\x2b\x01\x01\x01\x01\x01pitwall");
+  CHECK(d.stateKnown());
+  auto n = d.localName();
+  CHECK(n.user_name == "pitwall");
+  CHECK(n.version == 0x2b70);
+  CHECK(n.full_battery);
+  CHECK_FALSE(n.on_charger);
+}
+
 TEST_CASE("device: what BlueZ's Name keeps of an Anki name: state and version, no user name") {
   Device d;
   d.name = std::string("\x10p+");

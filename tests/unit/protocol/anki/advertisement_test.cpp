@@ -97,6 +97,83 @@ TEST_CASE("a user name that is not valid UTF-8 is kept printable") {
   CHECK(n.user_name == "R\xEF\xBF\xBDx\xC3\xA9");
 }
 
+TEST_CASE("a text local name has the binary one's layout with filler for the zeros") {
+  LocalName name;
+  name.full_battery = true;
+  name.version = 0x2b70;
+  name.user_name = "pitwall";
+  const auto text = localNameText(name);
+  REQUIRE(text.ok());
+  CHECK(*text == std::string("\x10\x70\x2b\x01\x01\x01\x01\x01pitwall"));
+  const std::span<const std::uint8_t> bytes(reinterpret_cast<const std::uint8_t*>(text->data()),
+                                            text->size());
+  CHECK(isAnkiLocalName(bytes));
+  const auto back = parseLocalName(bytes);
+  CHECK(back.full_battery);
+  CHECK_FALSE(back.low_battery);
+  CHECK_FALSE(back.on_charger);
+  CHECK(back.version == 0x2b70);
+  CHECK(back.user_name == "pitwall");
+}
+
+TEST_CASE("py-drivesdk's reading of the text name: byte 0 without the charger bit, UTF-8 from 8") {
+  // py-drivesdk (anki/control/controller.py, vehicle.py) takes a car when its local name,
+  // encoded as UTF-8, has bit 6 of byte 0 clear and bytes 8.. decode as UTF-8.
+  LocalName name;
+  name.low_battery = true;
+  name.version = 0x2b6e;
+  name.user_name = "Röd";  // two-byte characters stay whole
+  const auto text = localNameText(name);
+  REQUIRE(text.ok());
+  CHECK((static_cast<std::uint8_t>((*text)[0]) & 0x40) == 0);
+  CHECK(text->substr(8) == "Röd");
+  CHECK(text->find('\0') == std::string::npos);
+  name.on_charger = true;  // a car on its charger says so, and such a client passes it over
+  CHECK((static_cast<std::uint8_t>((*localNameText(name))[0]) & 0x40) != 0);
+}
+
+TEST_CASE("a text local name is refused where a byte would be NUL or half a character") {
+  LocalName name;
+  name.full_battery = true;
+  name.version = 0x2b70;
+  name.user_name = "pitwall";
+  LocalName no_state = name;
+  no_state.full_battery = false;
+  REQUIRE_FALSE(localNameText(no_state).ok());
+  CHECK(localNameText(no_state).error().find("NUL") != std::string::npos);
+  LocalName zero_byte = name;
+  zero_byte.version = 0x2b00;
+  REQUIRE_FALSE(localNameText(zero_byte).ok());
+  CHECK(localNameText(zero_byte).error().find("0x2B00") != std::string::npos);
+  LocalName high_byte = name;
+  high_byte.version = 0x802b;
+  CHECK_FALSE(localNameText(high_byte).ok());
+  LocalName bad_name = name;
+  bad_name.user_name = "R\xff";
+  CHECK_FALSE(localNameText(bad_name).ok());
+}
+
+TEST_CASE("a car's user name is 1 to 12 bytes of UTF-8 without control characters") {
+  CHECK(userNameProblem("pitwall").empty());
+  CHECK(userNameProblem("Red Devil 12").empty());  // 12 bytes
+  CHECK(userNameProblem("Rød Djævel").empty());
+  CHECK(userNameProblem("").find("empty") != std::string::npos);
+  CHECK(userNameProblem("Red Devil 123").find("13 bytes") != std::string::npos);
+  CHECK(userNameProblem("bad\x01").find("control") != std::string::npos);
+  CHECK(userNameProblem("tab\tname").find("control") != std::string::npos);
+  CHECK(userNameProblem("del\x7f").find("control") != std::string::npos);
+  CHECK(userNameProblem("R\xc3").find("UTF-8") != std::string::npos);
+}
+
+TEST_CASE("an Anki-shaped local name is told from a text name by its state and reserved bytes") {
+  CHECK(isAnkiLocalName("\x50\x6e\x2b\x00\x00\x00\x00\x00Skull"_b));    // a real car's
+  CHECK(isAnkiLocalName("\x00\x6e\x2b\x00\x00\x00\x00\x00"_b));         // state 0, no name
+  CHECK(isAnkiLocalName("\x10\x70\x2b\x01\x01\x01\x01\x01pitwall"_b));  // emulate-car's
+  CHECK_FALSE(isAnkiLocalName("pitwall emulated"_b));  // 'p' is a state byte, but letters follow
+  CHECK_FALSE(isAnkiLocalName("\x10\x70\x2b\x00\x00"_b));               // too short
+  CHECK_FALSE(isAnkiLocalName("\x11\x70\x2b\x00\x00\x00\x00\x00x"_b));  // bit 0x01 is no state
+}
+
 TEST_CASE("model ids name the car, unknown ones print as model-n") {
   CHECK(modelName(1) == "Kourai");
   CHECK(modelName(8) == "Groundshock");
