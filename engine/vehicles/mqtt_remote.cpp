@@ -212,7 +212,8 @@ void RemoteCars::handle(std::string_view topic, std::string_view payload) {
     auto message =
         topics::readMessageEvent(std::string_view(parts->rest).substr(11), payload, limits_);
     if (!message) return complain(message.error());
-    if (!*message) return;  // a message without a counterpart here
+    if (!*message) return;   // a message without a counterpart here
+    it->second.seed = true;  // whole-message events without E/frame: the seed's controller
     auto frame = anki::encode(**message);
     it->second.link->frame(frame.span());
   } else if (parts->rest == "S/Information") {
@@ -287,6 +288,14 @@ bool RemoteCars::sendCommand(const std::string& car, std::span<const std::uint8_
   auto message = anki::decode(frame);
   if (!message) return false;
   if (std::holds_alternative<anki::SdkMode>(*message)) return true;
+  auto it = cars_.find(car);
+  if (it != cars_.end() && it->second.seed && !topics::controllerIntentPayload(*message)) {
+    // Its bridge would drop it without a word: say so here, and send nothing.
+    warn("car " + car + " is bridged by the seed's controller (no E/frame), which has no intent " +
+         "for " + std::string(anki::name(*message)) + "; not sent (speed, lane, turn, battery, " +
+         "version and ping are what it takes)");
+    return false;
+  }
   auto payload = topics::intentPayload(*message);
   if (!payload) return false;
   return client_.publish("Anki/Car/" + car + "/I", *payload, 1, false);

@@ -71,6 +71,7 @@ class RemoteCars {
     bool listed = false;         // in its host's S/Cars now
     bool everListed = false;     // some S/Cars named it
     bool frames = false;         // E/frame seen: its E/Messages are not needed
+    bool seed = false;           // E/Messages without E/frame: the seed's controller bridges it
     bool present() const;        // its bridge has it connected
   };
   void message(std::string_view topic, std::string_view payload);

@@ -834,8 +834,7 @@ Publication intentError(std::string_view host, const IntentError& error, Millis 
 
 // ---- the reading side ----
 
-std::optional<std::string> intentPayload(const anki::Message& command) {
-  if (!isCommand(command)) return std::nullopt;
+std::optional<std::string> controllerIntentPayload(const anki::Message& command) {
   Json j;
   std::visit(Overload{
                  [&](const anki::SetSpeed& m) {
@@ -867,11 +866,15 @@ std::optional<std::string> intentPayload(const anki::Message& command) {
                  [&](const auto&) {},
              },
              command);
-  if (j.is_null()) {
-    auto frame = anki::encode(command);
-    j = Json{{"type", "message"}, {"frame", toHex(frame.span(), "")}};
-  }
+  if (j.is_null()) return std::nullopt;
   return j.dump();
+}
+
+std::optional<std::string> intentPayload(const anki::Message& command) {
+  if (!isCommand(command)) return std::nullopt;
+  if (auto seed = controllerIntentPayload(command)) return seed;
+  auto frame = anki::encode(command);
+  return Json{{"type", "message"}, {"frame", toHex(frame.span(), "")}}.dump();
 }
 
 std::optional<TopicParts> splitTopic(std::string_view topic) {

@@ -203,6 +203,8 @@ Publication intentError(std::string_view host, const IntentError& error, Millis 
 // seed's controller both execute; else pitwall's {"type":"message","frame":…}, which only a
 // pitwall bridge executes. nullopt for a vehicle→controller message.
 std::optional<std::string> intentPayload(const anki::Message& command);
+// Only the controller's form: nullopt for a command the seed's controller has no intent for.
+std::optional<std::string> controllerIntentPayload(const anki::Message& command);
 
 // What a topic of the tree is about: Anki/Car/<car>/<rest> or Anki/Host/<host>/<rest>.
 struct TopicParts {

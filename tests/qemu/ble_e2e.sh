@@ -10,17 +10,23 @@
 # script's. Exit 77 (ctest: skipped) when it cannot run here, always saying why.
 set -uo pipefail
 
-# Who plays the central on hci1 (PITWALL_QEMU_CENTRAL):
+# Who plays the central on hci1 (PITWALL_QEMU_CENTRAL): one or more of these, separated by
+# commas, one after the other against the same car in one boot (default bleak,pitwall):
+#   bleak    `pitwall scan` must show the car's name clean, with its state and version; then a
+#            client on Debian's bleak that behaves as py-drivesdk does (central_drivesdk.py): it
+#            finds the car by py-drivesdk's name rules, drives it with py-drivesdk's short
+#            set-speed, changes lane, pings, asks version and battery, stops it.
 #   pitwall  `pitwall run tests/qemu/laps_ble.lua --ble --adapter hci1 --car ADDR --duration 30`: the car
 #            is found, connected and driven 2 laps.
 #   tools    BlueZ's own bluetoothctl, no pitwall code on the central side: sees the
 #            advertisement (service UUID, manufacturer data, name), connects, subscribes, writes
 #            a ping `01 16`, expects the notification `01 17`, disconnects and does it again.
-#   both     tools, then pitwall against the same car (a reconnection by another central).
+#   both     tools,pitwall (a reconnection by another central).
 #   script:FILE  a developer's own check, sourced inside the guest by guest.sh.
-CENTRAL=${PITWALL_QEMU_CENTRAL:-pitwall}
+CENTRAL=${PITWALL_QEMU_CENTRAL:-bleak,pitwall}
 # Debian packages the harness needs (installed by the project's ./dev, never by this script).
 PACKAGES=(qemu-system-x86 busybox-static cpio kmod bluez bluez-test-tools dbus-daemon dbus-bin)
+[[ ",$CENTRAL," == *,bleak,* ]] && PACKAGES+=(python3-bleak)
 # Modules the guest loads (dependencies are added from the kernel's own modules.dep). Without
 # the AF_ALG ones btvirt fails with a misleading "Failed to open Virtual HCI device".
 MODULES=(crc16 ecc rfkill ecdh_generic bluetooth hci_vhci af_alg algif_hash algif_skcipher cmac ecb
@@ -43,10 +49,14 @@ fail() {
 PITWALL=$(realpath "$1")
 SRC=$(realpath "$2")
 [ -x "$PITWALL" ] || fail "no pitwall binary at $1"
-case "$CENTRAL" in
-  pitwall | tools | both | script:*) ;;
-  *) fail "PITWALL_QEMU_CENTRAL must be pitwall, tools, both or script:FILE, not '$CENTRAL'" ;;
-esac
+IFS=, read -r -a centrals <<<"$CENTRAL"
+[ ${#centrals[@]} -gt 0 ] || fail "PITWALL_QEMU_CENTRAL is empty"
+for c in "${centrals[@]}"; do
+  case "$c" in
+    bleak | pitwall | tools | both | script:?*) ;;
+    *) fail "PITWALL_QEMU_CENTRAL: '$c' is none of bleak, pitwall, tools, both, script:FILE" ;;
+  esac
+done
 
 [ "$(uname -m)" = x86_64 ] || skip "the guest kernel is Debian's amd64 one; this machine is $(uname -m)"
 missing=()

@@ -4,11 +4,14 @@
 # bluetoothd, `pitwall emulate-car` on hci0, then the central on hci1. Exit status: 0 passed,
 # 1 failed (with the last lines of each log).
 #
-#   guest.sh PITWALL SOURCE_DIR CENTRAL BLUETOOTHD   CENTRAL: pitwall | tools | both | script:FILE
+#   guest.sh PITWALL SOURCE_DIR CENTRALS BLUETOOTHD
+#
+# CENTRALS: one or more of bleak, pitwall, tools, both (= tools,pitwall), script:FILE, separated
+# by commas, run in that order against the same car (ble_e2e.sh says what each does).
 set -uo pipefail
 PITWALL=$1
 SRC=$2
-CENTRAL=$3
+CENTRALS=$3
 BLUETOOTHD=$4
 LOGS=/tmp/logs
 mkdir -p "$LOGS"
@@ -94,22 +97,50 @@ central_pitwall() {
   }
 }
 
+# pitwall's scanner, then a py-drivesdk-like client on bleak (tests/qemu/central_drivesdk.py).
+central_bleak() {
+  # `pitwall scan` through the real BlueZ: the emulated car's Anki-shaped name (state byte,
+  # version, filler, user name) reads as a clean name with its state and version.
+  "$PITWALL" scan --adapter hci1 --timeout 2 --json >"$LOGS/scan.json" 2>"$LOGS/scan.log" || {
+    say "pitwall scan failed: $(cat "$LOGS/scan.log")"
+    return 1
+  }
+  /usr/bin/python3 - "$LOGS/scan.json" "$ADDR0" <<'EOF' || return 1
+import json, sys
+cars = [json.loads(line) for line in open(sys.argv[1]) if line.strip()]
+car = next((c for c in cars if c["address"] == sys.argv[2]), None)
+want = {"name": "pitwall", "battery": "full", "firmware": 0x2B70, "modelId": 8}
+got = {k: car.get(k) for k in want} if car else None
+print(f"[scan] {got}" if got == want else f"[scan] {cars}, want {want}")
+sys.exit(0 if got == want else 1)
+EOF
+  /usr/bin/python3 "$SRC/tests/qemu/central_drivesdk.py" --adapter hci1 --address "$ADDR0" 2>&1 |
+    sed -u 's/^/[bleak] /'
+  return "${PIPESTATUS[0]}"
+}
+
 central_status=0
-case "$CENTRAL" in
-  tools | both)
-    source "$SRC/tests/qemu/central_tools.sh"
-    central_tools "$ADDR0" || central_status=$?
-    if [ "$CENTRAL" = both ] && [ "$central_status" -eq 0 ]; then
-      central_pitwall || central_status=$?
-    fi
-    ;;
-  pitwall)
-    central_pitwall || central_status=$?
-    ;;
-  script:*)  # a developer's own check, sourced here with this file's variables
-    source "${CENTRAL#script:}" || central_status=$?
-    ;;
-esac
+IFS=, read -r -a centrals <<<"${CENTRALS//both/tools,pitwall}"
+for central in "${centrals[@]}"; do
+  status=0
+  case "$central" in
+    tools)
+      source "$SRC/tests/qemu/central_tools.sh"
+      central_tools "$ADDR0" || status=$?
+      ;;
+    pitwall) central_pitwall || status=$? ;;
+    bleak) central_bleak || status=$? ;;
+    script:*)  # a developer's own check, sourced here with this file's variables
+      source "${central#script:}" || status=$?
+      ;;
+  esac
+  if [ "$status" -eq 0 ]; then
+    say "central '$central' passed"
+  else
+    say "central '$central' FAILED with status $status"
+    central_status=$status
+  fi
+done
 
 wait "$HCI9_PID"
 status=$?
@@ -128,7 +159,7 @@ else
   car_status=$?
   say "pitwall emulate-car had already exited"
 fi
-[ "$central_status" -eq 0 ] || fail "the central ($CENTRAL) failed with status $central_status"
+[ "$central_status" -eq 0 ] || fail "a central of '$CENTRALS' failed (status $central_status)"
 [ "$car_status" -eq 0 ] || fail "pitwall emulate-car exited with status $car_status after SIGTERM"
-say "passed: central '$CENTRAL', emulate-car stopped cleanly"
+say "passed: centrals '$CENTRALS', emulate-car stopped cleanly"
 exit 0

@@ -456,3 +456,70 @@ TEST_CASE("mqtt remote: ids a publisher invents are followed only up to a bound"
   CHECK(p.reaches(
       0, [](AnkiCar& c) { return c.setSpeed(420); }, anki::SetSpeed{420, kDefaultAccel, false}));
 }
+
+TEST_CASE("mqtt remote: a car of the seed's controller: its S/Cars decides, E/Messages feed it") {
+  // The controller's publications (hofdo/nodejsankisdk host.js, ReturnMsgHandler.js), by hand:
+  // no E/frame, S/Cars a bare array or {}, no S/CarStatus when it drops a car.
+  MosquittoBroker broker;
+  Loop loop{ClockKind::Real};
+  MqttClient controller(loop, MqttOptions::fromUrl(broker.url()));
+  std::vector<std::pair<std::string, std::string>> intents;
+  controller.onMessage = [&](std::string_view t, std::string_view p, bool) {
+    intents.emplace_back(std::string(t), std::string(p));
+  };
+  controller.subscribe("Anki/Car/+/I/#", 1);
+  controller.connect();
+  REQUIRE(runUntil(loop, [&] { return controller.state() == MqttClient::State::Connected; }));
+  const std::string car = "d205effe02cb", base = "Anki/Car/d205effe02cb/";
+  auto retain = [&](const std::string& topic, const std::string& payload) {
+    REQUIRE(controller.publish(topic, payload, 1, true));
+  };
+  retain("Anki/Host/host/S/HostStatus", R"({"value":true})");
+  retain(base + "S/Information", R"({"address":"d2:05:ef:fe:02:cb","identifier":2018915346,)"
+                                 R"("model":"Skull","modelId":9,"productId":61374})");
+  // an S/CarStatus online left over from before: S/Cars, once it names the car, decides
+  retain(base + "S/CarStatus", R"({"timestamp":1,"online":true,"charging":0,"onTrack":1})");
+  retain("Anki/Host/host/S/Cars", R"(["d205effe02cb"])");
+
+  RemoteHost b(loop, broker);
+  REQUIRE(runUntil(loop, [&] { return b.synced && b.remote.onlineCount() == 1; }));
+  AnkiCar& remote = b.car(0);
+  CHECK(remote.identity().model_id == 9);
+
+  // its position updates, rebuilt from the controller's whole-message events
+  REQUIRE(controller.publish(
+      base + "E/Messages/ANKI_VEHICLE_MSG_V2C_LOCALIZATION_POSITION_UPDATE",
+      R"({"message_id":39,"offset":-23.5,"speed":512,"flag":71,"pieceId":36,"pieceLocation":5,)"
+      R"("isReverse":false,"last_des_speed":500,"last_rec_lane_change_cmd":0,)"
+      R"("last_exe_lane_change_cmd":0,"last_des_lane_change_speed":0})",
+      0, false));
+  REQUIRE(runUntil(loop, [&] { return remote.state().piece == 36; }));
+  CHECK(remote.state().speed_mm_s == 512);
+  CHECK(remote.state().offset_mm == -23.5);
+  REQUIRE(controller.publish(base + "E/Messages/ANKI_VEHICLE_MSG_V2C_BATTERY_LEVEL_RESPONSE",
+                             R"({"message_id":27,"value":3950})", 0, false));
+  REQUIRE(runUntil(loop, [&] { return remote.state().battery_mv == 3950; }));
+
+  // commands go as the controller's intents; one it has no intent for is refused, unsent
+  intents.clear();
+  REQUIRE(remote.setSpeed(600, 2000).ok());
+  REQUIRE(runUntil(loop, [&] { return !intents.empty(); }));
+  CHECK(intents.back() ==
+        std::pair<std::string, std::string>{base + "I", R"({"speed":600,"acceleration":2000})"});
+  auto lights = remote.lights(0x44);
+  REQUIRE_FALSE(lights.ok());
+  CHECK(lights.error().find("refused set-lights") != std::string::npos);
+
+  // connecting false: S/Cars {} and a blank S/Information; the stale CarStatus keeps nothing up
+  retain("Anki/Host/host/S/Cars", "{}");
+  retain(base + "S/Information",
+         R"({"address":"","identifier":"","model":"","modelId":"","productId":""})");
+  REQUIRE(runUntil(loop, [&] { return !remote.state().connected; }));
+  CHECK(b.downs.back().second == "its bridge reports it offline");
+  // and back
+  retain(base + "S/Information", R"({"address":"d2:05:ef:fe:02:cb","identifier":2018915346,)"
+                                 R"("model":"Skull","modelId":9,"productId":61374})");
+  retain("Anki/Host/host/S/Cars", R"(["d205effe02cb"])");
+  REQUIRE(runUntil(loop, [&] { return remote.state().connected; }));
+  CHECK(b.fleet.cars().size() == 1);  // the same car, not a second one
+}
