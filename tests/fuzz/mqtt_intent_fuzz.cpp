@@ -1,9 +1,9 @@
 // The MQTT intent parser (engine/vehicles/mqtt_topics.hpp: parseIntent, intentError,
 // intentPayload): what anyone who can publish on the broker sends to a bridge. The first input
-// byte picks the topic (the four intent topics of host "pitA", or a topic taken from the input up
-// to a NUL byte); the rest is the payload. Never a crash or an exception; a refused intent's
+// byte picks the topic (the intent topics of host "pitA" and the seed's controller's global
+// Anki/Car/I, or a topic taken from the input up to a NUL byte); the rest is the payload. Never a crash or an exception; a refused intent's
 // error is a sentence, and its S/IntentError payload is valid JSON naming the topic.
-// Control byte 5: the rest is an Anki frame instead. A controller→vehicle message in range
+// Control byte 6: the rest is an Anki frame instead. A controller→vehicle message in range
 // (limits::validate) has an intent payload (intentPayload, what a remote pitwall publishes),
 // and the bridge's parser accepts that payload on the car's intent topic; a "message" intent
 // carries the very same message.
@@ -64,7 +64,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (size == 0) return 0;
   const std::span<const std::uint8_t> rest(data + 1, size - 1);
   const std::string text(rest.begin(), rest.end());
-  switch (data[0] % 6) {
+  switch (data[0] % 7) {
     case 0:
       intent("Anki/Host/pitA/I/connection", text);
       break;
@@ -82,6 +82,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       intent(parts.first, parts.second);
       break;
     }
+    case 5:
+      intent("Anki/Car/I", text);
+      break;
     default:
       commandRoundTrip(rest);
   }

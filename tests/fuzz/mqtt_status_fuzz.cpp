@@ -1,15 +1,20 @@
 // The readers a remote pitwall applies to what bridges publish (engine/vehicles/mqtt_topics.hpp:
-// splitTopic, readInformation, readCarStatus, readHostStatus, readHostCars, readFrameEvent). The
-// first input byte picks the reader, the rest is the payload (or the topic). Never a crash or an
-// exception; an error is a sentence. What a reader accepts survives the round trip through the
-// bridge's writer: carJoined's S/Information, hostCars, frameEvent and carOnline/carLeft read back
-// to the same values, and a topic splitTopic accepts is rebuilt from its parts.
+// splitTopic, readInformation, readCarStatus, readHostStatus, readHostCars, readFrameEvent,
+// readMessageEvent). The first input byte picks the reader, the rest is the payload (or the
+// topic). Never a crash or an exception; an error is a sentence. What a reader accepts survives
+// the round trip through the bridge's writer: carJoined's S/Information, hostCars, frameEvent and
+// carOnline/carLeft read back to the same values, a message read from the seed's controller's
+// E/Messages event is published by fromMessage as the same event and reads back as the same
+// message (offsets to the 0.01 mm the writer keeps), and a topic splitTopic accepts is rebuilt
+// from its parts.
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <span>
 #include <string>
 #include <vector>
 
+#include "engine/protocol/anki/codec.hpp"
 #include "engine/vehicles/mqtt_topics.hpp"
 #include "tests/fuzz/fuzz_check.hpp"
 
@@ -63,7 +68,7 @@ void hostCars(const std::string& payload) {
   auto cars = topics::readHostCars(payload);
   checkError(cars, payload);
   if (!cars) return;
-  const auto p = topics::hostCars("h", *cars, 1);
+  const auto p = topics::hostCars("h", *cars);
   auto again = topics::readHostCars(p.payload);
   FUZZ_CHECK(again.ok() && *again == *cars, payload + " → " + p.payload);
 }
@@ -75,6 +80,48 @@ void frameEvent(const std::string& payload) {
   const auto p = topics::frameEvent("c", *frame, 1);
   auto again = topics::readFrameEvent(p.payload);
   FUZZ_CHECK(again.ok() && *again == *frame, payload + " → " + p.payload);
+}
+
+// The names of the controller's whole-message events, one per message it publishes.
+const std::vector<std::string> kMessageEvents{
+    "ANKI_VEHICLE_MSG_V2C_PING_RESPONSE",
+    "ANKI_VEHICLE_MSG_V2C_VERSION_RESPONSE",
+    "ANKI_VEHICLE_MSG_V2C_BATTERY_LEVEL_RESPONSE",
+    "ANKI_VEHICLE_MSG_V2C_LOCALIZATION_POSITION_UPDATE",
+    "ANKI_VEHICLE_MSG_V2C_LOCALIZATION_TRANSITION_UPDATE",
+    "ANKI_VEHICLE_MSG_V2C_LOCALIZATION_INTERSECTION_UPDATE",
+    "ANKI_VEHICLE_MSG_V2C_VEHICLE_DELOCALIZED",
+    "ANKI_VEHICLE_MSG_V2C_VEHICLE_STATUS",
+};
+
+// Offsets are kept to 0.01 mm by the writer: compare messages with them rounded so.
+anki::Message rounded(anki::Message m) {
+  std::visit(
+      [](auto& x) {
+        if constexpr (requires { x.offset_mm; })
+          x.offset_mm = static_cast<float>(std::round(static_cast<double>(x.offset_mm) * 100) / 100);
+      },
+      m);
+  return m;
+}
+
+void messageEvent(const std::string& text) {
+  if (text.empty()) return;
+  const std::string& name = kMessageEvents[static_cast<unsigned char>(text[0]) % 8];
+  const std::string payload = text.substr(1);
+  auto read = topics::readMessageEvent(name, payload);
+  checkError(read, payload);
+  if (!read) return;
+  FUZZ_CHECK(read->has_value(), name + " " + payload);
+  const auto& m = **read;
+  FUZZ_CHECK(topics::messageEventName(m) == name, payload);
+  (void)anki::encode(m);  // every message read is one a frame can carry
+  const auto published = topics::fromMessage("c", m, std::nullopt, 1);
+  FUZZ_CHECK(!published.empty() && published.back().topic == "Anki/Car/c/E/Messages/" + name,
+             payload);
+  auto again = topics::readMessageEvent(name, published.back().payload);
+  FUZZ_CHECK(again.ok() && again->has_value() && rounded(**again) == rounded(m),
+             payload + " → " + published.back().payload);
 }
 
 void topic(const std::string& text) {
@@ -90,7 +137,7 @@ void topic(const std::string& text) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size == 0) return 0;
   const std::string text(data + 1, data + size);
-  switch (data[0] % 6) {
+  switch (data[0] % 7) {
     case 0:
       information(text);
       break;
@@ -105,6 +152,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       break;
     case 4:
       frameEvent(text);
+      break;
+    case 5:
+      messageEvent(text);
       break;
     default:
       topic(text);
