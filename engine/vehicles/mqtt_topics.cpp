@@ -9,6 +9,8 @@
 #include <cmath>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <tuple>
+#include <type_traits>
 
 #include <mosquitto.h>
 
@@ -206,93 +208,145 @@ std::string hostId(std::string_view host) {
 
 // ---- car → broker ----
 
-std::string_view messageEventName(const anki::Message& message) {
-  // The names of drive-sdk's protocol.h, as the seed's controller publishes them
-  return std::visit(
-      Overload{
-          [](const anki::PingResponse&) { return "ANKI_VEHICLE_MSG_V2C_PING_RESPONSE"; },
-          [](const anki::VersionResponse&) { return "ANKI_VEHICLE_MSG_V2C_VERSION_RESPONSE"; },
-          [](const anki::BatteryResponse&) {
-            return "ANKI_VEHICLE_MSG_V2C_BATTERY_LEVEL_RESPONSE";
-          },
-          [](const anki::PositionUpdate&) {
-            return "ANKI_VEHICLE_MSG_V2C_LOCALIZATION_POSITION_UPDATE";
-          },
-          [](const anki::TransitionUpdate&) {
-            return "ANKI_VEHICLE_MSG_V2C_LOCALIZATION_TRANSITION_UPDATE";
-          },
-          [](const anki::IntersectionUpdate&) {
-            return "ANKI_VEHICLE_MSG_V2C_LOCALIZATION_INTERSECTION_UPDATE";
-          },
-          [](const anki::Delocalized&) { return "ANKI_VEHICLE_MSG_V2C_VEHICLE_DELOCALIZED"; },
-          [](const anki::CarStatus&) { return "ANKI_VEHICLE_MSG_V2C_VEHICLE_STATUS"; },
-          [](const auto&) { return ""; },
-      },
-      message);
-}
-
 namespace {
 
-// The whole message as the seed's controller publishes it on E/Messages/<name>: its id, the
-// time, then its fields under the controller's keys (ReturnMsgHandler.js). Empty when the
-// controller has no such event.
-Json messageFields(const anki::Message& message) {
-  Json j;
-  std::visit(Overload{
-                 [&](const anki::PositionUpdate& m) {
-                   j = Json{{"offset", mm(m.offset_mm)},
-                            {"speed", m.speed_mm_s},
-                            {"flag", m.parsing_flags},
-                            {"pieceId", m.piece_id},
-                            {"pieceLocation", m.location_id},
-                            // the controller means reverse parsing (its own test of the bit
-                            // never matches: it compares the hex text with "0x40")
-                            {"isReverse", (m.parsing_flags & 0x40) != 0},
-                            {"last_des_speed", m.last_desired_speed_mm_s},
-                            {"last_rec_lane_change_cmd", m.last_recv_lane_change_id},
-                            {"last_exe_lane_change_cmd", m.last_exec_lane_change_id},
-                            {"last_des_lane_change_speed", m.last_desired_lane_change_speed_mm_s}};
-                 },
-                 [&](const anki::TransitionUpdate& m) {
-                   j = Json{{"offset", mm(m.offset_mm)},
-                            {"last_recv_lane_change_id", m.last_recv_lane_change_id},
-                            {"last_exec_lane_change_id", m.last_exec_lane_change_id},
-                            {"last_desired_lane_change_speed_mm_per_sec",
-                             m.last_desired_lane_change_speed_mm_s},
-                            {"ave_follow_line_drift_pixels", m.average_follow_line_drift_px},
-                            {"had_lane_change_activity", m.had_lane_change_activity},
-                            {"uphill_counter", m.uphill_counter},
-                            {"downhill_counter", m.downhill_counter},
-                            {"left_wheel_dist_cm", m.left_wheel_distance_cm},
-                            {"right_wheel_dist_cm", m.right_wheel_distance_cm}};
-                 },
-                 [&](const anki::IntersectionUpdate& m) {
-                   j = Json{{"offset", mm(m.offset_mm)},
-                            {"intersection_code", m.intersection_code},
-                            {"is_exiting", m.is_exiting},
-                            {"mm_since_last_transition_bar", m.mm_since_last_transition_bar}};
-                   if (m.mm_since_last_intersection_code)
-                     j["mm_since_last_intersection_code"] = *m.mm_since_last_intersection_code;
-                 },
-                 [&](const anki::VersionResponse& m) {
-                   j = Json{{"value", m.version}};
-                 },
-                 [&](const anki::BatteryResponse& m) {
-                   j = Json{{"value", m.millivolts}};
-                 },
-                 [&](const anki::CarStatus& m) {
-                   // 0/1 as the controller reads them (readUInt8)
-                   j = Json{{"online", true},
-                            {"charging", m.on_charger ? 1 : 0},
-                            {"onTrack", m.on_track ? 1 : 0}};
-                 },
-                 [&](const auto&) { j = Json::object(); },
-             },
-             message);
+// ---- the seed's controller's whole-message events (ReturnMsgHandler.js) ----
+//
+// One table per message it publishes: the event's name (drive-sdk's protocol.h name) and its keys
+// in the controller's order, each with the member it holds. fromMessage writes by it and
+// readMessageEvent reads by it.
+
+template <class T, class V>
+struct Key {
+  const char* name;
+  V T::*member;
+};
+template <class T, class V>
+Key(const char*, V T::*) -> Key<T, V>;
+
+template <class T>
+struct Controller;  // name and keys, for the messages the controller publishes
+
+template <>
+struct Controller<anki::PingResponse> {
+  static constexpr const char* name = "ANKI_VEHICLE_MSG_V2C_PING_RESPONSE";
+  static constexpr std::tuple<> keys{};
+};
+template <>
+struct Controller<anki::VersionResponse> {
+  static constexpr const char* name = "ANKI_VEHICLE_MSG_V2C_VERSION_RESPONSE";
+  static constexpr std::tuple keys{Key{"value", &anki::VersionResponse::version}};
+};
+template <>
+struct Controller<anki::BatteryResponse> {
+  static constexpr const char* name = "ANKI_VEHICLE_MSG_V2C_BATTERY_LEVEL_RESPONSE";
+  static constexpr std::tuple keys{Key{"value", &anki::BatteryResponse::millivolts}};
+};
+template <>
+struct Controller<anki::PositionUpdate> {
+  using M = anki::PositionUpdate;
+  static constexpr const char* name = "ANKI_VEHICLE_MSG_V2C_LOCALIZATION_POSITION_UPDATE";
+  static constexpr std::tuple keys{
+      Key{"offset", &M::offset_mm},
+      Key{"speed", &M::speed_mm_s},
+      Key{"flag", &M::parsing_flags},
+      Key{"pieceId", &M::piece_id},
+      Key{"pieceLocation", &M::location_id},
+      Key{"last_des_speed", &M::last_desired_speed_mm_s},
+      Key{"last_rec_lane_change_cmd", &M::last_recv_lane_change_id},
+      Key{"last_exe_lane_change_cmd", &M::last_exec_lane_change_id},
+      Key{"last_des_lane_change_speed", &M::last_desired_lane_change_speed_mm_s}};
+};
+template <>
+struct Controller<anki::TransitionUpdate> {
+  using M = anki::TransitionUpdate;
+  static constexpr const char* name = "ANKI_VEHICLE_MSG_V2C_LOCALIZATION_TRANSITION_UPDATE";
+  static constexpr std::tuple keys{
+      Key{"offset", &M::offset_mm},
+      Key{"last_recv_lane_change_id", &M::last_recv_lane_change_id},
+      Key{"last_exec_lane_change_id", &M::last_exec_lane_change_id},
+      Key{"last_desired_lane_change_speed_mm_per_sec", &M::last_desired_lane_change_speed_mm_s},
+      Key{"ave_follow_line_drift_pixels", &M::average_follow_line_drift_px},
+      Key{"had_lane_change_activity", &M::had_lane_change_activity},
+      Key{"uphill_counter", &M::uphill_counter},
+      Key{"downhill_counter", &M::downhill_counter},
+      Key{"left_wheel_dist_cm", &M::left_wheel_distance_cm},
+      Key{"right_wheel_dist_cm", &M::right_wheel_distance_cm}};
+};
+template <>
+struct Controller<anki::IntersectionUpdate> {
+  using M = anki::IntersectionUpdate;
+  static constexpr const char* name = "ANKI_VEHICLE_MSG_V2C_LOCALIZATION_INTERSECTION_UPDATE";
+  static constexpr std::tuple keys{
+      Key{"offset", &M::offset_mm}, Key{"intersection_code", &M::intersection_code},
+      Key{"is_exiting", &M::is_exiting},
+      Key{"mm_since_last_transition_bar", &M::mm_since_last_transition_bar},
+      Key{"mm_since_last_intersection_code", &M::mm_since_last_intersection_code}};
+};
+template <>
+struct Controller<anki::Delocalized> {
+  static constexpr const char* name = "ANKI_VEHICLE_MSG_V2C_VEHICLE_DELOCALIZED";
+  static constexpr std::tuple<> keys{};
+};
+template <>
+struct Controller<anki::CarStatus> {  // "online": true first, written by hand
+  static constexpr const char* name = "ANKI_VEHICLE_MSG_V2C_VEHICLE_STATUS";
+  static constexpr std::tuple keys{Key{"charging", &anki::CarStatus::on_charger},
+                                   Key{"onTrack", &anki::CarStatus::on_track}};
+};
+
+template <class T>
+concept Published = requires {
+  Controller<T>::name;
+};
+
+template <class T>
+struct IsOptional : std::false_type {};
+template <class T>
+struct IsOptional<std::optional<T>> : std::true_type {};
+
+// The payload after "message_id" and "timestamp".
+template <Published T>
+Json controllerFields(const T& m) {
+  Json j = Json::object();
+  if constexpr (std::is_same_v<T, anki::CarStatus>) j["online"] = true;
+  std::apply(
+      [&](const auto&... key) {
+        auto put = [&](const auto& k) {
+          const auto& v = m.*(k.member);
+          using V = std::decay_t<decltype(v)>;
+          if constexpr (IsOptional<V>::value) {
+            if (v) j[k.name] = *v;  // absent in the older layout
+          } else if constexpr (std::is_same_v<V, bool>) {
+            j[k.name] = v ? 1 : 0;  // 0/1, as the controller reads them (readUInt8)
+          } else if constexpr (std::is_floating_point_v<V>) {
+            j[k.name] = mm(v);
+          } else {
+            j[k.name] = v;
+          }
+        };
+        (put(key), ...);
+      },
+      Controller<T>::keys);
+  // the controller means reverse parsing (its own test of the bit never matches: it compares the
+  // hex text with "0x40")
+  if constexpr (std::is_same_v<T, anki::PositionUpdate>)
+    j["isReverse"] = (m.parsing_flags & 0x40) != 0;
   return j;
 }
 
 }  // namespace
+
+std::string_view messageEventName(const anki::Message& message) {
+  return std::visit(
+      []<class T>(const T&) -> std::string_view {
+        if constexpr (Published<T>)
+          return Controller<T>::name;
+        else
+          return "";
+      },
+      message);
+}
 
 std::vector<Publication> fromMessage(std::string_view car, const anki::Message& message,
                                      std::optional<double> pingRttSeconds, Millis now) {
@@ -358,12 +412,17 @@ std::vector<Publication> fromMessage(std::string_view car, const anki::Message& 
                  [&](const auto&) {},
              },
              message);
-  if (auto name = messageEventName(message); !name.empty()) {
-    Json j{{"message_id", anki::messageId(message)}, {"timestamp", now}};
-    Json fields = messageFields(message);  // items() refers to it: it must outlive the loop
-    for (auto& [key, value] : fields.items()) j[key] = value;
-    out.push_back({carTopic(car, "E/Messages/" + std::string(name)), j.dump(), kEventQos, false});
-  }
+  std::visit(
+      [&]<class T>(const T& m) {
+        if constexpr (Published<T>) {
+          Json j{{"message_id", anki::messageId(message)}, {"timestamp", now}};
+          Json fields = controllerFields(m);  // items() refers to it: it must outlive the loop
+          for (auto& [key, value] : fields.items()) j[key] = value;
+          out.push_back({carTopic(car, "E/Messages/" + std::string(Controller<T>::name)), j.dump(),
+                         kEventQos, false});
+        }
+      },
+      message);
   return out;
 }
 
@@ -1038,77 +1097,52 @@ Result<std::optional<anki::Message>, std::string> readMessageEvent(std::string_v
                                                                    std::string_view payload,
                                                                    const PayloadLimits& limits) {
   using Out = Result<std::optional<anki::Message>, std::string>;
-  // Which message the name is, from the one list of names (messageEventName).
-  static const std::vector<anki::Message> kMessages{
-      anki::PingResponse{},   anki::VersionResponse{},  anki::BatteryResponse{},
-      anki::PositionUpdate{}, anki::TransitionUpdate{}, anki::IntersectionUpdate{},
-      anki::Delocalized{},    anki::CarStatus{}};
-  auto kind = std::find_if(kMessages.begin(), kMessages.end(),
-                           [&](const anki::Message& m) { return messageEventName(m) == name; });
-  if (kind == kMessages.end()) return std::optional<anki::Message>{};
+  // Which message the name is: one of the published ones (Controller<T>).
+  std::optional<anki::Message> kind;
+  [&]<std::size_t... I>(std::index_sequence<I...>) {
+    auto match = [&]<class T>(std::type_identity<T>) {
+      if constexpr (Published<T>)
+        if (!kind && name == Controller<T>::name) kind = T{};
+    };
+    (match(std::type_identity<std::variant_alternative_t<I, anki::Message>>{}), ...);
+  }
+  (std::make_index_sequence<std::variant_size_v<anki::Message>>{});
+  if (!kind) return std::optional<anki::Message>{};
   auto j = object(payload, limits);
   if (!j) return Unexpected{j.error()};
   std::string error;
-  // Reads each field into its member; the first bad one is the error.
-  auto read = [&]<typename T>(T& member, const char* key) {
-    if (!error.empty()) return;
-    auto v = wireField<T>(*j, key);
-    if (v)
-      member = *v;
-    else
-      error = v.error();
-  };
-  anki::Message message = *kind;
-  std::visit(Overload{
-                 [&](anki::PositionUpdate& m) {
-                   read(m.offset_mm, "offset");
-                   read(m.speed_mm_s, "speed");
-                   read(m.parsing_flags, "flag");
-                   read(m.piece_id, "pieceId");
-                   read(m.location_id, "pieceLocation");
-                   read(m.last_desired_speed_mm_s, "last_des_speed");
-                   read(m.last_recv_lane_change_id, "last_rec_lane_change_cmd");
-                   read(m.last_exec_lane_change_id, "last_exe_lane_change_cmd");
-                   read(m.last_desired_lane_change_speed_mm_s, "last_des_lane_change_speed");
-                 },
-                 [&](anki::TransitionUpdate& m) {
-                   read(m.offset_mm, "offset");
-                   read(m.last_recv_lane_change_id, "last_recv_lane_change_id");
-                   read(m.last_exec_lane_change_id, "last_exec_lane_change_id");
-                   read(m.last_desired_lane_change_speed_mm_s,
-                        "last_desired_lane_change_speed_mm_per_sec");
-                   read(m.average_follow_line_drift_px, "ave_follow_line_drift_pixels");
-                   read(m.had_lane_change_activity, "had_lane_change_activity");
-                   read(m.uphill_counter, "uphill_counter");
-                   read(m.downhill_counter, "downhill_counter");
-                   read(m.left_wheel_distance_cm, "left_wheel_dist_cm");
-                   read(m.right_wheel_distance_cm, "right_wheel_dist_cm");
-                 },
-                 [&](anki::IntersectionUpdate& m) {
-                   read(m.offset_mm, "offset");
-                   read(m.intersection_code, "intersection_code");
-                   read(m.is_exiting, "is_exiting");
-                   read(m.mm_since_last_transition_bar, "mm_since_last_transition_bar");
-                   if (j->contains("mm_since_last_intersection_code")) {
-                     std::uint16_t v = 0;
-                     read(v, "mm_since_last_intersection_code");
-                     m.mm_since_last_intersection_code = v;
-                   }
-                 },
-                 [&](anki::VersionResponse& m) { read(m.version, "value"); },
-                 [&](anki::BatteryResponse& m) { read(m.millivolts, "value"); },
-                 [&](anki::CarStatus& m) {
-                   std::uint8_t charging = 0, onTrack = 0;
-                   read(charging, "charging");
-                   read(onTrack, "onTrack");
-                   m.on_charger = charging != 0;
-                   m.on_track = onTrack != 0;
-                 },
-                 [&](auto&) {},
-             },
-             message);
+  std::visit(
+      [&]<class T>(T& m) {
+        if constexpr (Published<T>) {
+          std::apply(
+              [&](const auto&... key) {
+                auto get = [&](const auto& k) {
+                  auto& member = m.*(k.member);
+                  using V = std::decay_t<decltype(member)>;
+                  if (!error.empty()) return;
+                  if constexpr (IsOptional<V>::value) {
+                    if (!j->contains(k.name)) return;  // the older layout
+                    auto v = wireField<typename V::value_type>(*j, k.name);
+                    if (v)
+                      member = *v;
+                    else
+                      error = v.error();
+                  } else {
+                    auto v = wireField<V>(*j, k.name);
+                    if (v)
+                      member = *v;
+                    else
+                      error = v.error();
+                  }
+                };
+                (get(key), ...);
+              },
+              Controller<T>::keys);
+        }
+      },
+      *kind);
   if (!error.empty()) return Unexpected{error};
-  return Out{std::optional<anki::Message>{std::move(message)}};
+  return Out{std::move(kind)};
 }
 
 }  // namespace pitwall::topics

@@ -83,9 +83,9 @@ TEST_CASE("mqtt topics: a position update gives the six seed events and speed an
                   st("Lane/Actual", "-23.1"),
                   whole("LOCALIZATION_POSITION_UPDATE",
                         R"({"message_id":39,"timestamp":1700000000123,"offset":-23.1,"speed":612,)"
-                        R"("flag":0,"pieceId":33,"pieceLocation":7,"isReverse":false,)"
-                        R"("last_des_speed":600,"last_rec_lane_change_cmd":0,)"
-                        R"("last_exe_lane_change_cmd":0,"last_des_lane_change_speed":300})"),
+                        R"("flag":0,"pieceId":33,"pieceLocation":7,"last_des_speed":600,)"
+                        R"("last_rec_lane_change_cmd":0,"last_exe_lane_change_cmd":0,)"
+                        R"("last_des_lane_change_speed":300,"isReverse":false})"),
               });
 }
 
