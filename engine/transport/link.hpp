@@ -21,6 +21,9 @@ class Link {
   virtual void disconnect() = 0;
   // A short human name of where the device is ("sim:0", "ble:AA:BB:…").
   virtual std::string address() const = 0;
+  // Why the last send() returned false, when the link knows more than "not connected": one
+  // sentence naming what to do, or empty.
+  virtual std::string refusal() const { return {}; }
 
   void onFrame(FrameHandler h) { frameHandler_ = std::move(h); }
   void onState(StateHandler h) { stateHandler_ = std::move(h); }

@@ -45,8 +45,11 @@ AnkiCar::Sent AnkiCar::send(const Message& message) {
     return Unexpected{label() + " is not connected; " + std::string(name(message)) +
                       " was not sent"};
   Frame frame = encode(message);
-  if (!link_.send(frame.span()))
-    return Unexpected{label() + ": the link refused " + std::string(name(message))};
+  if (!link_.send(frame.span())) {
+    std::string why = link_.refusal();
+    return Unexpected{label() + ": " + std::string(name(message)) +
+                      " was not sent: " + (why.empty() ? "the link refused it" : why)};
+  }
   ++state_.frames_out;
   if (onFrame) onFrame(Direction::Tx, frame.span(), message);
   return true;

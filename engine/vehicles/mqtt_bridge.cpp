@@ -14,8 +14,11 @@ constexpr std::size_t kMaxOtherHosts = 1024;
 
 namespace {
 constexpr const char* kLog = "mqtt bridge";
-// The bucket of the host's connection intents (car ids never hold a space).
-const std::string kConnection = "host intents";
+// The buckets of the host's own intents (car ids never hold a space): connecting, and the
+// requests to publish the car list or the cars' information again, each of its own so that a
+// flood of one never holds up the other.
+const std::string kConnection = "connection intents";
+const std::string kRepublish = "cars and car_status intents";
 
 std::string perSecond(const RateLimit& r) {
   std::ostringstream out;
@@ -303,11 +306,15 @@ bool MqttBridge::admit(const std::string& key, const std::string& topic) {
   ++s.count;
   s.topic = topic;
   summarise(s, [this, key](Summary& s) {
-    std::string what = key == kConnection ? key : "car " + key;
-    std::string why = std::to_string(s.count) + " intent" + (s.count == 1 ? "" : "s") + " for " +
-                      what + (s.count == 1 ? " was" : " were") +
-                      " dropped: more than the car's link can take (at most " +
-                      perSecond(options_.intents) + "); send fewer, e.g. only when a value changes";
+    const bool host = key == kConnection || key == kRepublish;
+    std::string why =
+        std::to_string(s.count) + " " +
+        (host ? key + (s.count == 1 ? " was" : " were") + " dropped: more than the host takes"
+              : std::string("intent") + (s.count == 1 ? "" : "s") + " for car " + key +
+                    (s.count == 1 ? " was" : " were") +
+                    " dropped: more than the car's link can take") +
+        " (at most " + perSecond(options_.intents) +
+        "); send fewer, e.g. only when a value changes";
     log::warn(kLog, why);
     emit(topics::intentError(host_, topics::IntentError{s.topic, why}, now()));
   });
@@ -380,25 +387,34 @@ void MqttBridge::execute(const topics::Intent& intent, const std::string& topic)
   using Kind = topics::Target::Kind;
   const bool stop = isStop(intent.action);
   if (auto* c = std::get_if<topics::ConnectIntent>(&intent.action)) {
-    if (!admit(kConnection, topic)) {
-      if (onIntentHandled) onIntentHandled(topic, false);
-      return;
+    // Dropping every car is never throttled, as a stop is not (docs/safety.md): beyond the
+    // rate it is still carried out, only not answered (no S/Cars unless the list changed, no
+    // log line).
+    bool answer = true;
+    if (c->connecting) {
+      if (!admit(kConnection, topic)) {
+        if (onIntentHandled) onIntentHandled(topic, false);
+        return;
+      }
+    } else {
+      answer = intentBuckets_[kConnection].take(options_.intents, loop_.now());
     }
     ++stats_.intents;
-    log::info(kLog, c->connecting ? "connection intent: connecting the cars"
-                                  : "connection intent: disconnecting every car");
+    if (answer)
+      log::info(kLog, c->connecting ? "connection intent: connecting the cars"
+                                    : "connection intent: disconnecting every car");
     auto& f = c->connecting ? connections_.connectAll : connections_.disconnectAll;
     if (f) f();
     // The seed's controller answers a connection intent with S/Cars: its clients wait for that
     // publication (they skip a retained one), so it comes even when the list is unchanged; cars
     // that connect later publish it again.
-    publishCars(true);
+    publishCars(answer);
     if (onIntentHandled) onIntentHandled(topic, true);
     return;
   }
   if (std::holds_alternative<topics::CarsIntent>(intent.action) ||
       std::holds_alternative<topics::CarStatusIntent>(intent.action)) {
-    if (!admit(kConnection, topic)) {
+    if (!admit(kRepublish, topic)) {
       if (onIntentHandled) onIntentHandled(topic, false);
       return;
     }

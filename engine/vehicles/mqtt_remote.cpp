@@ -21,8 +21,15 @@ class RemoteLink : public Link {
   RemoteLink(RemoteCars& owner, std::string id) : owner_(owner), id_(std::move(id)) {}
 
   bool send(std::span<const std::uint8_t> frame) override {
-    return up_ && owner_.sendCommand(id_, frame);
+    refusal_.clear();
+    if (!up_) return false;
+    if (auto why = owner_.sendCommand(id_, frame)) {
+      refusal_ = std::move(*why);
+      return false;
+    }
+    return true;
   }
+  std::string refusal() const override { return refusal_; }
   bool connected() const override { return up_; }
   // A remote car is the other bridge's to drop: AnkiCar::disconnect() has already sent the
   // disconnect message as an intent, and the car's status follows from its bridge.
@@ -42,6 +49,7 @@ class RemoteLink : public Link {
   RemoteCars& owner_;
   std::string id_;
   bool up_ = false;
+  std::string refusal_;  // why the last send() was refused
 };
 
 RemoteCars::RemoteCars(Loop& loop, Fleet& fleet, MqttClient& client, topics::PayloadLimits limits)
@@ -180,6 +188,7 @@ void RemoteCars::handle(std::string_view topic, std::string_view payload) {
       std::set<std::string> named;
       for (const auto& id : *list)
         if (Car* car = track(id, topic)) {
+          if (car->host != parts->id) car->forgetBridge();  // another bridge has it now
           car->host = parts->id;
           car->listed = car->everListed = true;
           named.insert(id);
@@ -205,10 +214,12 @@ void RemoteCars::handle(std::string_view topic, std::string_view payload) {
     auto bytes = topics::readFrameEvent(payload, limits_);
     if (!bytes) return complain(bytes.error());
     it->second.frames = true;  // a pitwall bridge: its E/Messages say the same again
+    it->second.seed = false;
     it->second.link->frame(*bytes);
   } else if (parts->rest.starts_with("E/Messages/")) {
     auto it = cars_.find(id);
-    if (it == cars_.end() || !it->second.link || it->second.frames) return;
+    if (it == cars_.end() || !it->second.link || !it->second.link->connected() || it->second.frames)
+      return;
     auto message =
         topics::readMessageEvent(std::string_view(parts->rest).substr(11), payload, limits_);
     if (!message) return complain(message.error());
@@ -249,11 +260,15 @@ std::string RemoteCars::uniqueName(const topics::CarInfo& info) const {
   return name;
 }
 
+void RemoteCars::Car::forgetBridge() {
+  frames = seed = false;
+}
+
 bool RemoteCars::Car::present() const {
   // A host's S/Cars, once it named the car, decides (the seed's controller publishes no
-  // S/CarStatus when it drops a car, and the one it published may still say online); a car no
+  // S/CarStatus when it drops a car, and the one left retained may say either); a car no
   // S/Cars named yet is as its S/CarStatus says.
-  if (everListed) return listed && online.value_or(true);
+  if (everListed) return listed;
   return online.value_or(false);
 }
 
@@ -279,26 +294,29 @@ void RemoteCars::update(const std::string& id, Car& car) {
                        : !brokerUp_        ? "lost the MQTT broker"
                                            : "connected through the MQTT broker";
   bool was = car.link->connected();
+  if (up && !was) car.forgetBridge();  // whoever bridges it now shows what it sends anew
   car.link->set(up, reason);
   if (was != up && onChange) onChange();
 }
 
-bool RemoteCars::sendCommand(const std::string& car, std::span<const std::uint8_t> frame) {
-  if (readOnly_) return false;
+std::optional<std::string> RemoteCars::sendCommand(const std::string& car,
+                                                   std::span<const std::uint8_t> frame) {
+  if (readOnly_) return "a spectator sends no commands";
   auto message = anki::decode(frame);
-  if (!message) return false;
-  if (std::holds_alternative<anki::SdkMode>(*message)) return true;
+  if (!message) return message.error().message();
+  if (std::holds_alternative<anki::SdkMode>(*message)) return std::nullopt;
   auto it = cars_.find(car);
   if (it != cars_.end() && it->second.seed && !topics::controllerIntentPayload(*message)) {
-    // Its bridge would drop it without a word: say so here, and send nothing.
-    warn("car " + car + " is bridged by the seed's controller (no E/frame), which has no intent " +
-         "for " + std::string(anki::name(*message)) + "; not sent (speed, lane, turn, battery, " +
-         "version and ping are what it takes)");
-    return false;
+    // Its bridge would drop it without a word: refuse it here, saying why.
+    return "car " + car + " is bridged by the seed's controller (it sends no E/frame), which " +
+           "has no intent for " + std::string(anki::name(*message)) +
+           "; it takes speed, lane, turn, battery, version and ping";
   }
   auto payload = topics::intentPayload(*message);
-  if (!payload) return false;
-  return client_.publish("Anki/Car/" + car + "/I", *payload, 1, false);
+  if (!payload) return std::string(anki::name(*message)) + " is not a command";
+  if (!client_.publish("Anki/Car/" + car + "/I", *payload, 1, false))
+    return "not connected to the MQTT broker";
+  return std::nullopt;
 }
 
 }  // namespace pitwall

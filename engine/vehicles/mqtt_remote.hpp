@@ -59,8 +59,9 @@ class RemoteCars {
   // Called whenever a remote car goes up or down.
   std::function<void()> onChange;
 
-  // Used by RemoteLink.
-  bool sendCommand(const std::string& car, std::span<const std::uint8_t> frame);
+  // Used by RemoteLink: publishes the command's intent; nullopt when published, else why not.
+  std::optional<std::string> sendCommand(const std::string& car,
+                                         std::span<const std::uint8_t> frame);
 
  private:
   struct Car {
@@ -73,6 +74,7 @@ class RemoteCars {
     bool frames = false;         // E/frame seen: its E/Messages are not needed
     bool seed = false;           // E/Messages without E/frame: the seed's controller bridges it
     bool present() const;        // its bridge has it connected
+    void forgetBridge();         // frames and seed, learnt anew from the next events
   };
   void message(std::string_view topic, std::string_view payload);
   void handle(std::string_view topic, std::string_view payload);

@@ -23,7 +23,11 @@
 namespace pitwall::topics {
 namespace {
 
+// What pitwall writes keeps its keys in the order written (golden strings stay stable); what it
+// reads is parsed into a map: ordered_json finds a key by a linear search, so a payload of
+// thousands of distinct keys would cost quadratic time before any rate limit is applied.
 using Json = nlohmann::ordered_json;
+using In = nlohmann::json;
 
 template <typename T, std::size_t I = 0>
 constexpr std::size_t variantIndex() {
@@ -95,7 +99,7 @@ std::string clip(std::string_view s, std::size_t n) {
 
 // A value received, as an error message shows it: its JSON, cut and escaped (a string value of
 // 60 KB stays a short sentence).
-std::string excerpt(const Json& v) {
+std::string excerpt(const In& v) {
   return quote(v.dump());
 }
 
@@ -119,20 +123,20 @@ std::string describe(const Json::exception& e) {
 
 // The one way a payload from the broker becomes JSON: size first, then a parse that stops at the
 // depth limit; every exception of the parser becomes an error sentence.
-Result<Json, std::string> parse(std::string_view payload, const PayloadLimits& limits) {
+Result<In, std::string> parse(std::string_view payload, const PayloadLimits& limits) {
   if (payload.size() > limits.maxBytes)
     return Unexpected{"payload is " + std::to_string(payload.size()) + " bytes, more than " +
                       std::to_string(limits.maxBytes) + " (it begins " + quote(payload) +
                       "); send a smaller payload, or raise the limit with --mqtt-max-payload"};
-  Json::parser_callback_t depth = [&](int level, Json::parse_event_t event, Json&) {
+  In::parser_callback_t depth = [&](int level, In::parse_event_t event, In&) {
     // `level` counts the containers around this one
-    if ((event == Json::parse_event_t::object_start || event == Json::parse_event_t::array_start) &&
+    if ((event == In::parse_event_t::object_start || event == In::parse_event_t::array_start) &&
         level >= limits.maxDepth)
       throw TooDeep{};
     return true;
   };
   try {
-    return Json::parse(payload, depth);
+    return In::parse(payload, depth);
   } catch (const TooDeep&) {
     return Unexpected{"payload nests objects and arrays more than " +
                       std::to_string(limits.maxDepth) + " deep (it begins " + quote(payload) +
@@ -515,7 +519,7 @@ namespace {
 
 using Parsed = Result<Action, std::string>;
 
-std::string typeName(const Json& v) {
+std::string typeName(const In& v) {
   if (v.is_number_integer()) return "an integer";
   if (v.is_number()) return "a number";
   std::string name = v.type_name();
@@ -523,18 +527,18 @@ std::string typeName(const Json& v) {
 }
 
 // The key, present and of the right kind; otherwise the sentence saying why not.
-Result<const Json*, std::string> field(const Json& j, const char* key, const char* kind) {
+Result<const In*, std::string> field(const In& j, const char* key, const char* kind) {
   auto it = j.find(key);
   if (it == j.end()) return Unexpected{std::string("missing key \"") + key + "\" (" + kind + ")"};
   return &*it;
 }
 
 // An integer within [lo, hi], checked as a double so that 1e30 or 2^64 cannot wrap.
-Result<int, std::string> integer(const Json& j, const char* key, int lo, int hi,
+Result<int, std::string> integer(const In& j, const char* key, int lo, int hi,
                                  std::string_view unit) {
   auto f = field(j, key, "an integer");
   if (!f) return Unexpected{f.error()};
-  const Json& v = **f;
+  const In& v = **f;
   if (!v.is_number_integer())
     return Unexpected{std::string("\"") + key + "\" must be an integer, not " + typeName(v) + " (" +
                       excerpt(v) + ")"};
@@ -555,7 +559,7 @@ Result<int, std::string> integer(const Json& j, const char* key, int lo, int hi,
 
 // A number, or a string holding one ("600", as a form field gives it); nullopt with the
 // sentence when neither.
-Result<double, std::string> looseNumber(const Json& v, std::string_view key) {
+Result<double, std::string> looseNumber(const In& v, std::string_view key) {
   if (v.is_number()) return v.get<double>();
   if (v.is_string()) {
     const auto& text = v.get_ref<const std::string&>();
@@ -573,7 +577,7 @@ Result<double, std::string> looseNumber(const Json& v, std::string_view key) {
 }
 
 // The number at `key` rounded to an integer within [lo, hi].
-Result<int, std::string> looseInteger(const Json& v, std::string_view key, int lo, int hi,
+Result<int, std::string> looseInteger(const In& v, std::string_view key, int lo, int hi,
                                       std::string_view unit) {
   auto d = looseNumber(v, key);
   if (!d) return Unexpected{d.error()};
@@ -585,7 +589,7 @@ Result<int, std::string> looseInteger(const Json& v, std::string_view key, int l
   return static_cast<int>(r);
 }
 
-Result<double, std::string> offsetValue(const Json& v, std::string_view key) {
+Result<double, std::string> offsetValue(const In& v, std::string_view key) {
   namespace L = anki::limits;
   auto d = looseNumber(v, key);
   if (!d) return Unexpected{d.error()};
@@ -597,7 +601,7 @@ Result<double, std::string> offsetValue(const Json& v, std::string_view key) {
   return *d;
 }
 
-Parsed speedIntent(const Json& j) {
+Parsed speedIntent(const In& j) {
   namespace L = anki::limits;
   auto speed = integer(j, "speed", L::kSpeedMin, L::kSpeedMax, "mm/s");
   if (!speed) return Unexpected{speed.error()};
@@ -606,11 +610,11 @@ Parsed speedIntent(const Json& j) {
   return Action{SpeedIntent{*speed, *accel}};
 }
 
-Parsed laneIntent(const Json& j) {
+Parsed laneIntent(const In& j) {
   namespace L = anki::limits;
   auto f = field(j, "offset", "a number, mm from road centre");
   if (!f) return Unexpected{f.error()};
-  const Json& v = **f;
+  const In& v = **f;
   if (!v.is_number())
     return Unexpected{"\"offset\" must be a number, not " + typeName(v) + " (" + excerpt(v) + ")"};
   auto d = offsetValue(v, "offset");
@@ -630,10 +634,10 @@ Parsed laneIntent(const Json& j) {
   return Action{lane};
 }
 
-Parsed messageIntent(const Json& j) {
+Parsed messageIntent(const In& j) {
   auto f = field(j, "frame", "a string of hex digits");
   if (!f) return Unexpected{f.error()};
-  const Json& v = **f;
+  const In& v = **f;
   if (!v.is_string())
     return Unexpected{"\"frame\" must be a string of hex digits, not " + typeName(v) + " (" +
                       excerpt(v) + ")"};
@@ -648,7 +652,7 @@ Parsed messageIntent(const Json& j) {
   return Action{MessageIntent{std::move(*message)}};
 }
 
-Parsed turnIntent(const Json& j) {
+Parsed turnIntent(const In& j) {
   // anki-overdrive.md: type 0 none … 4 U-turn jump; trigger 0 immediate, 1 at next intersection
   auto type = integer(j, "turnType", 0, static_cast<int>(anki::TurnType::UTurnJump), "");
   if (!type) return Unexpected{type.error()};
@@ -658,10 +662,10 @@ Parsed turnIntent(const Json& j) {
       TurnIntent{static_cast<anki::TurnType>(*type), static_cast<anki::TurnTrigger>(*trigger)}};
 }
 
-Parsed commandIntent(const Json& j) {
+Parsed commandIntent(const In& j) {
   auto f = field(j, "type", "one of speed, lane, turn, battery, version, ping, message");
   if (!f) return Unexpected{f.error()};
-  const Json& t = **f;
+  const In& t = **f;
   if (!t.is_string())
     return Unexpected{"\"type\" must be a string, not " + typeName(t) + " (" + excerpt(t) + ")"};
   const auto& type = t.get_ref<const std::string&>();
@@ -681,7 +685,7 @@ constexpr std::array<const char*, 6> kCommandKeys{"speed",   "lane",    "turn",
                                                   "battery", "version", "ping"};
 constexpr const char* kCommandKeyList = "speed, lane, turn, battery, version or ping";
 
-Parsed keyedSpeed(const Json& j) {
+Parsed keyedSpeed(const In& j) {
   namespace L = anki::limits;
   auto it = j.find("speed");
   if (it == j.end())
@@ -698,14 +702,15 @@ Parsed keyedSpeed(const Json& j) {
   return Action{SpeedIntent{*speed, accel}};
 }
 
-Parsed keyedLane(const Json& j) {
+Parsed keyedLane(const In& j) {
   namespace L = anki::limits;
-  // The controller reads "offset"; its clients send the offset as "lane" itself, or both.
-  auto it = j.find("offset");
-  const char* key = "offset";
-  if (it == j.end()) {
-    it = j.find("lane");
-    key = "lane";
+  // The controller's current CmdHandler reads the offset from "lane" itself (an earlier one read
+  // "offset", and some clients send both): "lane" when it holds a number, else "offset".
+  auto it = j.find("lane");
+  const char* key = "lane";
+  if (auto offset = j.find("offset"); offset != j.end() && !looseNumber(*it, key)) {
+    it = offset;
+    key = "offset";
   }
   auto offset = offsetValue(*it, key);
   if (!offset) return Unexpected{offset.error()};
@@ -724,8 +729,8 @@ Parsed keyedLane(const Json& j) {
   return Action{lane};
 }
 
-Parsed keyedTurn(const Json& j) {
-  const Json& t = j.at("turn");
+Parsed keyedTurn(const In& j) {
+  const In& t = j.at("turn");
   if (!t.is_object())
     return Unexpected{"\"turn\" must be an object {\"type\":0..4,\"time\":0..1}, not " +
                       typeName(t) + " (" + excerpt(t) + ")"};
@@ -749,7 +754,7 @@ Parsed keyedTurn(const Json& j) {
 
 // A command in the controller's form; `also` is what else the topic takes, for the sentence
 // when the payload names no command.
-Parsed keyedCommand(const Json& j, std::string_view also) {
+Parsed keyedCommand(const In& j, std::string_view also) {
   std::vector<std::string> named;
   for (const char* key : kCommandKeys)
     if (j.contains(key)) named.emplace_back(key);
@@ -786,13 +791,13 @@ Parsed keyedCommand(const Json& j, std::string_view also) {
   return Action{PingIntent{}};
 }
 
-Parsed carCommand(const Json& j, std::string_view also = "") {
+Parsed carCommand(const In& j, std::string_view also = "") {
   if (j.contains("type")) return commandIntent(j);
   return keyedCommand(j, also);
 }
 
 // On Anki/Host/<host>/I…: a host intent, or else a command for every car of the host.
-Parsed hostIntent(const Json& j) {
+Parsed hostIntent(const In& j) {
   std::vector<std::string> named;
   for (const char* key : {"connecting", "cars", "car_status"})
     if (j.contains(key)) named.emplace_back(key);
@@ -805,7 +810,7 @@ Parsed hostIntent(const Json& j) {
   }
   if (named[0] == "cars") return Action{CarsIntent{}};
   if (named[0] == "car_status") return Action{CarStatusIntent{}};
-  const Json& v = j.at("connecting");
+  const In& v = j.at("connecting");
   if (!v.is_boolean())
     return Unexpected{"\"connecting\" must be true or false, not " + typeName(v) + " (" +
                       excerpt(v) + ")"};
@@ -953,7 +958,7 @@ std::optional<TopicParts> splitTopic(std::string_view topic) {
 
 namespace {
 
-Result<Json, std::string> object(std::string_view payload, const PayloadLimits& limits) {
+Result<In, std::string> object(std::string_view payload, const PayloadLimits& limits) {
   auto j = parse(payload, limits);
   if (!j) return j;
   if (!j->is_object()) return Unexpected{"payload must be a JSON object, not " + typeName(*j)};
@@ -961,7 +966,7 @@ Result<Json, std::string> object(std::string_view payload, const PayloadLimits& 
 }
 
 template <typename T>
-Result<T, std::string> key(const Json& j, const char* name) {
+Result<T, std::string> key(const In& j, const char* name) {
   auto it = j.find(name);
   if (it == j.end()) return Unexpected{std::string("missing key \"") + name + "\""};
   try {
@@ -973,7 +978,7 @@ Result<T, std::string> key(const Json& j, const char* name) {
 
 // An unsigned integer no larger than `max` (nlohmann would wrap -1 into a uint32_t).
 template <typename T>
-Result<T, std::string> unsignedKey(const Json& j, const char* name) {
+Result<T, std::string> unsignedKey(const In& j, const char* name) {
   auto it = j.find(name);
   if (it == j.end()) return Unexpected{std::string("missing key \"") + name + "\""};
   constexpr auto max = std::numeric_limits<T>::max();
@@ -1032,7 +1037,7 @@ Result<std::vector<std::string>, std::string> readHostCars(std::string_view payl
                                                            const PayloadLimits& limits) {
   auto j = parse(payload, limits);
   if (!j) return Unexpected{j.error()};
-  const Json* list = &*j;
+  const In* list = &*j;
   if (j->is_object()) {
     if (j->empty()) return std::vector<std::string>{};  // the seed's controller's "none"
     auto it = j->find("value");                         // earlier pitwall bridges
@@ -1069,7 +1074,7 @@ namespace {
 // A field of an E/Messages payload: absent is 0 (the controller always sends every key it has);
 // present, it must be a number within the field's type.
 template <typename T>
-Result<T, std::string> wireField(const Json& j, const char* name) {
+Result<T, std::string> wireField(const In& j, const char* name) {
   auto it = j.find(name);
   if (it == j.end()) return T{};
   if (it->is_boolean()) return static_cast<T>(it->get<bool>());

@@ -43,11 +43,11 @@ struct Record {
 };
 
 inline constexpr std::size_t kMaxLineBytes = 64 * 1024;
-inline constexpr int kMaxRecordedCar = 64;        // as --cars
-inline constexpr double kMaxRecordedTime = 1e7;   // seconds (116 days): any real run is shorter
-inline constexpr double kBackwardsSlack = 0.001;  // seconds a line's t may lie before the last
-inline constexpr int kMaxJsonDepth = 16;          // a frame's line nests 2 deep ("msg")
-inline constexpr std::size_t kMaxRecordedName = 64;      // bytes of a car's name
+inline constexpr int kMaxRecordedCar = 64;           // as --cars
+inline constexpr double kMaxRecordedTime = 1e7;      // seconds (116 days): any real run is shorter
+inline constexpr double kBackwardsSlack = 0.001;     // seconds a line's t may lie before the last
+inline constexpr int kMaxJsonDepth = 16;             // a frame's line nests 2 deep ("msg")
+inline constexpr std::size_t kMaxRecordedName = 64;  // bytes of a car's name
 inline constexpr std::size_t kMaxRecordedLayout = 8192;  // bytes of a layout's text
 
 // One line (without its newline) against the time of the last good frame; the frame, or why not.

@@ -481,3 +481,30 @@ BENCHMARK(BM_MqttFrameToLua)
     ->Unit(benchmark::kMicrosecond);
 
 }  // namespace
+
+// BM_IntentManyKeys/<kind>: topics::parseIntent on a 64 KiB payload (the default
+// --mqtt-max-payload) that anyone on the broker may send before any rate limit applies: kind 0
+// one long string value (the floor: the parser's bytes alone), kind 1 thousands of distinct keys
+// (the adversary: a parser that finds keys by a linear search pays quadratic time here).
+// Report the ratio kind 1 / kind 0 (docs/performance.md "MQTT").
+namespace {
+std::string manyKeysPayload(bool keys) {
+  const std::size_t size = pitwall::topics::kDefaultMaxPayload - 20;
+  if (!keys) return R"({"pad":")" + std::string(size, 'x') + R"("})";
+  std::string payload = "{";
+  for (int i = 0; payload.size() < size; ++i)
+    payload += (i ? "," : "") + std::string("\"") + std::to_string(i) + "\":0";
+  return payload + "}";
+}
+}  // namespace
+
+void BM_IntentManyKeys(benchmark::State& state) {
+  const std::string payload = manyKeysPayload(state.range(0) == 1);
+  const std::vector<std::string> cars{"e85a0f112233"};
+  for (auto _ : state) {
+    auto r = pitwall::topics::parseIntent("pit1", "Anki/Car/I", payload, cars);
+    benchmark::DoNotOptimize(r);
+  }
+  state.SetBytesProcessed(state.iterations() * static_cast<std::int64_t>(payload.size()));
+}
+BENCHMARK(BM_IntentManyKeys)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);

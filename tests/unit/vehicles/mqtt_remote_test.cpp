@@ -508,7 +508,10 @@ TEST_CASE("mqtt remote: a car of the seed's controller: its S/Cars decides, E/Me
         std::pair<std::string, std::string>{base + "I", R"({"speed":600,"acceleration":2000})"});
   auto lights = remote.lights(0x44);
   REQUIRE_FALSE(lights.ok());
-  CHECK(lights.error().find("refused set-lights") != std::string::npos);
+  CHECK(lights.error() ==
+        "car 1 (skull): set-lights was not sent: car d205effe02cb is bridged by the seed's "
+        "controller (it sends no E/frame), which has no intent for set-lights; it takes speed, "
+        "lane, turn, battery, version and ping");
 
   // connecting false: S/Cars {} and a blank S/Information; the stale CarStatus keeps nothing up
   retain("Anki/Host/host/S/Cars", "{}");

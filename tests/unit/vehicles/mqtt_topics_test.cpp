@@ -689,7 +689,10 @@ TEST_CASE("mqtt intents: the seed's controller's forms, the key naming the comma
         Intent{one, SpeedIntent{600, 5000}});
   CHECK(accepted(car, R"({"speed":600})") == Intent{one, SpeedIntent{600, 1000}});
   CHECK(accepted(car, R"({"lane":-23})") == Intent{one, LaneIntent{-23, {}, {}}});
-  CHECK(accepted(car, R"({"lane":1,"offset":44.5})") == Intent{one, LaneIntent{44.5, {}, {}}});
+  CHECK(accepted(car, R"({"lane":44.5,"offset":44.5})") == Intent{one, LaneIntent{44.5, {}, {}}});
+  // "lane" holds the offset (the controller's current reading); "offset" when "lane" holds none
+  CHECK(accepted(car, R"({"lane":-23,"offset":44.5})") == Intent{one, LaneIntent{-23, {}, {}}});
+  CHECK(accepted(car, R"({"lane":true,"offset":44.5})") == Intent{one, LaneIntent{44.5, {}, {}}});
   CHECK(accepted(car, R"({"turn":{"type":3,"time":0}})") ==
         Intent{one, TurnIntent{anki::TurnType::UTurn, anki::TurnTrigger::Immediate}});
   CHECK(accepted(car, R"({"turn":{"type":1}})") ==
@@ -724,7 +727,7 @@ TEST_CASE("mqtt intents: a bad command in the controller's form names the key, v
         "missing key \"speed\" (a number, mm/s) beside \"acceleration\"");
   CHECK(rejected(car, R"({"lane":-71})") ==
         "lane -71 mm is out of range -70..70 mm (beyond it the car leaves the road)");
-  CHECK(rejected(car, R"({"lane":0,"offset":"x"})") ==
+  CHECK(rejected(car, R"({"lane":true,"offset":"x"})") ==
         "\"offset\" must be a number, not a string (\"x\")");
   CHECK(rejected(car, R"({"lane":null})") == "\"lane\" must be a number, not a null (null)");
   CHECK(rejected(car, R"({"turn":3})") ==
