@@ -17,8 +17,8 @@ constexpr const char* kLog = "mqtt bridge";
 // The buckets of the host's own intents (car ids never hold a space): connecting, and the
 // requests to publish the car list or the cars' information again, each of its own so that a
 // flood of one never holds up the other.
-const std::string kConnection = "connection intents";
-const std::string kRepublish = "cars and car_status intents";
+const std::string kConnection = "connection";
+const std::string kRepublish = "cars/car_status";
 
 std::string perSecond(const RateLimit& r) {
   std::ostringstream out;
@@ -307,14 +307,14 @@ bool MqttBridge::admit(const std::string& key, const std::string& topic) {
   s.topic = topic;
   summarise(s, [this, key](Summary& s) {
     const bool host = key == kConnection || key == kRepublish;
-    std::string why =
-        std::to_string(s.count) + " " +
-        (host ? key + (s.count == 1 ? " was" : " were") + " dropped: more than the host takes"
-              : std::string("intent") + (s.count == 1 ? "" : "s") + " for car " + key +
-                    (s.count == 1 ? " was" : " were") +
-                    " dropped: more than the car's link can take") +
-        " (at most " + perSecond(options_.intents) +
-        "); send fewer, e.g. only when a value changes";
+    std::string why = std::to_string(s.count) + " " +
+                      (host ? key + " intent" + (s.count == 1 ? " was" : "s were") +
+                                  " dropped: more than the host takes"
+                            : std::string("intent") + (s.count == 1 ? "" : "s") + " for car " +
+                                  key + (s.count == 1 ? " was" : " were") +
+                                  " dropped: more than the car's link can take") +
+                      " (at most " + perSecond(options_.intents) +
+                      "); send fewer, e.g. only when a value changes";
     log::warn(kLog, why);
     emit(topics::intentError(host_, topics::IntentError{s.topic, why}, now()));
   });
