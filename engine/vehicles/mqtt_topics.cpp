@@ -316,7 +316,7 @@ Json controllerFields(const T& m) {
   if constexpr (std::is_same_v<T, anki::CarStatus>) j["online"] = true;
   std::apply(
       [&](const auto&... key) {
-        auto put = [&](const auto& k) {
+        [[maybe_unused]] auto put = [&](const auto& k) {
           const auto& v = m.*(k.member);
           using V = std::decay_t<decltype(v)>;
           if constexpr (IsOptional<V>::value) {
@@ -1121,7 +1121,7 @@ Result<std::optional<anki::Message>, std::string> readMessageEvent(std::string_v
         if constexpr (Published<T>) {
           std::apply(
               [&](const auto&... key) {
-                auto get = [&](const auto& k) {
+                [[maybe_unused]] auto get = [&](const auto& k) {
                   auto& member = m.*(k.member);
                   using V = std::decay_t<decltype(member)>;
                   if (!error.empty()) return;
