@@ -1,12 +1,12 @@
-// The MQTT intent parser (engine/vehicles/mqtt_topics.hpp: parseIntent, intentError,
+// The MQTT intent parser (engine/mqtt/topics.hpp: parseIntent, intentError,
 // intentPayload): what anyone who can publish on the broker sends to a bridge. The first input
 // byte picks the topic (the intent topics of host "pitA" and the seed's controller's global
-// Anki/Car/I, or a topic taken from the input up to a NUL byte); the rest is the payload. Never a crash or an exception; a refused intent's
-// error is a sentence, and its S/IntentError payload is valid JSON naming the topic.
-// Control byte 6: the rest is an Anki frame instead. A controller→vehicle message in range
-// (limits::validate) has an intent payload (intentPayload, what a remote pitwall publishes),
-// and the bridge's parser accepts that payload on the car's intent topic; a "message" intent
-// carries the very same message.
+// Anki/Car/I, or a topic taken from the input up to a NUL byte); the rest is the payload. Never a
+// crash or an exception; a refused intent's error is a sentence, and its S/IntentError payload is
+// valid JSON naming the topic. Control byte 6: the rest is an Anki frame instead. A
+// controller→vehicle message in range (limits::validate) has an intent payload (intentPayload, what
+// a remote pitwall publishes), and the bridge's parser accepts that payload on the car's intent
+// topic; a "message" intent carries the very same message.
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -16,9 +16,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "engine/mqtt/topics.hpp"
 #include "engine/protocol/anki/codec.hpp"
 #include "engine/protocol/anki/limits.hpp"
-#include "engine/vehicles/mqtt_topics.hpp"
 #include "tests/fuzz/fuzz_check.hpp"
 
 using namespace pitwall;

@@ -1,4 +1,4 @@
-// The readers a remote pitwall applies to what bridges publish (engine/vehicles/mqtt_topics.hpp:
+// The readers a remote pitwall applies to what bridges publish (engine/mqtt/topics.hpp:
 // splitTopic, readInformation, readCarStatus, readHostStatus, readHostCars, readFrameEvent,
 // readMessageEvent). The first input byte picks the reader, the rest is the payload (or the
 // topic). Never a crash or an exception; an error is a sentence. What a reader accepts survives
@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "engine/mqtt/topics.hpp"
 #include "engine/protocol/anki/codec.hpp"
-#include "engine/vehicles/mqtt_topics.hpp"
 #include "tests/fuzz/fuzz_check.hpp"
 
 using namespace pitwall;
@@ -99,7 +99,8 @@ anki::Message rounded(anki::Message m) {
   std::visit(
       [](auto& x) {
         if constexpr (requires { x.offset_mm; })
-          x.offset_mm = static_cast<float>(std::round(static_cast<double>(x.offset_mm) * 100) / 100);
+          x.offset_mm =
+              static_cast<float>(std::round(static_cast<double>(x.offset_mm) * 100) / 100);
       },
       m);
   return m;

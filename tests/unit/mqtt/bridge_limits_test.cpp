@@ -1,6 +1,6 @@
 // MqttBridge against hostile and excessive input (docs/mqtt.md "Hostile input"): hostile intents,
 // floods of intents and of bad intents, and the stop that no rate limit holds back.
-#include "tests/unit/vehicles/mqtt_bridge_fixture.hpp"
+#include "tests/unit/mqtt/bridge_fixture.hpp"
 
 #include <doctest/doctest.h>
 

@@ -1,4 +1,4 @@
-#include "engine/vehicles/mqtt_topics.hpp"
+#include "engine/mqtt/topics.hpp"
 
 #include <doctest/doctest.h>
 

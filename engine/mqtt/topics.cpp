@@ -1,6 +1,6 @@
 // The seed's MQTT topic tree (seed 000 §4.4, ../shared/protocols/mqtt-topics.md) as pure
 // functions. Payloads keep the seed's key order (ordered_json), so golden strings are stable.
-#include "engine/vehicles/mqtt_topics.hpp"
+#include "engine/mqtt/topics.hpp"
 
 #include <algorithm>
 #include <array>

@@ -1,7 +1,7 @@
 // MqttBridge against a real mosquitto broker (tests/support/mosquitto_broker.hpp): two simulated
 // cars on the oval, driven in real time on the one real-clock loop, published under the seed's
 // topic tree; intents sent by an observer client that also records everything under Anki/#.
-#include "tests/unit/vehicles/mqtt_bridge_fixture.hpp"
+#include "tests/unit/mqtt/bridge_fixture.hpp"
 
 #include <doctest/doctest.h>
 

@@ -1,4 +1,4 @@
-#include "engine/vehicles/mqtt_bridge.hpp"
+#include "engine/mqtt/bridge.hpp"
 
 #include <algorithm>
 #include <sstream>

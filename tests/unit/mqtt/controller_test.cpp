@@ -14,9 +14,9 @@
 
 #include "engine/core/hex.hpp"
 #include "engine/core/log.hpp"
+#include "engine/mqtt/remote.hpp"
 #include "engine/protocol/anki/codec.hpp"
-#include "engine/vehicles/mqtt_remote.hpp"
-#include "tests/unit/vehicles/mqtt_bridge_fixture.hpp"
+#include "tests/unit/mqtt/bridge_fixture.hpp"
 
 using namespace pitwall;
 using namespace std::chrono_literals;

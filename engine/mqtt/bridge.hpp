@@ -28,10 +28,10 @@
 #include <string>
 #include <vector>
 
+#include "engine/mqtt/throttle.hpp"
+#include "engine/mqtt/topics.hpp"
 #include "engine/transport/mqtt_client.hpp"
 #include "engine/vehicles/fleet.hpp"
-#include "engine/vehicles/mqtt_throttle.hpp"
-#include "engine/vehicles/mqtt_topics.hpp"
 
 namespace pitwall {
 

@@ -1,7 +1,7 @@
 // RemoteCars against a real mosquitto broker: host A bridges two simulated cars (MqttBridge);
 // host B, on the same real-clock loop, sees them as AnkiCars of its own fleet and drives them
 // through intents.
-#include "engine/vehicles/mqtt_remote.hpp"
+#include "engine/mqtt/remote.hpp"
 
 #include <doctest/doctest.h>
 
@@ -15,11 +15,11 @@
 
 #include "engine/core/hex.hpp"
 #include "engine/core/log.hpp"
+#include "engine/mqtt/bridge.hpp"
 #include "engine/protocol/anki/codec.hpp"
 #include "engine/sim/grid.hpp"
 #include "engine/sim/track.hpp"
 #include "engine/sim/world.hpp"
-#include "engine/vehicles/mqtt_bridge.hpp"
 #include "tests/support/hostile_payloads.hpp"
 #include "tests/support/mosquitto_broker.hpp"
 #include "tests/support/run_until.hpp"

@@ -1,4 +1,4 @@
-#include "engine/vehicles/mqtt_remote.hpp"
+#include "engine/mqtt/remote.hpp"
 
 #include <unistd.h>
 

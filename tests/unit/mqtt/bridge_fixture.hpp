@@ -1,9 +1,9 @@
 #pragma once
-// The set-up of the MqttBridge tests (mqtt_bridge_test.cpp, mqtt_bridge_limits_test.cpp): a real
+// The set-up of the MqttBridge tests (bridge_test.cpp, bridge_limits_test.cpp): a real
 // mosquitto broker (tests/support/mosquitto_broker.hpp), two simulated cars on the oval driven in
 // real time on the one real-clock loop and published under the seed's topic tree, and an observer
 // client that sends intents and records everything under Anki/#.
-#include "engine/vehicles/mqtt_bridge.hpp"
+#include "engine/mqtt/bridge.hpp"
 
 #include <doctest/doctest.h>
 #include <signal.h>
