@@ -232,6 +232,10 @@ Result<std::vector<std::string>, std::string> readHostCars(std::string_view payl
 Result<std::vector<std::uint8_t>, std::string> readFrameEvent(std::string_view payload,
                                                               const PayloadLimits& limits = {});
 
+// Anki/Car/<car>/E/Messages/<name>, the seed's controller's whole-message event for `message`
+// (QoS 0, not retained); nullopt for a message the controller publishes none for.
+std::optional<Publication> messageEvent(std::string_view car, const anki::Message& message,
+                                        Millis now);
 // The seed's controller's whole-message events: "ANKI_VEHICLE_MSG_V2C_LOCALIZATION_POSITION_UPDATE"
 // for a position update, …; empty for a message without one.
 std::string_view messageEventName(const anki::Message& message);
