@@ -1,8 +1,10 @@
 // pitwall bridge: the cars of this host (simulated, or real ones with --ble) on an MQTT broker,
 // under the seed's topic tree, executing the intents other clients send (docs/mqtt.md).
 #include <iostream>
+#include <memory>
 
 #include "engine/cli/commands.hpp"
+#include "engine/cli/options.hpp"
 #include "engine/cli/session.hpp"
 #include "engine/core/log.hpp"
 
@@ -38,6 +40,22 @@ int bridge(const BridgeOptions& options) {
     });
   session.loop().run();  // ends through Session::finish: SIGINT, SIGTERM, --duration
   return session.interrupted() ? 130 : 0;
+}
+
+Command addBridgeCommand(CLI::App& app) {
+  auto bridge = std::make_shared<BridgeOptions>();
+  auto* cmd = app.add_subcommand("bridge",
+                                 "Publish the cars (simulated, or --ble) on an MQTT broker "
+                                 "and execute intents (docs/mqtt.md)");
+  addCarSource(cmd, *bridge, "before the bridge starts");
+  addMqtt(cmd, bridge->mqtt, bridge->mqttTimeout, "where the cars are published")->required();
+  cmd->add_option("--host-id", bridge->hostId,
+                  "The <host> of Anki/Host/<host>/… (default: this machine's host name)");
+  addView(cmd, bridge->view);
+  cmd->add_flag("--read-only", bridge->readOnly, "Publish only; never execute intents");
+  cmd->add_option("--duration", bridge->duration, "Stop after this many seconds")
+      ->check(CLI::PositiveNumber);
+  return {cmd, [bridge] { return cli::bridge(*bridge); }};
 }
 
 }  // namespace pitwall::cli

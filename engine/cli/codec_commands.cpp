@@ -1,8 +1,10 @@
 // pitwall decode / pitwall encode: the codecs from the shell.
 #include <cctype>
 #include <iostream>
+#include <memory>
 
 #include "engine/cli/commands.hpp"
+#include "engine/cli/options.hpp"
 #include "engine/core/hex.hpp"
 #include "engine/protocol/anki/codec.hpp"
 #include "engine/protocol/anki/command_text.hpp"
@@ -93,6 +95,36 @@ int encode(const std::string& protocol, const std::vector<std::string>& words) {
   }
   std::cout << toHex(anki::encode(*message).span()) << "\n";
   return 0;
+}
+
+namespace {
+struct CodecArguments {
+  std::string protocol;
+  std::vector<std::string> words;
+};
+}  // namespace
+
+Command addDecodeCommand(CLI::App& app) {
+  auto args = std::make_shared<CodecArguments>();
+  auto* cmd = app.add_subcommand("decode", "Decode one frame: pitwall decode anki \"01 17\"");
+  cmd->add_option("protocol", args->protocol, "Protocol (anki, mindroad, alphabot, alphabot-ble)")
+      ->required();
+  cmd->add_option("hex", args->words, "The frame's bytes in hex")->required();
+  cmd->positionals_at_end(false);  // negative numbers are arguments, not options
+  return {cmd, [args] { return cli::decode(args->protocol, args->words); }};
+}
+
+Command addEncodeCommand(CLI::App& app) {
+  auto args = std::make_shared<CodecArguments>();
+  auto* cmd =
+      app.add_subcommand("encode", "Encode one command: pitwall encode anki set-speed 600 1000");
+  cmd->add_option("protocol", args->protocol, "Protocol (anki, mindroad, alphabot)")->required();
+  cmd->add_option("message", args->words, "The command and its arguments")->required();
+  std::string forms;
+  for (const auto& f : anki::commandForms()) forms += "\n  " + f;
+  cmd->footer("Commands (anki):" + forms);
+  cmd->positionals_at_end(false);  // set-offset -23.5: -23.5 is an argument, not an option
+  return {cmd, [args] { return cli::encode(args->protocol, args->words); }};
 }
 
 }  // namespace pitwall::cli

@@ -4,10 +4,12 @@
 #include <csignal>
 #include <cstdio>
 #include <iostream>
+#include <memory>
 
 #include <sdbus-c++/sdbus-c++.h>
 
 #include "engine/cli/commands.hpp"
+#include "engine/cli/options.hpp"
 #include "engine/core/log.hpp"
 #include "engine/protocol/anki/advertisement.hpp"
 #include "engine/sim/grid.hpp"
@@ -166,6 +168,23 @@ int emulateCar(const EmulateOptions& options) {
   car.disconnect();  // no callback into the peripheral from here on
   log::setTimeSource(nullptr);
   return status;
+}
+
+Command addEmulateCommand(CLI::App& app) {
+  auto emulate = std::make_shared<EmulateOptions>();
+  auto* cmd = app.add_subcommand(
+      "emulate-car", "Be an Anki car: a BLE peripheral driven by the simulator (needs BlueZ)");
+  cmd->add_option("--adapter", emulate->adapter, "The controller to advertise on (hci0)");
+  cmd->add_option("--name", emulate->name, "The car's user name (pitwall, ≤ 12 bytes)");
+  cmd->add_flag("--plain-name", emulate->plainName,
+                "Advertise the user name alone, not laid out as a car's local name");
+  cmd->add_option("--model", emulate->model, "Model id (8: Groundshock)")
+      ->check(CLI::Range(1, 255));
+  cmd->add_option("--track", emulate->track, "Track layout the car drives on (oval)");
+  cmd->add_option("--seed", emulate->seed, "Seed of the simulator");
+  cmd->add_option("--duration", emulate->duration, "Stop after this many seconds")
+      ->check(CLI::PositiveNumber);
+  return {cmd, [emulate] { return cli::emulateCar(*emulate); }};
 }
 
 }  // namespace pitwall::cli

@@ -1,8 +1,10 @@
 // pitwall repl: a Lua prompt with the cars bound (docs/repl.md). The simulator runs behind it in
 // real time, or real cars are driven over Bluetooth LE with --ble.
 #include <iostream>
+#include <memory>
 
 #include "engine/cli/commands.hpp"
+#include "engine/cli/options.hpp"
 #include "engine/cli/repl.hpp"
 #include "engine/cli/session.hpp"
 #include "engine/core/log.hpp"
@@ -53,6 +55,18 @@ int repl(const ReplOptions& options) {
   prompt.start();
   loop.run();  // ends through Session::finish: :quit, Ctrl-D, end of input, SIGTERM, pitwall.stop()
   return session.exitStatus(!prompt.interactive() && prompt.failures() > 0 ? 1 : 0);
+}
+
+Command addReplCommand(CLI::App& app) {
+  auto repl = std::make_shared<ReplOptions>();
+  auto* cmd = app.add_subcommand(
+      "repl", "A Lua prompt with the cars bound; the simulator runs behind it in real time");
+  addCarSource(cmd, *repl, "before the prompt opens");
+  addRemoteCars(cmd, *repl);
+  addView(cmd, repl->view);
+  cmd->add_option("--history", repl->history,
+                  "History file (default $PITWALL_HISTORY, else ~/.pitwall_history)");
+  return {cmd, [repl] { return cli::repl(*repl); }};
 }
 
 }  // namespace pitwall::cli

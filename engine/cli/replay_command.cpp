@@ -8,9 +8,11 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <nlohmann/json.hpp>
 
 #include "engine/cli/commands.hpp"
+#include "engine/cli/options.hpp"
 #include "engine/cli/session.hpp"
 #include "engine/core/log.hpp"
 #include "engine/vehicles/record_player.hpp"
@@ -238,6 +240,35 @@ int replay(const ReplayOptions& options) {
   if (session->interrupted()) return 130;
   printSummary(player, *feed, options.json);
   return 0;
+}
+
+Command addReplayCommand(CLI::App& app) {
+  auto replay = std::make_shared<ReplayOptions>();
+  auto* cmd = app.add_subcommand(
+      "replay",
+      "Play a --record file back through the codec and the car model: a summary per car, the "
+      "race view, or a script's handlers (docs/view.md)");
+  cmd->add_option("file", replay->file, "The record: JSON lines written by --record")->required();
+  cmd->add_flag("--summary", replay->summary,
+                "Print a table per car: laps, best and last lap, frames in and out, "
+                "malformed frames (the default without --view and --script)");
+  cmd->add_flag("--json", replay->json,
+                "The summary as one JSON object per car per line instead of the table");
+  auto* view = addView(cmd, replay->view);
+  cmd->add_option("--speed", replay->speed, "With --view: playback speed, 0.1..100 (default 1)")
+      ->check(CLI::Range(0.1, 100.0))
+      ->needs(view);
+  cmd->add_option("--track", replay->track,
+                  "With --view: the layout drawn, a name or a file (default: the record's own; "
+                  "oval for a record that keeps none)")
+      ->needs(view);
+  auto* script = cmd->add_option(
+      "--script", replay->script,
+      "Deliver the recorded events to this Lua script's handlers, in virtual time; its commands "
+      "are logged, not sent");
+  script->excludes(view);
+  cmd->add_option("--seed", replay->seed, "With --script: the seed of math.random")->needs(script);
+  return {cmd, [replay] { return cli::replay(*replay); }};
 }
 
 }  // namespace pitwall::cli

@@ -2,9 +2,11 @@
 // Bluetooth LE with --ble.
 #include <cstdio>
 #include <iostream>
+#include <memory>
 
 #include "bindings/results.hpp"
 #include "engine/cli/commands.hpp"
+#include "engine/cli/options.hpp"
 #include "engine/cli/repl.hpp"
 #include "engine/cli/session.hpp"
 #include "engine/core/log.hpp"
@@ -124,6 +126,40 @@ int run(const RunOptions& options) {
   repl.reset();
   if (capped) return session.exitStatus(kExitCapped);
   return session.exitStatus(session.host().mainFailed() ? 1 : 0);
+}
+
+Command addRunCommand(CLI::App& app) {
+  auto run = std::make_shared<RunOptions>();
+  auto* cmd =
+      app.add_subcommand("run", "Run a Lua script; by default against the built-in simulator");
+  cmd->add_option("script", run->script, "The Lua script to run")->required();
+  auto* fastFlag =
+      cmd->add_flag("--fast", run->fast, "Virtual time: the run goes as fast as the machine can");
+  auto* durationOption = cmd->add_option("--duration", run->duration,
+                                         "End the run after this many seconds of engine time")
+                             ->check(CLI::PositiveNumber);
+  cmd->add_option("--fast-cap", run->fastCap,
+                  "With --fast and no --duration: stop a script that has not ended the run after "
+                  "this many simulated seconds, exit status 124 (default 86400)")
+      ->check(CLI::PositiveNumber)
+      ->needs(fastFlag)
+      ->excludes(durationOption);
+  cmd->add_option("--record", run->record, "Write every frame in and out as JSON lines to FILE");
+  cmd->add_option("--results", run->results,
+                  "Where the race library writes the results: FILE.json or FILE.csv");
+  // Real cars run in real time.
+  addCarSource(cmd, *run, "before the script starts")->excludes(fastFlag);
+  // a broker lives in real time
+  addRemoteCars(cmd, *run)->excludes(fastFlag);
+  addView(cmd, run->view);
+  auto* replFlag = cmd->add_flag("--repl", run->repl,
+                                 "Open a Lua prompt beside the script, in the same Lua world");
+  cmd->add_flag("--watch", run->watch,
+                "Reload the script when one of its files is saved (docs/hot-reload.md)");
+  cmd->add_option("--history", run->history, "With --repl: the history file")->needs(replFlag);
+  // A prompt needs the real clock: virtual time would race ahead while the operator types.
+  replFlag->excludes(fastFlag);
+  return {cmd, [run] { return cli::run(*run); }};
 }
 
 }  // namespace pitwall::cli

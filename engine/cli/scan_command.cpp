@@ -4,10 +4,12 @@
 #include <cstdio>
 #include <iomanip>
 #include <iostream>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "engine/cli/commands.hpp"
+#include "engine/cli/options.hpp"
 #include "engine/core/log.hpp"
 #include "engine/vehicles/ble_central.hpp"
 
@@ -150,6 +152,16 @@ int scan(const ScanOptions& options) {
     printTable(rows);
   }
   return 0;
+}
+
+Command addScanCommand(CLI::App& app) {
+  auto scan = std::make_shared<ScanOptions>();
+  auto* cmd = app.add_subcommand("scan", "List the Anki cars in Bluetooth range");
+  cmd->add_option("--timeout", scan->timeout, "Seconds to listen (default 5)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_flag("--json", scan->json, "JSON lines instead of a table");
+  cmd->add_option("--adapter", scan->adapters, "Use this controller, hci0, … (repeatable)");
+  return {cmd, [scan] { return cli::scan(*scan); }};
 }
 
 }  // namespace pitwall::cli

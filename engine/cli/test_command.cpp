@@ -4,10 +4,12 @@
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 
 #include "bindings/interrupt.hpp"
 #include "bindings/sandbox.hpp"
 #include "engine/cli/commands.hpp"
+#include "engine/cli/options.hpp"
 #include "engine/cli/session.hpp"
 #include "engine/core/log.hpp"
 
@@ -112,6 +114,27 @@ int test(const TestOptions& options) {
   }
   std::cout << passed << " passed, " << failed << " failed\n";
   return failed ? 1 : 0;
+}
+
+Command addTestCommand(CLI::App& app) {
+  auto test = std::make_shared<TestOptions>();
+  auto* cmd = app.add_subcommand("test", "Run scenario test scripts in virtual time");
+  cmd->add_option("paths", test->paths, "Scenario files, or folders of *_test.lua files");
+  cmd->add_option("--seed", test->seed, "Seed of the simulator's and the scripts' randomness");
+  cmd->add_option("--timeout", test->timeout, "Virtual seconds a scenario may run (default 600)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--budget", test->budget,
+                  "Seconds a callback may run before it is interrupted (default 0.1; 0: no limit)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--lua-memory", test->luaMemory,
+                  "MB of memory a scenario's Lua world may hold (default 512; 0: no limit)")
+      ->check(CLI::Range(0, 1 << 20));
+  return {cmd,
+          [test] {
+            if (test->paths.empty()) test->paths.push_back("tests/scenarios");
+            return cli::test(*test);
+          },
+          /*quiet=*/true};
 }
 
 }  // namespace pitwall::cli

@@ -4,8 +4,10 @@
 #include <cstring>
 #include <fstream>
 #include <iostream>
+#include <memory>
 
 #include "engine/cli/commands.hpp"
+#include "engine/cli/options.hpp"
 #include "engine/sim/track.hpp"
 #include "engine/view/geometry.hpp"
 
@@ -35,6 +37,18 @@ int trackShow(const TrackShowOptions& options) {
   }
   std::cerr << "wrote " << options.svg << "\n";
   return 0;
+}
+
+Command addTrackCommand(CLI::App& app) {
+  auto show = std::make_shared<TrackShowOptions>();
+  auto* track = app.add_subcommand("track", "Track layouts");
+  track->require_subcommand(1);
+  auto* cmd = track->add_subcommand(
+      "show", "Describe a layout and draw it as the race view does: pitwall track show oval");
+  cmd->add_option("layout", show->layout, "A layout name (oval, kidney, long) or a layout file")
+      ->required();
+  cmd->add_option("--svg", show->svg, "Write the drawing as SVG to OUT (- : stdout)");
+  return {cmd, [show] { return cli::trackShow(*show); }};
 }
 
 }  // namespace pitwall::cli

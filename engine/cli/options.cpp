@@ -1,0 +1,94 @@
+#include "engine/cli/options.hpp"
+
+#include <list>
+
+namespace pitwall::cli {
+
+CLI::Option* addCarSource(CLI::App* cmd, CarSource& source, const char* when) {
+  cmd->add_option("--seed", source.seed, "Seed of the simulator's and the script's randomness");
+  auto* cars =
+      cmd->add_option("--cars", source.cars, "Number of simulated cars on the grid (default 4)")
+          ->check(CLI::Range(0, 64));
+  auto* track =
+      cmd->add_option("--track", source.track, "Track layout: a name (oval, …) or a layout file");
+  auto* ble = cmd->add_flag("--ble", source.ble,
+                            "Drive real cars over Bluetooth LE (BlueZ) instead of the simulator");
+  ble->excludes(cars)->excludes(track);  // real cars are on a real track
+  cmd->add_option("--car", source.carAddresses, "With --ble: only this car (repeatable)")
+      ->needs(ble);
+  cmd->add_option("--adapter", source.adapters,
+                  "With --ble: use this controller, hci0, … (repeatable; default: all)")
+      ->needs(ble);
+  cmd->add_option("--scan-timeout", source.scanTimeout,
+                  std::string("With --ble: seconds to look for cars ") + when + " (default 5)")
+      ->check(CLI::PositiveNumber)
+      ->needs(ble);
+  cmd->add_option("--budget", source.budget,
+                  "Seconds a callback may run before it is interrupted (default 0.1; 0: no limit)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--lua-memory", source.luaMemory,
+                  "MB of memory the script's Lua world may hold (default 512; 0: no limit)")
+      ->check(CLI::Range(0, 1 << 20));
+  return ble;
+}
+
+CLI::Option* addMqtt(CLI::App* cmd, MqttSettings& mqtt, double& timeout, const char* what) {
+  auto* url = cmd->add_option(
+      "--mqtt", mqtt.url,
+      std::string("MQTT broker, mqtt://HOST[:PORT] or mqtts://HOST[:PORT]: ") + what);
+  cmd->add_option("--mqtt-user", mqtt.user, "Username for the broker")->needs(url);
+  cmd->add_option("--mqtt-password-file", mqtt.passwordFile,
+                  "File whose first line is the password (default: $PITWALL_MQTT_PASSWORD)")
+      ->needs(url);
+  cmd->add_option("--mqtt-ca", mqtt.caFile,
+                  "With mqtts://: the CA certificate (PEM) that signed the broker's")
+      ->needs(url);
+  cmd->add_option("--mqtt-client-id", mqtt.clientId, "MQTT client id (default: a random one)")
+      ->needs(url);
+  cmd->add_option("--mqtt-max-payload", mqtt.maxPayload,
+                  "Refuse a payload from the broker larger than this many bytes, unread "
+                  "(default 65536)")
+      ->check(CLI::Range(std::size_t{1}, std::size_t{256} * 1024 * 1024))
+      ->needs(url);
+  cmd->add_option("--mqtt-timeout", timeout,
+                  "Seconds to wait for the broker (and --remote-cars) at start (default 5)")
+      ->check(CLI::PositiveNumber)
+      ->needs(url);
+  return url;
+}
+
+CLI::Option* addRemoteCars(CLI::App* cmd, CarSource& source) {
+  auto* url = addMqtt(cmd, source.mqtt, source.mqttTimeout,
+                      "the cars that bridges on other hosts publish join as remote cars");
+  cmd->add_option("--remote-cars", source.remoteCars,
+                  "With --mqtt: wait until this many remote cars are online (default 0)")
+      ->check(CLI::Range(0, 64))
+      ->needs(url);
+  return url;
+}
+
+namespace {
+struct ViewOption {
+  CLI::Option* option = nullptr;
+  std::string value;
+  std::optional<std::string>* target = nullptr;
+};
+std::list<ViewOption> g_views;  // a list: the options keep pointers to the values
+}  // namespace
+
+CLI::Option* addView(CLI::App* cmd, std::optional<std::string>& target) {
+  auto& v = g_views.emplace_back();
+  v.target = &target;
+  v.option = cmd->add_option("--view", v.value,
+                             "Serve the race view in a browser on [HOST:]PORT (default "
+                             "127.0.0.1:8080; PORT 0: any free port) — docs/view.md")
+                 ->expected(0, 1);
+  return v.option;
+}
+
+void takeViews() {
+  for (auto& v : g_views)
+    if (v.option->count() > 0) *v.target = v.value;
+}
+
+}  // namespace pitwall::cli
