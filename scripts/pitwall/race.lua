@@ -592,35 +592,25 @@ function Race:_race()
   return self
 end
 
---- Runs the session to its end inside a task; returns the session. A session that a reload of
---- the script interrupted is taken up where it was by the same call in the new version.
-function Race:run()
-  if not coroutine.isyieldable() then
-    error("race: a session drives and waits: run it inside a task (the main chunk or "
-      .. "pitwall.spawn), not in a handler", 2)
-  end
-  local o = self.options
-  self.lastKind = lastKind
-  runs = runs + 1
-  local index = runs
-  listenKinds(self.cars)
-  local h = headless[index]
-  if h then
-    headless[index] = nil
-    return h:_attach(self)
-  end
-  sessions[index] = self
+-- The session a reload interrupted at this call's place (the index-th run() of the version),
+-- taken up where it was; true when it had already ended.
+function Race:_takeUpCarried(index)
   local c = carried.sessions[index]
   if type(c) ~= "table" or type(c.order) ~= "table" or type(c.entries) ~= "table" then c = nil end
   carried.sessions[index] = nil
-  if c then
-    self:_takeUp(c)
-    if self.phase == "done" then return self end
-    pitwall.log("info", string.format("race: %s taken up by the new version (%s)", self.title,
-      PHASES[self.phase] or self.phase))
-  end
+  if not c then return false end
+  self:_takeUp(c)
+  if self.phase == "done" then return true end
+  pitwall.log("info", string.format("race: %s taken up by the new version (%s)", self.title,
+    PHASES[self.phase] or self.phase))
+  return false
+end
+
+-- What a session needs before the grid: the track's map and the entries (a new session), or the
+-- trackers adopted (one taken up); the view told; the drivers made.
+function Race:_prepare()
   self.phase = self.phase or "new"
-  self.penalty = o.falseStartPenalty or self.penalty or 5
+  self.penalty = self.options.falseStartPenalty or self.penalty or 5
   if self.phase == "new" then
     self.scanning = nil -- (a scan a reload cut short starts again, or is not needed)
     self.map = self:_map()
@@ -635,6 +625,12 @@ function Race:run()
     self:_viewMap()
   end
   self:_drivers()
+end
+
+-- From the grid to the green light: the cars to their places, the lap timers, the board, the
+-- lights (each skipped when the session is already past it).
+function Race:_startSession()
+  local o = self.options
   if self.phase == "grid" then
     if self.mode ~= "practice" then self:_toGrid() end
     self:_timing(false)
@@ -654,6 +650,28 @@ function Race:run()
     self.phase = "racing"
     self:_tick()
   end
+end
+
+--- Runs the session to its end inside a task; returns the session. A session that a reload of
+--- the script interrupted is taken up where it was by the same call in the new version.
+function Race:run()
+  if not coroutine.isyieldable() then
+    error("race: a session drives and waits: run it inside a task (the main chunk or "
+      .. "pitwall.spawn), not in a handler", 2)
+  end
+  self.lastKind = lastKind
+  runs = runs + 1
+  local index = runs
+  listenKinds(self.cars)
+  local h = headless[index]
+  if h then
+    headless[index] = nil
+    return h:_attach(self)
+  end
+  sessions[index] = self
+  if self:_takeUpCarried(index) then return self end
+  self:_prepare()
+  self:_startSession()
   return self:_race()
 end
 
