@@ -138,8 +138,7 @@ int lights(lua_State* L) {
     return 0;
   }
   auto mask = lua::checkInteger(L, 2, "lights mask");
-  if (mask < 0 || mask > 255)
-    throw LuaError("lights mask " + std::to_string(mask) + " is out of range 0..255");
+  if (auto e = checkRange("lights mask", static_cast<double>(mask), 0, 255)) throw LuaError(*e);
   raiseIfRefused(car.lights(static_cast<int>(mask)));
   return 0;
 }
@@ -157,9 +156,8 @@ int nameOrNumber(lua_State* L, int idx, const char* what, std::initializer_list<
     throw LuaError(std::string(what) + " '" + s + "' is unknown; use one of " + all);
   }
   auto v = lua::checkInteger(L, idx, what);
-  if (v < 0 || v > max)
-    throw LuaError(std::string(what) + " " + std::to_string(v) + " is out of range 0.." +
-                   std::to_string(max));
+  if (auto e = checkRange(what, static_cast<double>(v), 0, static_cast<double>(max)))
+    throw LuaError(*e);
   return static_cast<int>(v);
 }
 int lightsPattern(lua_State* L) {

@@ -12,17 +12,17 @@
 #include <string>
 #include <string_view>
 
+#include "engine/core/numbers.hpp"
+
 namespace pitwall::lua {
 
 struct LuaError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// A number as a script wrote it: 600, -23.5, 0.25 (not 600.000000).
+// A number as a script wrote it: 600, -23.5, 0.25 (not 600.000000): engine/core/numbers.hpp.
 inline std::string show(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.10g", v);
-  return buf;
+  return formatNumber(v);
 }
 
 template <int (*Body)(lua_State*)>
@@ -55,6 +55,14 @@ inline double checkNumber(lua_State* L, int idx, const char* what) {
   if (!isnum) throw LuaError(std::string(what) + " must be a number, got " + typeName(L, idx));
   if (!std::isfinite(v)) throw LuaError(std::string(what) + " must be a finite number");
   return v;
+}
+
+// Raises engine/core/numbers.hpp's sentence when v is outside lo..hi; `why` (the range's reason)
+// follows in parentheses.
+inline void requireRange(std::string_view what, double v, double lo, double hi,
+                         std::string_view unit = {}, std::string_view why = {}) {
+  if (auto e = checkRange(what, v, lo, hi, unit))
+    throw LuaError(why.empty() ? *e : *e + " (" + std::string(why) + ")");
 }
 
 inline double optNumber(lua_State* L, int idx, const char* what, double fallback) {

@@ -1,5 +1,7 @@
 #include "bindings/results.hpp"
 
+#include "engine/core/numbers.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -23,9 +25,7 @@ bool whole(double v) {
 
 std::string number(double v) {
   if (whole(v)) return std::to_string(static_cast<long long>(v));
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
+  return formatNumber(v, 6);
 }
 
 std::string csvField(const std::string& s) {

@@ -42,8 +42,7 @@ std::uint8_t modelFromLua(lua_State* L, int idx) {
     throw LuaError("model '" + want + "' is unknown (try groundshock, skull, thermo, nuke, …)");
   }
   auto id = lua::checkInteger(L, idx, "model");
-  if (id < 0 || id > 255)
-    throw LuaError("model id " + std::to_string(id) + " is out of range 0..255");
+  lua::requireRange("model id", static_cast<double>(id), 0, 255);
   return static_cast<std::uint8_t>(id);
 }
 
@@ -125,9 +124,8 @@ int addCar(lua_State* L) {
   lua_pop(L, 1);
   if (lua_getfield(L, 1, "piece") != LUA_TNIL) {
     auto piece = lua::checkInteger(L, -1, "piece (index into the track, from 1)");
-    if (piece < 1 || piece > static_cast<long long>(track.size()))
-      throw LuaError("piece " + std::to_string(piece) + " is out of range 1.." +
-                     std::to_string(track.size()) + " (an index into the track's pieces)");
+    lua::requireRange("piece", static_cast<double>(piece), 1, static_cast<double>(track.size()), {},
+                      "an index into the track's pieces");
     spec.piece_index = static_cast<std::size_t>(piece - 1);
     spec.distance_mm = 0;
   }
@@ -142,8 +140,7 @@ int addCar(lua_State* L) {
   lua_pop(L, 1);
   if (lua_getfield(L, 1, "lane") != LUA_TNIL) {
     auto lane = lua::checkInteger(L, -1, "lane");
-    if (lane < 1 || lane > 4)
-      throw LuaError("lane " + std::to_string(lane) + " is out of range 1..4 (1 is leftmost)");
+    lua::requireRange("lane", static_cast<double>(lane), 1, 4, {}, "1 is leftmost");
     spec.offset_mm = sim::kLaneOffsets[lane - 1];
   }
   lua_pop(L, 1);
@@ -154,15 +151,13 @@ int addCar(lua_State* L) {
   lua_pop(L, 1);
   if (lua_getfield(L, 1, "battery") != LUA_TNIL) {
     auto mv = lua::checkInteger(L, -1, "battery (mV)");
-    if (mv < 3000 || mv > 4300)
-      throw LuaError("battery " + std::to_string(mv) + " mV is out of range 3000..4300 mV");
+    lua::requireRange("battery", static_cast<double>(mv), 3000, 4300, "mV");
     spec.battery_mv = static_cast<std::uint16_t>(mv);
   }
   lua_pop(L, 1);
   if (lua_getfield(L, 1, "version") != LUA_TNIL) {
     auto v = lua::checkInteger(L, -1, "version");
-    if (v < 0 || v > 0xffff)
-      throw LuaError("version " + std::to_string(v) + " is out of range 0..0xffff");
+    lua::requireRange("version", static_cast<double>(v), 0, 0xffff);
     spec.version = static_cast<std::uint16_t>(v);
   }
   lua_pop(L, 1);
@@ -213,9 +208,7 @@ int place(lua_State* L) {
   sim::SimCar& car = simCarOf(L, 1);
   const sim::Track& track = session(L).world->track();
   auto piece = lua::checkInteger(L, 2, "piece (index into the track, from 1)");
-  if (piece < 1 || piece > static_cast<long long>(track.size()))
-    throw LuaError("piece " + std::to_string(piece) + " is out of range 1.." +
-                   std::to_string(track.size()));
+  lua::requireRange("piece", static_cast<double>(piece), 1, static_cast<double>(track.size()));
   double offset = lua::optNumber(L, 3, "offset (mm)", 0);
   checkOnRoad(offset);
   car.place(static_cast<std::size_t>(piece - 1), offset);
@@ -230,9 +223,7 @@ int noise(lua_State* L) {
     auto prob = [L](const char* key, double& out) {
       if (lua_getfield(L, 1, key) != LUA_TNIL) {
         double v = lua::checkNumber(L, -1, key);
-        if (v < 0 || v > 1)
-          throw LuaError(std::string("noise ") + key + " " + lua::show(v) +
-                         " is out of range 0..1 (a probability)");
+        lua::requireRange(std::string("noise ") + key, v, 0, 1, {}, "a probability");
         out = v;
       }
       lua_pop(L, 1);
@@ -241,8 +232,7 @@ int noise(lua_State* L) {
     prob("late", n.late);
     if (lua_getfield(L, 1, "lateBy") != LUA_TNIL) {
       double v = lua::checkNumber(L, -1, "lateBy (s)");
-      if (v < 0 || v > 10)
-        throw LuaError("noise lateBy " + lua::show(v) + " s is out of range 0..10 s");
+      lua::requireRange("noise lateBy", v, 0, 10, "s");
       n.late_by = fromSeconds(v);
     }
     lua_pop(L, 1);

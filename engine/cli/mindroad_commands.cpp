@@ -11,6 +11,7 @@
 #include "engine/core/hex.hpp"
 #include "engine/core/log.hpp"
 #include "engine/core/loop.hpp"
+#include "engine/core/numbers.hpp"
 #include "engine/protocol/mindroad/codec.hpp"
 #include "engine/protocol/mindroad/command_text.hpp"
 #include "engine/protocol/mindroad/message_json.hpp"
@@ -50,9 +51,7 @@ namespace {
 constexpr const char* kComponent = "sim-robot";
 
 std::string showNumber(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
+  return formatNumber(v, 6);
 }
 
 // "127.0.0.1:4000" → host, port; the port may be 0 (any free one).

@@ -10,6 +10,7 @@
 #include "engine/cli/repl.hpp"
 #include "engine/cli/session.hpp"
 #include "engine/core/log.hpp"
+#include "engine/core/numbers.hpp"
 
 namespace pitwall::cli {
 
@@ -21,11 +22,8 @@ constexpr double kFastCap = 24 * 3600;
 
 namespace {
 std::string simulatedTime(double seconds) {
-  char text[64];
-  if (seconds >= 3600)
-    std::snprintf(text, sizeof text, "%g s (%g h)", seconds, seconds / 3600);
-  else
-    std::snprintf(text, sizeof text, "%g s", seconds);
+  std::string text = formatNumber(seconds, 6) + " s";
+  if (seconds >= 3600) text += " (" + formatNumber(seconds / 3600, 6) + " h)";
   return text;
 }
 }  // namespace

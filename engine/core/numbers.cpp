@@ -5,14 +5,14 @@
 
 namespace pitwall {
 
-std::string formatNumber(double v) {
+std::string formatNumber(double v, int digits) {
   if (std::isnan(v)) return "nan";
   if (std::isinf(v)) return v < 0 ? "-inf" : "inf";
   char buf[32];
   if (v == std::trunc(v) && std::fabs(v) < 9007199254740992.0)
     std::snprintf(buf, sizeof buf, "%.0f", v == 0 ? 0.0 : v);  // no "-0"
   else
-    std::snprintf(buf, sizeof buf, "%.10g", v);
+    std::snprintf(buf, sizeof buf, "%.*g", digits, v);
   return buf;
 }
 

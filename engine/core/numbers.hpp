@@ -9,8 +9,9 @@
 namespace pitwall {
 
 // A number as a script or a person writes it: 600, -23.5, 0.25, 1e+20, nan, inf (not
-// 600.000000). Whole numbers below 2^53 print in full; others with up to 10 significant digits.
-std::string formatNumber(double v);
+// 600.000000). Whole numbers below 2^53 print in full; others with up to `digits` significant
+// digits (10: what a script wrote; 6: a figure in a table or a summary).
+std::string formatNumber(double v, int digits = 10);
 
 // "<what> <value>[ unit] is out of range <lo>..<hi>[ unit]". `value` is the text as given (so a
 // huge or unparsed value is quoted as it came); the doubles' forms format it.

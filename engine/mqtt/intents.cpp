@@ -10,6 +10,7 @@
 
 #include "engine/core/hex.hpp"
 #include "engine/core/overload.hpp"
+#include "engine/core/numbers.hpp"
 #include "engine/mqtt/payload.hpp"
 #include "engine/mqtt/topics.hpp"
 #include "engine/protocol/anki/codec.hpp"
@@ -62,10 +63,7 @@ Result<int, std::string> integer(const In& j, const char* key, int lo, int hi,
     return Unexpected{std::string("\"") + key + "\" must be an integer, not " + typeName(v) + " (" +
                       excerpt(v) + ")"};
   double d = v.get<double>();
-  std::string u = unit.empty() ? "" : " " + std::string(unit);
-  if (d < lo || d > hi)
-    return Unexpected{std::string(key) + " " + v.dump() + u + " is out of range " +
-                      std::to_string(lo) + ".." + std::to_string(hi) + u};
+  if (d < lo || d > hi) return Unexpected{outOfRange(key, v.dump(), lo, hi, unit)};
   return static_cast<int>(d);
 }
 
@@ -101,10 +99,7 @@ Result<int, std::string> looseInteger(const In& v, std::string_view key, int lo,
   auto d = looseNumber(v, key);
   if (!d) return Unexpected{d.error()};
   double r = std::round(*d);
-  std::string u = unit.empty() ? "" : " " + std::string(unit);
-  if (!(r >= lo && r <= hi))
-    return Unexpected{std::string(key) + " " + excerpt(v) + u + " is out of range " +
-                      std::to_string(lo) + ".." + std::to_string(hi) + u};
+  if (!(r >= lo && r <= hi)) return Unexpected{outOfRange(key, excerpt(v), lo, hi, unit)};
   return static_cast<int>(r);
 }
 
@@ -113,10 +108,8 @@ Result<double, std::string> offsetValue(const In& v, std::string_view key) {
   auto d = looseNumber(v, key);
   if (!d) return Unexpected{d.error()};
   if (!(*d >= L::kOffsetMin && *d <= L::kOffsetMax))
-    return Unexpected{std::string(key) + " " + excerpt(v) + " mm is out of range " +
-                      std::to_string(static_cast<int>(L::kOffsetMin)) + ".." +
-                      std::to_string(static_cast<int>(L::kOffsetMax)) +
-                      " mm (beyond it the car leaves the road)"};
+    return Unexpected{outOfRange(key, excerpt(v), L::kOffsetMin, L::kOffsetMax, "mm") +
+                      " (beyond it the car leaves the road)"};
   return *d;
 }
 

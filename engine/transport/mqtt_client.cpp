@@ -1,5 +1,7 @@
 #include "engine/transport/mqtt_client.hpp"
 
+#include "engine/core/numbers.hpp"
+
 #include <netinet/in.h>
 #include <netinet/tcp.h>
 #include <sys/socket.h>
@@ -34,8 +36,7 @@ void initLibrary() {
 
 void checkQos(int qos, std::string_view what) {
   if (qos < 0 || qos > 2)
-    throw std::invalid_argument(std::string(what) + ": QoS " + std::to_string(qos) +
-                                " is out of range (0, 1 or 2)");
+    throw std::invalid_argument(std::string(what) + ": " + outOfRange("QoS", qos, 0, 2));
 }
 
 void checkPublishTopic(std::string_view topic, std::string_view what) {
@@ -120,11 +121,10 @@ MqttClient::MqttClient(Loop& loop, MqttOptions options)
     throw std::invalid_argument("the MQTT client needs a loop on the real clock");
   if (o.host.empty()) throw std::invalid_argument("MQTT: no broker host given");
   if (o.port < 1 || o.port > 65535)
-    throw std::invalid_argument("MQTT: port " + std::to_string(o.port) +
-                                " is out of range (1 to 65535)");
+    throw std::invalid_argument("MQTT: " + outOfRange("port", o.port, 1, 65535));
   if (o.keepaliveSeconds < 5 || o.keepaliveSeconds > 65535)
-    throw std::invalid_argument("MQTT: keepalive " + std::to_string(o.keepaliveSeconds) +
-                                " s is out of range (5 to 65535 s)");
+    throw std::invalid_argument("MQTT: " +
+                                outOfRange("keepalive", o.keepaliveSeconds, 5, 65535, "s"));
   if (o.clientId.size() > 65535) throw std::invalid_argument("MQTT: the client id is too long");
   if (o.username.empty() && !o.password.empty())
     throw std::invalid_argument("MQTT: a password was given without a username");

@@ -4,24 +4,13 @@
 
 #include "engine/core/hex.hpp"
 #include "engine/core/log.hpp"
+#include "engine/core/numbers.hpp"
 #include "engine/protocol/anki/advertisement.hpp"
 #include "engine/protocol/anki/limits.hpp"
 
 namespace pitwall {
 
 using namespace anki;
-
-namespace {
-// Does a number fit the field it is narrowed to? Checked before validate() sees the message so
-// that 70000 is reported as 70000, not as what it wraps to.
-std::optional<std::string> outOfField(const char* what, long long v, const char* unit, int lo,
-                                      int hi) {
-  if (v < lo || v > hi)
-    return std::string(what) + " " + std::to_string(v) + " " + unit + " is out of range " +
-           std::to_string(lo) + ".." + std::to_string(hi) + " " + unit;
-  return std::nullopt;
-}
-}  // namespace
 
 AnkiCar::AnkiCar(Loop& loop, Link& link, CarIdentity identity)
     : loop_(loop), link_(link), identity_(std::move(identity)) {
@@ -56,9 +45,9 @@ AnkiCar::Sent AnkiCar::send(const Message& message) {
 }
 
 AnkiCar::Sent AnkiCar::setSpeed(int speed, int accel, bool respect_limit) {
-  if (auto e = outOfField("speed", speed, "mm/s", limits::kSpeedMin, limits::kSpeedMax))
+  if (auto e = checkRange("speed", speed, limits::kSpeedMin, limits::kSpeedMax, "mm/s"))
     return Unexpected{*e};
-  if (auto e = outOfField("acceleration", accel, "mm/s²", limits::kAccelMin, limits::kAccelMax))
+  if (auto e = checkRange("acceleration", accel, limits::kAccelMin, limits::kAccelMax, "mm/s²"))
     return Unexpected{*e};
   auto sent =
       send(SetSpeed{static_cast<int16_t>(speed), static_cast<int16_t>(accel), respect_limit});
@@ -78,11 +67,11 @@ AnkiCar::Sent AnkiCar::halt() {
 }
 
 AnkiCar::Sent AnkiCar::changeLane(double offset, int h_speed, int h_accel) {
-  if (auto e = outOfField("lane-change speed", h_speed, "mm/s", limits::kLaneSpeedMin,
-                          limits::kLaneSpeedMax))
+  if (auto e = checkRange("lane-change speed", h_speed, limits::kLaneSpeedMin,
+                          limits::kLaneSpeedMax, "mm/s"))
     return Unexpected{*e};
-  if (auto e = outOfField("lane-change acceleration", h_accel, "mm/s²", limits::kLaneAccelMin,
-                          limits::kLaneAccelMax))
+  if (auto e = checkRange("lane-change acceleration", h_accel, limits::kLaneAccelMin,
+                          limits::kLaneAccelMax, "mm/s²"))
     return Unexpected{*e};
   auto sent = send(ChangeLane{static_cast<uint16_t>(h_speed), static_cast<uint16_t>(h_accel),
                               static_cast<float>(offset), 0, 0});
@@ -107,7 +96,7 @@ AnkiCar::Sent AnkiCar::turn(TurnType type, TurnTrigger trigger) {
 }
 
 AnkiCar::Sent AnkiCar::lights(int mask) {
-  if (auto e = outOfField("lights mask", mask, "", 0, 255)) return Unexpected{*e};
+  if (auto e = checkRange("lights mask", mask, 0, 255)) return Unexpected{*e};
   return send(SetLights{static_cast<uint8_t>(mask)});
 }
 

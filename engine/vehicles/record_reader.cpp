@@ -1,5 +1,7 @@
 #include "engine/vehicles/record_reader.hpp"
 
+#include "engine/core/numbers.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -119,7 +121,7 @@ std::variant<RecordedFrame, std::string> parseRecordLine(std::string_view line, 
   if (!t->is_number()) return "\"t\" is not a number: " + shown(*t);
   frame.t = t->get<double>();
   if (!std::isfinite(frame.t) || frame.t < 0 || frame.t > kMaxRecordedTime)
-    return "\"t\" " + shown(*t) + " is out of range 0..1e7 seconds";
+    return outOfRange("\"t\"", shown(*t), 0, kMaxRecordedTime, "seconds");
   if (frame.t < lastTime - kBackwardsSlack)
     return "\"t\" " + shown(*t) + " goes back in time (the frame before was at " +
            shown(json(lastTime)) + ")";

@@ -3,6 +3,8 @@
 // goes through limits::validate like any other command from the edge.
 #include "engine/protocol/anki/command_text.hpp"
 
+#include "engine/core/numbers.hpp"
+
 #include <charconv>
 #include <cmath>
 #include <optional>
@@ -46,8 +48,7 @@ class Words {
     if (!value) {
       fail(quoted(what, *word) + " is not a whole number; expected " + range(min, max, unit));
     } else if (*value < min || *value > max) {
-      fail(std::string(what) + " " + withUnit(std::string(*word), unit) + " is out of range " +
-           range(min, max, unit));
+      fail(outOfRange(what, *word, static_cast<double>(min), static_cast<double>(max), unit));
     } else {
       return static_cast<T>(*value);
     }
@@ -61,11 +62,11 @@ class Words {
     if (!word) return 0;
     double value = 0;
     const auto [end, ec] = std::from_chars(word->data(), word->data() + word->size(), value);
-    const std::string expected = number(min) + ".." + number(max) + " mm";
+    const std::string expected = formatNumber(min) + ".." + formatNumber(max) + " mm";
     if (word->empty() || end != word->data() + word->size() || ec == std::errc::invalid_argument) {
       fail(quoted(what, *word) + " is not a number; expected " + expected);
     } else if (ec != std::errc{} || !(value >= min && value <= max)) {
-      fail(std::string(what) + " " + std::string(*word) + " mm is out of range " + expected +
+      fail(outOfRange(what, *word, min, max, "mm") +
            (why.empty() ? std::string() : " (" + std::string(why) + ")"));
     } else {
       return static_cast<float>(value);
@@ -122,10 +123,6 @@ class Words {
     return negative ? -v : v;
   }
 
-  static std::string number(double v) {
-    char buf[32];
-    return {buf, std::to_chars(buf, buf + sizeof buf, v).ptr};
-  }
   static std::string withUnit(std::string text, string_view unit) {
     if (!unit.empty()) (text += ' ') += unit;
     return text;
@@ -158,7 +155,8 @@ Message setSpeed(Words& w) {
   m.speed_mm_s = w.integer<std::int16_t>("speed", limits::kSpeedMin, limits::kSpeedMax, "mm/s");
   m.accel_mm_s2 = 1000;
   if (w.more() && !w.nextIs("respect-limit")) {
-    m.accel_mm_s2 = w.integer<std::int16_t>("accel", limits::kAccelMin, limits::kAccelMax, "mm/s²");
+    m.accel_mm_s2 =
+        w.integer<std::int16_t>("acceleration", limits::kAccelMin, limits::kAccelMax, "mm/s²");
   }
   if (w.nextIs("respect-limit")) {
     m.respect_limit = true;
@@ -174,7 +172,7 @@ Message changeLane(Words& w) {
   ChangeLane m;
   m.h_speed_mm_s = w.integer<std::uint16_t>("lane-change speed", limits::kLaneSpeedMin,
                                             limits::kLaneSpeedMax, "mm/s");
-  m.h_accel_mm_s2 = w.integer<std::uint16_t>("lane-change accel", limits::kLaneAccelMin,
+  m.h_accel_mm_s2 = w.integer<std::uint16_t>("lane-change acceleration", limits::kLaneAccelMin,
                                              limits::kLaneAccelMax, "mm/s²");
   m.offset_mm = w.millimetres("offset", limits::kOffsetMin, limits::kOffsetMax, kOffRoad);
   if (w.more()) {  // HOP and TAG come together

@@ -15,6 +15,7 @@ TEST_CASE("formatNumber writes numbers as people write them") {
   CHECK(formatNumber(0.1 + 0.2) == "0.3");
   CHECK(formatNumber(70000000000.0) == "70000000000");
   CHECK(formatNumber(1e300) == "1e+300");
+  CHECK(formatNumber(12.3456789, 6) == "12.3457");
   CHECK(formatNumber(std::nan("")) == "nan");
   CHECK(formatNumber(-std::numeric_limits<double>::infinity()) == "-inf");
 }

@@ -38,7 +38,7 @@ TEST_CASE("a speed out of range is refused with field, value and range") {
         "speed 2000 mm/s is out of range 0..1500 mm/s");
   CHECK(refusal(SetSpeed{.speed_mm_s = -1}) == "speed -1 mm/s is out of range 0..1500 mm/s");
   CHECK(refusal(SetSpeed{.speed_mm_s = 500, .accel_mm_s2 = 30000}) ==
-        "accel 30000 mm/s² is out of range 0..25000 mm/s²");
+        "acceleration 30000 mm/s² is out of range 0..25000 mm/s²");
 }
 
 TEST_CASE("a lane change out of range is refused") {
