@@ -11,7 +11,7 @@
 #include <string>
 #include <string_view>
 
-#include "bindings/lua_support.hpp"
+#include "bindings/lua_object.hpp"
 #include "bindings/pitwall_module.hpp"
 #include "bindings/script_host.hpp"
 #include "engine/core/log.hpp"
@@ -515,8 +515,9 @@ void registerType(lua_State* L) {
                                      {"clearObstacles", lua::guarded<clearObstacles>},
                                      {"close", lua::guarded<close>},
                                      {nullptr, nullptr}};
+  static const lua::EventNames events(kEventNames);
   lua::registerObjectType(
-      L, {kMetatable, "alphabot", methods, kFieldNames, kEventNames, lua::guarded<index>,
+      L, {kMetatable, "alphabot", methods, kFieldNames, events, lua::guarded<index>,
           lua::guarded<newindex>, lua::guarded<tostring>, gc});
 }
 

@@ -10,7 +10,7 @@
 #include <string>
 #include <string_view>
 
-#include "bindings/lua_support.hpp"
+#include "bindings/lua_object.hpp"
 #include "bindings/script_host.hpp"
 #include "engine/core/hex.hpp"
 #include "engine/core/log.hpp"
@@ -27,16 +27,20 @@ namespace {
 constexpr const char* kMetatable = "pitwall.car";
 
 constexpr std::array<const char*, kCarEventCount> kEventNames = {
-    "onPosition", "onTransition", "onIntersection", "onDelocalized", "onOffset", "onBattery",
-    "onVersion",  "onPing",       "onStatus",       "onCollision",   "onSpeed",  "onLaneChange",
-    "onRecovery", "onConnect",    "onDisconnect",   "onMalformed",   "onMessage"};
+#define PITWALL_CAR_EVENT_NAME(name) "on" #name,
+    PITWALL_CAR_EVENTS(PITWALL_CAR_EVENT_NAME)
+#undef PITWALL_CAR_EVENT_NAME
+};
 
-int eventIndex(std::string_view key) {
-  for (std::size_t i = 0; i < kEventNames.size(); ++i)
-    if (key == kEventNames[i]) return static_cast<int>(i);
-  return -1;
+}  // namespace
+
+const lua::EventNames& carEvents() {
+  static const lua::EventNames names(kEventNames);
+  return names;
 }
 
+namespace {
+const lua::ObjectType& carType();
 }  // namespace
 
 namespace {
@@ -323,24 +327,7 @@ int index(lua_State* L) {
 }
 
 int newindex(lua_State* L) {
-  // 1: car, 2: key, 3: value
-  auto& p = proxyAt(L, 1);
-  if (lua_type(L, 2) == LUA_TSTRING) {
-    std::string key = lua_tostring(L, 2);
-    int e = eventIndex(key);
-    if (e >= 0) {
-      lua::checkHandler(L, "car", key);
-      luaL_unref(L, LUA_REGISTRYINDEX, p.handlers[e]);
-      p.handlers[e] = LUA_NOREF;
-      if (lua_isfunction(L, 3)) {
-        lua_pushvalue(L, 3);
-        p.handlers[e] = luaL_ref(L, LUA_REGISTRYINDEX);
-      }
-    } else {
-      lua::refuseReserved(L, "car", key, kFieldNames, kEventNames);
-    }
-  }
-  return lua::storeOwnField(L);
+  return lua::newindexObject(L, carType(), proxyAt(L, 1).slots);
 }
 
 int tostring(lua_State* L) {
@@ -370,7 +357,8 @@ void CarBinding::detach() {
   for (auto& [car, proxy] : proxies_) unhookEvents(*proxy);
 }
 
-void CarBinding::registerType(lua_State* L) {
+namespace {
+const lua::ObjectType& carType() {
   static const luaL_Reg methods[] = {{"setSpeed", lua::guarded<setSpeed>},
                                      {"stop", lua::guarded<stop>},
                                      {"changeLane", lua::guarded<changeLane>},
@@ -385,27 +373,24 @@ void CarBinding::registerType(lua_State* L) {
                                      {"version", lua::guarded<version>},
                                      {"disconnect", lua::guarded<disconnect>},
                                      {nullptr, nullptr}};
-  lua::registerObjectType(
-      L, {kMetatable, "car", methods, kFieldNames, kEventNames, lua::guarded<index>,
-          lua::guarded<newindex>, lua::guarded<tostring>, nullptr});
+  static const lua::ObjectType type{kMetatable,
+                                    "car",
+                                    methods,
+                                    kFieldNames,
+                                    carEvents(),
+                                    lua::guarded<index>,
+                                    lua::guarded<newindex>,
+                                    lua::guarded<tostring>};
+  return type;
+}
+}  // namespace
+
+void CarBinding::registerType(lua_State* L) {
+  lua::registerObjectType(L, carType());
 }
 
 int CarBinding::setHub(lua_State* L) {
-  auto& p = proxyAt(L, 1);
-  std::string name = lua::checkString(L, 2, "event name");
-  int e = eventIndex(name);
-  if (e < 0 || name == "onMessage")
-    throw LuaError("cannot listen to '" + name + "'; the events are " +
-                   lua::joinNames(kEventNames) + " (onMessage only through car.onMessage)");
-  if (!lua_isnil(L, 3) && !lua_isfunction(L, 3))
-    throw LuaError(std::string("a listener hub must be a function or nil, got ") +
-                   luaL_typename(L, 3));
-  luaL_unref(L, LUA_REGISTRYINDEX, p.hubs[e]);
-  p.hubs[e] = LUA_NOREF;
-  if (lua_isfunction(L, 3)) {
-    lua_pushvalue(L, 3);
-    p.hubs[e] = luaL_ref(L, LUA_REGISTRYINDEX);
-  }
+  lua::setHubOf(L, carType(), proxyAt(L, 1).slots, "onMessage");
   return 0;
 }
 
@@ -423,6 +408,7 @@ void CarBinding::bind(AnkiCar& car) {
   auto proxy = std::make_unique<Proxy>();
   Proxy& p = *proxy;
   p.car = &car;
+  p.label = car.label();
   lua_State* L = L_;
   auto** ud = static_cast<Proxy**>(lua_newuserdatauv(L, sizeof(Proxy*), 1));
   *ud = &p;

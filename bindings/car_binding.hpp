@@ -14,25 +14,18 @@ namespace pitwall {
 
 class ScriptHost;
 
+// The car's events, in one list: CarEvent::Position is "onPosition", … (docs/lua-api.md).
+#define PITWALL_CAR_EVENTS(X)                                                                   \
+  X(Position)                                                                                   \
+  X(Transition)                                                                                 \
+  X(Intersection) X(Delocalized) X(Offset) X(Battery) X(Version) X(Ping) X(Status) X(Collision) \
+      X(Speed) X(LaneChange) X(Recovery) X(Connect) X(Disconnect) X(Malformed) X(Message)
+
 enum class CarEvent {
-  Position,
-  Transition,
-  Intersection,
-  Delocalized,
-  Offset,
-  Battery,
-  Version,
-  Ping,
-  Status,
-  Collision,
-  Speed,
-  LaneChange,
-  Recovery,
-  Connect,
-  Disconnect,
-  Malformed,
-  Message,
-  Count_
+#define PITWALL_CAR_EVENT_ENUM(name) name,
+  PITWALL_CAR_EVENTS(PITWALL_CAR_EVENT_ENUM)
+#undef PITWALL_CAR_EVENT_ENUM
+      Count_
 };
 inline constexpr std::size_t kCarEventCount = static_cast<std::size_t>(CarEvent::Count_);
 
@@ -66,10 +59,9 @@ class CarBinding {
   void hookEvents(Proxy& p);
   void unhookEvents(Proxy& p);
   void dispatch(Proxy& p, const anki::Message& m);
-  // Pushes traceback handler, handler, car and the reused event table (time set); false, and
-  // nothing pushed, when the car has no handler for `e`.
-  bool begin(Proxy& p, CarEvent e);
-  void finish(Proxy& p, CarEvent e);
+  // Delivers event e to the car's listeners and handler (lua::emit), in its reused table.
+  template <class Fill>
+  void deliver(Proxy& p, CarEvent e, Fill&& fill);
 
   ScriptHost& host_;
   lua_State* L_;

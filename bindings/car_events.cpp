@@ -9,10 +9,11 @@
 
 #include "bindings/car_binding.hpp"
 #include "bindings/car_proxy.hpp"
-#include "bindings/lua_support.hpp"
+#include "bindings/lua_object.hpp"
 #include "bindings/script_host.hpp"
 #include "engine/core/hex.hpp"
 #include "engine/core/log.hpp"
+#include "engine/core/overload.hpp"
 #include "engine/protocol/anki/message_json.hpp"
 
 namespace pitwall {
@@ -79,20 +80,6 @@ constexpr std::array<const char*, kKeyCount> kKeyNames = {
     "hSpeed",       "vSpeed",          "succeeded",
     "reason",       "error",           "hex"};
 
-constexpr std::array<const char*, kCarEventCount> kHandlerNames = {
-    "onPosition handler", "onTransition handler", "onIntersection handler", "onDelocalized handler",
-    "onOffset handler",   "onBattery handler",    "onVersion handler",      "onPing handler",
-    "onStatus handler",   "onCollision handler",  "onSpeed handler",        "onLaneChange handler",
-    "onRecovery handler", "onConnect handler",    "onDisconnect handler",   "onMalformed handler",
-    "onMessage handler"};
-constexpr std::array<const char*, kCarEventCount> kListenerNames = {
-    "onPosition listeners",    "onTransition listeners", "onIntersection listeners",
-    "onDelocalized listeners", "onOffset listeners",     "onBattery listeners",
-    "onVersion listeners",     "onPing listeners",       "onStatus listeners",
-    "onCollision listeners",   "onSpeed listeners",      "onLaneChange listeners",
-    "onRecovery listeners",    "onConnect listeners",    "onDisconnect listeners",
-    "onMalformed listeners",   "onMessage listeners"};
-
 }  // namespace
 
 // Sets fields of the event table on top of the stack.
@@ -137,34 +124,13 @@ class CarBinding::EventTable {
   lua_State* L_;
 };
 
-bool CarBinding::begin(Proxy& p, CarEvent e) {
-  // Listeners first (their hub), then the car's own handler: see finish().
-  int h = p.hubs[static_cast<std::size_t>(e)];
-  if (h == LUA_NOREF) h = p.handlers[static_cast<std::size_t>(e)];
-  if (h == LUA_NOREF) return false;
-  lua_State* L = L_;
-  lua_pushcfunction(L, lua::traceback);
-  lua_rawgeti(L, LUA_REGISTRYINDEX, h);
-  lua_rawgeti(L, LUA_REGISTRYINDEX, p.selfRef);
-  lua_rawgeti(L, LUA_REGISTRYINDEX, p.tables[static_cast<std::size_t>(e)]);
-  EventTable(L).number(kTime, host_.loop().seconds());
-  return true;
-}
-
-void CarBinding::finish(Proxy& p, CarEvent e) {
-  auto i = static_cast<std::size_t>(e);
-  bool hubFirst = p.hubs[i] != LUA_NOREF;
-  host_.callAboveHandler(2, hubFirst ? kListenerNames[i] : kHandlerNames[i], p.car);
-  // The listeners ran: now the car's own handler, with the same event table (read after the
-  // listeners, which may have changed it).
-  if (hubFirst && p.handlers[i] != LUA_NOREF) {
-    lua_State* L = L_;
-    lua_pushcfunction(L, lua::traceback);
-    lua_rawgeti(L, LUA_REGISTRYINDEX, p.handlers[i]);
-    lua_rawgeti(L, LUA_REGISTRYINDEX, p.selfRef);
-    lua_rawgeti(L, LUA_REGISTRYINDEX, p.tables[i]);
-    host_.callAboveHandler(2, kHandlerNames[i], p.car);
-  }
+template <class Fill>
+void CarBinding::deliver(Proxy& p, CarEvent e, Fill&& fill) {
+  const auto i = static_cast<std::size_t>(e);
+  lua::emit({host_, p.slots, carEvents(), p.selfRef, p.label}, i, p.tables[i], [&](lua_State* L) {
+    EventTable t(L);
+    fill(t);
+  });
 }
 
 void CarBinding::hookEvents(Proxy& p) {
@@ -174,21 +140,18 @@ void CarBinding::hookEvents(Proxy& p) {
   p.previousOnConnection = std::move(car.onConnection);
   car.onConnection = [this, &p](bool up, const std::string& reason) {
     if (p.previousOnConnection) p.previousOnConnection(up, reason);
-    if (up) {
-      if (begin(p, CarEvent::Connect)) finish(p, CarEvent::Connect);
-    } else if (begin(p, CarEvent::Disconnect)) {
-      EventTable(L_).string(kReason, reason);
-      finish(p, CarEvent::Disconnect);
-    }
+    if (up)
+      deliver(p, CarEvent::Connect, [](EventTable&) {});
+    else
+      deliver(p, CarEvent::Disconnect, [&](EventTable& t) { t.string(kReason, reason); });
   };
   car.onMalformed = [this, &p](const DecodeError& e, std::span<const std::uint8_t> bytes) {
     std::string what = e.message();
     log::warn(p.car->label(), "malformed frame ignored: " + what);
-    if (!begin(p, CarEvent::Malformed)) return;
-    EventTable t(L_);
-    t.string(kError, what);
-    t.string(kHex, toHex(bytes));
-    finish(p, CarEvent::Malformed);
+    deliver(p, CarEvent::Malformed, [&](EventTable& t) {
+      t.string(kError, what);
+      t.string(kHex, toHex(bytes));
+    });
   };
 }
 
@@ -200,115 +163,122 @@ void CarBinding::unhookEvents(Proxy& p) {
 }
 
 void CarBinding::dispatch(Proxy& p, const Message& m) {
-  auto deliver = [&](CarEvent e, auto&& fill) {
-    if (!begin(p, e)) return;
-    EventTable t(L_);
-    fill(t);
-    finish(p, e);
-  };
-  if (auto* pos = std::get_if<PositionUpdate>(&m)) {
-    deliver(CarEvent::Position, [&](EventTable& t) {
-      Proxy::Written& w = p.position;
-      t.changedInteger(w, 0, kLocation, pos->location_id);
-      t.changedInteger(w, 1, kPiece, pos->piece_id);
-      t.changedInteger(w, 2, kSpeed, pos->speed_mm_s);
-      t.changed(w, 3, kOffset, pos->offset_mm);
-      t.changedBoolean(w, 4, kReverse, (pos->parsing_flags & 0x20) != 0);
-    });
-  } else if (auto* tr = std::get_if<TransitionUpdate>(&m)) {
-    deliver(CarEvent::Transition, [&](EventTable& t) {
-      Proxy::Written& w = p.transition;
-      t.changed(w, 0, kOffset, tr->offset_mm);
-      t.changedInteger(w, 1, kLeftWheel, tr->left_wheel_distance_cm);
-      t.changedInteger(w, 2, kRightWheel, tr->right_wheel_distance_cm);
-      t.changedInteger(w, 3, kDrift, tr->average_follow_line_drift_px);
-      t.changedInteger(w, 4, kUphill, tr->uphill_counter);
-      t.changedInteger(w, 5, kDownhill, tr->downhill_counter);
-    });
-  } else if (auto* i = std::get_if<IntersectionUpdate>(&m)) {
-    deliver(CarEvent::Intersection, [&](EventTable& t) {
-      t.integer(kPiece, i->piece_idx);
-      t.number(kOffset, i->offset_mm);
-      t.integer(kCode, i->intersection_code);
-      t.boolean(kExiting, i->is_exiting != 0);
-      t.integer(kSinceTransition, i->mm_since_last_transition_bar);
-      if (i->mm_since_last_intersection_code)
-        t.integer(kSinceIntersection, *i->mm_since_last_intersection_code);
-    });
-  } else if (std::holds_alternative<Delocalized>(m)) {
-    deliver(CarEvent::Delocalized, [](EventTable&) {});
-  } else if (auto* o = std::get_if<OffsetUpdate>(&m)) {
-    deliver(CarEvent::Offset, [&](EventTable& t) {
-      t.number(kOffset, o->offset_mm);
-      t.integer(kLaneChangeId, o->lane_change_id);
-    });
-  } else if (auto* b = std::get_if<BatteryResponse>(&m)) {
-    deliver(CarEvent::Battery, [&](EventTable& t) {
-      const CarState& s = p.car->state();
-      t.integer(kMillivolts, b->millivolts);
-      t.boolean(kLow, s.battery_low);
-      t.boolean(kFull, s.battery_full);
-      t.boolean(kCharging, s.on_charger);
-    });
-  } else if (auto* v = std::get_if<VersionResponse>(&m)) {
-    deliver(CarEvent::Version, [&](EventTable& t) { t.integer(kVersion, v->version); });
-  } else if (std::holds_alternative<PingResponse>(m)) {
-    deliver(CarEvent::Ping, [&](EventTable& t) {
-      if (auto rtt = p.car->lastPingRtt()) t.number(kRtt, *rtt);
-    });
-  } else if (auto* s = std::get_if<CarStatus>(&m)) {
-    deliver(CarEvent::Status, [&](EventTable& t) {
-      t.boolean(kOnTrack, s->on_track);
-      t.boolean(kOnCharger, s->on_charger);
-      t.boolean(kLowBattery, s->low_battery.value_or(false));
-      t.boolean(kFullyCharged, s->fully_charged.value_or(false));
-    });
-  } else if (auto* c = std::get_if<Collision>(&m)) {
-    deliver(CarEvent::Collision, [&](EventTable& t) {
-      t.integer(kSide, c->side);
-      t.string(kWhere, c->front_back ? "back" : "front");
-    });
-  } else if (auto* sp = std::get_if<SpeedUpdate>(&m)) {
-    deliver(CarEvent::Speed, [&](EventTable& t) {
-      t.integer(kDesired, sp->desired_mm_s);
-      t.integer(kAccel, sp->accel_mm_s2);
-      t.integer(kActual, sp->actual_mm_s);
-    });
-  } else if (auto* lc = std::get_if<LaneChangeUpdate>(&m)) {
-    deliver(CarEvent::LaneChange, [&](EventTable& t) {
-      t.number(kCurrent, lc->current_offset_mm);
-      t.number(kTarget, lc->target_offset_mm);
-      t.integer(kHSpeed, lc->h_speed_mm_s);
-      t.integer(kVSpeed, lc->v_speed_mm_s);
-      t.integer(kLaneChangeId, lc->lane_change_id);
-    });
-  } else if (std::holds_alternative<AutoRecoveryEntered>(m) ||
-             std::holds_alternative<AutoRecoverySucceeded>(m)) {
-    deliver(CarEvent::Recovery, [&](EventTable& t) {
-      t.boolean(kSucceeded, std::holds_alternative<AutoRecoverySucceeded>(m));
-    });
-  }
+  std::visit(
+      Overload{
+          [&](const PositionUpdate& pos) {
+            deliver(p, CarEvent::Position, [&](EventTable& t) {
+              Proxy::Written& w = p.position;
+              t.changedInteger(w, 0, kLocation, pos.location_id);
+              t.changedInteger(w, 1, kPiece, pos.piece_id);
+              t.changedInteger(w, 2, kSpeed, pos.speed_mm_s);
+              t.changed(w, 3, kOffset, pos.offset_mm);
+              t.changedBoolean(w, 4, kReverse, (pos.parsing_flags & 0x20) != 0);
+            });
+          },
+          [&](const TransitionUpdate& tr) {
+            deliver(p, CarEvent::Transition, [&](EventTable& t) {
+              Proxy::Written& w = p.transition;
+              t.changed(w, 0, kOffset, tr.offset_mm);
+              t.changedInteger(w, 1, kLeftWheel, tr.left_wheel_distance_cm);
+              t.changedInteger(w, 2, kRightWheel, tr.right_wheel_distance_cm);
+              t.changedInteger(w, 3, kDrift, tr.average_follow_line_drift_px);
+              t.changedInteger(w, 4, kUphill, tr.uphill_counter);
+              t.changedInteger(w, 5, kDownhill, tr.downhill_counter);
+            });
+          },
+          [&](const IntersectionUpdate& i) {
+            deliver(p, CarEvent::Intersection, [&](EventTable& t) {
+              t.integer(kPiece, i.piece_idx);
+              t.number(kOffset, i.offset_mm);
+              t.integer(kCode, i.intersection_code);
+              t.boolean(kExiting, i.is_exiting != 0);
+              t.integer(kSinceTransition, i.mm_since_last_transition_bar);
+              if (i.mm_since_last_intersection_code)
+                t.integer(kSinceIntersection, *i.mm_since_last_intersection_code);
+            });
+          },
+          [&](const Delocalized&) { deliver(p, CarEvent::Delocalized, [](EventTable&) {}); },
+          [&](const OffsetUpdate& o) {
+            deliver(p, CarEvent::Offset, [&](EventTable& t) {
+              t.number(kOffset, o.offset_mm);
+              t.integer(kLaneChangeId, o.lane_change_id);
+            });
+          },
+          [&](const BatteryResponse& b) {
+            deliver(p, CarEvent::Battery, [&](EventTable& t) {
+              const CarState& s = p.car->state();
+              t.integer(kMillivolts, b.millivolts);
+              t.boolean(kLow, s.battery_low);
+              t.boolean(kFull, s.battery_full);
+              t.boolean(kCharging, s.on_charger);
+            });
+          },
+          [&](const VersionResponse& v) {
+            deliver(p, CarEvent::Version, [&](EventTable& t) { t.integer(kVersion, v.version); });
+          },
+          [&](const PingResponse&) {
+            deliver(p, CarEvent::Ping, [&](EventTable& t) {
+              if (auto rtt = p.car->lastPingRtt()) t.number(kRtt, *rtt);
+            });
+          },
+          [&](const CarStatus& s) {
+            deliver(p, CarEvent::Status, [&](EventTable& t) {
+              t.boolean(kOnTrack, s.on_track);
+              t.boolean(kOnCharger, s.on_charger);
+              t.boolean(kLowBattery, s.low_battery.value_or(false));
+              t.boolean(kFullyCharged, s.fully_charged.value_or(false));
+            });
+          },
+          [&](const Collision& c) {
+            deliver(p, CarEvent::Collision, [&](EventTable& t) {
+              t.integer(kSide, c.side);
+              t.string(kWhere, c.front_back ? "back" : "front");
+            });
+          },
+          [&](const SpeedUpdate& sp) {
+            deliver(p, CarEvent::Speed, [&](EventTable& t) {
+              t.integer(kDesired, sp.desired_mm_s);
+              t.integer(kAccel, sp.accel_mm_s2);
+              t.integer(kActual, sp.actual_mm_s);
+            });
+          },
+          [&](const LaneChangeUpdate& lc) {
+            deliver(p, CarEvent::LaneChange, [&](EventTable& t) {
+              t.number(kCurrent, lc.current_offset_mm);
+              t.number(kTarget, lc.target_offset_mm);
+              t.integer(kHSpeed, lc.h_speed_mm_s);
+              t.integer(kVSpeed, lc.v_speed_mm_s);
+              t.integer(kLaneChangeId, lc.lane_change_id);
+            });
+          },
+          [&](const AutoRecoveryEntered&) {
+            deliver(p, CarEvent::Recovery, [](EventTable& t) { t.boolean(kSucceeded, false); });
+          },
+          [&](const AutoRecoverySucceeded&) {
+            deliver(p, CarEvent::Recovery, [](EventTable& t) { t.boolean(kSucceeded, true); });
+          },
+          [](const auto&) {},  // commands, and reports with no event of their own
+      },
+      m);
   // onMessage sees every message as a fresh table built from its JSON form (for debugging).
-  if (p.handlers[static_cast<std::size_t>(CarEvent::Message)] != LUA_NOREF) {
-    lua_State* L = L_;
-    lua_rawgeti(L, LUA_REGISTRYINDEX, p.handlers[static_cast<std::size_t>(CarEvent::Message)]);
-    lua_rawgeti(L, LUA_REGISTRYINDEX, p.selfRef);
-    nlohmann::json j = toJson(m);
-    lua_createtable(L, 0, static_cast<int>(j.size()) + 1);
-    for (auto& [k, v] : j.items()) {
-      if (v.is_boolean())
-        lua_pushboolean(L, v.get<bool>());
-      else if (v.is_number_integer())
-        lua_pushinteger(L, v.get<lua_Integer>());
-      else if (v.is_number())
-        lua_pushnumber(L, v.get<double>());
-      else
-        lua_pushstring(L, v.is_string() ? v.get<std::string>().c_str() : v.dump().c_str());
-      lua_setfield(L, -2, k.c_str());
-    }
-    lua::setNumber(L, "time", host_.loop().seconds());
-    host_.call(2, 0, "onMessage handler", p.car);
-  }
+  const auto message = static_cast<std::size_t>(CarEvent::Message);
+  if (p.slots.handler(message) == LUA_NOREF) return;
+  lua::emit(
+      {host_, p.slots, carEvents(), p.selfRef, p.label}, message, LUA_NOREF, [&](lua_State* L) {
+        nlohmann::json j = toJson(m);
+        for (auto& [k, v] : j.items()) {
+          if (v.is_boolean())
+            lua_pushboolean(L, v.get<bool>());
+          else if (v.is_number_integer())
+            lua_pushinteger(L, v.get<lua_Integer>());
+          else if (v.is_number())
+            lua_pushnumber(L, v.get<double>());
+          else
+            lua_pushstring(L, v.is_string() ? v.get<std::string>().c_str() : v.dump().c_str());
+          lua_setfield(L, -2, k.c_str());
+        }
+        lua::setNumber(L, "time", host_.loop().seconds());
+      });
 }
 
 }  // namespace pitwall

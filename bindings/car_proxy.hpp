@@ -6,16 +6,19 @@
 #include <string>
 
 #include "bindings/car_binding.hpp"
+#include "bindings/lua_object.hpp"
 
 namespace pitwall {
 
+// The car's events by name (bindings/car_binding.cpp).
+const lua::EventNames& carEvents();
+
 struct CarBinding::Proxy {
   AnkiCar* car = nullptr;
+  std::string label;  // "car 1 (skull)": how errors in its handlers name it
   int selfRef = LUA_NOREF;
-  std::array<int, kCarEventCount> handlers;
-  // The library's listeners of each event (pitwall.listen): one Lua function per event that runs
-  // them all, called before the handler (scripts/pitwall/core.lua).
-  std::array<int, kCarEventCount> hubs;
+  // The handler of each event and the hub of its listeners (pitwall.listen).
+  lua::EventSlots slots;
   std::array<int, kCarEventCount> tables;
   // What the reused onPosition / onTransition tables hold now: a field is written only when its
   // value changed (at a steady speed a position event rewrites just time and location). This is
@@ -27,11 +30,7 @@ struct CarBinding::Proxy {
   Written position, transition;
   // What watched the car's connection before the binding did (the fleet): called first.
   std::function<void(bool, const std::string&)> previousOnConnection;
-  Proxy() {
-    handlers.fill(LUA_NOREF);
-    hubs.fill(LUA_NOREF);
-    tables.fill(LUA_NOREF);
-  }
+  Proxy() { tables.fill(LUA_NOREF); }
 };
 
 }  // namespace pitwall

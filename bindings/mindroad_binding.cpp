@@ -14,7 +14,7 @@
 #include <string_view>
 
 #include "bindings/interrupt.hpp"
-#include "bindings/lua_support.hpp"
+#include "bindings/lua_object.hpp"
 #include "bindings/pitwall_module.hpp"
 #include "bindings/script_host.hpp"
 #include "engine/core/console.hpp"
@@ -256,9 +256,9 @@ void registerType(lua_State* L) {
                                      {"shutdown", lua::guarded<shutdown>},
                                      {"close", lua::guarded<close>},
                                      {nullptr, nullptr}};
-  lua::registerObjectType(L,
-                          {kMetatable, "mindroad", methods, kFields, kEvents, lua::guarded<index>,
-                           lua::guarded<newindex>, lua::guarded<tostring>, gc});
+  static const lua::EventNames events(kEvents);
+  lua::registerObjectType(L, {kMetatable, "mindroad", methods, kFields, events, lua::guarded<index>,
+                              lua::guarded<newindex>, lua::guarded<tostring>, gc});
 }
 
 // Reads the options table at idx into o; unknown keys are refused (a typo would silently fall

@@ -9,7 +9,7 @@
 #include <cstdlib>
 
 #include "bindings/car_binding.hpp"
-#include "bindings/lua_support.hpp"
+#include "bindings/lua_args.hpp"
 #include "bindings/results.hpp"
 #include "bindings/script_host.hpp"
 #include "engine/core/console.hpp"

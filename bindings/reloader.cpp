@@ -4,7 +4,7 @@
 #include <filesystem>
 
 #include "bindings/car_binding.hpp"
-#include "bindings/lua_support.hpp"
+#include "bindings/lua_args.hpp"
 #include "engine/core/log.hpp"
 
 namespace pitwall {

@@ -4,7 +4,7 @@
 
 #include "bindings/car_binding.hpp"
 #include "bindings/interrupt.hpp"
-#include "bindings/lua_support.hpp"
+#include "bindings/lua_args.hpp"
 #include "bindings/pitwall_module.hpp"
 #include "engine/core/console.hpp"
 #include "engine/core/log.hpp"
@@ -151,7 +151,7 @@ void ScriptHost::carJoined(AnkiCar& car) {
   if (lua_istable(L, -1) && lua_getfield(L, -1, "onCar") == LUA_TFUNCTION) {
     lua_remove(L, -2);
     cars_->push(L, car);
-    call(1, 0, "pitwall.onCar handler", &car);
+    call(1, 0, "pitwall.onCar handler", car.label());
   } else {
     lua_settop(L, top);
   }
@@ -258,7 +258,7 @@ int ScriptHost::searchAndRecord(lua_State* L) {
   return 2;
 }
 
-bool ScriptHost::call(int nargs, int nresults, const char* what, const AnkiCar* car) {
+bool ScriptHost::call(int nargs, int nresults, const char* what, std::string_view who) {
   lua_State* L = L_;
   if (shutDown_ && !lastWords_) {
     lua_pop(L, nargs + 1);
@@ -273,7 +273,7 @@ bool ScriptHost::call(int nargs, int nresults, const char* what, const AnkiCar* 
     status = lua_pcall(L, nargs, nresults, base);
   }
   lua_remove(L, base);
-  return finishCall(status, what, car);
+  return finishCall(status, what, who);
 }
 
 bool ScriptHost::callInteractive(int nargs, int nresults, std::string& error) {
@@ -303,7 +303,7 @@ bool ScriptHost::protectedCall(int nargs, int nresults, std::string& error, bool
   return false;
 }
 
-bool ScriptHost::callAboveHandler(int nargs, const char* what, const AnkiCar* car) {
+bool ScriptHost::callAboveHandler(int nargs, const char* what, std::string_view who) {
   if (shutDown_) {
     lua_pop(L_, nargs + 2);
     return false;
@@ -318,10 +318,10 @@ bool ScriptHost::callAboveHandler(int nargs, const char* what, const AnkiCar* ca
     return true;
   }
   lua_remove(L_, -2);  // the handler, under the error
-  return finishCall(status, what, car);
+  return finishCall(status, what, who);
 }
 
-bool ScriptHost::finishCall(int status, const char* what, const AnkiCar* car) {
+bool ScriptHost::finishCall(int status, const char* what, std::string_view who) {
   if (status == LUA_OK) return true;
   std::string message = lua_tostring(L_, -1) ? lua_tostring(L_, -1) : "(error without a message)";
   lua_pop(L_, 1);
@@ -330,7 +330,7 @@ bool ScriptHost::finishCall(int status, const char* what, const AnkiCar* car) {
     return false;
   }
   std::string where = what;
-  if (car) where += " of " + car->label();
+  if (!who.empty()) (where += " of ") += who;
   reportError(where, message);
   return false;
 }

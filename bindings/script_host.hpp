@@ -11,6 +11,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <unordered_map>
 #include <vector>
 
@@ -78,13 +79,13 @@ class ScriptHost {
   bool mainFailed() const { return mainFailed_; }
 
   // Calls the function under the top `nargs` values with the traceback handler. On error the
-  // failure is reported as happening in `what` (of `car`, when given): "onPosition handler of
+  // failure is reported as happening in `what` (of `who`, when given): "onPosition handler of
   // car 1 (skull)". Returns true when the call succeeded; results are left on the stack. Builds
   // no string unless the call fails: this is the hot path of every event.
-  bool call(int nargs, int nresults, const char* what, const AnkiCar* car = nullptr);
+  bool call(int nargs, int nresults, const char* what, std::string_view who = {});
   // The same with no results, for a caller that pushed lua::traceback itself right under the
   // function (the event hot path: no stack rotation). Pops the handler too.
-  bool callAboveHandler(int nargs, const char* what, const AnkiCar* car = nullptr);
+  bool callAboveHandler(int nargs, const char* what, std::string_view who = {});
   // A chunk typed at the REPL (the function under the top `nargs` values): Ctrl-C interrupts
   // it, the callback budget does not apply. On failure returns false with the message and
   // traceback in `error` (not reported: the REPL prints it). Results are left on the stack.
@@ -163,7 +164,7 @@ class ScriptHost {
   void carJoined(AnkiCar& car);
   static int searchAndRecord(lua_State* L);
   bool protectedCall(int nargs, int nresults, std::string& error, bool console);
-  bool finishCall(int status, const char* what, const AnkiCar* car);
+  bool finishCall(int status, const char* what, std::string_view who);
   void resume(lua_State* co, int nargs);
   void endTask(lua_State* co, const std::string& error);  // error empty: it returned
   void fireTimer(int handle);

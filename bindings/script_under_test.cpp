@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <memory>
 
-#include "bindings/lua_support.hpp"
+#include "bindings/lua_args.hpp"
 #include "bindings/pitwall_module.hpp"
 #include "bindings/reloader.hpp"
 #include "engine/core/log.hpp"

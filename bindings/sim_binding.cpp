@@ -4,7 +4,7 @@
 #include <cctype>
 
 #include "bindings/car_binding.hpp"
-#include "bindings/lua_support.hpp"
+#include "bindings/lua_args.hpp"
 #include "bindings/pitwall_module.hpp"
 #include "bindings/script_host.hpp"
 #include "engine/protocol/anki/advertisement.hpp"

@@ -7,7 +7,7 @@
 // Without a view they do nothing, so a script never needs to ask.
 #include <cmath>
 
-#include "bindings/lua_support.hpp"
+#include "bindings/lua_args.hpp"
 #include "bindings/pitwall_module.hpp"
 #include "bindings/script_host.hpp"
 #include "engine/view/feed.hpp"

@@ -16,7 +16,7 @@
 #include <string>
 #include <variant>
 
-#include "bindings/lua_support.hpp"
+#include "bindings/lua_args.hpp"
 #include "bindings/script_host.hpp"
 #include "engine/protocol/anki/codec.hpp"
 #include "engine/vehicles/fleet.hpp"

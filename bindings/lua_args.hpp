@@ -1,0 +1,123 @@
+#pragma once
+// Arguments and errors, the tools every binding body uses: reading a Lua argument as what it
+// must be (a number, a whole number in a range, a string, a function), writing event-table
+// fields, and raising errors. Lua raises errors with longjmp, which must never cross a C++ frame
+// holding live objects (LÖVE's rule): binding bodies throw LuaError instead, and guarded() turns
+// the exception into a Lua error only after every C++ object of the body is destroyed.
+#include <lua.hpp>
+
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include "engine/core/numbers.hpp"
+
+namespace pitwall::lua {
+
+struct LuaError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// A number as a script wrote it: 600, -23.5, 0.25 (not 600.000000): engine/core/numbers.hpp.
+inline std::string show(double v) {
+  return formatNumber(v);
+}
+
+template <int (*Body)(lua_State*)>
+int guarded(lua_State* L) {
+  int results = 0;
+  bool failed = false;
+  try {
+    results = Body(L);
+  } catch (const std::exception& e) {
+    lua_pushstring(L, e.what());
+    failed = true;
+  }
+  if (failed) {
+    // Prefix "file:line:" of the Lua code that called us, as luaL_error does.
+    luaL_where(L, 1);
+    lua_insert(L, -2);
+    lua_concat(L, 2);
+    return lua_error(L);
+  }
+  return results;
+}
+
+inline std::string typeName(lua_State* L, int idx) {
+  return luaL_typename(L, idx);
+}
+
+inline double checkNumber(lua_State* L, int idx, const char* what) {
+  int isnum = 0;
+  double v = lua_tonumberx(L, idx, &isnum);
+  if (!isnum) throw LuaError(std::string(what) + " must be a number, got " + typeName(L, idx));
+  if (!std::isfinite(v)) throw LuaError(std::string(what) + " must be a finite number");
+  return v;
+}
+
+// Raises engine/core/numbers.hpp's sentence when v is outside lo..hi; `why` (the range's reason)
+// follows in parentheses.
+inline void requireRange(std::string_view what, double v, double lo, double hi,
+                         std::string_view unit = {}, std::string_view why = {}) {
+  if (auto e = checkRange(what, v, lo, hi, unit))
+    throw LuaError(why.empty() ? *e : *e + " (" + std::string(why) + ")");
+}
+
+inline double optNumber(lua_State* L, int idx, const char* what, double fallback) {
+  return lua_isnoneornil(L, idx) ? fallback : checkNumber(L, idx, what);
+}
+
+// An integral number (600 or 600.0, not 600.5), range-checked by the caller.
+inline long long checkInteger(lua_State* L, int idx, const char* what) {
+  int isint = 0;
+  lua_Integer v = lua_tointegerx(L, idx, &isint);
+  if (isint) return v;
+  if (lua_type(L, idx) == LUA_TNUMBER)
+    throw LuaError(std::string(what) + " must be a whole number, got " +
+                   show(lua_tonumber(L, idx)));
+  throw LuaError(std::string(what) + " must be a whole number, got " + typeName(L, idx));
+}
+
+inline long long optInteger(lua_State* L, int idx, const char* what, long long fallback) {
+  return lua_isnoneornil(L, idx) ? fallback : checkInteger(L, idx, what);
+}
+
+inline std::string checkString(lua_State* L, int idx, const char* what) {
+  if (lua_type(L, idx) != LUA_TSTRING)
+    throw LuaError(std::string(what) + " must be a string, got " + typeName(L, idx));
+  size_t n = 0;
+  const char* s = lua_tolstring(L, idx, &n);
+  return std::string(s, n);
+}
+
+inline void checkFunction(lua_State* L, int idx, const char* what) {
+  if (lua_type(L, idx) != LUA_TFUNCTION)
+    throw LuaError(std::string(what) + " must be a function, got " + typeName(L, idx));
+}
+
+// Message handler for lua_pcall: the error text plus a traceback.
+int traceback(lua_State* L);
+
+// t[key] = value for the table on top of the stack.
+inline void setInteger(lua_State* L, const char* key, lua_Integer v) {
+  lua_pushinteger(L, v);
+  lua_setfield(L, -2, key);
+}
+inline void setNumber(lua_State* L, const char* key, double v) {
+  lua_pushnumber(L, v);
+  lua_setfield(L, -2, key);
+}
+inline void setBoolean(lua_State* L, const char* key, bool v) {
+  lua_pushboolean(L, v);
+  lua_setfield(L, -2, key);
+}
+inline void setString(lua_State* L, const char* key, std::string_view v) {
+  lua_pushlstring(L, v.data(), v.size());
+  lua_setfield(L, -2, key);
+}
+
+}  // namespace pitwall::lua
