@@ -1,11 +1,11 @@
 #pragma once
 // What CarBinding keeps per car (private to bindings/car_binding.cpp and car_events.cpp).
 #include <array>
-#include <functional>
 #include <limits>
 #include <string>
 
 #include "bindings/car_binding.hpp"
+#include "engine/core/signal.hpp"
 
 namespace pitwall {
 
@@ -25,8 +25,9 @@ struct CarBinding::Proxy {
     Written() { value.fill(std::numeric_limits<double>::quiet_NaN()); }
   };
   Written position, transition;
-  // What watched the car's connection before the binding did (the fleet): called first.
-  std::function<void(bool, const std::string&)> previousOnConnection;
+  // The binding's slot of the car's connection signal while attached (after the fleet's, which
+  // subscribed when the car joined the fleet).
+  Subscription connection;
   Proxy() {
     handlers.fill(LUA_NOREF);
     hubs.fill(LUA_NOREF);

@@ -127,19 +127,14 @@ void ScriptHost::attach() {
   if (attached_) return;
   attached_ = true;
   cars_->attach();
-  previousOnCar_ = std::move(fleet_.onCar);
-  fleet_.onCar = [this](AnkiCar& car) {
-    if (previousOnCar_) previousOnCar_(car);
-    carJoined(car);
-  };
+  joined_ = fleet_.carJoined.connect([this](AnkiCar& car) { carJoined(car); });
 }
 
 void ScriptHost::detach() {
   if (!attached_) return;
   attached_ = false;
   cars_->detach();
-  fleet_.onCar = std::move(previousOnCar_);
-  previousOnCar_ = nullptr;
+  joined_.disconnect();
 }
 
 void ScriptHost::carJoined(AnkiCar& car) {

@@ -194,7 +194,7 @@ class ScriptHost {
   int errors_ = 0;
   ErrorFlood flood_{loop_, "script"};  // errors to the log: one traceback per place, then counts
   bool attached_ = false;
-  std::function<void(AnkiCar&)> previousOnCar_;
+  Subscription joined_;  // Fleet::carJoined, while attached
   bool trial_ = false;
   std::optional<std::string> trialError_;
   std::vector<std::string> loadedFiles_;

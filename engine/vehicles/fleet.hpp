@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "engine/core/loop.hpp"
+#include "engine/core/signal.hpp"
 #include "engine/sim/world.hpp"
 #include "engine/vehicles/anki_car.hpp"
 
@@ -27,14 +28,15 @@ class Fleet {
   AnkiCar* find(int number) const;
   std::size_t connectedCount() const;
 
-  // Called once per car, the first time it connects.
-  std::function<void(AnkiCar&)> onCar;
-  // Every connection change of every car, after the car's own handler (the MQTT bridge).
-  std::function<void(AnkiCar&, bool connected, const std::string& reason)> onConnectionChange;
-  // Every frame of every car (for --record, and the MQTT bridge).
-  std::function<void(AnkiCar&, AnkiCar::Direction, std::span<const std::uint8_t>,
-                     const anki::Message&)>
-      onFrame;
+  // Listeners (the Lua world, the MQTT bridge, the race view, --record) subscribe and hold their
+  // Subscription; they are called in the order they subscribed.
+  // Once per car, the first time it connects.
+  Signal<AnkiCar&> carJoined;
+  // Every connection change of every car, after carJoined on a first connection (the MQTT
+  // bridge, the race view).
+  Signal<AnkiCar&, bool /*connected*/, const std::string& /*reason*/> connectionChanged;
+  // Every frame of every car, in and out (--record, the MQTT bridge, the race view).
+  Signal<AnkiCar&, AnkiCar::Direction, std::span<const std::uint8_t>, const anki::Message&> frames;
 
   // Sends speed 0 to every connected car (shutdown, end of run, script death).
   void stopAll();

@@ -73,13 +73,13 @@ struct SimRig {
       fleet->addSimulated(*world, spec);
     }
     auto total = static_cast<std::size_t>(count);
-    fleet->onCar = [this, total](AnkiCar&) {
+    Subscription joined = fleet->carJoined.connect([this, total](AnkiCar&) {
       if (fleet->connectedCount() == total) loop.stop();
-    };
+    });
     auto timeout = loop.after(std::chrono::seconds(5), [this] { loop.stop(); });
     loop.run();
     loop.cancel(timeout);
-    fleet->onCar = nullptr;
+    joined.disconnect();
     if (fleet->connectedCount() != total) error = "not every simulated car connected";
   }
 

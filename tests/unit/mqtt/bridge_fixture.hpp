@@ -110,6 +110,7 @@ struct Host {
   sim::World world;
   Fleet fleet;
   std::vector<SentFrame> tx;  // every command sent to a car, recorded before the bridge sees it
+  Subscription watch;
   std::unique_ptr<MqttClient> client;
   std::unique_ptr<MqttBridge> bridge;
   std::int64_t connectedAt = 0, lostAt = 0;  // the client's last connection and loss (ms)
@@ -120,10 +121,10 @@ struct Host {
   Host(Loop& l, const MosquittoBroker& broker, BridgeOptions o)
       : loop(l), world(l, *sim::loadLayout("oval"), 7), fleet(l), bridgeOptions(std::move(o)) {
     for (int i = 0; i < 2; ++i) fleet.addSimulated(world, sim::gridSpec(world.track(), i));
-    fleet.onFrame = [this](AnkiCar& car, AnkiCar::Direction d, std::span<const std::uint8_t>,
-                           const anki::Message& m) {
+    watch = fleet.frames.connect([this](AnkiCar& car, AnkiCar::Direction d,
+                                        std::span<const std::uint8_t>, const anki::Message& m) {
       if (d == AnkiCar::Direction::Tx) tx.push_back({&car, m});
-    };
+    });
     REQUIRE(runUntil(loop, [&] { return fleet.connectedCount() == 2; }));
     startBridge(broker);
   }

@@ -100,8 +100,9 @@ TEST_CASE("view feed: cars are placed where the simulator has them, and laps are
 TEST_CASE("view feed: connections and log lines join the event log; others' hooks still run") {
   Race r;
   int framesSeen = 0;
-  r.fleet.onFrame = [&](AnkiCar&, AnkiCar::Direction, std::span<const std::uint8_t>,
-                        const anki::Message&) { ++framesSeen; };
+  auto counting =
+      r.fleet.frames.connect([&](AnkiCar&, AnkiCar::Direction, std::span<const std::uint8_t>,
+                                 const anki::Message&) { ++framesSeen; });
   r.feed = std::make_unique<view::Feed>(r.loop, r.fleet, "simulator");
   r.feed->followLog(true);
   auto& car = r.fleet.addSimulated(r.world, sim::CarSpec{.name = "skull"});
