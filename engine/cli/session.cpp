@@ -364,7 +364,11 @@ bool Session::addGridCars(int count) {
     sim::CarSpec spec = sim::gridSpec(sim_.world->track(), i);
     spec.name = anki::uniqueCarName(spec.model_id, names);
     names.push_back(spec.name);
-    fleet_.addSimulated(*sim_.world, spec);
+    sim::SimCar& simCar = sim_.world->addCar(spec);
+    auto link = std::make_unique<SimLink>(loop_, simCar);
+    SimLink& toCar = *link;
+    fleet_.add(std::move(link), CarIdentity{0, spec.name, spec.model_id, simCar.identifier()});
+    toCar.connect();  // now that the fleet listens
   }
   if (count == 0) return true;
   Subscription joined = fleet_.carJoined.connect([&](AnkiCar&) {

@@ -2,7 +2,6 @@
 
 #include "engine/core/log.hpp"
 #include "engine/protocol/anki/advertisement.hpp"
-#include "engine/transport/sim_link.hpp"
 
 namespace pitwall {
 
@@ -38,19 +37,6 @@ AnkiCar& Fleet::add(std::unique_ptr<Link> link, CarIdentity identity) {
                           const anki::Message& m) { frames.emit(*e->car, d, f, m); };
   entries_.push_back(std::move(entry));
   cars_.push_back(&car);
-  return car;
-}
-
-AnkiCar& Fleet::addSimulated(sim::World& world, const sim::CarSpec& spec) {
-  sim::SimCar& simCar = world.addCar(spec);
-  auto link = std::make_unique<SimLink>(loop_, simCar);
-  SimLink* raw = link.get();
-  CarIdentity id;
-  id.name = spec.name;
-  id.model_id = spec.model_id;
-  id.identifier = simCar.identifier();
-  AnkiCar& car = add(std::move(link), std::move(id));
-  raw->connect();
   return car;
 }
 

@@ -1,13 +1,13 @@
 #pragma once
 // The cars of one run: each an AnkiCar over the Link that owns its connection. Cars are numbered
-// from 1 in the order they join. Simulated cars join through a SimLink.
+// from 1 in the order they join. The fleet knows links, not where they lead: a simulated car
+// joins with the SimLink its session made (engine/cli/session.cpp), a real one with its BLE link.
 #include <functional>
 #include <memory>
 #include <vector>
 
 #include "engine/core/loop.hpp"
 #include "engine/core/signal.hpp"
-#include "engine/sim/world.hpp"
 #include "engine/vehicles/anki_car.hpp"
 
 namespace pitwall {
@@ -19,10 +19,10 @@ class Fleet {
   Fleet(const Fleet&) = delete;
   Fleet& operator=(const Fleet&) = delete;
 
-  // Takes the link; the car is known at once and joins (onCar) when its link first connects.
+  // Takes the link; the car is known at once and joins (carJoined) when its link first
+  // connects. A link that connects when told is told after this returns, so that the fleet sees
+  // the connection.
   AnkiCar& add(std::unique_ptr<Link> link, CarIdentity identity);
-  // A simulated car placed in `world`, connected through a SimLink.
-  AnkiCar& addSimulated(sim::World& world, const sim::CarSpec& spec);
 
   const std::vector<AnkiCar*>& cars() const { return cars_; }
   AnkiCar* find(int number) const;

@@ -20,6 +20,7 @@
 #include "engine/sim/track.hpp"
 #include "engine/sim/world.hpp"
 #include "engine/vehicles/fleet.hpp"
+#include "tests/support/sim_cars.hpp"
 
 namespace {
 
@@ -70,7 +71,7 @@ struct SimRig {
           count <= 4 ? sim::gridSpec(world->track(), i) : spreadSpec(world->track(), i, count);
       spec.name = anki::uniqueCarName(spec.model_id, names);
       names.push_back(spec.name);
-      fleet->addSimulated(*world, spec);
+      testing::addSimulatedCar(loop, *fleet, *world, spec);
     }
     auto total = static_cast<std::size_t>(count);
     Subscription joined = fleet->carJoined.connect([this, total](AnkiCar&) {

@@ -11,6 +11,7 @@
 #include "engine/core/log.hpp"
 #include "engine/protocol/anki/messages.hpp"
 #include "engine/sim/grid.hpp"
+#include "tests/support/sim_cars.hpp"
 
 using namespace pitwall;
 using namespace std::chrono_literals;
@@ -35,7 +36,7 @@ struct ReloadFixture {
     fs::create_directories(dir);
     sim.world = std::make_unique<sim::World>(loop, *sim::loadLayout("oval"), 1);
     for (int i = 0; i < cars; ++i)
-      fleet.addSimulated(*sim.world, sim::gridSpec(sim.world->track(), i));
+      testing::addSimulatedCar(loop, fleet, *sim.world, sim::gridSpec(sim.world->track(), i));
     counting = fleet.frames.connect([this](AnkiCar&, AnkiCar::Direction d,
                                            std::span<const std::uint8_t>, const anki::Message& m) {
       if (d == AnkiCar::Direction::Rx && std::holds_alternative<anki::PositionUpdate>(m))

@@ -25,6 +25,7 @@
 #include "tests/support/hostile_payloads.hpp"
 #include "tests/support/mosquitto_broker.hpp"
 #include "tests/support/run_until.hpp"
+#include "tests/support/sim_cars.hpp"
 
 namespace pitwall::testing::bridge {
 
@@ -120,7 +121,8 @@ struct Host {
       : Host(l, broker, optionsFor(kHost, readOnly)) {}
   Host(Loop& l, const MosquittoBroker& broker, BridgeOptions o)
       : loop(l), world(l, *sim::loadLayout("oval"), 7), fleet(l), bridgeOptions(std::move(o)) {
-    for (int i = 0; i < 2; ++i) fleet.addSimulated(world, sim::gridSpec(world.track(), i));
+    for (int i = 0; i < 2; ++i)
+      testing::addSimulatedCar(loop, fleet, world, sim::gridSpec(world.track(), i));
     watch = fleet.frames.connect([this](AnkiCar& car, AnkiCar::Direction d,
                                         std::span<const std::uint8_t>, const anki::Message& m) {
       if (d == AnkiCar::Direction::Tx) tx.push_back({&car, m});

@@ -23,6 +23,7 @@
 #include "tests/support/hostile_payloads.hpp"
 #include "tests/support/mosquitto_broker.hpp"
 #include "tests/support/run_until.hpp"
+#include "tests/support/sim_cars.hpp"
 
 using namespace pitwall;
 using namespace std::chrono_literals;
@@ -46,7 +47,8 @@ struct BridgedHost {
 
   BridgedHost(Loop& l, const MosquittoBroker& b)
       : loop(l), broker(b), world(l, *sim::loadLayout("oval"), 11), fleet(l) {
-    for (int i = 0; i < 2; ++i) fleet.addSimulated(world, sim::gridSpec(world.track(), i));
+    for (int i = 0; i < 2; ++i)
+      testing::addSimulatedCar(loop, fleet, world, sim::gridSpec(world.track(), i));
     watch = fleet.frames.connect([this](AnkiCar& car, AnkiCar::Direction d,
                                         std::span<const std::uint8_t>, const anki::Message& m) {
       if (d == AnkiCar::Direction::Tx) tx.emplace_back(&car, m);
