@@ -425,6 +425,7 @@ void CarBinding::bind(AnkiCar& car) {
   auto proxy = std::make_unique<Proxy>();
   Proxy& p = *proxy;
   p.car = &car;
+  p.label = car.label();
   lua_State* L = L_;
   auto** ud = static_cast<Proxy**>(lua_newuserdatauv(L, sizeof(Proxy*), 1));
   *ud = &p;

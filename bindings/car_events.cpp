@@ -154,7 +154,7 @@ bool CarBinding::begin(Proxy& p, CarEvent e) {
 void CarBinding::finish(Proxy& p, CarEvent e) {
   auto i = static_cast<std::size_t>(e);
   bool hubFirst = p.hubs[i] != LUA_NOREF;
-  host_.callAboveHandler(2, hubFirst ? kListenerNames[i] : kHandlerNames[i], p.car);
+  host_.callAboveHandler(2, hubFirst ? kListenerNames[i] : kHandlerNames[i], p.label);
   // The listeners ran: now the car's own handler, with the same event table (read after the
   // listeners, which may have changed it).
   if (hubFirst && p.handlers[i] != LUA_NOREF) {
@@ -163,7 +163,7 @@ void CarBinding::finish(Proxy& p, CarEvent e) {
     lua_rawgeti(L, LUA_REGISTRYINDEX, p.handlers[i]);
     lua_rawgeti(L, LUA_REGISTRYINDEX, p.selfRef);
     lua_rawgeti(L, LUA_REGISTRYINDEX, p.tables[i]);
-    host_.callAboveHandler(2, kHandlerNames[i], p.car);
+    host_.callAboveHandler(2, kHandlerNames[i], p.label);
   }
 }
 
@@ -305,7 +305,7 @@ void CarBinding::dispatch(Proxy& p, const Message& m) {
       lua_setfield(L, -2, k.c_str());
     }
     lua::setNumber(L, "time", host_.loop().seconds());
-    host_.call(2, 0, "onMessage handler", p.car);
+    host_.call(2, 0, "onMessage handler", p.label);
   }
 }
 

@@ -11,6 +11,7 @@ namespace pitwall {
 
 struct CarBinding::Proxy {
   AnkiCar* car = nullptr;
+  std::string label;  // "car 1 (skull)": errors in its handlers name it (made once, at bind)
   int selfRef = LUA_NOREF;
   std::array<int, kCarEventCount> handlers;
   // The library's listeners of each event (pitwall.listen): one Lua function per event that runs
