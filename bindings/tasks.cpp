@@ -15,11 +15,11 @@ void closeThread(lua_State* co) {
 }
 }  // namespace
 
-Tasks::Tasks(ScriptHost& host) : host_(host) {}
+Tasks::Tasks(ScriptHost& host) : host_(host), loop_(host.loop()) {}
 
 Tasks::~Tasks() {
   for (auto& [co, task] : tasks_)
-    if (task.wake) host_.loop().cancel(*task.wake);
+    if (task.wake) loop_.cancel(*task.wake);
 }
 
 void Tasks::spawn(lua_State* L, const std::string& name, bool main) {
@@ -38,7 +38,7 @@ void Tasks::spawn(lua_State* L, const std::string& name, bool main) {
 void Tasks::sleep(lua_State* co, Duration delay) {
   auto it = tasks_.find(co);
   if (it == tasks_.end() || host_.isShutDown()) return;
-  it->second.wake = host_.loop().after(delay, [this, co] {
+  it->second.wake = loop_.after(delay, [this, co] {
     auto t = tasks_.find(co);
     if (t == tasks_.end()) return;
     t->second.wake.reset();
@@ -49,7 +49,7 @@ void Tasks::sleep(lua_State* co, Duration delay) {
 void Tasks::shutDown() {
   for (auto& [co, task] : tasks_)
     if (task.wake) {
-      host_.loop().cancel(*task.wake);
+      loop_.cancel(*task.wake);
       task.wake.reset();
     }
 }

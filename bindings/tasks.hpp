@@ -40,6 +40,7 @@ class Tasks {
   void end(lua_State* co, const std::string& error);  // error empty: it returned
 
   ScriptHost& host_;
+  Loop& loop_;  // the host's
   std::unordered_map<lua_State*, Task> tasks_;
   lua_State* main_ = nullptr;
 };

@@ -4,10 +4,10 @@
 
 namespace pitwall {
 
-Timers::Timers(ScriptHost& host) : host_(host) {}
+Timers::Timers(ScriptHost& host) : host_(host), loop_(host.loop()) {}
 
 Timers::~Timers() {
-  for (auto& [handle, timer] : timers_) host_.loop().cancel(timer.id);
+  for (auto& [handle, timer] : timers_) loop_.cancel(timer.id);
 }
 
 int Timers::add(lua_State* L, Duration first, std::optional<Duration> period) {
@@ -16,7 +16,6 @@ int Timers::add(lua_State* L, Duration first, std::optional<Duration> period) {
     lua_pop(L, 1);
     return handle;
   }
-  Loop& loop = host_.loop();
   Timer t;
   // Errors name the timer by where its function was written: two failing timers are two places
   // (the error flood counts each apart), not one "pitwall.every callback".
@@ -29,8 +28,8 @@ int Timers::add(lua_State* L, Duration first, std::optional<Duration> period) {
   t.what = std::make_shared<const std::string>(std::move(what));
   t.fnRef = luaL_ref(L, LUA_REGISTRYINDEX);
   t.period = period;
-  t.due = loop.now() + first;
-  t.id = loop.at(t.due, [this, handle] { fire(handle); });
+  t.due = loop_.now() + first;
+  t.id = loop_.at(t.due, [this, handle] { fire(handle); });
   timers_.emplace(handle, t);
   return handle;
 }
@@ -38,7 +37,7 @@ int Timers::add(lua_State* L, Duration first, std::optional<Duration> period) {
 bool Timers::cancel(int handle) {
   auto it = timers_.find(handle);
   if (it == timers_.end()) return false;
-  host_.loop().cancel(it->second.id);
+  loop_.cancel(it->second.id);
   luaL_unref(host_.state(), LUA_REGISTRYINDEX, it->second.fnRef);
   timers_.erase(it);
   return true;
@@ -46,7 +45,7 @@ bool Timers::cancel(int handle) {
 
 void Timers::shutDown() {
   for (auto& [handle, timer] : timers_) {
-    host_.loop().cancel(timer.id);
+    loop_.cancel(timer.id);
     luaL_unref(host_.state(), LUA_REGISTRYINDEX, timer.fnRef);
   }
   timers_.clear();
@@ -55,7 +54,6 @@ void Timers::shutDown() {
 void Timers::fire(int handle) {
   auto it = timers_.find(handle);
   if (it == timers_.end()) return;
-  Loop& loop = host_.loop();
   lua_State* L = host_.state();
   Timer& t = it->second;
   int fnRef = t.fnRef;
@@ -65,23 +63,23 @@ void Timers::fire(int handle) {
     // that is behind (its callback is slower than its period, or the loop was busy) skips the
     // ticks it missed instead of queueing them: the next tick is the next one in phase after
     // now, so a hog slows itself, never the engine (docs/lua-api.md).
-    auto skipMissed = [&loop](Timer& timer) {
-      if (const TimePoint now = loop.now(); timer.due <= now)
+    auto skipMissed = [this](Timer& timer) {
+      if (const TimePoint now = loop_.now(); timer.due <= now)
         timer.due += (((now - timer.due) / *timer.period) + 1) * *timer.period;
     };
     t.due += *t.period;
     skipMissed(t);
-    const Loop::TimerId id = t.id = loop.at(t.due, [this, handle] { fire(handle); });
+    const Loop::TimerId id = t.id = loop_.at(t.due, [this, handle] { fire(handle); });
     lua_rawgeti(L, LUA_REGISTRYINDEX, fnRef);
     auto what = t.what;  // (the callback may cancel the timer)
     host_.call(0, 0, what->c_str());
     // A callback slower than its period: its next tick is the first after it returned, so the
     // timers that came due while it ran go first.
     auto again = timers_.find(handle);
-    if (again != timers_.end() && again->second.id == id && again->second.due <= loop.now()) {
-      loop.cancel(id);
+    if (again != timers_.end() && again->second.id == id && again->second.due <= loop_.now()) {
+      loop_.cancel(id);
       skipMissed(again->second);
-      again->second.id = loop.at(again->second.due, [this, handle] { fire(handle); });
+      again->second.id = loop_.at(again->second.due, [this, handle] { fire(handle); });
     }
   } else {
     auto what = std::move(t.what);

@@ -41,6 +41,7 @@ class Timers {
   void fire(int handle);
 
   ScriptHost& host_;
+  Loop& loop_;  // the host's
   std::unordered_map<int, Timer> timers_;
   int next_ = 1;
 };
