@@ -136,15 +136,14 @@ void CarBinding::deliver(Proxy& p, CarEvent e, Fill&& fill) {
 void CarBinding::hookEvents(Proxy& p) {
   AnkiCar& car = *p.car;
   car.onMessage = [this, &p](const Message& m) { dispatch(p, m); };
-  // The fleet watches connections too (a car joins the run on its first one): chain, don't replace.
-  p.previousOnConnection = std::move(car.onConnection);
-  car.onConnection = [this, &p](bool up, const std::string& reason) {
-    if (p.previousOnConnection) p.previousOnConnection(up, reason);
+  // The fleet watches connections too (a car joins the run on its first one), and hears each
+  // before the binding: it subscribed first.
+  p.connection = car.connectionChanged.connect([this, &p](bool up, const std::string& reason) {
     if (up)
       deliver(p, CarEvent::Connect, [](EventTable&) {});
     else
       deliver(p, CarEvent::Disconnect, [&](EventTable& t) { t.string(kReason, reason); });
-  };
+  });
   car.onMalformed = [this, &p](const DecodeError& e, std::span<const std::uint8_t> bytes) {
     std::string what = e.message();
     log::warn(p.car->label(), "malformed frame ignored: " + what);
@@ -157,8 +156,7 @@ void CarBinding::hookEvents(Proxy& p) {
 
 void CarBinding::unhookEvents(Proxy& p) {
   p.car->onMessage = nullptr;
-  p.car->onConnection = std::move(p.previousOnConnection);
-  p.previousOnConnection = nullptr;
+  p.connection.disconnect();
   p.car->onMalformed = nullptr;
 }
 

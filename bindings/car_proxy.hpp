@@ -1,12 +1,12 @@
 #pragma once
 // What CarBinding keeps per car (private to bindings/car_binding.cpp and car_events.cpp).
 #include <array>
-#include <functional>
 #include <limits>
 #include <string>
 
 #include "bindings/car_binding.hpp"
 #include "bindings/lua_object.hpp"
+#include "engine/core/signal.hpp"
 
 namespace pitwall {
 
@@ -15,7 +15,7 @@ const lua::EventNames& carEvents();
 
 struct CarBinding::Proxy {
   AnkiCar* car = nullptr;
-  std::string label;  // "car 1 (skull)": how errors in its handlers name it
+  std::string label;  // "car 1 (skull)": errors in its handlers name it (made once, at bind)
   int selfRef = LUA_NOREF;
   // The handler of each event and the hub of its listeners (pitwall.listen).
   lua::EventSlots slots;
@@ -28,8 +28,9 @@ struct CarBinding::Proxy {
     Written() { value.fill(std::numeric_limits<double>::quiet_NaN()); }
   };
   Written position, transition;
-  // What watched the car's connection before the binding did (the fleet): called first.
-  std::function<void(bool, const std::string&)> previousOnConnection;
+  // The binding's slot of the car's connection signal while attached (after the fleet's, which
+  // subscribed when the car joined the fleet).
+  Subscription connection;
   Proxy() { tables.fill(LUA_NOREF); }
 };
 

@@ -79,7 +79,7 @@ int after(lua_State* L) {
   Duration d = checkDelay(L, 1, "pitwall.after delay", true);
   lua::checkFunction(L, 2, "pitwall.after callback");
   lua_settop(L, 2);
-  return pushTimer(L, ScriptHost::from(L).addTimer(L, d, std::nullopt));
+  return pushTimer(L, ScriptHost::from(L).timers().add(L, d, std::nullopt));
 }
 
 int every(lua_State* L) {
@@ -89,13 +89,13 @@ int every(lua_State* L) {
                    lua::show(lua_tonumber(L, 1)));
   lua::checkFunction(L, 2, "pitwall.every callback");
   lua_settop(L, 2);
-  return pushTimer(L, ScriptHost::from(L).addTimer(L, d, d));
+  return pushTimer(L, ScriptHost::from(L).timers().add(L, d, d));
 }
 
 int cancelTimer(lua_State* L) {
   auto* h = static_cast<int*>(luaL_testudata(L, 1, kTimerMetatable));
   if (!h) throw LuaError(std::string("expected a timer, got ") + luaL_typename(L, 1));
-  lua_pushboolean(L, ScriptHost::from(L).cancelTimer(*h));
+  lua_pushboolean(L, ScriptHost::from(L).timers().cancel(*h));
   return 1;
 }
 
@@ -110,7 +110,7 @@ int spawn(lua_State* L) {
       name = "task";
   }
   lua_settop(L, 1);
-  ScriptHost::from(L).spawn(L, name);
+  ScriptHost::from(L).tasks().spawn(L, name);
   return 0;
 }
 
@@ -120,7 +120,7 @@ int sleepBody(lua_State* L) {
     throw LuaError(
         "pitwall.sleep works only inside a task (pitwall.spawn or the script's main chunk); "
         "callbacks must return quickly — start a task from the callback instead");
-  ScriptHost::from(L).sleepCurrent(L, d);
+  ScriptHost::from(L).tasks().sleep(L, d);
   return -1;  // the caller yields
 }
 

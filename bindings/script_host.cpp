@@ -28,14 +28,6 @@ int traceback(lua_State* L) {
 }  // namespace lua
 
 namespace {
-void closeThread(lua_State* co) {
-#if LUA_VERSION_RELEASE_NUM >= 50406
-  lua_closethread(co, nullptr);
-#else
-  lua_resetthread(co);
-#endif
-}
-
 // print and io.write go to the console: straight to stdout, or above the REPL's prompt.
 int consolePrint(lua_State* L) {
   int n = lua_gettop(L);
@@ -127,19 +119,14 @@ void ScriptHost::attach() {
   if (attached_) return;
   attached_ = true;
   cars_->attach();
-  previousOnCar_ = std::move(fleet_.onCar);
-  fleet_.onCar = [this](AnkiCar& car) {
-    if (previousOnCar_) previousOnCar_(car);
-    carJoined(car);
-  };
+  joined_ = fleet_.carJoined.connect([this](AnkiCar& car) { carJoined(car); });
 }
 
 void ScriptHost::detach() {
   if (!attached_) return;
   attached_ = false;
   cars_->detach();
-  fleet_.onCar = std::move(previousOnCar_);
-  previousOnCar_ = nullptr;
+  joined_.disconnect();
 }
 
 void ScriptHost::carJoined(AnkiCar& car) {
@@ -159,9 +146,7 @@ void ScriptHost::carJoined(AnkiCar& car) {
 
 ScriptHost::~ScriptHost() {
   detach();
-  for (auto& [co, task] : tasks_)
-    if (task.wake) loop_.cancel(*task.wake);
-  for (auto& [handle, timer] : timers_) loop_.cancel(timer.id);
+  // (the tasks' and timers' wake-ups are cancelled by their destructors)
   cars_.reset();  // unhooks the cars before their Lua objects go
   lua_close(L_);
 }
@@ -330,7 +315,7 @@ bool ScriptHost::finishCall(int status, const char* what, std::string_view who) 
     return false;
   }
   std::string where = what;
-  if (!who.empty()) (where += " of ") += who;
+  if (!who.empty()) where.append(" of ").append(who);
   reportError(where, message);
   return false;
 }
@@ -386,16 +371,8 @@ void ScriptHost::shutDown() {
   flood_.flush();  // counts of errors not yet logged: none is lost
   // The handlers stay hooked until the world closes (this may run inside one of them); call()
   // turns every call into Lua away from now on.
-  for (auto& [co, task] : tasks_)
-    if (task.wake) {
-      loop_.cancel(*task.wake);
-      task.wake.reset();
-    }
-  for (auto& [handle, timer] : timers_) {
-    loop_.cancel(timer.id);
-    luaL_unref(L_, LUA_REGISTRYINDEX, timer.fnRef);
-  }
-  timers_.clear();
+  tasks_.shutDown();
+  timers_.shutDown();
   auto hooks = std::move(atShutDown_);
   for (auto& fn : hooks) fn();
 }
@@ -435,7 +412,7 @@ Result<bool, std::string> ScriptHost::startLoaded(int status) {
     lua_pop(L_, 1);
     return Unexpected{err};
   }
-  spawn(L_, "main chunk", true);
+  tasks_.spawn(L_, "main chunk", true);
   return true;
 }
 
@@ -493,153 +470,20 @@ Result<bool, std::string> ScriptHost::startString(const std::string& code,
       luaL_loadbufferx(L_, code.data(), code.size(), ("@" + chunkname).c_str(), "t"));
 }
 
-void ScriptHost::spawn(lua_State* L, const std::string& name, bool main) {
-  if (shutDown_) {
-    lua_pop(L, 1);
-    return;
-  }
-  lua_State* co = lua_newthread(L);
-  int ref = luaL_ref(L, LUA_REGISTRYINDEX);  // pops the thread, keeps it alive
-  lua_xmove(L, co, 1);                       // the function
-  tasks_.emplace(co, Task{ref, main ? name : "task " + name, std::nullopt});
-  if (main) mainTask_ = co;
-  resume(co, 0);
-}
-
-void ScriptHost::sleepCurrent(lua_State* co, Duration delay) {
-  auto it = tasks_.find(co);
-  if (it == tasks_.end() || shutDown_) return;
-  it->second.wake = loop_.after(delay, [this, co] {
-    auto t = tasks_.find(co);
-    if (t == tasks_.end()) return;
-    t->second.wake.reset();
-    resume(co, 0);
-  });
-}
-
-void ScriptHost::resume(lua_State* co, int nargs) {
-  if (shutDown_ || !tasks_.count(co)) return;
-  int nres = 0;
-  int status;
-  {
-    interrupt::Scope scope(co, interrupt::Kind::Callback);
-    status = lua_resume(co, L_, nargs, &nres);
-  }
-  std::string error;
-  if (status == LUA_YIELD) {
-    lua_pop(co, nres);
-    if (tasks_.at(co).wake) return;  // asleep: its timer resumes it
-    if (shutDown_) return;           // the run ended while it ran: it stays asleep for good
-    // A bare coroutine.yield() has nobody to wake it: end the task with a clear error.
-    error =
-        "the task yielded without pitwall.sleep or pitwall.waitUntil; nothing would ever "
-        "resume it";
-  } else if (status != LUA_OK && memory_.exceeded) {
-    checkMemory();
-    error = sandbox::memoryMessage(memory_);
-  } else if (status != LUA_OK) {
-    const char* msg = lua_tostring(co, -1);
-    luaL_traceback(L_, co, msg ? msg : "(error without a message)", 0);
-    error = lua_tostring(L_, -1);
-    lua_pop(L_, 1);
-  }
-  endTask(co, error);
-}
-
-void ScriptHost::endTask(lua_State* co, const std::string& error) {
-  auto it = tasks_.find(co);
-  std::string where = it->second.name;
-  closeThread(co);
-  luaL_unref(L_, LUA_REGISTRYINDEX, it->second.threadRef);
-  tasks_.erase(it);
-  bool wasMain = co == mainTask_;
-  if (wasMain) {
-    mainTask_ = nullptr;
-    mainFinished_ = true;
-  }
-  if (wasMain && trial_ && !error.empty()) {  // a trial start gives the error back instead
+void ScriptHost::mainEnded(const std::string& where, const std::string& error) {
+  mainFinished_ = true;
+  if (trial_ && !error.empty()) {  // a trial start gives the error back instead
     mainFailed_ = true;
     trialError_ = error;
     return;
   }
-  if (!error.empty()) reportError(where, error);
-  if (wasMain && !error.empty()) {
+  if (!error.empty()) {
+    reportError(where, error);
     // The script died: the run ends and its cars are stopped (DESIGN.md, "keeps cars safe").
     mainFailed_ = true;
     requestStop();
   }
-  if (wasMain && options_.test_mode) requestStop();  // a scenario ends with its main chunk
-}
-
-int ScriptHost::addTimer(lua_State* L, Duration first, std::optional<Duration> period) {
-  int handle = nextTimer_++;
-  if (shutDown_) {  // the run is ending: a timer that never fires
-    lua_pop(L, 1);
-    return handle;
-  }
-  Timer t;
-  // Errors name the timer by where its function was written: two failing timers are two places
-  // (the error flood counts each apart), not one "pitwall.every callback".
-  std::string what = period ? "pitwall.every callback" : "pitwall.after callback";
-  lua_pushvalue(L, -1);
-  lua_Debug ar;
-  if (lua_getinfo(L, ">S", &ar) && ar.linedefined > 0)
-    what.append(" (").append(ar.short_src).append(":").append(std::to_string(ar.linedefined)) +=
-        ')';
-  t.what = std::make_shared<const std::string>(std::move(what));
-  t.fnRef = luaL_ref(L, LUA_REGISTRYINDEX);
-  t.period = period;
-  t.due = loop_.now() + first;
-  t.id = loop_.at(t.due, [this, handle] { fireTimer(handle); });
-  timers_.emplace(handle, t);
-  return handle;
-}
-
-bool ScriptHost::cancelTimer(int handle) {
-  auto it = timers_.find(handle);
-  if (it == timers_.end()) return false;
-  loop_.cancel(it->second.id);
-  luaL_unref(L_, LUA_REGISTRYINDEX, it->second.fnRef);
-  timers_.erase(it);
-  return true;
-}
-
-void ScriptHost::fireTimer(int handle) {
-  auto it = timers_.find(handle);
-  if (it == timers_.end()) return;
-  Timer& t = it->second;
-  int fnRef = t.fnRef;
-  bool repeating = t.period.has_value();
-  if (repeating) {
-    // Scheduled before the call, so the callback may cancel it; due times do not drift. A timer
-    // that is behind (its callback is slower than its period, or the loop was busy) skips the
-    // ticks it missed instead of queueing them: the next tick is the next one in phase after
-    // now, so a hog slows itself, never the engine (docs/lua-api.md).
-    auto skipMissed = [this](Timer& timer) {
-      if (const TimePoint now = loop_.now(); timer.due <= now)
-        timer.due += (((now - timer.due) / *timer.period) + 1) * *timer.period;
-    };
-    t.due += *t.period;
-    skipMissed(t);
-    const Loop::TimerId id = t.id = loop_.at(t.due, [this, handle] { fireTimer(handle); });
-    lua_rawgeti(L_, LUA_REGISTRYINDEX, fnRef);
-    auto what = t.what;  // (the callback may cancel the timer)
-    call(0, 0, what->c_str());
-    // A callback slower than its period: its next tick is the first after it returned, so the
-    // timers that came due while it ran go first.
-    auto again = timers_.find(handle);
-    if (again != timers_.end() && again->second.id == id && again->second.due <= loop_.now()) {
-      loop_.cancel(id);
-      skipMissed(again->second);
-      again->second.id = loop_.at(again->second.due, [this, handle] { fireTimer(handle); });
-    }
-  } else {
-    auto what = std::move(t.what);
-    timers_.erase(it);
-    lua_rawgeti(L_, LUA_REGISTRYINDEX, fnRef);
-    luaL_unref(L_, LUA_REGISTRYINDEX, fnRef);
-    call(0, 0, what->c_str());
-  }
+  if (options_.test_mode) requestStop();  // a scenario ends with its main chunk
 }
 
 }  // namespace pitwall

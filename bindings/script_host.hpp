@@ -1,6 +1,7 @@
 #pragma once
-// The Lua world of one run: the state, the `pitwall` module, car objects, timers and tasks on the
-// engine clock, and the one protected-call path every call into Lua goes through.
+// The Lua world of one run: the state, the `pitwall` module, car objects, its tasks and timers on
+// the engine clock (bindings/tasks.hpp, bindings/timers.hpp), the world's life (attach, shut
+// down, last words), and the one protected-call path every call into Lua goes through.
 //
 // Errors: an error in a callback is reported with a traceback (or handed to pitwall.onError) and
 // the run carries on; in test mode it fails the scenario instead. In the log, a place that keeps
@@ -12,10 +13,11 @@
 #include <optional>
 #include <string>
 #include <string_view>
-#include <unordered_map>
 #include <vector>
 
 #include "bindings/sandbox.hpp"
+#include "bindings/tasks.hpp"
+#include "bindings/timers.hpp"
 #include "engine/core/error_flood.hpp"
 #include "engine/core/loop.hpp"
 #include "engine/core/result.hpp"
@@ -59,6 +61,8 @@ class ScriptHost {
   Fleet& fleet() { return fleet_; }
   SimSession* sim() { return sim_; }
   CarBinding& cars() { return *cars_; }
+  Tasks& tasks() { return tasks_; }
+  Timers& timers() { return timers_; }
   const HostOptions& options() const { return options_; }
 
   // Loads SCRIPT and starts its main chunk as a task (so it may pitwall.sleep). A script that
@@ -79,9 +83,10 @@ class ScriptHost {
   bool mainFailed() const { return mainFailed_; }
 
   // Calls the function under the top `nargs` values with the traceback handler. On error the
-  // failure is reported as happening in `what` (of `who`, when given): "onPosition handler of
-  // car 1 (skull)". Returns true when the call succeeded; results are left on the stack. Builds
-  // no string unless the call fails: this is the hot path of every event.
+  // failure is reported as happening in `what` of `who`, when given: "onPosition handler" of
+  // "car 1 (skull)". Returns true when the call succeeded; results are left on the stack. Builds
+  // no string unless the call fails: this is the hot path of every event (a caller keeps its
+  // label made, as the car binding does).
   bool call(int nargs, int nresults, const char* what, std::string_view who = {});
   // The same with no results, for a caller that pushed lua::traceback itself right under the
   // function (the event hot path: no stack rotation). Pops the handler too.
@@ -106,16 +111,6 @@ class ScriptHost {
   // the first in full, then a count a second); in test mode, a failure.
   void reportError(const std::string& where, const std::string& message);
 
-  // A task: a coroutine resumed on the loop. The function is on top of L's stack (L: the
-  // calling thread, which may itself be a task).
-  void spawn(lua_State* L, const std::string& name, bool main = false);
-  // Called by pitwall.sleep from inside a task: resume it after `delay`.
-  void sleepCurrent(lua_State* co, Duration delay);
-
-  // Timers from Lua (pitwall.after / pitwall.every): the function is on top of L's stack.
-  int addTimer(lua_State* L, Duration first, std::optional<Duration> period);
-  bool cancelTimer(int handle);
-
   // pitwall.stop() and failures end the run through this.
   std::function<void()> onStopRequested;
   void requestStop();
@@ -139,6 +134,12 @@ class ScriptHost {
   void lastWords();
   // The memory this world's allocations hold now, and its cap (sandbox.hpp).
   const sandbox::Memory& memory() const { return memory_; }
+  // After a failed call into Lua: when the memory limit was reached, says so once and ends the
+  // run (exit status 1).
+  void checkMemory();
+  // How the script's main chunk ended (Tasks): `error` empty when it returned. A failure ends
+  // the run (its cars are stopped), or is handed back by a trial start; a scenario ends with it.
+  void mainEnded(const std::string& where, const std::string& error);
   // In test mode: the first failure (error in a task or callback, failed expectation).
   const std::optional<std::string>& failure() const { return failure_; }
   int errorCount() const { return errors_; }
@@ -146,31 +147,13 @@ class ScriptHost {
   static ScriptHost& from(lua_State* L);
 
  private:
-  struct Task {
-    int threadRef = LUA_NOREF;
-    std::string name;  // as errors name it: "main chunk", "task lap.lua:12"
-    std::optional<Loop::TimerId> wake;
-  };
-  struct Timer {
-    int fnRef = LUA_NOREF;
-    Loop::TimerId id = 0;
-    std::optional<Duration> period;
-    TimePoint due{};
-    // "pitwall.every callback (race.lua:12)", as errors name it (shared: a tick copies it)
-    std::shared_ptr<const std::string> what;
-  };
   void openLibraries();
   void trackRequire();
   void carJoined(AnkiCar& car);
   static int searchAndRecord(lua_State* L);
   bool protectedCall(int nargs, int nresults, std::string& error, bool console);
   bool finishCall(int status, const char* what, std::string_view who);
-  void resume(lua_State* co, int nargs);
-  void endTask(lua_State* co, const std::string& error);  // error empty: it returned
-  void fireTimer(int handle);
   Result<bool, std::string> startLoaded(int status);
-
-  void checkMemory();
 
   Loop& loop_;
   Fleet& fleet_;
@@ -179,12 +162,10 @@ class ScriptHost {
   sandbox::Memory memory_;  // before L_: the state's allocator counts in it until lua_close
   lua_State* L_ = nullptr;
   std::unique_ptr<CarBinding> cars_;
-  std::unordered_map<lua_State*, Task> tasks_;
-  lua_State* mainTask_ = nullptr;
+  Tasks tasks_{*this};
+  Timers timers_{*this};
   bool mainFinished_ = false;
   bool mainFailed_ = false;
-  std::unordered_map<int, Timer> timers_;
-  int nextTimer_ = 1;
   bool stopRequested_ = false;
   bool shutDown_ = false;
   bool lastWords_ = false;  // lastWords() is running: its call() is let through
@@ -195,7 +176,7 @@ class ScriptHost {
   int errors_ = 0;
   ErrorFlood flood_{loop_, "script"};  // errors to the log: one traceback per place, then counts
   bool attached_ = false;
-  std::function<void(AnkiCar&)> previousOnCar_;
+  Subscription joined_;  // Fleet::carJoined, while attached
   bool trial_ = false;
   std::optional<std::string> trialError_;
   std::vector<std::string> loadedFiles_;

@@ -171,7 +171,12 @@ int addCar(lua_State* L) {
   if (std::find(taken.begin(), taken.end(), spec.name) != taken.end())
     throw LuaError("a car named '" + spec.name + "' is already in the run");
 
-  AnkiCar& car = host.fleet().addSimulated(*s.world, spec);
+  sim::SimCar& simCar = s.world->addCar(spec);
+  auto link = std::make_unique<SimLink>(host.loop(), simCar);
+  SimLink& toCar = *link;
+  AnkiCar& car = host.fleet().add(std::move(link),
+                                  CarIdentity{0, spec.name, spec.model_id, simCar.identifier()});
+  toCar.connect();  // now that the fleet listens: the car joins the run (pitwall.onCar) here
   host.cars().bind(car);
   host.cars().push(L, car);
   return 1;

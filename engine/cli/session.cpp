@@ -333,8 +333,9 @@ void Session::record(const std::string& path) {
   auto layout = std::make_shared<std::string>(
       sim_.world ? ",\"layout\":" + nlohmann::json(sim::layoutText(sim_.world->track())).dump()
                  : "");
-  fleet_.onFrame = [this, named, layout](AnkiCar& car, AnkiCar::Direction d,
-                                         std::span<const std::uint8_t> f, const anki::Message& m) {
+  recording_ = fleet_.frames.connect([this, named, layout](AnkiCar& car, AnkiCar::Direction d,
+                                                           std::span<const std::uint8_t> f,
+                                                           const anki::Message& m) {
     std::string extra = std::exchange(*layout, {});
     if (named->insert(car.identity().number).second)
       extra +=
@@ -342,7 +343,7 @@ void Session::record(const std::string& path) {
                                 .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
     recorder_->write(loop_.seconds(), car.identity().number, d == AnkiCar::Direction::Tx, f, m,
                      extra);
-  };
+  });
 }
 
 // A killed run loses at most the last 100 ms of its record: in real time the record reaches
@@ -363,17 +364,19 @@ bool Session::addGridCars(int count) {
     sim::CarSpec spec = sim::gridSpec(sim_.world->track(), i);
     spec.name = anki::uniqueCarName(spec.model_id, names);
     names.push_back(spec.name);
-    fleet_.addSimulated(*sim_.world, spec);
+    sim::SimCar& simCar = sim_.world->addCar(spec);
+    auto link = std::make_unique<SimLink>(loop_, simCar);
+    SimLink& toCar = *link;
+    fleet_.add(std::move(link), CarIdentity{0, spec.name, spec.model_id, simCar.identifier()});
+    toCar.connect();  // now that the fleet listens
   }
   if (count == 0) return true;
-  auto previous = fleet_.onCar;
-  fleet_.onCar = [&](AnkiCar&) {
+  Subscription joined = fleet_.carJoined.connect([&](AnkiCar&) {
     if (fleet_.connectedCount() == static_cast<std::size_t>(count)) loop_.stop();
-  };
+  });
   auto timeout = loop_.after(std::chrono::seconds(5), [this] { loop_.stop(); });
   loop_.run();
   loop_.cancel(timeout);
-  fleet_.onCar = previous;
   return fleet_.connectedCount() == static_cast<std::size_t>(count);
 }
 

@@ -85,6 +85,7 @@ class Session {
   SimSession sim_;
   Fleet fleet_;
   std::unique_ptr<Recorder> recorder_;
+  Subscription recording_;                 // the fleet's frames into recorder_ (--record)
   std::unique_ptr<ble::Central> central_;  // real cars; after the fleet: its links live there
   std::unique_ptr<Reloader> scripts_;
   // MQTT (docs/mqtt.md): the client, and either remote cars (--mqtt) or the bridge

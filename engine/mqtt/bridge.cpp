@@ -50,22 +50,12 @@ MqttBridge::MqttBridge(Loop& loop, Fleet& fleet, MqttClient& client, BridgeOptio
     client_.subscribe("Anki/Host/+/S/HostStatus", 1);
   }
 
-  previousOnCar_ = std::move(fleet_.onCar);
-  fleet_.onCar = [this](AnkiCar& car) {
-    if (previousOnCar_) previousOnCar_(car);
-    joined(car);
-  };
-  previousOnConnection_ = std::move(fleet_.onConnectionChange);
-  fleet_.onConnectionChange = [this](AnkiCar& car, bool up, const std::string& reason) {
-    if (previousOnConnection_) previousOnConnection_(car, up, reason);
-    connectionChanged(car, up);
-  };
-  previousOnFrame_ = std::move(fleet_.onFrame);
-  fleet_.onFrame = [this](AnkiCar& car, AnkiCar::Direction d, std::span<const std::uint8_t> f,
-                          const anki::Message& m) {
-    if (previousOnFrame_) previousOnFrame_(car, d, f, m);
-    frame(car, d, f, m);
-  };
+  joinedSub_ = fleet_.carJoined.connect([this](AnkiCar& car) { joined(car); });
+  connectionSub_ = fleet_.connectionChanged.connect(
+      [this](AnkiCar& car, bool up, const std::string&) { connectionChanged(car, up); });
+  framesSub_ = fleet_.frames.connect([this](AnkiCar& car, AnkiCar::Direction d,
+                                            std::span<const std::uint8_t> f,
+                                            const anki::Message& m) { frame(car, d, f, m); });
   // Cars that were connected before the bridge started.
   for (auto* car : fleet_.cars())
     if (car->state().connected) joined(*car);
@@ -75,9 +65,9 @@ MqttBridge::MqttBridge(Loop& loop, Fleet& fleet, MqttClient& client, BridgeOptio
 MqttBridge::~MqttBridge() {
   for (auto& [key, s] : dropped_) loop_.cancel(s.timer);
   loop_.cancel(unanswered_.timer);
-  fleet_.onCar = std::move(previousOnCar_);
-  fleet_.onConnectionChange = std::move(previousOnConnection_);
-  fleet_.onFrame = std::move(previousOnFrame_);
+  joinedSub_.disconnect();
+  connectionSub_.disconnect();
+  framesSub_.disconnect();
   client_.onConnected = nullptr;
   client_.onMessage = nullptr;
 }

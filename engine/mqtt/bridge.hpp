@@ -141,11 +141,8 @@ class MqttBridge {
   TokenBucket errorBucket_;
   Summary unanswered_;
   Stats stats_;
-  std::function<void(AnkiCar&)> previousOnCar_;
-  std::function<void(AnkiCar&, bool, const std::string&)> previousOnConnection_;
-  std::function<void(AnkiCar&, AnkiCar::Direction, std::span<const std::uint8_t>,
-                     const anki::Message&)>
-      previousOnFrame_;
+  // The fleet's events, while the bridge lives (after whoever subscribed before it).
+  Subscription joinedSub_, connectionSub_, framesSub_;
 };
 
 }  // namespace pitwall

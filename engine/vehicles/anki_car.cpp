@@ -15,7 +15,7 @@ using namespace anki;
 AnkiCar::AnkiCar(Loop& loop, Link& link, CarIdentity identity)
     : loop_(loop), link_(link), identity_(std::move(identity)) {
   link_.onFrame([this](std::span<const std::uint8_t> f) { receive(f); });
-  link_.onState([this](bool up, const std::string& why) { connectionChanged(up, why); });
+  link_.onState([this](bool up, const std::string& why) { linkStateChanged(up, why); });
   state_.connected = link_.connected();
 }
 
@@ -218,7 +218,7 @@ void AnkiCar::apply(const Message& message) {
   }
 }
 
-void AnkiCar::connectionChanged(bool up, const std::string& reason) {
+void AnkiCar::linkStateChanged(bool up, const std::string& reason) {
   state_.connected = up;
   if (up) {
     // Without SDK mode the car ignores speed and lane commands (anki-overdrive.md "GATT").
@@ -231,7 +231,7 @@ void AnkiCar::connectionChanged(bool up, const std::string& reason) {
     pingSentAt_.reset();
   }
   log::info(label(), up ? "connected" : "disconnected: " + reason);
-  if (onConnection) onConnection(up, reason);
+  connectionChanged.emit(up, reason);
 }
 
 }  // namespace pitwall

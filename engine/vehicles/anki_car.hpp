@@ -12,6 +12,7 @@
 
 #include "engine/core/loop.hpp"
 #include "engine/core/result.hpp"
+#include "engine/core/signal.hpp"
 #include "engine/protocol/anki/codec.hpp"
 #include "engine/transport/link.hpp"
 
@@ -99,7 +100,9 @@ class AnkiCar {
 
   // Events. Handlers are called on the loop; the message has already updated state().
   std::function<void(const anki::Message&)> onMessage;
-  std::function<void(bool connected, const std::string& reason)> onConnection;
+  // Every connection change. Several listen (the fleet, which subscribes first, then the car's
+  // Lua object), each holding its subscription.
+  Signal<bool /*connected*/, const std::string& /*reason*/> connectionChanged;
   std::function<void(const anki::DecodeError&, std::span<const std::uint8_t>)> onMalformed;
   // Round-trip time of the last ping, delivered with the ping response (seconds).
   std::optional<double> lastPingRtt() const { return lastPingRtt_; }
@@ -116,7 +119,7 @@ class AnkiCar {
  private:
   void apply(const anki::Message& message);
   void keepExtra(const anki::Message& message, std::span<const std::uint8_t> extra);
-  void connectionChanged(bool up, const std::string& reason);
+  void linkStateChanged(bool up, const std::string& reason);
   void laneChangeReached();
 
   Loop& loop_;

@@ -2,7 +2,6 @@
 
 #include "engine/core/log.hpp"
 #include "engine/protocol/anki/advertisement.hpp"
-#include "engine/transport/sim_link.hpp"
 
 namespace pitwall {
 
@@ -10,6 +9,7 @@ struct Fleet::Entry {
   std::unique_ptr<Link> link;
   std::unique_ptr<AnkiCar> car;
   bool joined = false;
+  Subscription connection;  // the fleet's, first of the car's connection listeners
 };
 
 Fleet::Fleet(Loop& loop) : loop_(loop) {}
@@ -24,36 +24,19 @@ AnkiCar& Fleet::add(std::unique_ptr<Link> link, CarIdentity identity) {
   Entry* e = entry.get();
   AnkiCar& car = *e->car;
   if (halted_) (void)car.halt();  // a car that joins after the end of the run obeys nothing
-  car.onConnection = [this, e](bool up, const std::string& reason) {
-    // onCar may replace this very handler (a Lua world that takes the car hooks its events,
-    // chaining this one): nothing of the lambda is touched after it, only these copies.
-    Fleet* fleet = this;
-    Entry* entry = e;
-    if (up && !entry->joined) {
-      entry->joined = true;
-      if (fleet->onCar) fleet->onCar(*entry->car);
+  // A Lua world that takes the car in carJoined subscribes to its connection too, after the
+  // fleet: it hears of the connections from the next one on (Signal's rules).
+  e->connection = car.connectionChanged.connect([this, e](bool up, const std::string& reason) {
+    if (up && !e->joined) {
+      e->joined = true;
+      carJoined.emit(*e->car);
     }
-    if (fleet->onConnectionChange) fleet->onConnectionChange(*entry->car, up, reason);
-  };
+    connectionChanged.emit(*e->car, up, reason);
+  });
   car.onFrame = [this, e](AnkiCar::Direction d, std::span<const std::uint8_t> f,
-                          const anki::Message& m) {
-    if (onFrame) onFrame(*e->car, d, f, m);
-  };
+                          const anki::Message& m) { frames.emit(*e->car, d, f, m); };
   entries_.push_back(std::move(entry));
   cars_.push_back(&car);
-  return car;
-}
-
-AnkiCar& Fleet::addSimulated(sim::World& world, const sim::CarSpec& spec) {
-  sim::SimCar& simCar = world.addCar(spec);
-  auto link = std::make_unique<SimLink>(loop_, simCar);
-  SimLink* raw = link.get();
-  CarIdentity id;
-  id.name = spec.name;
-  id.model_id = spec.model_id;
-  id.identifier = simCar.identifier();
-  AnkiCar& car = add(std::move(link), std::move(id));
-  raw->connect();
   return car;
 }
 

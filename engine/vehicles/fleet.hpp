@@ -1,12 +1,13 @@
 #pragma once
 // The cars of one run: each an AnkiCar over the Link that owns its connection. Cars are numbered
-// from 1 in the order they join. Simulated cars join through a SimLink.
+// from 1 in the order they join. The fleet knows links, not where they lead: a simulated car
+// joins with the SimLink its session made (engine/cli/session.cpp), a real one with its BLE link.
 #include <functional>
 #include <memory>
 #include <vector>
 
 #include "engine/core/loop.hpp"
-#include "engine/sim/world.hpp"
+#include "engine/core/signal.hpp"
 #include "engine/vehicles/anki_car.hpp"
 
 namespace pitwall {
@@ -18,23 +19,24 @@ class Fleet {
   Fleet(const Fleet&) = delete;
   Fleet& operator=(const Fleet&) = delete;
 
-  // Takes the link; the car is known at once and joins (onCar) when its link first connects.
+  // Takes the link; the car is known at once and joins (carJoined) when its link first
+  // connects. A link that connects when told is told after this returns, so that the fleet sees
+  // the connection.
   AnkiCar& add(std::unique_ptr<Link> link, CarIdentity identity);
-  // A simulated car placed in `world`, connected through a SimLink.
-  AnkiCar& addSimulated(sim::World& world, const sim::CarSpec& spec);
 
   const std::vector<AnkiCar*>& cars() const { return cars_; }
   AnkiCar* find(int number) const;
   std::size_t connectedCount() const;
 
-  // Called once per car, the first time it connects.
-  std::function<void(AnkiCar&)> onCar;
-  // Every connection change of every car, after the car's own handler (the MQTT bridge).
-  std::function<void(AnkiCar&, bool connected, const std::string& reason)> onConnectionChange;
-  // Every frame of every car (for --record, and the MQTT bridge).
-  std::function<void(AnkiCar&, AnkiCar::Direction, std::span<const std::uint8_t>,
-                     const anki::Message&)>
-      onFrame;
+  // Listeners (the Lua world, the MQTT bridge, the race view, --record) subscribe and hold their
+  // Subscription; they are called in the order they subscribed.
+  // Once per car, the first time it connects.
+  Signal<AnkiCar&> carJoined;
+  // Every connection change of every car, after carJoined on a first connection (the MQTT
+  // bridge, the race view).
+  Signal<AnkiCar&, bool /*connected*/, const std::string& /*reason*/> connectionChanged;
+  // Every frame of every car, in and out (--record, the MQTT bridge, the race view).
+  Signal<AnkiCar&, AnkiCar::Direction, std::span<const std::uint8_t>, const anki::Message&> frames;
 
   // Sends speed 0 to every connected car (shutdown, end of run, script death).
   void stopAll();

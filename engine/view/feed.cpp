@@ -32,24 +32,20 @@ struct Feed::Car {
 
 Feed::Feed(Loop& loop, Fleet& fleet, std::string source)
     : loop_(loop), fleet_(fleet), source_(std::move(source)) {
-  previousOnFrame_ = std::move(fleet_.onFrame);
-  fleet_.onFrame = [this](AnkiCar& car, AnkiCar::Direction d, std::span<const std::uint8_t> f,
-                          const anki::Message& m) {
-    if (previousOnFrame_) previousOnFrame_(car, d, f, m);
-    frame(car, d, m);
-  };
-  previousOnConnection_ = std::move(fleet_.onConnectionChange);
-  fleet_.onConnectionChange = [this](AnkiCar& car, bool up, const std::string& reason) {
-    if (previousOnConnection_) previousOnConnection_(car, up, reason);
-    event(up ? "info" : "warn", car.label() + (up ? " connected" : " disconnected") +
-                                    (up || reason.empty() ? "" : ": " + reason));
-  };
+  framesSub_ = fleet_.frames.connect([this](AnkiCar& car, AnkiCar::Direction d,
+                                            std::span<const std::uint8_t>,
+                                            const anki::Message& m) { frame(car, d, m); });
+  connectionSub_ =
+      fleet_.connectionChanged.connect([this](AnkiCar& car, bool up, const std::string& reason) {
+        event(up ? "info" : "warn", car.label() + (up ? " connected" : " disconnected") +
+                                        (up || reason.empty() ? "" : ": " + reason));
+      });
 }
 
 Feed::~Feed() {
   followLog(false);
-  fleet_.onFrame = std::move(previousOnFrame_);
-  fleet_.onConnectionChange = std::move(previousOnConnection_);
+  framesSub_.disconnect();
+  connectionSub_.disconnect();
 }
 
 void Feed::followLog(bool on) {

@@ -1,7 +1,7 @@
 #pragma once
 // What the race view shows (docs/view.md): the track, every car where the controller believes
 // it is, the race as the race library reports it, and an event log. The feed follows the fleet's
-// frames (chained on Fleet::onFrame and onConnectionChange, as the MQTT bridge does) and the
+// frames (subscribed to Fleet::frames and connectionChanged, as the MQTT bridge is) and the
 // engine's log; the server turns it into /api/state and /ws updates. It sends nothing to a car.
 #include <cstdint>
 #include <deque>
@@ -99,8 +99,7 @@ class Feed {
   std::deque<Event> events_;
   std::uint64_t nextEvent_ = 0;
   std::map<int, std::unique_ptr<Car>> cars_;
-  decltype(Fleet::onFrame) previousOnFrame_;
-  decltype(Fleet::onConnectionChange) previousOnConnection_;
+  Subscription framesSub_, connectionSub_;  // the fleet's events, while the feed lives
   std::uint64_t logTap_ = 0;
   std::uint64_t changes_ = 0;
   mutable std::string shared_;  // updateText's shared part, as of change sharedAt_

@@ -22,7 +22,7 @@
 // BM_MqttRemoteThroughput/<cars>/<window>/<broker_nodelay>: the same with B = RemoteCars, which
 //   takes 3 messages per update (E/frame and the 2 status; not the other events), so the window
 //   is window × 3 messages: items are the frames that reach B's AnkiCars (AnkiCar::receive),
-//   counted by B's Fleet::onFrame.
+//   counted by B's Fleet::frames.
 // BM_MqttFrameToLua/<samples>/<broker_nodelay>: one sample at a time (tests/bench/latency.hpp):
 //   t0, inject a position update on A's car, t1 when B's Lua onPosition handler calls
 //   mark(ev.location). Path `eng`:
@@ -387,13 +387,13 @@ void BM_MqttRemoteThroughput(benchmark::State& state) {
     auto inner = b.onMessage;
     b.onMessage = [&](std::string_view topic, std::string_view payload, bool retained) {
       if (topic == "bench/sync") rig.synced = true;
-      inner(topic, payload, retained);  // a frame reaches B's car (and onFrame) in here
+      inner(topic, payload, retained);  // a frame reaches B's car (and Fleet::frames) in here
       if (isVehicleTopic(topic)) p.received();
     };
-    fleetB.onFrame = [&](AnkiCar&, AnkiCar::Direction d, std::span<const std::uint8_t>,
-                         const anki::Message&) {
-      if (d == AnkiCar::Direction::Rx && p.counting) ++p.delivered;
-    };
+    auto counting = fleetB.frames.connect(
+        [&](AnkiCar&, AnkiCar::Direction d, std::span<const std::uint8_t>, const anki::Message&) {
+          if (d == AnkiCar::Direction::Rx && p.counting) ++p.delivered;
+        });
     if (!rig.connect(*rig.clientA) || !rig.startRemote(remote, static_cast<std::size_t>(cars))) {
       state.SkipWithError(rig.error.c_str());
       return;

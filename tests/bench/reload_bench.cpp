@@ -31,6 +31,7 @@
 #include "engine/sim/grid.hpp"
 #include "tests/bench/frames.hpp"
 #include "tests/support/run_until.hpp"
+#include "tests/support/sim_cars.hpp"
 
 namespace {
 
@@ -136,7 +137,8 @@ void BM_ReloadRace(benchmark::State& state) {
   SimSession sim;
   sim.world = std::make_unique<sim::World>(loop, *sim::loadLayout("oval"), 1);
   Fleet fleet(loop);
-  for (int i = 0; i < 4; ++i) fleet.addSimulated(*sim.world, sim::gridSpec(sim.world->track(), i));
+  for (int i = 0; i < 4; ++i)
+    testing::addSimulatedCar(loop, fleet, *sim.world, sim::gridSpec(sim.world->track(), i));
   auto runFor = [&](Duration d) {
     auto id = loop.after(d, [&] { loop.stop(); });
     loop.run();

@@ -20,6 +20,7 @@
 #include "engine/sim/track.hpp"
 #include "engine/sim/world.hpp"
 #include "engine/vehicles/fleet.hpp"
+#include "tests/support/sim_cars.hpp"
 
 namespace {
 
@@ -70,16 +71,16 @@ struct SimRig {
           count <= 4 ? sim::gridSpec(world->track(), i) : spreadSpec(world->track(), i, count);
       spec.name = anki::uniqueCarName(spec.model_id, names);
       names.push_back(spec.name);
-      fleet->addSimulated(*world, spec);
+      testing::addSimulatedCar(loop, *fleet, *world, spec);
     }
     auto total = static_cast<std::size_t>(count);
-    fleet->onCar = [this, total](AnkiCar&) {
+    Subscription joined = fleet->carJoined.connect([this, total](AnkiCar&) {
       if (fleet->connectedCount() == total) loop.stop();
-    };
+    });
     auto timeout = loop.after(std::chrono::seconds(5), [this] { loop.stop(); });
     loop.run();
     loop.cancel(timeout);
-    fleet->onCar = nullptr;
+    joined.disconnect();
     if (fleet->connectedCount() != total) error = "not every simulated car connected";
   }
 

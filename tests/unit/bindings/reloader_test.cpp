@@ -11,6 +11,7 @@
 #include "engine/core/log.hpp"
 #include "engine/protocol/anki/messages.hpp"
 #include "engine/sim/grid.hpp"
+#include "tests/support/sim_cars.hpp"
 
 using namespace pitwall;
 using namespace std::chrono_literals;
@@ -26,6 +27,7 @@ struct ReloadFixture {
   fs::path dir;
   std::vector<std::string> logged;
   long positions = 0;  // position updates the cars sent, counted below Lua
+  Subscription counting;
 
   explicit ReloadFixture(ClockKind clock = ClockKind::Virtual, int cars = 2) : loop(clock) {
     setenv("PITWALL_SCRIPTS", PITWALL_SOURCE_DIR "/scripts", 1);
@@ -34,12 +36,12 @@ struct ReloadFixture {
     fs::create_directories(dir);
     sim.world = std::make_unique<sim::World>(loop, *sim::loadLayout("oval"), 1);
     for (int i = 0; i < cars; ++i)
-      fleet.addSimulated(*sim.world, sim::gridSpec(sim.world->track(), i));
-    fleet.onFrame = [this](AnkiCar&, AnkiCar::Direction d, std::span<const std::uint8_t>,
-                           const anki::Message& m) {
+      testing::addSimulatedCar(loop, fleet, *sim.world, sim::gridSpec(sim.world->track(), i));
+    counting = fleet.frames.connect([this](AnkiCar&, AnkiCar::Direction d,
+                                           std::span<const std::uint8_t>, const anki::Message& m) {
       if (d == AnkiCar::Direction::Rx && std::holds_alternative<anki::PositionUpdate>(m))
         ++positions;
-    };
+    });
     runFor(1s);  // the cars connect
     REQUIRE(fleet.connectedCount() == static_cast<std::size_t>(cars));
     scripts = std::make_unique<Reloader>(loop, fleet, &sim, HostOptions{});

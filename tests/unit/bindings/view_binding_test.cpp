@@ -9,6 +9,7 @@
 #include "engine/sim/grid.hpp"
 #include "engine/vehicles/fleet.hpp"
 #include "engine/view/feed.hpp"
+#include "tests/support/sim_cars.hpp"
 
 using namespace pitwall;
 
@@ -105,7 +106,8 @@ TEST_CASE("race library → view: phases in order, the table with drivers, the s
   SimSession sim;
   sim.world = std::make_unique<sim::World>(loop, *sim::loadLayout("oval"), 1);
   Fleet fleet{loop};
-  for (int i = 0; i < 3; ++i) fleet.addSimulated(*sim.world, sim::gridSpec(sim.world->track(), i));
+  for (int i = 0; i < 3; ++i)
+    testing::addSimulatedCar(loop, fleet, *sim.world, sim::gridSpec(sim.world->track(), i));
   auto until = loop.after(std::chrono::seconds(1), [&] { loop.stop(); });
   loop.run();
   loop.cancel(until);

@@ -25,6 +25,7 @@
 #include "tests/support/hostile_payloads.hpp"
 #include "tests/support/mosquitto_broker.hpp"
 #include "tests/support/run_until.hpp"
+#include "tests/support/sim_cars.hpp"
 
 namespace pitwall::testing::bridge {
 
@@ -110,6 +111,7 @@ struct Host {
   sim::World world;
   Fleet fleet;
   std::vector<SentFrame> tx;  // every command sent to a car, recorded before the bridge sees it
+  Subscription watch;
   std::unique_ptr<MqttClient> client;
   std::unique_ptr<MqttBridge> bridge;
   std::int64_t connectedAt = 0, lostAt = 0;  // the client's last connection and loss (ms)
@@ -119,11 +121,12 @@ struct Host {
       : Host(l, broker, optionsFor(kHost, readOnly)) {}
   Host(Loop& l, const MosquittoBroker& broker, BridgeOptions o)
       : loop(l), world(l, *sim::loadLayout("oval"), 7), fleet(l), bridgeOptions(std::move(o)) {
-    for (int i = 0; i < 2; ++i) fleet.addSimulated(world, sim::gridSpec(world.track(), i));
-    fleet.onFrame = [this](AnkiCar& car, AnkiCar::Direction d, std::span<const std::uint8_t>,
-                           const anki::Message& m) {
+    for (int i = 0; i < 2; ++i)
+      testing::addSimulatedCar(loop, fleet, world, sim::gridSpec(world.track(), i));
+    watch = fleet.frames.connect([this](AnkiCar& car, AnkiCar::Direction d,
+                                        std::span<const std::uint8_t>, const anki::Message& m) {
       if (d == AnkiCar::Direction::Tx) tx.push_back({&car, m});
-    };
+    });
     REQUIRE(runUntil(loop, [&] { return fleet.connectedCount() == 2; }));
     startBridge(broker);
   }

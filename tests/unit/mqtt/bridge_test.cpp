@@ -1,6 +1,7 @@
 // MqttBridge against a real mosquitto broker (tests/support/mosquitto_broker.hpp): two simulated
 // cars on the oval, driven in real time on the one real-clock loop, published under the seed's
 // topic tree; intents sent by an observer client that also records everything under Anki/#.
+#include "tests/support/sim_cars.hpp"
 #include "tests/unit/mqtt/bridge_fixture.hpp"
 
 #include <doctest/doctest.h>
@@ -412,7 +413,8 @@ TEST_CASE("mqtt bridge: the broker publishes HostStatus false when a bridge's pr
     Loop childLoop(ClockKind::Real);
     sim::World world(childLoop, *sim::loadLayout("oval"), 7);
     Fleet fleet(childLoop);
-    for (int i = 0; i < 2; ++i) fleet.addSimulated(world, sim::gridSpec(world.track(), i));
+    for (int i = 0; i < 2; ++i)
+      testing::addSimulatedCar(childLoop, fleet, world, sim::gridSpec(world.track(), i));
     auto options = MqttOptions::fromUrl(broker.url());
     options.will = MqttBridge::will(kHost);
     MqttClient client(childLoop, options);

@@ -84,11 +84,12 @@ struct Remote {
   RemoteCars remote;
   bool synced = false;
   std::vector<std::string> downs;
+  Subscription watch;
   Remote(Loop& loop, const MosquittoBroker& broker)
       : fleet(loop), client(loop, MqttOptions::fromUrl(broker.url())), remote(loop, fleet, client) {
-    fleet.onConnectionChange = [this](AnkiCar&, bool up, const std::string& reason) {
+    watch = fleet.connectionChanged.connect([this](AnkiCar&, bool up, const std::string& reason) {
       if (!up) downs.push_back(reason);
-    };
+    });
     remote.start([this] { synced = true; }, [](const std::string&) {});
   }
 };

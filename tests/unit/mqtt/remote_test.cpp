@@ -23,6 +23,7 @@
 #include "tests/support/hostile_payloads.hpp"
 #include "tests/support/mosquitto_broker.hpp"
 #include "tests/support/run_until.hpp"
+#include "tests/support/sim_cars.hpp"
 
 using namespace pitwall;
 using namespace std::chrono_literals;
@@ -40,16 +41,18 @@ struct BridgedHost {
   sim::World world;
   Fleet fleet;
   std::vector<std::pair<AnkiCar*, anki::Message>> tx;
+  Subscription watch;
   std::unique_ptr<MqttClient> client;
   std::unique_ptr<MqttBridge> bridge;
 
   BridgedHost(Loop& l, const MosquittoBroker& b)
       : loop(l), broker(b), world(l, *sim::loadLayout("oval"), 11), fleet(l) {
-    for (int i = 0; i < 2; ++i) fleet.addSimulated(world, sim::gridSpec(world.track(), i));
-    fleet.onFrame = [this](AnkiCar& car, AnkiCar::Direction d, std::span<const std::uint8_t>,
-                           const anki::Message& m) {
+    for (int i = 0; i < 2; ++i)
+      testing::addSimulatedCar(loop, fleet, world, sim::gridSpec(world.track(), i));
+    watch = fleet.frames.connect([this](AnkiCar& car, AnkiCar::Direction d,
+                                        std::span<const std::uint8_t>, const anki::Message& m) {
       if (d == AnkiCar::Direction::Tx) tx.emplace_back(&car, m);
-    };
+    });
     REQUIRE(runUntil(loop, [&] { return fleet.connectedCount() == 2; }));
     startBridge();
   }
@@ -91,12 +94,14 @@ struct RemoteHost {
   std::optional<std::string> failed;
   std::vector<std::pair<std::string, std::string>> downs;  // car name, reason
   int changes = 0;
+  Subscription watch;
 
   RemoteHost(Loop& loop, const MosquittoBroker& broker)
       : fleet(loop), client(loop, MqttOptions::fromUrl(broker.url())), remote(loop, fleet, client) {
-    fleet.onConnectionChange = [this](AnkiCar& car, bool up, const std::string& reason) {
-      if (!up) downs.emplace_back(car.identity().name, reason);
-    };
+    watch =
+        fleet.connectionChanged.connect([this](AnkiCar& car, bool up, const std::string& reason) {
+          if (!up) downs.emplace_back(car.identity().name, reason);
+        });
     remote.onChange = [this] { ++changes; };
     remote.start([this] { synced = true; }, [this](const std::string& r) { failed = r; });
   }

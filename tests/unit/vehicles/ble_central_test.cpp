@@ -138,7 +138,8 @@ TEST_CASE("ble: a dropped car is reported, reconnected, and gets SDK mode again"
   REQUIRE(rig.start() == std::nullopt);
   AnkiCar* car = rig.car(kCar1);
   std::vector<std::pair<bool, std::string>> states;
-  car->onConnection = [&](bool up, const std::string& why) { states.emplace_back(up, why); };
+  auto watch = car->connectionChanged.connect(
+      [&](bool up, const std::string& why) { states.emplace_back(up, why); });
   REQUIRE(car->setSpeed(800, 5000));
   REQUIRE(rig.waitFor([&] { return rig.fake.car(kCar1).truth().speed_mm_s > 0; }));
 
@@ -164,9 +165,9 @@ TEST_CASE("ble: a vanished car is reported and looked for, without connection at
   AnkiCar* car = rig.car(kCar2);
   REQUIRE(rig.waitFor([&] { return car->state().connected; }));
   std::string reason;
-  car->onConnection = [&](bool up, const std::string& why) {
+  auto watch = car->connectionChanged.connect([&](bool up, const std::string& why) {
     if (!up) reason = why;
-  };
+  });
   rig.fake.vanish(kCar2);
   REQUIRE(rig.waitFor([&] { return !reason.empty(); }));
   CHECK(reason.find(kCar2) != std::string::npos);

@@ -10,6 +10,7 @@
 #include "engine/vehicles/fleet.hpp"
 #include "engine/view/feed.hpp"
 #include "engine/view/geometry.hpp"
+#include "tests/support/sim_cars.hpp"
 
 using namespace pitwall;
 
@@ -30,7 +31,7 @@ struct Race {
   AnkiCar& driving(int speed, int accel) {
     feed = std::make_unique<view::Feed>(loop, fleet, "simulator");
     feed->setTrack(world.track(), "layout");
-    auto& car = fleet.addSimulated(world, sim::CarSpec{.name = "skull"});
+    auto& car = testing::addSimulatedCar(loop, fleet, world, sim::CarSpec{.name = "skull"});
     run(0.5);
     REQUIRE(car.sdkMode(true));
     REQUIRE(car.setSpeed(speed, accel));
@@ -53,8 +54,8 @@ TEST_CASE("view feed: cars are placed where the simulator has them, and laps are
     r.feed->setTrack(r.world.track(), "layout");
     sim::CarSpec a{.name = "a", .piece_index = 0, .offset_mm = -68};
     sim::CarSpec b{.name = "b", .piece_index = 0, .offset_mm = 68};
-    auto& ca = r.fleet.addSimulated(r.world, a);
-    auto& cb = r.fleet.addSimulated(r.world, b);
+    auto& ca = testing::addSimulatedCar(r.loop, r.fleet, r.world, a);
+    auto& cb = testing::addSimulatedCar(r.loop, r.fleet, r.world, b);
     r.run(0.5);
     REQUIRE(ca.sdkMode(true));
     REQUIRE(cb.sdkMode(true));
@@ -100,11 +101,12 @@ TEST_CASE("view feed: cars are placed where the simulator has them, and laps are
 TEST_CASE("view feed: connections and log lines join the event log; others' hooks still run") {
   Race r;
   int framesSeen = 0;
-  r.fleet.onFrame = [&](AnkiCar&, AnkiCar::Direction, std::span<const std::uint8_t>,
-                        const anki::Message&) { ++framesSeen; };
+  auto counting =
+      r.fleet.frames.connect([&](AnkiCar&, AnkiCar::Direction, std::span<const std::uint8_t>,
+                                 const anki::Message&) { ++framesSeen; });
   r.feed = std::make_unique<view::Feed>(r.loop, r.fleet, "simulator");
   r.feed->followLog(true);
-  auto& car = r.fleet.addSimulated(r.world, sim::CarSpec{.name = "skull"});
+  auto& car = testing::addSimulatedCar(r.loop, r.fleet, r.world, sim::CarSpec{.name = "skull"});
   r.run(0.5);
   (void)car.sdkMode(true);
   r.run(0.2);

@@ -1,0 +1,101 @@
+#include "bindings/tasks.hpp"
+
+#include "bindings/interrupt.hpp"
+#include "bindings/script_host.hpp"
+
+namespace pitwall {
+
+namespace {
+void closeThread(lua_State* co) {
+#if LUA_VERSION_RELEASE_NUM >= 50406
+  lua_closethread(co, nullptr);
+#else
+  lua_resetthread(co);
+#endif
+}
+}  // namespace
+
+Tasks::Tasks(ScriptHost& host) : host_(host), loop_(host.loop()) {}
+
+Tasks::~Tasks() {
+  for (auto& [co, task] : tasks_)
+    if (task.wake) loop_.cancel(*task.wake);
+}
+
+void Tasks::spawn(lua_State* L, const std::string& name, bool main) {
+  if (host_.isShutDown()) {
+    lua_pop(L, 1);
+    return;
+  }
+  lua_State* co = lua_newthread(L);
+  int ref = luaL_ref(L, LUA_REGISTRYINDEX);  // pops the thread, keeps it alive
+  lua_xmove(L, co, 1);                       // the function
+  tasks_.emplace(co, Task{ref, main ? name : "task " + name, std::nullopt});
+  if (main) main_ = co;
+  resume(co, 0);
+}
+
+void Tasks::sleep(lua_State* co, Duration delay) {
+  auto it = tasks_.find(co);
+  if (it == tasks_.end() || host_.isShutDown()) return;
+  it->second.wake = loop_.after(delay, [this, co] {
+    auto t = tasks_.find(co);
+    if (t == tasks_.end()) return;
+    t->second.wake.reset();
+    resume(co, 0);
+  });
+}
+
+void Tasks::shutDown() {
+  for (auto& [co, task] : tasks_)
+    if (task.wake) {
+      loop_.cancel(*task.wake);
+      task.wake.reset();
+    }
+}
+
+void Tasks::resume(lua_State* co, int nargs) {
+  if (host_.isShutDown() || !tasks_.count(co)) return;
+  lua_State* L = host_.state();
+  int nres = 0;
+  int status;
+  {
+    interrupt::Scope scope(co, interrupt::Kind::Callback);
+    status = lua_resume(co, L, nargs, &nres);
+  }
+  std::string error;
+  if (status == LUA_YIELD) {
+    lua_pop(co, nres);
+    if (tasks_.at(co).wake) return;  // asleep: its timer resumes it
+    if (host_.isShutDown()) return;  // the run ended while it ran: it stays asleep for good
+    // A bare coroutine.yield() has nobody to wake it: end the task with a clear error.
+    error =
+        "the task yielded without pitwall.sleep or pitwall.waitUntil; nothing would ever "
+        "resume it";
+  } else if (status != LUA_OK && host_.memory().exceeded) {
+    host_.checkMemory();
+    error = sandbox::memoryMessage(host_.memory());
+  } else if (status != LUA_OK) {
+    const char* msg = lua_tostring(co, -1);
+    luaL_traceback(L, co, msg ? msg : "(error without a message)", 0);
+    error = lua_tostring(L, -1);
+    lua_pop(L, 1);
+  }
+  end(co, error);
+}
+
+void Tasks::end(lua_State* co, const std::string& error) {
+  auto it = tasks_.find(co);
+  std::string where = it->second.name;
+  closeThread(co);
+  luaL_unref(host_.state(), LUA_REGISTRYINDEX, it->second.threadRef);
+  tasks_.erase(it);
+  if (co == main_) {
+    main_ = nullptr;
+    host_.mainEnded(where, error);
+  } else if (!error.empty()) {
+    host_.reportError(where, error);
+  }
+}
+
+}  // namespace pitwall
