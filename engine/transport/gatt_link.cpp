@@ -285,6 +285,15 @@ void GattLink::disconnect() {
   }
 }
 
+void GattLink::reconnect(const std::string& reason) {
+  if (closed_ || !gatt_ || gatt_->idle()) return;
+  reportDown(reason);  // first: the hang-up's own "disconnected by the controller" is no news
+  std::weak_ptr<bool> alive = alive_;
+  gatt_->disconnect([this, alive, reason] {
+    if (!alive.expired()) retryLater(reason);
+  });
+}
+
 // ---- frames ----
 
 void GattLink::notified(std::size_t index, std::span<const std::uint8_t> bytes) {

@@ -86,6 +86,8 @@ class GattLink : public Link {
   bool send(std::span<const std::uint8_t> frame) override;
   bool connected() const override;
   void disconnect() override;
+  // Hangs up (reporting `reason`) and connects again after the backoff.
+  void reconnect(const std::string& reason) override;
   std::string address() const override { return "ble:" + address_; }
   // Down: why ("ble:…: not connected (…)"); up: the last failed write or read, or empty.
   std::string refusal() const override;
