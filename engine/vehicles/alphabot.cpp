@@ -29,8 +29,8 @@ std::int16_t i16(long long v) {
 }  // namespace
 
 std::unique_ptr<Link> makeAlphabotTcpLink(Loop& loop, const std::string& host, std::uint16_t port,
-                                          double connectTimeout, ab::wlan::Options codec) {
-  (void)codec;  // every packet's length follows from its id in either byte order
+                                          double connectTimeout) {
+  // Every packet's length follows from its id (and 0x83's count byte) in either byte order.
   SocketLinkOptions o;
   o.host = host;
   o.port = port;

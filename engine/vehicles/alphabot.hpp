@@ -51,8 +51,7 @@ struct AlphabotOptions {
 // The TCP link to an Alphabot at host:port, framed by its response packets; it starts
 // connecting at once, each attempt bounded by connectTimeout (s).
 std::unique_ptr<Link> makeAlphabotTcpLink(Loop& loop, const std::string& host, std::uint16_t port,
-                                          double connectTimeout,
-                                          alphabot::wlan::Options codec = {});
+                                          double connectTimeout);
 
 // The GATT link to an Alphabot at `address` (AA:BB:CC:DD:EE:FF): its eight characteristics by
 // ble::Characteristic, the five it notifies subscribed. nullptr and `error` set when the address

@@ -3,6 +3,8 @@
 // (tests/fake_bluez/fake_alphabot.hpp). Real clock; every wait is for a condition, with a deadline.
 #include "engine/vehicles/alphabot.hpp"
 
+#include "engine/transport/faulty_link.hpp"
+
 #include <doctest/doctest.h>
 
 #include <sdbus-c++/sdbus-c++.h>
@@ -49,12 +51,14 @@ struct Rig {
   std::vector<std::string> malformed;
   std::vector<std::pair<bool, std::string>> states;
 
-  explicit Rig(FakeBluez::Options o, std::string address = kRobot, GattLinkOptions lo = quick())
+  explicit Rig(FakeBluez::Options o, std::string address = kRobot, GattLinkOptions lo = quick(),
+               std::optional<Faults> faults = std::nullopt)
       : fake(loop, *fakeConnection, std::move(o)) {
     std::string error;
-    auto made = makeAlphabotBleLink(loop, address, lo, error);
+    std::unique_ptr<Link> made = makeAlphabotBleLink(loop, address, lo, error);
     REQUIRE_MESSAGE(made, error);
     gattLink = static_cast<GattLink*>(made.get());
+    if (faults) made = std::make_unique<FaultyLink>(std::move(made), *faults);
     AlphabotOptions options;
     options.wire = AlphabotOptions::Wire::Ble;
     link = std::make_unique<Alphabot>(loop, std::move(made), options);
@@ -323,4 +327,15 @@ TEST_CASE("alphabot ble: a malformed address is refused before anything starts")
   std::string error;
   CHECK_FALSE(makeAlphabotBleLink(loop, "AB:00:00:00:01", GattLinkOptions{}, error));
   CHECK(error == "'AB:00:00:00:01' is not a Bluetooth address: write it as AA:BB:CC:DD:EE:FF");
+}
+
+TEST_CASE("alphabot ble: an injected drop after a notification is a lost link, then back") {
+  Rig rig(robots(1), kRobot, quick(), Faults{.dropAfterFrames = 1});
+  REQUIRE(rig.up());
+  REQUIRE(rig.link->send(MeasureDistance{0}));
+  REQUIRE(rig.waitFor([&] { return rig.states.size() >= 3; }));
+  CHECK(rig.states[1] ==
+        std::make_pair(false, std::string("injected fault: dropped after 1 frames")));
+  CHECK(rig.states[2].first);  // the GATT link hung up and connected again
+  CHECK(rig.fake.counters(kRobot).connects == 2);
 }
