@@ -1,8 +1,8 @@
 // pitwall.alphabot{host=…, port=…} / {ble=ADDR}: an Alphabot robot as a Lua object
-// (docs/robots.md). One full userdata per robot, owning its C++ state (the link and
-// the handler references); the world keeps it in the registry until robot:close() or the end
-// of the world (lua_close runs __gc: the robot is sent a stop and its link is closed, so
-// nothing reaches a Lua state that is gone).
+// (docs/robots.md) over its model (engine/vehicles/alphabot.hpp). One full userdata per robot,
+// owning the model and the handler references; the world keeps it in the registry until
+// robot:close() or the end of the world (lua_close runs __gc: the robot is sent a stop and its link
+// is closed, so nothing reaches a Lua state that is gone).
 #include <array>
 #include <cctype>
 #include <cstring>
@@ -15,11 +15,11 @@
 #include "bindings/pitwall_module.hpp"
 #include "bindings/script_host.hpp"
 #include "engine/core/log.hpp"
+#include "engine/core/numbers.hpp"
 #include "engine/core/overload.hpp"
 #include "engine/protocol/alphabot/command_text.hpp"
 #include "engine/protocol/alphabot/toggles.hpp"
-#include "engine/vehicles/alphabot_ble_link.hpp"
-#include "engine/vehicles/alphabot_tcp_link.hpp"
+#include "engine/vehicles/alphabot.hpp"
 
 namespace pitwall {
 
@@ -56,16 +56,9 @@ constexpr std::array<const char*, 11> kFieldNames = {"connected", "x",         "
 
 struct Robot {
   ScriptHost* host = nullptr;
-  std::unique_ptr<ab::RobotLink> link;
+  std::unique_ptr<Alphabot> model;
   std::array<int, kEventCount> handlers;
   int selfRef = LUA_NOREF;
-  ab::Toggles toggles;
-  std::optional<int> x, y, heading;
-  std::optional<double> lastPing;
-  std::size_t pings = 0;  // ping replies received
-  std::vector<ab::Waypoint> path;
-  bool everConnected = false;
-  std::size_t malformed = 0;
   std::string label;  // "alphabot tcp:127.0.0.1:4000"
 
   Robot() { handlers.fill(LUA_NOREF); }
@@ -73,12 +66,9 @@ struct Robot {
   // Ends the robot's part in the world: a stop for a connected robot, the link closed, no more
   // events. Safe to call twice, and from __gc during lua_close.
   void close(lua_State* L) {
-    // The link's handlers stay set (one of them may be running: a handler that calls
-    // robot:close()); a closed link calls none of them again, and dispatch() checks closed().
-    if (link) {
-      if (link->connected()) link->send(ab::Drive{0, 0});
-      link->close();
-    }
+    // The model stays (one of its handlers may be running: a handler that calls
+    // robot:close()); a closed model calls none of them again, and dispatch() checks closed().
+    if (model) model->close();
     for (auto& h : handlers) {
       luaL_unref(L, LUA_REGISTRYINDEX, h);
       h = LUA_NOREF;
@@ -131,15 +121,12 @@ void received(Robot& r, const ab::Response& response) {
             });
           },
           [&](const ab::Position& p) {
-            r.x = p.x;
-            r.y = p.y;
             dispatch(r, kPosition, [&](lua_State* L) {
               lua::setInteger(L, "x", p.x);
               lua::setInteger(L, "y", p.y);
             });
           },
           [&](const ab::Path& p) {
-            r.path = p.waypoints;
             dispatch(r, kPath, [&](lua_State* L) {
               pushWaypoints(L, p.waypoints);
               lua_setfield(L, -2, "waypoints");
@@ -147,15 +134,10 @@ void received(Robot& r, const ab::Response& response) {
             });
           },
           [&](const ab::Compass& c) {
-            r.heading = c.degree;
             dispatch(r, kCompass, [&](lua_State* L) { lua::setInteger(L, "degree", c.degree); });
           },
-          [&](const ab::PingReply& p) {
-            // The time we sent is the loop clock in µs (ping()); the robot echoes it.
-            auto now = std::chrono::duration_cast<std::chrono::microseconds>(r.host->loop().now());
-            double rtt = static_cast<double>(now.count() - p.time) / 1e6;
-            r.lastPing = rtt;
-            ++r.pings;
+          [&](const ab::PingReply&) {
+            double rtt = r.model->state().lastPing.value_or(0);
             dispatch(r, kPing, [&](lua_State* L) { lua::setNumber(L, "rtt", rtt); });
           },
           [&](const ab::ObstacleRegistered& o) {
@@ -186,70 +168,49 @@ void received(Robot& r, const ab::Response& response) {
 }
 
 void hook(Robot& r) {
-  r.link->onResponse = [&r](const ab::Response& response) { received(r, response); };
-  r.link->onState = [&r](bool up, const std::string& reason) {
-    if (up) {
-      r.everConnected = true;
-      log::info(kComponent, r.label + ": connected");
-      dispatch(r, kConnect, [](lua_State*) {});
-      return;
-    }
-    log::warn(kComponent, r.label + ": " + (r.everConnected ? "lost: " : "cannot connect: ") +
-                              reason + "; retrying");
-    if (!r.everConnected) return;  // onDisconnect follows a connection, not a failed attempt
+  Alphabot& m = *r.model;
+  m.onResponse = [&r](const ab::Response& response) { received(r, response); };
+  m.onConnection = [&r](bool up, const std::string& reason) {
+    if (up) return dispatch(r, kConnect, [](lua_State*) {});
+    // onDisconnect follows a connection, not a failed attempt
+    if (!r.model->state().everConnected) return;
     dispatch(r, kDisconnect, [&](lua_State* L) { lua::setString(L, "reason", reason); });
   };
-  r.link->onMalformed = [&r](const std::string& error) {
-    ++r.malformed;
-    log::warn(kComponent, r.label + ": malformed packet: " + error);
+  m.onMalformed = [&r](const std::string& error) {
     dispatch(r, kMalformed, [&](lua_State* L) { lua::setString(L, "error", error); });
   };
 }
 
 // ---- commands ----
 
-void sendOrRaise(Robot& r, const ab::Request& request) {
-  if (r.closed()) throw LuaError(r.label + " is closed");
-  if (!r.link->send(request)) {
-    std::string why = r.link->lastError();
-    throw LuaError(r.label + ": nothing sent: " + (why.empty() ? "not connected" : why));
-  }
+void raiseIfRefused(const Alphabot::Sent& sent) {
+  if (!sent) throw LuaError(sent.error());
 }
 
-long long ranged(lua_State* L, int idx, const char* what, long long lo, long long hi) {
-  auto v = lua::checkInteger(L, idx, what);
-  auto error = ab::checkRange(what, v, lo, hi);
-  if (!error.empty()) throw LuaError(error);
-  return v;
-}
-
-std::int16_t coord(lua_State* L, int idx, const char* what) {
-  return static_cast<std::int16_t>(ranged(L, idx, what, ab::kCoordMin, ab::kCoordMax));
+Alphabot& model(lua_State* L, int idx) {
+  return *robotAt(L, idx).model;
 }
 
 int drive(lua_State* L) {
-  Robot& r = robotAt(L, 1);
-  auto speed = ranged(L, 2, "speed", ab::kDriveMin, ab::kDriveMax);
-  auto steer = ranged(L, 3, "steer", ab::kDriveMin, ab::kDriveMax);
-  sendOrRaise(r, ab::Drive{static_cast<std::int8_t>(speed), static_cast<std::int8_t>(steer)});
+  auto& m = model(L, 1);
+  raiseIfRefused(m.drive(lua::checkInteger(L, 2, "speed"), lua::checkInteger(L, 3, "steer")));
   return 0;
 }
 int stop(lua_State* L) {
-  sendOrRaise(robotAt(L, 1), ab::Drive{0, 0});
+  raiseIfRefused(model(L, 1).stop());
   return 0;
 }
 int measureDistance(lua_State* L) {
-  Robot& r = robotAt(L, 1);
-  auto degree = ranged(L, 2, "degree", ab::kDegreeMin, ab::kDegreeMax);
-  sendOrRaise(r, ab::MeasureDistance{static_cast<std::int16_t>(degree)});
+  auto& m = model(L, 1);
+  raiseIfRefused(m.measureDistance(lua::checkInteger(L, 2, "degree")));
   return 0;
 }
 int calibrateSteering(lua_State* L) {
-  sendOrRaise(robotAt(L, 1), ab::CalibrateSteering{});
+  raiseIfRefused(model(L, 1).calibrateSteering());
   return 0;
 }
 int calibrateCompass(lua_State* L) {
-  sendOrRaise(robotAt(L, 1), ab::CalibrateCompass{});
+  raiseIfRefused(model(L, 1).calibrateCompass());
   return 0;
 }
 int set(lua_State* L) {
@@ -257,7 +218,7 @@ int set(lua_State* L) {
   if (!lua_istable(L, 2))
     throw LuaError("set takes a table of toggles, e.g. {collisionAvoidance = true}; names: " +
                    ab::toggleNames());
-  ab::Toggles next = r.toggles;
+  ab::Toggles next = r.model->state().toggles;
   lua_pushnil(L);
   while (lua_next(L, 2) != 0) {
     if (lua_type(L, -2) != LUA_TSTRING)
@@ -272,55 +233,43 @@ int set(lua_State* L) {
     lua_pop(L, 1);
   }
   // The robot takes the whole field: every bit not named keeps its last value.
-  sendOrRaise(r, ab::SetToggles{next});
-  r.toggles = next;
+  raiseIfRefused(r.model->setToggles(next));
   return 0;
 }
 int ping(lua_State* L) {
-  Robot& r = robotAt(L, 1);
-  auto now = std::chrono::duration_cast<std::chrono::microseconds>(r.host->loop().now());
-  sendOrRaise(r, ab::Ping{static_cast<std::int64_t>(now.count())});
+  raiseIfRefused(model(L, 1).ping());
   return 0;
 }
 int setAnchor(lua_State* L) {
-  Robot& r = robotAt(L, 1);
-  auto id = ranged(L, 2, "anchor id", ab::kIdMin, ab::kIdMax);
-  auto x = coord(L, 3, "x (cm)");
-  auto y = coord(L, 4, "y (cm)");
-  sendOrRaise(r, ab::SetAnchor{static_cast<std::uint8_t>(id), x, y});
+  auto& m = model(L, 1);
+  raiseIfRefused(m.setAnchor(lua::checkInteger(L, 2, "anchor id"),
+                             lua::checkInteger(L, 3, "x (cm)"), lua::checkInteger(L, 4, "y (cm)")));
   return 0;
 }
 int navigateTo(lua_State* L) {
-  Robot& r = robotAt(L, 1);
-  auto x = coord(L, 2, "x (cm)");
-  auto y = coord(L, 3, "y (cm)");
-  sendOrRaise(r, ab::NavigateTo{x, y});
+  auto& m = model(L, 1);
+  raiseIfRefused(
+      m.navigateTo(lua::checkInteger(L, 2, "x (cm)"), lua::checkInteger(L, 3, "y (cm)")));
   return 0;
 }
 int addObstacle(lua_State* L) {
-  Robot& r = robotAt(L, 1);
-  auto x = coord(L, 2, "x (cm)");
-  auto y = coord(L, 3, "y (cm)");
-  auto w = ranged(L, 4, "width (cm)", ab::kSizeMin, ab::kSizeMax);
-  auto h = ranged(L, 5, "height (cm)", ab::kSizeMin, ab::kSizeMax);
-  sendOrRaise(r,
-              ab::AddObstacle{x, y, static_cast<std::uint16_t>(w), static_cast<std::uint16_t>(h)});
+  auto& m = model(L, 1);
+  raiseIfRefused(m.addObstacle(lua::checkInteger(L, 2, "x (cm)"), lua::checkInteger(L, 3, "y (cm)"),
+                               lua::checkInteger(L, 4, "width (cm)"),
+                               lua::checkInteger(L, 5, "height (cm)")));
   return 0;
 }
 int removeObstacle(lua_State* L) {
-  Robot& r = robotAt(L, 1);
-  if (lua_isnoneornil(L, 3)) {
-    auto id = ranged(L, 2, "obstacle id", ab::kIdMin, ab::kIdMax);
-    sendOrRaise(r, ab::RemoveObstacleById{static_cast<std::uint8_t>(id)});
-  } else {
-    auto x = coord(L, 2, "x (cm)");
-    auto y = coord(L, 3, "y (cm)");
-    sendOrRaise(r, ab::RemoveObstacleAt{x, y});
-  }
+  auto& m = model(L, 1);
+  if (lua_isnoneornil(L, 3))
+    raiseIfRefused(m.removeObstacle(lua::checkInteger(L, 2, "obstacle id")));
+  else
+    raiseIfRefused(
+        m.removeObstacleAt(lua::checkInteger(L, 2, "x (cm)"), lua::checkInteger(L, 3, "y (cm)")));
   return 0;
 }
 int clearObstacles(lua_State* L) {
-  sendOrRaise(robotAt(L, 1), ab::ClearObstacles{});
+  raiseIfRefused(model(L, 1).clearObstacles());
   return 0;
 }
 int close(lua_State* L) {
@@ -331,6 +280,7 @@ int close(lua_State* L) {
 // ---- fields and metamethods ----
 
 bool pushField(lua_State* L, Robot& r, std::string_view key) {
+  const AlphabotState& st = r.model->state();
   auto integer = [&](const std::optional<int>& v) {
     if (v)
       lua_pushinteger(L, *v);
@@ -339,29 +289,29 @@ bool pushField(lua_State* L, Robot& r, std::string_view key) {
     return true;
   };
   if (key == "connected") {
-    lua_pushboolean(L, !r.closed() && r.link->connected());
+    lua_pushboolean(L, !r.closed() && r.model->connected());
     return true;
   }
-  if (key == "x") return integer(r.x);
-  if (key == "y") return integer(r.y);
-  if (key == "heading") return integer(r.heading);
+  if (key == "x") return integer(st.x);
+  if (key == "y") return integer(st.y);
+  if (key == "heading") return integer(st.heading);
   if (key == "pings") {
-    lua_pushinteger(L, static_cast<lua_Integer>(r.pings));
+    lua_pushinteger(L, static_cast<lua_Integer>(st.pings));
     return true;
   }
   if (key == "lastPing") {
-    if (r.lastPing)
-      lua_pushnumber(L, *r.lastPing);
+    if (st.lastPing)
+      lua_pushnumber(L, *st.lastPing);
     else
       lua_pushnil(L);
     return true;
   }
   if (key == "address") {
-    lua_pushstring(L, r.link->address().c_str());
+    lua_pushstring(L, r.model->address().c_str());
     return true;
   }
   if (key == "lastError") {
-    std::string e = r.closed() ? r.label + " is closed" : r.link->lastError();
+    std::string e = r.closed() ? r.label + " is closed" : r.model->lastError();
     if (e.empty())
       lua_pushnil(L);
     else
@@ -369,17 +319,17 @@ bool pushField(lua_State* L, Robot& r, std::string_view key) {
     return true;
   }
   if (key == "malformed") {
-    lua_pushinteger(L, static_cast<lua_Integer>(r.malformed));
+    lua_pushinteger(L, static_cast<lua_Integer>(st.malformed));
     return true;
   }
   if (key == "toggles") {
     lua_createtable(L, 0, static_cast<int>(ab::toggleBits().size()));
     for (const auto& bit : ab::toggleBits())
-      lua::setBoolean(L, bit.name, ab::isSet(r.toggles, bit));
+      lua::setBoolean(L, bit.name, ab::isSet(st.toggles, bit));
     return true;
   }
   if (key == "path") {
-    pushWaypoints(L, r.path);
+    pushWaypoints(L, st.path);
     return true;
   }
   return false;
@@ -448,9 +398,10 @@ int newRobot(lua_State* L) {
     std::string key = lua_type(L, -2) == LUA_TSTRING ? lua_tostring(L, -2) : "";
     if (key == "host")
       host = lua::checkString(L, -1, "host");
-    else if (key == "port")
-      port = ranged(L, -1, "port", 1, 65535);
-    else if (key == "ble")
+    else if (key == "port") {
+      port = lua::checkInteger(L, -1, "port");
+      if (auto e = checkRange("port", static_cast<double>(port), 1, 65535)) throw LuaError(*e);
+    } else if (key == "ble")
       ble = lua::checkString(L, -1, "ble (the robot's Bluetooth address)");
     else if (key == "connectTimeout") {
       timeout = lua::checkNumber(L, -1, "connectTimeout (s)");
@@ -467,27 +418,26 @@ int newRobot(lua_State* L) {
     throw LuaError("pitwall.alphabot needs either host (and port) for WLAN or ble for Bluetooth");
   ScriptHost& scriptHost = ScriptHost::from(L);
   Loop& loop = scriptHost.loop();
-  std::unique_ptr<ab::RobotLink> link;
+  std::unique_ptr<Link> link;
+  AlphabotOptions options;
   if (!host.empty()) {
     if (port == 0) throw LuaError("pitwall.alphabot{host=…} needs a port (1..65535)");
     if (loop.clockKind() == ClockKind::Virtual)
       throw LuaError(
           "pitwall.alphabot{host=…} talks to a robot over the network and needs the real clock: "
           "run without --fast (not in `pitwall test`)");
-    ab::TcpLinkOptions options;
-    options.connectTimeout = timeout;
-    link =
-        std::make_unique<ab::TcpRobotLink>(loop, host, static_cast<std::uint16_t>(port), options);
+    link = makeAlphabotTcpLink(loop, host, static_cast<std::uint16_t>(port), timeout);
   } else {
     std::string error;
-    link = ab::makeBleRobotLink(loop, ble, error);
+    options.wire = AlphabotOptions::Wire::Ble;
+    link = makeAlphabotBleLink(loop, ble, GattLinkOptions{}, error);
     if (!link) throw LuaError("pitwall.alphabot{ble=\"" + ble + "\"}: " + error);
   }
 
   auto robot = std::make_unique<Robot>();
   robot->host = &scriptHost;
-  robot->label = "alphabot " + link->address();
-  robot->link = std::move(link);
+  robot->model = std::make_unique<Alphabot>(loop, std::move(link), options);
+  robot->label = robot->model->label();
   auto** ud = static_cast<Robot**>(lua_newuserdatauv(L, sizeof(Robot*), 1));
   *ud = nullptr;
   luaL_setmetatable(L, kMetatable);

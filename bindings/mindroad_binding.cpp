@@ -1,9 +1,9 @@
 // pitwall.mindroad{host=…, port=…}: a MindRoad robot car as a Lua object (docs/robots.md).
-// One full userdata per robot holding its client link; a uservalue table keeps the event
-// handlers and the script's own fields, as cars do. The object belongs to the Lua world that
-// made it: a registry reference keeps it (and its connection) alive until robot:close() or the
-// end of that world (end of the run, a hot reload), when __gc closes the link — the robot then
-// gets a stop, or stops by its watchdog.
+// One full userdata per robot holding its model (engine/vehicles/mindroad_robot.hpp); a uservalue
+// table keeps the event handlers and the script's own fields, as cars do. The object belongs to the
+// Lua world that made it: a registry reference keeps it (and its connection) alive until
+// robot:close() or the end of that world (end of the run, a hot reload), when __gc closes the link
+// — the robot then gets a stop, or stops by its watchdog.
 #include <lua.hpp>
 
 #include <array>
@@ -19,7 +19,7 @@
 #include "bindings/script_host.hpp"
 #include "engine/core/console.hpp"
 #include "engine/core/log.hpp"
-#include "engine/vehicles/mindroad_client.hpp"
+#include "engine/vehicles/mindroad_robot.hpp"
 
 namespace pitwall {
 
@@ -35,7 +35,8 @@ constexpr std::array<const char*, 8> kFields = {"connected", "host",  "port",   
                                                 "watchdog",  "phase", "lastError", "contacts"};
 
 struct Robot {
-  std::shared_ptr<MindroadClient> client;
+  std::unique_ptr<MindroadRobot> client;  // closed, not destroyed, by close(): a handler may
+                                          // be running in it
   ScriptHost* host = nullptr;
   int selfRef = LUA_NOREF;            // held while open: events need the object, the script may not
   std::string label;                  // "mindroad tcp 127.0.0.1:4000"
@@ -50,13 +51,17 @@ Robot& robotAt(lua_State* L, int idx) {
   return *r;
 }
 
-MindroadClient& open(lua_State* L, int idx) {
+bool isOpen(const Robot& r) {
+  return r.client && r.client->phase() != MindroadRobot::Phase::Closed;
+}
+
+MindroadRobot& open(lua_State* L, int idx) {
   Robot& r = robotAt(L, idx);
-  if (!r.client) throw LuaError(r.label + " is closed");
+  if (!isOpen(r)) throw LuaError(r.label + " is closed");
   return *r.client;
 }
 
-void raiseIfRefused(const MindroadClient::Sent& sent) {
+void raiseIfRefused(const MindroadRobot::Sent& sent) {
   if (!sent) throw LuaError(sent.error());
 }
 
@@ -170,10 +175,7 @@ int shutdown(lua_State* L) {
 }
 
 void closeRobot(lua_State* L, Robot& r) {
-  if (r.client) {
-    r.client->close();
-    r.client.reset();
-  }
+  if (r.client) r.client->close();
   if (r.selfRef != LUA_NOREF) {
     luaL_unref(L, LUA_REGISTRYINDEX, r.selfRef);
     r.selfRef = LUA_NOREF;
@@ -196,7 +198,7 @@ int gc(lua_State* L) {
 
 int tostring(lua_State* L) {
   Robot& r = robotAt(L, 1);
-  std::string s = r.label + " (" + (r.client ? r.client->phaseName() : "closed") + ")";
+  std::string s = r.label + " (" + (isOpen(r) ? r.client->phaseName() : "closed") + ")";
   lua_pushlstring(L, s.data(), s.size());
   return 1;
 }
@@ -204,16 +206,16 @@ int tostring(lua_State* L) {
 bool pushField(lua_State* L, Robot& r, std::string_view key) {
   const MindroadOptions* o = &r.options;
   if (key == "connected") {
-    lua_pushboolean(L, r.client && r.client->connected());
+    lua_pushboolean(L, isOpen(r) && r.client->connected());
   } else if (key == "phase") {
-    lua_pushstring(L, r.client ? r.client->phaseName().c_str() : "closed");
+    lua_pushstring(L, isOpen(r) ? r.client->phaseName().c_str() : "closed");
   } else if (key == "lastError") {
-    if (r.client && !r.client->lastError().empty())
+    if (isOpen(r) && !r.client->lastError().empty())
       lua_pushstring(L, r.client->lastError().c_str());
     else
       lua_pushnil(L);
   } else if (key == "contacts") {
-    lua_pushinteger(L, r.client ? static_cast<lua_Integer>(r.client->contacts()) : 0);
+    lua_pushinteger(L, isOpen(r) ? static_cast<lua_Integer>(r.client->contacts()) : 0);
   } else if (key == "host") {
     lua_pushstring(L, o->host.c_str());
   } else if (key == "port") {
@@ -313,7 +315,8 @@ int newRobot(lua_State* L) {
   lua_setiuservalue(L, -2, 1);
   r->host = &host;
   r->options = options;
-  r->client = MindroadClient::create(host.loop(), options);
+  r->client =
+      std::make_unique<MindroadRobot>(host.loop(), makeMindroadLink(host.loop(), options), options);
   r->label = "mindroad " + r->client->address();
   r->contactWhat = "onContact handler of " + r->label;
   r->lostWhat = "onLost handler of " + r->label;
@@ -328,7 +331,6 @@ int newRobot(lua_State* L) {
     log::warn("mindroad", r->label +
                               ": virtual time (--fast, tests) races past the timeouts of a real "
                               "socket; a robot needs a real-time run");
-  r->client->start();
   return 1;
 }
 

@@ -18,7 +18,9 @@ if pitwall.virtualTime then
   return
 end
 
+-- In the main chunk (a task) this waits for contact: the robot is ready on the next line.
 local robot = pitwall.mindroad { host = host, port = port, udp = os.getenv("MINDROAD_UDP") == "1" }
+print(tostring(robot) .. ": contact")
 
 robot.onContact = function(r)
   print(tostring(r) .. ": contact")

@@ -3,6 +3,7 @@
 // driven by the engine's one loop; callbacks run on it.
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <span>
 #include <string>
 
@@ -19,8 +20,17 @@ class Link {
   virtual bool connected() const = 0;
   // Asks the device side to drop the connection; the state handler reports it.
   virtual void disconnect() = 0;
+  // Drops the connection because the model above saw it fail (a device that stopped answering),
+  // reporting `reason` through the state handler, and connects again the way the link does
+  // after any drop. A link that does not reconnect by itself only disconnects.
+  virtual void reconnect(const std::string& reason) {
+    (void)reason;
+    disconnect();
+  }
   // A short human name of where the device is ("sim:0", "ble:AA:BB:…").
   virtual std::string address() const = 0;
+  // After a drop, how long until the link tries again by itself; nullopt when it does not.
+  virtual std::optional<double> retryIn() const { return std::nullopt; }
   // Why the last send() returned false, when the link knows more than "not connected": one
   // sentence naming what to do, or empty.
   virtual std::string refusal() const { return {}; }

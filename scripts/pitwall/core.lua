@@ -177,6 +177,42 @@ function pitwall.copy(t)
   return c
 end
 
+-- Robots ready when made: inside a task (the main chunk, pitwall.spawn) pitwall.mindroad{…} and
+-- pitwall.alphabot{…} wait until the robot is connected (a MindRoad robot: in contact), up to
+-- its timeout (contactTimeout, connectTimeout; 3 s by default), then close it and raise an error
+-- naming the robot, its address and why. In a callback or at the REPL they return at once.
+local function readyWhenMade(make, timeoutKey, notReady)
+  return function(options)
+    local ok, robot = pcall(make, options)
+    if not ok then
+      -- the error names the script's line, not this one
+      if type(robot) == "string" then robot = robot:gsub("^[^\n]-pitwall[/\\]core%.lua:%d+: ", "") end
+      error(robot, 2)
+    end
+    if not coroutine.isyieldable() then return robot end
+    local timeout = type(options) == "table" and options[timeoutKey] or 3
+    if pitwall.waitUntil(function() return robot.connected end, timeout, 0.005) then
+      return robot
+    end
+    local what = notReady(robot)
+    robot:close()
+    error(string.format("%s after %g s (%s): %s", what.name, timeout, timeoutKey, what.why), 2)
+  end
+end
+if pitwall.mindroad then
+  pitwall.mindroad = readyWhenMade(pitwall.mindroad, "contactTimeout", function(r)
+    return {
+      name = string.format("mindroad %s %s:%d has no contact", r.udp and "udp" or "tcp", r.host, r.port),
+      why = r.lastError or ("still " .. r.phase),
+    }
+  end)
+end
+if pitwall.alphabot then
+  pitwall.alphabot = readyWhenMade(pitwall.alphabot, "connectTimeout", function(r)
+    return { name = "alphabot " .. r.address .. " is not connected", why = r.lastError or "no answer" }
+  end)
+end
+
 local sim = pitwall.sim
 if sim then
   --- Adds a simulated car; inside a task it waits until the car is connected.

@@ -171,9 +171,9 @@ kill "$ROBOT_PID" 2>/dev/null; wait "$ROBOT_PID" 2>/dev/null
 startRobot vanish
 cat >"$TMP/vanish.lua" <<'LUA'
 local r = pitwall.alphabot{host = "127.0.0.1", port = tonumber(os.getenv("PORT"))}
-r.onConnect = function() print("connected"); io.stdout:flush() end
+print("connected"); io.stdout:flush()  -- ready when made: connected already
+r.onConnect = function() print("connected again"); io.stdout:flush() end
 r.onDisconnect = function(_, ev) print("disconnected: " .. ev.reason); io.stdout:flush() end
-assert(pitwall.waitUntil(function() return r.connected end, 3), "no connection")
 assert(pitwall.waitUntil(function() return not r.connected end, 10), "never lost")
 local ok, e = pcall(r.drive, r, 10, 0)
 print("drive while lost: " .. tostring(e)); io.stdout:flush()
@@ -199,6 +199,23 @@ contains "reconnected after the robot came back" "back, ping answered" "$out"
 contains "the log says it was lost" "lost: the robot closed the connection; retrying" "$(cat "$TMP/vanish.log")"
 kill "$ROBOT_PID" 2>/dev/null; wait "$ROBOT_PID" 2>/dev/null
 
+# ---- ready when made: the line after pitwall.alphabot{…} drives; an unreachable robot errs ----
+startRobot ready
+cat >"$TMP/ready.lua" <<'LUA'
+local r = pitwall.alphabot{host = "127.0.0.1", port = tonumber(os.getenv("PORT"))}
+r:drive(40, 0)
+pitwall.sleep(0.3)
+print("drove: " .. tostring(r.connected))
+pitwall.stop()
+LUA
+out=$(PORT=$PORT timeout 20 $PITWALL run "$TMP/ready.lua" --cars 0 2>&1); rc=$?
+check "ready when made: exit status" 0 "$rc"
+contains "ready when made: the first command went" "drove: true" "$out"
+kill "$ROBOT_PID" 2>/dev/null; wait "$ROBOT_PID" 2>/dev/null
+out=$(PORT=$PORT timeout 20 $PITWALL run "$TMP/ready.lua" --cars 0 2>&1); rc=$?
+[ "$rc" -ne 0 ] && echo "ok: an unreachable robot fails the script" || fail "an unreachable robot: exit status 0"
+contains "an unreachable robot: a clear error" "alphabot tcp:127.0.0.1:$PORT is not connected after 3 s (connectTimeout)" "$out"
+
 # ---- a robot that sends malformed bytes (a fake one in Python) ----
 if command -v python3 >/dev/null; then
   cat >"$TMP/fake.py" <<'PY'
@@ -215,9 +232,14 @@ PY
   wait_for "$TMP/fake.out" "listening on" 5
   FPORT=$(sed -n 's/^listening on .*:\([0-9]*\)$/\1/p' "$TMP/fake.out")
   cat >"$TMP/malformed.lua" <<'LUA'
-local r = pitwall.alphabot{host = "127.0.0.1", port = tonumber(os.getenv("PORT"))}
-r.onMalformed = function(_, ev) print("malformed: " .. ev.error) end
-r.onDistance = function(_, ev) print("distance " .. ev.degree .. " " .. ev.distance) end
+-- made in a callback, the robot returns at once: the handlers are set before the robot's
+-- first bytes (in a task it would be connected, and the bytes read, before the next line)
+pitwall.after(0, function()
+  r = pitwall.alphabot{host = "127.0.0.1", port = tonumber(os.getenv("PORT"))}
+  r.onMalformed = function(_, ev) print("malformed: " .. ev.error) end
+  r.onDistance = function(_, ev) print("distance " .. ev.degree .. " " .. ev.distance) end
+end)
+assert(pitwall.waitUntil(function() return r end, 1))
 assert(pitwall.waitUntil(function() return r.malformed == 1 and r.connected end, 5))
 pitwall.sleep(0.2)
 print("still connected: " .. tostring(r.connected))

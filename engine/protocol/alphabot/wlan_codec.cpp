@@ -388,8 +388,9 @@ Result<Packet, DecodeError> decode(std::span<const std::uint8_t> bytes, Options 
   return decodeKnown(bytes, options);
 }
 
-bool StreamDecoder::accepted(std::uint8_t id) const {
-  switch (accept_) {
+namespace {
+bool accepted(std::uint8_t id, Accept accept) {
+  switch (accept) {
     case Accept::Requests:
       return isRequestId(id);
     case Accept::Responses:
@@ -398,6 +399,31 @@ bool StreamDecoder::accepted(std::uint8_t id) const {
       return isRequestId(id) || isResponseId(id);
   }
   return false;
+}
+}  // namespace
+
+std::size_t frameLength(std::span<const std::uint8_t> pending, Accept accept) {
+  if (pending.empty()) return 0;
+  if (!accepted(pending[0], accept)) {
+    std::size_t skip = 1;
+    while (skip < pending.size() && !accepted(pending[skip], accept)) ++skip;
+    return skip;
+  }
+  auto length = packetLength(pending);
+  if (!length || pending.size() < *length) return 0;
+  return *length;
+}
+
+Result<Packet, DecodeError> decodeFrame(std::span<const std::uint8_t> frame, Accept accept,
+                                        Options options) {
+  if (frame.empty()) return Unexpected{DecodeError{}};
+  const std::uint8_t id = frame[0];
+  if (!accepted(id, accept)) {
+    auto kind =
+        fixedLength(id) == 0 ? DecodeError::Kind::UnknownId : DecodeError::Kind::WrongDirection;
+    return Unexpected{DecodeError{kind, id, 0, frame.size()}};
+  }
+  return decode(frame, options);
 }
 
 void StreamDecoder::feed(std::span<const std::uint8_t> bytes) {
@@ -410,26 +436,16 @@ void StreamDecoder::feed(std::span<const std::uint8_t> bytes) {
 
 std::optional<Result<Packet, DecodeError>> StreamDecoder::next() {
   std::span<const std::uint8_t> rest(buffer_.data() + start_, buffer_.size() - start_);
-  if (rest.empty()) return std::nullopt;
-  std::uint8_t id = rest[0];
-  if (!accepted(id)) {
-    std::size_t skip = 1;
-    while (skip < rest.size() && !accepted(rest[skip])) ++skip;
-    start_ += skip;
-    auto kind =
-        fixedLength(id) == 0 ? DecodeError::Kind::UnknownId : DecodeError::Kind::WrongDirection;
-    return Result<Packet, DecodeError>(Unexpected{DecodeError{kind, id, 0, skip}});
-  }
-  auto length = packetLength(rest);
-  if (!length || rest.size() < *length) return std::nullopt;
-  Packet packet = decodeKnown(rest.first(*length), options_);
-  start_ += *length;
+  const std::size_t length = frameLength(rest, accept_);
+  if (length == 0) return std::nullopt;
+  auto packet = decodeFrame(rest.first(length), accept_, options_);
+  start_ += length;
   // Keep the buffer from growing without bound on a long stream.
   if (start_ > 4096) {
     buffer_.erase(buffer_.begin(), buffer_.begin() + static_cast<std::ptrdiff_t>(start_));
     start_ = 0;
   }
-  return Result<Packet, DecodeError>(std::move(packet));
+  return packet;
 }
 
 }  // namespace pitwall::alphabot::wlan

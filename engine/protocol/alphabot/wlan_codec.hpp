@@ -66,6 +66,18 @@ std::string_view nameOfId(std::uint8_t id);  // "" for an unknown id
 bool isRequestId(std::uint8_t id);           // 0x01..0x0C, 0xC0
 bool isResponseId(std::uint8_t id);          // 0x81..0x86
 
+// Where a stream of `accept`ed packets cuts: the length of the next frame at the start of
+// `pending` (bytes received, not yet framed), 0 when its packet is not complete yet. A run of
+// bytes that is not an accepted packet (up to the next byte that is an accepted id, or all of
+// `pending`) is a frame of its own, for decodeFrom to report (the resynchronisation below).
+enum class Accept { Requests, Responses, Both };
+std::size_t frameLength(std::span<const std::uint8_t> pending, Accept accept);
+
+// Decodes one frame cut by frameLength: a packet, or the error the stream decoder reports for
+// it (UnknownId or WrongDirection with received = the frame's length).
+Result<Packet, DecodeError> decodeFrame(std::span<const std::uint8_t> frame, Accept accept,
+                                        Options options = {});
+
 // Reassembles packets from a TCP stream: bytes may arrive split or merged in any way.
 // Resynchronisation: a byte at the start of a packet that is not an accepted id is skipped,
 // together with every following byte up to the next byte that is an accepted id, and reported
@@ -73,7 +85,7 @@ bool isResponseId(std::uint8_t id);          // 0x81..0x86
 // packet is taken whole (a corrupted length cannot be detected without framing).
 class StreamDecoder {
  public:
-  enum class Accept { Requests, Responses, Both };
+  using Accept = wlan::Accept;
   explicit StreamDecoder(Accept accept, Options options = {})
       : accept_(accept), options_(options) {}
   void feed(std::span<const std::uint8_t> bytes);
@@ -86,7 +98,6 @@ class StreamDecoder {
   }
 
  private:
-  bool accepted(std::uint8_t id) const;
   Accept accept_;
   Options options_;
   Bytes buffer_;

@@ -40,6 +40,11 @@ Frame encode(const Instruction& instruction);
 
 // Robot → client: the contact answer. Result<bool> is true for K.
 Result<bool, DecodeError> decodeAnswer(std::span<const std::uint8_t> bytes);
+// Robot → client bytes cut into answers: every answer is one byte (mindroad.md "Behaviour"), so
+// the next frame of `pending` is its first byte (0 when there is none).
+inline std::size_t answerLength(std::span<const std::uint8_t> pending) {
+  return pending.empty() ? 0 : 1;
+}
 
 // Stable kebab-case name: "stop", "contact", "steering", "mouse-position", "buttons", "ping",
 // "picture-mode", "shutdown".

@@ -231,3 +231,32 @@ TEST_CASE("pitwall.alphabot{host=…} refuses a virtual clock, saying why") {
   REQUIRE(!logged.empty());
   CHECK(logged.back().find("needs the real clock: run without --fast") != std::string::npos);
 }
+
+TEST_CASE_FIXTURE(AlphabotFixture, "ready when made: in a task the next line can drive") {
+  REQUIRE(run("local r = pitwall.alphabot{host = '127.0.0.1', port = ROBOT_PORT}\n"
+              "r:drive(40, 0)\n"
+              "DONE = true") == "");
+  REQUIRE(runUntilRobot([&] { return robot.moving(); }));
+}
+
+TEST_CASE_FIXTURE(AlphabotFixture,
+                  "an unreachable robot gives a clear error after connectTimeout") {
+  std::uint16_t port = server.port();
+  server.close();  // nothing listens there now
+  REQUIRE(run("local ok, e = pcall(pitwall.alphabot, {host = '127.0.0.1', port = ROBOT_PORT, "
+              "connectTimeout = 0.3})\n"
+              "E = e; DONE = true") == "");
+  const std::string p = std::to_string(port);
+  CHECK(global("E").find("alphabot tcp:127.0.0.1:" + p +
+                         " is not connected after 0.3 s (connectTimeout): ") != std::string::npos);
+  CHECK(global("E").find("refused") != std::string::npos);
+}
+
+TEST_CASE_FIXTURE(AlphabotFixture, "in a callback pitwall.alphabot returns at once") {
+  REQUIRE(run("pitwall.after(0, function()\n"
+              "  local r = pitwall.alphabot{host = '127.0.0.1', port = ROBOT_PORT}\n"
+              "  AT_ONCE = r.connected\n"
+              "  DONE = true\n"
+              "end)") == "");
+  CHECK(global("AT_ONCE") == "false");
+}

@@ -80,9 +80,8 @@ TEST_CASE_FIXTURE(RobotLua,
   start(R"(
     robot = pitwall.mindroad{host = "127.0.0.1", port = PORT}
     name = getmetatable(robot).__name
-    label = tostring(robot)
-    robot.onContact = function(r) contacted = (r == robot) end
-    pitwall.waitUntil(function() return robot.connected end, 3)
+    label = tostring(robot)  -- ready when made: in contact already
+    contacted = robot.connected
     robot:steer(127, 0)
     robot:click(80, 60)
     robot:buttons("automatic")
@@ -94,7 +93,7 @@ TEST_CASE_FIXTURE(RobotLua,
   )");
   REQUIRE(waitFor("done"));
   CHECK(string("name") == "mindroad");
-  CHECK(string("label") == "mindroad tcp 127.0.0.1:" + port() + " (connecting)");
+  CHECK(string("label") == "mindroad tcp 127.0.0.1:" + port() + " (contact)");
   CHECK(global("contacted"));
   CHECK(global("fields"));
   REQUIRE(runUntil(loop, [&] { return state().picture == mindroad::Picture::Hsv; }));
@@ -151,7 +150,8 @@ TEST_CASE_FIXTURE(RobotLua,
   start(R"(
     robot = pitwall.mindroad{port = PORT}
     contacts = 0
-    robot.onContact = function() contacts = contacts + 1; contactedAgain = contacts >= 2 end
+    -- the first contact came while pitwall.mindroad waited: onContact hears the next one
+    robot.onContact = function() contacts = contacts + 1; contactedAgain = contacts >= 1 end
     robot.onLost = function(r, reason) lostReason = reason; gone = true end
     pitwall.waitUntil(function() return robot.connected end, 3)
     up = true
@@ -265,4 +265,46 @@ TEST_CASE_FIXTURE(RobotLua, "mindroad: a closed robot refuses commands and says 
   REQUIRE(waitFor("done"));
   CHECK(string("label") == "mindroad tcp 127.0.0.1:" + port() + " (closed)");
   CHECK(string("closedError") == "mindroad tcp 127.0.0.1:" + port() + " is closed");
+}
+
+TEST_CASE_FIXTURE(RobotLua, "mindroad: ready when made: in a task the next line can steer") {
+  start(R"(
+    robot = pitwall.mindroad{host = "127.0.0.1", port = PORT}
+    robot:steer(100, 0)
+    done = true
+  )");
+  REQUIRE(waitFor("done"));
+  REQUIRE(runUntil(loop, [&] { return state().steerX == 100; }));
+}
+
+TEST_CASE_FIXTURE(RobotLua,
+                  "mindroad: an unreachable robot gives a clear error after contactTimeout") {
+  const auto port = robot->port();
+  robot.reset();  // nothing listens there now
+  lua_pushinteger(host->state(), port);
+  lua_setglobal(host->state(), "UNREACHABLE");
+  startRobot(0);  // another robot, elsewhere
+  start(R"(
+    local ok, e = pcall(pitwall.mindroad, {port = UNREACHABLE, contactTimeout = 0.3})
+    failure = e
+    done = true
+  )");
+  REQUIRE(waitFor("done"));
+  const std::string p = std::to_string(port);
+  CHECK(string("failure").find("mindroad tcp 127.0.0.1:" + p + " has no contact after 0.3 s " +
+                               "(contactTimeout): cannot connect to tcp 127.0.0.1:" + p) !=
+        std::string::npos);
+  CHECK(string("failure").find("refused") != std::string::npos);
+}
+
+TEST_CASE_FIXTURE(RobotLua, "mindroad: in a callback pitwall.mindroad returns at once") {
+  start(R"(
+    pitwall.after(0, function()
+      robot = pitwall.mindroad{port = PORT}
+      phaseAtOnce = robot.phase
+      done = true
+    end)
+  )");
+  REQUIRE(waitFor("done"));
+  CHECK(string("phaseAtOnce") == "connecting");
 }

@@ -1,25 +1,24 @@
 #pragma once
-// The client side of a MindRoad robot car (../shared/protocols/mindroad.md): a TCP (default) or
-// UDP link on the engine loop, the contact handshake (contact every 100 ms until K arrives, with
-// an overall timeout), keep-alive pings at a third of the watchdog period, and reconnection with
-// backoff (0.5 s doubling to 8 s) when the link or the contact is lost. Commands are validated
-// here, at the edge: an out-of-range value or a robot without contact gives an error and sends
-// nothing.
+// The controller-side model of a MindRoad robot car (../shared/protocols/mindroad.md) over a
+// link: the contact handshake (contact every 100 ms until K arrives, within contactTimeout),
+// keep-alive pings at a third of the watchdog period, contact probes once in contact, validated
+// commands, and the phases and counters a user reads. Commands are validated here, at the edge:
+// an out-of-range value or a robot without contact gives an error and sends nothing.
 //
-// Lost contact is seen as: TCP end of stream or a socket error; UDP an ICMP error from the
-// robot's host (port unreachable); both: a handshake or a contact probe (every second once in
-// contact) that gets no K within the contact timeout.
-#include <boost/asio/ip/tcp.hpp>
-#include <boost/asio/ip/udp.hpp>
-#include <deque>
+// The link (TCP by default, UDP as an option: makeMindroadLink) reconnects by itself with its
+// backoff (0.5 s doubling to 8 s). Lost contact is seen as: the link dropping (TCP end of stream
+// or a socket error; UDP an ICMP error from the robot's host), or a handshake or a contact probe
+// (every second once in contact) that gets no K within the contact timeout — then the model asks
+// the link to reconnect. onLost is called once per outage.
+#include <cstdint>
 #include <functional>
 #include <memory>
-#include <optional>
 #include <string>
 
 #include "engine/core/loop.hpp"
 #include "engine/core/result.hpp"
 #include "engine/protocol/mindroad/codec.hpp"
+#include "engine/transport/link.hpp"
 
 namespace pitwall {
 
@@ -39,17 +38,21 @@ struct MindroadOptions {
   double probeInterval = 1;
 };
 
-class MindroadClient : public std::enable_shared_from_this<MindroadClient> {
+// The TCP or UDP link to the robot the options name (engine/transport/socket_link.hpp), framed
+// by the robot's one-byte answers; it starts connecting at once.
+std::unique_ptr<Link> makeMindroadLink(Loop& loop, const MindroadOptions& options);
+
+class MindroadRobot {
  public:
   using Sent = Result<bool, std::string>;
-  enum class Phase { Idle, Connecting, Handshake, Contact, Waiting, Closed };
+  enum class Phase { Connecting, Handshake, Contact, Waiting, Closed };
 
-  static std::shared_ptr<MindroadClient> create(Loop& loop, MindroadOptions options);
-  ~MindroadClient();
+  MindroadRobot(Loop& loop, std::unique_ptr<Link> link, MindroadOptions options);
+  ~MindroadRobot();
+  MindroadRobot(const MindroadRobot&) = delete;
+  MindroadRobot& operator=(const MindroadRobot&) = delete;
 
-  // Connects and shakes hands; reconnects by itself until close().
-  void start();
-  // Sends stop (best effort, without blocking), closes the link, cancels every timer. No event
+  // Sends stop (best effort, without waiting), closes the link, cancels every timer. No event
   // is called afterwards.
   void close();
 
@@ -74,6 +77,7 @@ class MindroadClient : public std::enable_shared_from_this<MindroadClient> {
   std::uint64_t contactsSent() const { return contactsSent_; }
   std::uint64_t instructionsSent() const { return instructionsSent_; }
   std::uint64_t contacts() const { return contactCount_; }
+  Link& link() { return *link_; }
 
   // Tests: stop (or resume) the keep-alive pings and probes, so the robot's watchdog fires.
   void pauseKeepAlive(bool paused) { keepAlivePaused_ = paused; }
@@ -85,34 +89,25 @@ class MindroadClient : public std::enable_shared_from_this<MindroadClient> {
   std::function<void(const std::string& reason)> onLost;
 
  private:
-  MindroadClient(Loop& loop, MindroadOptions options);
-  void connect();
-  void linkUp();
+  void linkChanged(bool up, const std::string& reason);
+  void received(std::span<const std::uint8_t> frame);
   void sendContact();
   void contactAnswered();
   void keepAlive();
   void probe();
-  void read();
-  void lose(const std::string& reason);
-  void write(const mindroad::Frame& frame);
-  void writeNext();
+  void fail(const std::string& reason);  // contact failed while the link is up
+  void lose(const std::string& reason);  // the link went down
+  void write(const mindroad::Instruction& instruction);
   void cancelTimers();
   template <class F>
   Loop::TimerId after(double seconds, F fn);
 
   Loop& loop_;
+  std::unique_ptr<Link> link_;
   MindroadOptions options_;
-  Phase phase_ = Phase::Idle;
-  std::unique_ptr<boost::asio::ip::tcp::socket> tcp_;
-  std::unique_ptr<boost::asio::ip::udp::socket> udp_;
-  std::unique_ptr<boost::asio::ip::tcp::resolver> resolver_;
-  std::array<std::uint8_t, 64> in_{};
-  std::deque<mindroad::Frame> queue_;
-  bool writing_ = false;
-  std::uint64_t generation_ = 0;  // bumps on every new link: stale handlers see a change
-  Loop::TimerId contactTimer_ = 0, contactDeadline_ = 0, pingTimer_ = 0, retryTimer_ = 0,
-                probeTimer_ = 0, probeDeadline_ = 0;
-  double backoff_ = 0;
+  Phase phase_ = Phase::Connecting;
+  Loop::TimerId contactTimer_ = 0, contactDeadline_ = 0, pingTimer_ = 0, probeTimer_ = 0,
+                probeDeadline_ = 0;
   bool lostReported_ = false;
   bool keepAlivePaused_ = false;
   bool shutdownSent_ = false;  // the robot was turned off: a lost link is not retried

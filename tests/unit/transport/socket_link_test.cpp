@@ -1,14 +1,15 @@
-// The Alphabot's TCP link over real loopback sockets, against the simulated robot's server (and
-// a raw socket that sends garbage): requests answered, malformed bytes, a robot that disappears
-// and comes back. The loop runs in real time; every wait ends on the event it waits for, with a
-// deadline that fails the test instead of hanging.
-#include "engine/vehicles/alphabot_tcp_link.hpp"
+// The TCP socket link, framed by the Alphabot's packets, over real loopback sockets, against the
+// simulated robot's server (and a raw socket that sends garbage): requests answered, malformed
+// bytes, a robot that disappears and comes back. The loop runs in real time; every wait ends on the
+// event it waits for, with a deadline that fails the test instead of hanging.
+#include "engine/transport/socket_link.hpp"
 
 #include <doctest/doctest.h>
 
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/write.hpp>
 
+#include "engine/protocol/alphabot/wlan_codec.hpp"
 #include "engine/sim/alphabot_server.hpp"
 #include "tests/support/run_until.hpp"
 
@@ -25,10 +26,15 @@ struct Events {
   std::vector<Response> responses;
   std::vector<std::pair<bool, std::string>> states;
   std::vector<std::string> malformed;
-  void hook(RobotLink& link) {
-    link.onResponse = [this](const Response& r) { responses.push_back(r); };
-    link.onState = [this](bool up, const std::string& why) { states.emplace_back(up, why); };
-    link.onMalformed = [this](const std::string& e) { malformed.push_back(e); };
+  void hook(Link& link) {
+    link.onFrame([this](std::span<const std::uint8_t> frame) {
+      auto packet = wlan::decodeFrame(frame, wlan::Accept::Responses);
+      if (!packet)
+        malformed.push_back(packet.error().message());
+      else if (auto* r = std::get_if<Response>(&*packet))
+        responses.push_back(*r);
+    });
+    link.onState([this](bool up, const std::string& why) { states.emplace_back(up, why); });
   }
   template <class T>
   std::vector<T> all() const {
@@ -39,28 +45,44 @@ struct Events {
   }
 };
 
+struct Options {
+  double backoffFirst = 0.5;
+};
+
+// A TCP link to an Alphabot's port, framed by its responses (as makeAlphabotTcpLink makes it).
+SocketLinkOptions robotLinkOptions(std::uint16_t port, Options o = {}) {
+  SocketLinkOptions options;
+  options.port = port;
+  options.peer = "the robot";
+  options.backoffFirst = o.backoffFirst;
+  options.frameLength = [](std::span<const std::uint8_t> pending) {
+    return wlan::frameLength(pending, wlan::Accept::Responses);
+  };
+  return options;
+}
+
 }  // namespace
 
 TEST_CASE("the TCP link reaches the simulated robot and every request is answered") {
   Loop loop(ClockKind::Real);
   simab::Robot robot(simab::defaultRoom());
   simab::RobotServer server(loop, robot, "127.0.0.1", 0);
-  TcpRobotLink link(loop, "127.0.0.1", server.port());
+  SocketLink link(loop, robotLinkOptions(server.port()));
   Events ev;
   ev.hook(link);
   REQUIRE(runUntil(loop, [&] { return link.connected(); }));
   CHECK(ev.states == std::vector<std::pair<bool, std::string>>{{true, ""}});
   CHECK(link.address() == "tcp:127.0.0.1:" + std::to_string(server.port()));
 
-  CHECK(link.send(MeasureDistance{0}));
-  CHECK(link.send(MeasureDistance{180}));
-  CHECK(link.send(Ping{42}));
-  CHECK(link.send(CalibrateCompass{}));
-  CHECK(link.send(AddObstacle{180, 100, 40, 100}));
+  CHECK(link.send(wlan::encode(MeasureDistance{0})));
+  CHECK(link.send(wlan::encode(MeasureDistance{180})));
+  CHECK(link.send(wlan::encode(Ping{42})));
+  CHECK(link.send(wlan::encode(CalibrateCompass{})));
+  CHECK(link.send(wlan::encode(AddObstacle{180, 100, 40, 100})));
   Toggles t;
   t.settings = 0x20;  // positioning
-  CHECK(link.send(SetToggles{t}));
-  CHECK(link.send(NavigateTo{350, 150}));
+  CHECK(link.send(wlan::encode(SetToggles{t})));
+  CHECK(link.send(wlan::encode(NavigateTo{350, 150})));
   REQUIRE(runUntil(loop, [&] { return !ev.all<Path>().empty() && !ev.all<Position>().empty(); }));
   CHECK(ev.all<Distance>() == std::vector<Distance>{{0, 130}, {180, 50}});
   CHECK(ev.all<PingReply>() == std::vector<PingReply>{{42}});
@@ -85,7 +107,7 @@ TEST_CASE("malformed bytes from the robot are reported and the stream resynchron
     loop.after(std::chrono::milliseconds(20),
                [&] { boost::asio::write(peer, boost::asio::buffer(part2)); });
   });
-  TcpRobotLink link(loop, "127.0.0.1", acceptor.local_endpoint().port());
+  SocketLink link(loop, robotLinkOptions(acceptor.local_endpoint().port()));
   Events ev;
   ev.hook(link);
   REQUIRE(runUntil(loop, [&] { return ev.responses.size() == 2; }));
@@ -102,9 +124,9 @@ TEST_CASE("a robot that disappears is reported down, and the link reconnects whe
   simab::Robot robot(simab::defaultRoom());
   auto server = std::make_unique<simab::RobotServer>(loop, robot, "127.0.0.1", 0);
   std::uint16_t port = server->port();
-  TcpLinkOptions options;
+  Options options;
   options.backoffFirst = 0.05;
-  TcpRobotLink link(loop, "127.0.0.1", port, options);
+  SocketLink link(loop, robotLinkOptions(port, options));
   Events ev;
   ev.hook(link);
   REQUIRE(runUntil(loop, [&] { return link.connected(); }));
@@ -114,8 +136,8 @@ TEST_CASE("a robot that disappears is reported down, and the link reconnects whe
   CHECK(!ev.states[1].first);
   CHECK(ev.states[1].second == "the robot closed the connection");
   CHECK(!link.connected());
-  CHECK(!link.send(Drive{10, 0}));
-  CHECK(link.lastError().find("not connected") != std::string::npos);
+  CHECK(!link.send(wlan::encode(Drive{10, 0})));
+  CHECK(link.refusal().find("not connected") != std::string::npos);
 
   // Retries fail (refused) without more reports, then the robot is back on the same port.
   REQUIRE(runUntil(loop, [&] { return link.attempts() >= 3; }));
@@ -123,7 +145,7 @@ TEST_CASE("a robot that disappears is reported down, and the link reconnects whe
   server = std::make_unique<simab::RobotServer>(loop, robot, "127.0.0.1", port);
   REQUIRE(runUntil(loop, [&] { return link.connected(); }));
   CHECK(ev.states.back() == std::pair<bool, std::string>{true, ""});
-  CHECK(link.send(Ping{7}));
+  CHECK(link.send(wlan::encode(Ping{7})));
   REQUIRE(runUntil(loop, [&] { return !ev.all<PingReply>().empty(); }));
 }
 
@@ -134,18 +156,18 @@ TEST_CASE("a robot that is not there: the first failure is reported once, with t
     tcp::acceptor probe(loop.io(), tcp::endpoint(boost::asio::ip::make_address("127.0.0.1"), 0));
     port = probe.local_endpoint().port();
   }  // closed: nothing listens there now
-  TcpLinkOptions options;
+  Options options;
   options.backoffFirst = 0.02;
-  TcpRobotLink link(loop, "127.0.0.1", port, options);
+  SocketLink link(loop, robotLinkOptions(port, options));
   Events ev;
   ev.hook(link);
   REQUIRE(runUntil(loop, [&] { return link.attempts() >= 3; }));
   REQUIRE(ev.states.size() == 1);
   CHECK(!ev.states[0].first);
   CHECK(ev.states[0].second.find("refused") != std::string::npos);
-  CHECK(link.lastError().find("not connected") != std::string::npos);
-  link.close();
-  CHECK(link.lastError().find("closed") != std::string::npos);
+  CHECK(link.refusal().find("not connected") != std::string::npos);
+  link.disconnect();
+  CHECK(link.refusal().find("closed") != std::string::npos);
 }
 
 TEST_CASE("the sim server refuses an address it cannot listen on, naming it") {

@@ -1,7 +1,7 @@
-// The MindRoad client against the simulated robot over real loopback sockets, on one real-time
-// loop: handshake, keep-alive and watchdog, TCP and UDP, a robot that disappears and comes
-// back, and validation at the edge.
-#include "engine/vehicles/mindroad_client.hpp"
+// The MindRoad robot model over its socket link, against the simulated robot over real loopback
+// sockets, on one real-time loop: handshake, keep-alive and watchdog, TCP and UDP, a robot that
+// disappears and comes back, and validation at the edge.
+#include "engine/vehicles/mindroad_robot.hpp"
 
 #include <doctest/doctest.h>
 
@@ -24,7 +24,7 @@ namespace {
 struct Fixture {
   Loop loop{ClockKind::Real};
   std::unique_ptr<MindroadRobotServer> robot;
-  std::shared_ptr<MindroadClient> client;
+  std::unique_ptr<MindroadRobot> client;
   int contacts = 0;
   std::vector<std::string> lost;
   std::vector<std::string> robotEvents;
@@ -43,10 +43,9 @@ struct Fixture {
     };
   }
   void startClient(MindroadOptions o) {
-    client = MindroadClient::create(loop, o);
+    client = std::make_unique<MindroadRobot>(loop, makeMindroadLink(loop, o), o);
     client->onContact = [this] { ++contacts; };
     client->onLost = [this](const std::string& reason) { lost.push_back(reason); };
-    client->start();
   }
   MindroadOptions options(bool udp = false) {
     MindroadOptions o;
@@ -215,7 +214,7 @@ TEST_CASE_FIXTURE(Fixture,
   CHECK(lost[0].find("refused") != std::string::npos);
   runFor(loop, std::chrono::milliseconds(700));
   CHECK(lost.size() == 1);
-  CHECK(client->phase() == MindroadClient::Phase::Waiting);
+  CHECK(client->phase() == MindroadRobot::Phase::Waiting);
 }
 
 TEST_CASE_FIXTURE(Fixture,
@@ -257,6 +256,6 @@ TEST_CASE_FIXTURE(Fixture,
   REQUIRE(runUntil(
       loop, [&] { return !state().moving(); }, std::chrono::seconds(2)));
   CHECK(state().lastStop == "stop instruction");
-  CHECK(client->phase() == MindroadClient::Phase::Closed);
+  CHECK(client->phase() == MindroadRobot::Phase::Closed);
   CHECK(client->steer(1, 0).error().find("is closed") != std::string::npos);
 }
