@@ -36,9 +36,11 @@ struct AnkiRig {
   FaultyLink link;
   AnkiCar car{loop, link, CarIdentity{1, "skull", 9, 42}};
   std::vector<std::pair<bool, std::string>> states;
+  Subscription watch;
 
   explicit AnkiRig(Faults faults) : link(sim, faults) {
-    car.onConnection = [this](bool up, const std::string& why) { states.emplace_back(up, why); };
+    watch = car.connectionChanged.connect(
+        [this](bool up, const std::string& why) { states.emplace_back(up, why); });
     sim.connect();
   }
 };
