@@ -22,7 +22,7 @@
 #include "engine/core/loop.hpp"
 #include "engine/core/result.hpp"
 #include "engine/sim/world.hpp"
-#include "engine/vehicles/fleet.hpp"
+#include "engine/fleet/fleet.hpp"
 
 namespace pitwall {
 

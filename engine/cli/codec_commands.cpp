@@ -9,7 +9,7 @@
 #include "engine/protocol/anki/codec.hpp"
 #include "engine/protocol/anki/command_text.hpp"
 #include "engine/protocol/anki/message_json.hpp"
-#include "engine/vehicles/recorder.hpp"
+#include "engine/record/recorder.hpp"
 
 namespace pitwall::cli {
 

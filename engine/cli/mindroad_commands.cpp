@@ -16,7 +16,7 @@
 #include "engine/protocol/mindroad/command_text.hpp"
 #include "engine/protocol/mindroad/message_json.hpp"
 #include "engine/sim/mindroad_robot_server.hpp"
-#include "engine/vehicles/recorder.hpp"
+#include "engine/record/recorder.hpp"
 
 namespace pitwall::cli {
 

@@ -15,8 +15,8 @@
 #include "engine/cli/options.hpp"
 #include "engine/cli/session.hpp"
 #include "engine/core/log.hpp"
-#include "engine/vehicles/record_player.hpp"
-#include "engine/vehicles/record_reader.hpp"
+#include "engine/record/record_player.hpp"
+#include "engine/record/record_reader.hpp"
 
 namespace pitwall::cli {
 

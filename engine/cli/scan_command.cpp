@@ -11,7 +11,7 @@
 #include "engine/cli/commands.hpp"
 #include "engine/cli/options.hpp"
 #include "engine/core/log.hpp"
-#include "engine/vehicles/ble_central.hpp"
+#include "engine/fleet/ble_central.hpp"
 
 namespace pitwall::cli {
 

@@ -11,9 +11,9 @@
 #include "engine/mqtt/bridge.hpp"
 #include "engine/mqtt/remote.hpp"
 #include "engine/transport/mqtt_client.hpp"
-#include "engine/vehicles/ble_central.hpp"
-#include "engine/vehicles/fleet.hpp"
-#include "engine/vehicles/recorder.hpp"
+#include "engine/fleet/ble_central.hpp"
+#include "engine/fleet/fleet.hpp"
+#include "engine/record/recorder.hpp"
 #include "engine/view/feed.hpp"
 #include "engine/view/server.hpp"
 

@@ -31,7 +31,7 @@
 #include "engine/mqtt/throttle.hpp"
 #include "engine/mqtt/topics.hpp"
 #include "engine/transport/mqtt_client.hpp"
-#include "engine/vehicles/fleet.hpp"
+#include "engine/fleet/fleet.hpp"
 
 namespace pitwall {
 

@@ -14,7 +14,7 @@
 
 #include "engine/core/loop.hpp"
 #include "engine/sim/track.hpp"
-#include "engine/vehicles/fleet.hpp"
+#include "engine/fleet/fleet.hpp"
 #include "engine/view/tracker.hpp"
 
 namespace pitwall::view {

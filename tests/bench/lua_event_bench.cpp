@@ -19,7 +19,7 @@
 #include "bindings/lua_args.hpp"
 #include "bindings/script_host.hpp"
 #include "engine/protocol/anki/codec.hpp"
-#include "engine/vehicles/fleet.hpp"
+#include "engine/fleet/fleet.hpp"
 #include "tests/bench/frames.hpp"
 
 namespace {

@@ -57,7 +57,7 @@
 #include "engine/mqtt/topics.hpp"
 #include "engine/protocol/anki/codec.hpp"
 #include "engine/transport/mqtt_client.hpp"
-#include "engine/vehicles/fleet.hpp"
+#include "engine/fleet/fleet.hpp"
 #include "tests/bench/frames.hpp"
 #include "tests/bench/latency.hpp"
 #include "tests/support/mosquitto_broker.hpp"

@@ -19,7 +19,7 @@
 #include "engine/sim/grid.hpp"
 #include "engine/sim/track.hpp"
 #include "engine/sim/world.hpp"
-#include "engine/vehicles/fleet.hpp"
+#include "engine/fleet/fleet.hpp"
 #include "tests/support/sim_cars.hpp"
 
 namespace {

@@ -22,7 +22,7 @@
 
 #include "bindings/script_host.hpp"
 #include "engine/sim/track.hpp"
-#include "engine/vehicles/fleet.hpp"
+#include "engine/fleet/fleet.hpp"
 #include "engine/view/server.hpp"
 #include "tests/bench/frames.hpp"
 

@@ -1,4 +1,4 @@
-// Reading a --record file back (engine/vehicles/record_reader.hpp), the input of `pitwall replay`:
+// Reading a --record file back (engine/record/record_reader.hpp), the input of `pitwall replay`:
 // any bytes are a file. Never a crash or an exception; every line is a frame, a bad line with its
 // number and a short reason, valid UTF-8 without control characters, or blank; frames keep the
 // reader's promises (car 1..64, t within range and never going back by more than the slack, a
@@ -10,7 +10,7 @@
 #include <sstream>
 #include <string>
 
-#include "engine/vehicles/record_reader.hpp"
+#include "engine/record/record_reader.hpp"
 #include "tests/fuzz/fuzz_check.hpp"
 
 using namespace pitwall;

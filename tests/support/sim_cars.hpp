@@ -5,7 +5,7 @@
 
 #include "engine/sim/world.hpp"
 #include "engine/transport/sim_link.hpp"
-#include "engine/vehicles/fleet.hpp"
+#include "engine/fleet/fleet.hpp"
 
 namespace pitwall::testing {
 

@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "bindings/script_host.hpp"
-#include "engine/vehicles/fleet.hpp"
+#include "engine/fleet/fleet.hpp"
 
 using namespace pitwall;
 using results::Cell;

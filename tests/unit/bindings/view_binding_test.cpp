@@ -7,7 +7,7 @@
 
 #include "bindings/script_host.hpp"
 #include "engine/sim/grid.hpp"
-#include "engine/vehicles/fleet.hpp"
+#include "engine/fleet/fleet.hpp"
 #include "engine/view/feed.hpp"
 #include "tests/support/sim_cars.hpp"
 

@@ -3,7 +3,7 @@
 #include <doctest/doctest.h>
 
 #include "engine/core/log.hpp"
-#include "engine/vehicles/fleet.hpp"
+#include "engine/fleet/fleet.hpp"
 #include "tests/unit/capture_link.hpp"
 
 using namespace pitwall;

@@ -7,7 +7,7 @@
 
 #include "engine/core/log.hpp"
 #include "engine/sim/world.hpp"
-#include "engine/vehicles/fleet.hpp"
+#include "engine/fleet/fleet.hpp"
 #include "engine/view/feed.hpp"
 #include "engine/view/geometry.hpp"
 #include "tests/support/sim_cars.hpp"

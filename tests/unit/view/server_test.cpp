@@ -14,7 +14,7 @@
 #include <fstream>
 #include <thread>
 
-#include "engine/vehicles/fleet.hpp"
+#include "engine/fleet/fleet.hpp"
 #include "engine/view/server.hpp"
 #include "tests/support/run_until.hpp"
 

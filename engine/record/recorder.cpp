@@ -1,4 +1,4 @@
-#include "engine/vehicles/recorder.hpp"
+#include "engine/record/recorder.hpp"
 
 #include <fcntl.h>
 #include <unistd.h>

@@ -1,4 +1,4 @@
-#include "engine/vehicles/ble_central.hpp"
+#include "engine/fleet/ble_central.hpp"
 
 #include <algorithm>
 #include <cctype>

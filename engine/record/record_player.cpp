@@ -1,4 +1,4 @@
-#include "engine/vehicles/record_player.hpp"
+#include "engine/record/record_player.hpp"
 
 #include <algorithm>
 

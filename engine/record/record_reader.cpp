@@ -1,4 +1,4 @@
-#include "engine/vehicles/record_reader.hpp"
+#include "engine/record/record_reader.hpp"
 
 #include "engine/core/numbers.hpp"
 

@@ -1,5 +1,5 @@
 #pragma once
-// Reading a `--record` file back (docs/cli.md "Record format", engine/vehicles/recorder.hpp): one
+// Reading a `--record` file back (docs/cli.md "Record format", engine/record/recorder.hpp): one
 // JSON object per line, {"t":…,"car":N,"dir":"rx"|"tx","hex":"…","msg":{…}}. Only t, car, dir
 // and hex are read: the frame is decoded again by whoever replays it, so "msg" is never trusted.
 //

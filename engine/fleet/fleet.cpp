@@ -1,4 +1,4 @@
-#include "engine/vehicles/fleet.hpp"
+#include "engine/fleet/fleet.hpp"
 
 #include "engine/core/log.hpp"
 #include "engine/protocol/anki/advertisement.hpp"

@@ -17,8 +17,8 @@
 
 #include "engine/core/loop.hpp"
 #include "engine/transport/replay_link.hpp"
-#include "engine/vehicles/fleet.hpp"
-#include "engine/vehicles/record_reader.hpp"
+#include "engine/fleet/fleet.hpp"
+#include "engine/record/record_reader.hpp"
 
 namespace pitwall {
 

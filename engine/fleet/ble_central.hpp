@@ -20,7 +20,7 @@
 
 #include "engine/transport/ble_link.hpp"
 #include "engine/transport/bluez.hpp"
-#include "engine/vehicles/fleet.hpp"
+#include "engine/fleet/fleet.hpp"
 
 namespace pitwall::ble {
 

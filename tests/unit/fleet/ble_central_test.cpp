@@ -1,7 +1,7 @@
 // The BlueZ client (Bluez, BleLink, Central) against the fake org.bluez on a private bus: the
 // same code that drives real cars, with the cars simulated behind D-Bus. Real clock; every wait
 // is for a condition on the loop, with a deadline.
-#include "engine/vehicles/ble_central.hpp"
+#include "engine/fleet/ble_central.hpp"
 
 #include <doctest/doctest.h>
 
