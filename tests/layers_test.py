@@ -1,0 +1,93 @@
+#!/usr/bin/env python3
+"""The floors of docs/architecture.md, checked on every #include of engine/ and bindings/.
+
+A file may include only floors below its own (peers on one floor do not include each other), and
+nothing below bindings/ includes Lua. Usage: layers_test.py SOURCE_ROOT [--self-test].
+Fails naming the file, the line and the floor it reaches.
+"""
+import pathlib
+import re
+import sys
+
+# Lower first. Peers share a rank: they may not include each other.
+FLOORS = {
+    "engine/core": 0,
+    "engine/protocol": 1,
+    "engine/sim": 2,
+    "engine/transport": 3,  # SimLink carries frames to the simulator's cars
+    "engine/vehicles": 4,
+    "engine/fleet": 5,
+    "engine/record": 6,
+    "engine/mqtt": 6,
+    "engine/view": 6,
+    "bindings": 7,
+    "engine/cli": 8,
+}
+LUA_FROM = FLOORS["bindings"]  # the lowest floor that may know Lua
+INCLUDE = re.compile(r'^\s*#\s*include\s*[<"]([^>"]+)[>"]')
+LUA_HEADERS = {"lua.hpp", "lua.h", "lualib.h", "lauxlib.h"}
+
+
+def floor_of(path):
+    for floor in sorted(FLOORS, key=len, reverse=True):
+        if path == floor or path.startswith(floor + "/"):
+            return floor
+    return None
+
+
+def violations(files):
+    """files: {relative path: text}. Yields one sentence per include that goes up or sideways."""
+    for path, text in sorted(files.items()):
+        here = floor_of(path)
+        if here is None:
+            continue
+        for number, line in enumerate(text.splitlines(), 1):
+            m = INCLUDE.match(line)
+            if not m:
+                continue
+            target = m.group(1)
+            if target in LUA_HEADERS and FLOORS[here] < LUA_FROM:
+                yield f"{path}:{number}: includes <{target}>: nothing below bindings/ knows Lua"
+                continue
+            there = floor_of(target)
+            if there is None or there == here:
+                continue
+            if FLOORS[there] >= FLOORS[here]:
+                kind = "a peer" if FLOORS[there] == FLOORS[here] else "a floor above"
+                yield (f"{path}:{number}: {here} includes {target}, {kind} "
+                       f"({there}); a layer uses only layers below it (docs/architecture.md)")
+
+
+def self_test():
+    bad = {
+        "engine/vehicles/x.cpp": '#include "engine/fleet/fleet.hpp"\n',
+        "engine/mqtt/y.cpp": '#include "engine/view/feed.hpp"\n',
+        "engine/transport/z.cpp": "#include <lua.hpp>\n",
+    }
+    good = {
+        "engine/fleet/f.cpp": '#include "engine/vehicles/anki_car.hpp"\n#include <vector>\n',
+        "engine/cli/c.cpp": '#include "bindings/script_host.hpp"\n#include <lua.hpp>\n',
+        "bindings/b.cpp": "#include <lua.hpp>\n",
+    }
+    found = list(violations(bad))
+    assert len(found) == 3, found
+    assert not list(violations(good)), list(violations(good))
+
+
+def main():
+    root = pathlib.Path(sys.argv[1])
+    self_test()
+    files = {}
+    for top in ("engine", "bindings"):
+        for p in (root / top).rglob("*"):
+            if p.suffix in (".cpp", ".hpp"):
+                files[str(p.relative_to(root))] = p.read_text(encoding="utf-8", errors="replace")
+    found = list(violations(files))
+    for v in found:
+        print(v, file=sys.stderr)
+    print(f"layers: {len(files)} files, {len(found)} includes out of order")
+    return 1 if found else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
