@@ -1,6 +1,8 @@
 // The simulated MindRoad robot car: the behaviour rules of ../shared/protocols/mindroad.md.
 #include "engine/sim/mindroad_robot.hpp"
 
+#include "engine/core/numbers.hpp"
+
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -12,9 +14,7 @@ using namespace mindroad;
 
 namespace {
 std::string seconds(double s) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g s", s);
-  return buf;
+  return formatNumber(s, 3) + " s";
 }
 }  // namespace
 

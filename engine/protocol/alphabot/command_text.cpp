@@ -1,5 +1,7 @@
 #include "engine/protocol/alphabot/command_text.hpp"
 
+#include "engine/core/numbers.hpp"
+
 #include <charconv>
 #include <limits>
 #include <string_view>
@@ -54,8 +56,7 @@ struct Parser {
     }
     constexpr auto kMax = static_cast<unsigned long long>(std::numeric_limits<long long>::max());
     if (ec == std::errc::result_out_of_range || magnitude > kMax + (negative ? 1 : 0)) {
-      error = std::string(what) + " " + std::string(s) + " is out of range " + std::to_string(lo) +
-              ".." + std::to_string(hi);
+      error = outOfRange(what, s, static_cast<double>(lo), static_cast<double>(hi));
       return false;
     }
     out = negative ? static_cast<long long>(0ULL - magnitude) : static_cast<long long>(magnitude);
@@ -68,8 +69,7 @@ struct Parser {
 
 std::string checkRange(const char* what, long long value, long long lo, long long hi) {
   if (value >= lo && value <= hi) return {};
-  return std::string(what) + " " + std::to_string(value) + " is out of range " +
-         std::to_string(lo) + ".." + std::to_string(hi);
+  return outOfRange(what, std::to_string(value), static_cast<double>(lo), static_cast<double>(hi));
 }
 
 std::vector<std::string> commandForms() {

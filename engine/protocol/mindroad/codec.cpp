@@ -1,6 +1,8 @@
 // The MindRoad codec (../shared/protocols/mindroad.md; seed 002 §2–4).
 #include "engine/protocol/mindroad/codec.hpp"
 
+#include "engine/core/numbers.hpp"
+
 #include <type_traits>
 
 #include "engine/core/hex.hpp"
@@ -95,12 +97,14 @@ std::string DecodeError::message() const {
     case Kind::WrongLength:
       return idText(id) + " takes " + bytesWord(expected) + ", the header announces " +
              std::to_string(received);
-    case Kind::OutOfRange:
-      return idText(id) + ": " + field + " " + std::to_string(value) + " is out of range " +
-             (field == "x"      ? "1..160"
-              : field == "y"    ? "1..120"
-              : field == "mode" ? "0..2 (0 rgb, 1 hsv, 2 filter)"
-                                : "");
+    case Kind::OutOfRange: {
+      const std::string what = idText(id) + ": " + field;
+      if (field == "x") return pitwall::outOfRange(what, value, kClickMinX, kClickMaxX);
+      if (field == "y") return pitwall::outOfRange(what, value, kClickMinY, kClickMaxY);
+      if (field == "mode")
+        return pitwall::outOfRange(what, value, 0, 2) + " (0 rgb, 1 hsv, 2 filter)";
+      return what + " " + std::to_string(value) + " is out of range";
+    }
     case Kind::NotAnAnswer:
       return "robot answer " + hexByte(value) + (received == 1 ? "" : " (and more)") +
              " is not the contact answer 0x4b (K), the only byte the robot sends";
@@ -195,15 +199,13 @@ std::uint8_t instructionId(const Instruction& instruction) {
 
 std::optional<std::string> validate(const Instruction& instruction) {
   if (const auto* c = std::get_if<MousePosition>(&instruction)) {
-    if (c->x < kClickMinX || c->x > kClickMaxX)
-      return "click x " + std::to_string(c->x) + " is out of range 1..160";
-    if (c->y < kClickMinY || c->y > kClickMaxY)
-      return "click y " + std::to_string(c->y) + " is out of range 1..120";
+    if (auto e = pitwall::checkRange("click x", c->x, kClickMinX, kClickMaxX)) return e;
+    if (auto e = pitwall::checkRange("click y", c->y, kClickMinY, kClickMaxY)) return e;
   }
   if (const auto* p = std::get_if<PictureMode>(&instruction)) {
     if (static_cast<int>(p->mode) > 2)
-      return "picture mode " + std::to_string(static_cast<int>(p->mode)) +
-             " is out of range 0..2 (rgb, hsv, filter)";
+      return pitwall::outOfRange("picture mode", static_cast<int>(p->mode), 0, 2) +
+             " (rgb, hsv, filter)";
   }
   return std::nullopt;
 }

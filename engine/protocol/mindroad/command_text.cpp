@@ -2,6 +2,8 @@
 // against its range before it is narrowed into its field.
 #include "engine/protocol/mindroad/command_text.hpp"
 
+#include "engine/core/numbers.hpp"
+
 #include <charconv>
 #include <optional>
 #include <string_view>
@@ -37,7 +39,8 @@ struct Args {
     if (!v)
       return Unexpected{what + " '" + words[i] + "' is not a whole number; expected " + range};
     if (*v < min || *v > max)
-      return Unexpected{what + " " + words[i] + " is out of range " + range};
+      return Unexpected{
+          outOfRange(what, words[i], static_cast<double>(min), static_cast<double>(max))};
     return *v;
   }
   std::optional<std::string> extra(std::size_t count) const {
