@@ -45,6 +45,10 @@ rm -f "$ART"/view-*.png
 # says "live" by itself with the cars back. Screenshots $ART/view-NAME.png and view-NAME-gone.png.
 in_browser() {
   local name=$1 option=$2 path=$3
+  # Emptied here, not by the redirection below: that happens in the background child, after
+  # wait_for may already have read the previous run's address from the old file.
+  : > "$TMP/out"
+  : > "$TMP/err"
   LAPS=50 "$PITWALL" run "$SRC/examples/grand_prix.lua" --view 127.0.0.1:0 \
     > "$TMP/out" 2> "$TMP/err" &
   pid=$!
