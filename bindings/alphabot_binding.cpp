@@ -1,10 +1,9 @@
 // pitwall.alphabot{host=…, port=…} / {ble=ADDR}: an Alphabot robot as a Lua object
 // (docs/robots.md) over its model (engine/vehicles/alphabot.hpp). One full userdata per robot,
-// owning the model and the handler references; the world keeps it in the registry until
-// robot:close() or the end of the world (lua_close runs __gc: the robot is sent a stop and its link
-// is closed, so nothing reaches a Lua state that is gone).
+// owning the model and its events' handlers (lua::EventSlots); the world keeps it in the registry
+// until robot:close() or the end of the world (lua_close runs __gc: the robot is sent a stop and
+// its link is closed, so nothing reaches a Lua state that is gone).
 #include <array>
-#include <cctype>
 #include <cstring>
 #include <memory>
 #include <optional>
@@ -31,24 +30,24 @@ namespace {
 constexpr const char* kMetatable = "pitwall.alphabot";
 constexpr const char* kComponent = "alphabot";
 
-enum Event {
-  kDistance,
-  kPosition,
-  kCompass,
-  kObstacle,
-  kPath,
-  kPing,
-  kConnect,
-  kDisconnect,
-  kMalformed,
-  kMapSize,
-  kAnchor,
-  kCalibrated,
-  kEventCount
+// The robot's events, from this one list: each handler is called as fn(robot, ev), ev.time
+// being the loop's seconds.
+// clang-format off
+#define PITWALL_ALPHABOT_EVENTS(X)                                                 \
+  X(Distance) X(Position) X(Compass) X(Obstacle) X(Path) X(Ping) X(Connect)        \
+  X(Disconnect) X(Malformed) X(MapSize) X(Anchor) X(Calibrated)
+// clang-format on
+
+enum class Event {
+#define PITWALL_ALPHABOT_EVENT_ENUM(name) name,
+  PITWALL_ALPHABOT_EVENTS(PITWALL_ALPHABOT_EVENT_ENUM)
+#undef PITWALL_ALPHABOT_EVENT_ENUM
 };
-constexpr std::array<const char*, kEventCount> kEventNames = {
-    "onDistance", "onPosition",   "onCompass",   "onObstacle", "onPath",   "onPing",
-    "onConnect",  "onDisconnect", "onMalformed", "onMapSize",  "onAnchor", "onCalibrated"};
+constexpr const char* kEventNames[] = {
+#define PITWALL_ALPHABOT_EVENT_NAME(name) "on" #name,
+    PITWALL_ALPHABOT_EVENTS(PITWALL_ALPHABOT_EVENT_NAME)
+#undef PITWALL_ALPHABOT_EVENT_NAME
+};
 
 constexpr std::array<const char*, 11> kFieldNames = {"connected", "x",         "y",     "heading",
                                                      "address",   "lastPing",  "pings", "lastError",
@@ -57,22 +56,17 @@ constexpr std::array<const char*, 11> kFieldNames = {"connected", "x",         "
 struct Robot {
   ScriptHost* host = nullptr;
   std::unique_ptr<Alphabot> model;
-  std::array<int, kEventCount> handlers;
+  lua::EventSlots slots;
   int selfRef = LUA_NOREF;
   std::string label;  // "alphabot tcp:127.0.0.1:4000"
-
-  Robot() { handlers.fill(LUA_NOREF); }
 
   // Ends the robot's part in the world: a stop for a connected robot, the link closed, no more
   // events. Safe to call twice, and from __gc during lua_close.
   void close(lua_State* L) {
     // The model stays (one of its handlers may be running: a handler that calls
-    // robot:close()); a closed model calls none of them again, and dispatch() checks closed().
+    // robot:close()); a closed model calls none of them again, and deliver() checks closed().
     if (model) model->close();
-    for (auto& h : handlers) {
-      luaL_unref(L, LUA_REGISTRYINDEX, h);
-      h = LUA_NOREF;
-    }
+    slots.release(L);
     luaL_unref(L, LUA_REGISTRYINDEX, selfRef);
     selfRef = LUA_NOREF;
   }
@@ -87,18 +81,17 @@ Robot& robotAt(lua_State* L, int idx) {
 
 // ---- events ----
 
-// Calls robot.onX(robot, ev) with ev filled by `fill` (the table on top of the stack).
+const lua::EventNames& events() {
+  static const lua::EventNames names(kEventNames);
+  return names;
+}
+
+// Calls robot.onX(robot, ev) with a fresh ev filled by `fill` (the table on top of the stack).
 template <class Fill>
-void dispatch(Robot& r, Event e, Fill fill) {
-  if (r.closed() || r.handlers[e] == LUA_NOREF) return;
-  lua_State* L = r.host->state();
-  lua_rawgeti(L, LUA_REGISTRYINDEX, r.handlers[e]);
-  lua_rawgeti(L, LUA_REGISTRYINDEX, r.selfRef);
-  lua_createtable(L, 0, 4);
-  fill(L);
-  lua::setNumber(L, "time", r.host->loop().seconds());
-  std::string what = std::string(kEventNames[e]) + " handler of " + r.label;
-  r.host->call(2, 0, what.c_str());
+void deliver(Robot& r, Event e, Fill&& fill) {
+  if (r.closed()) return;
+  lua::emit({*r.host, r.slots, events(), r.selfRef, r.label}, static_cast<std::size_t>(e),
+            LUA_NOREF, fill);
 }
 
 void pushWaypoints(lua_State* L, const std::vector<ab::Waypoint>& waypoints) {
@@ -115,33 +108,34 @@ void received(Robot& r, const ab::Response& response) {
   std::visit(
       Overload{
           [&](const ab::Distance& d) {
-            dispatch(r, kDistance, [&](lua_State* L) {
+            deliver(r, Event::Distance, [&](lua_State* L) {
               lua::setInteger(L, "degree", d.degree);
               lua::setInteger(L, "distance", d.distance);
             });
           },
           [&](const ab::Position& p) {
-            dispatch(r, kPosition, [&](lua_State* L) {
+            deliver(r, Event::Position, [&](lua_State* L) {
               lua::setInteger(L, "x", p.x);
               lua::setInteger(L, "y", p.y);
             });
           },
           [&](const ab::Path& p) {
-            dispatch(r, kPath, [&](lua_State* L) {
+            deliver(r, Event::Path, [&](lua_State* L) {
               pushWaypoints(L, p.waypoints);
               lua_setfield(L, -2, "waypoints");
               lua::setBoolean(L, "reachable", !p.waypoints.empty());
             });
           },
           [&](const ab::Compass& c) {
-            dispatch(r, kCompass, [&](lua_State* L) { lua::setInteger(L, "degree", c.degree); });
+            deliver(r, Event::Compass,
+                    [&](lua_State* L) { lua::setInteger(L, "degree", c.degree); });
           },
           [&](const ab::PingReply&) {
             double rtt = r.model->state().lastPing.value_or(0);
-            dispatch(r, kPing, [&](lua_State* L) { lua::setNumber(L, "rtt", rtt); });
+            deliver(r, Event::Ping, [&](lua_State* L) { lua::setNumber(L, "rtt", rtt); });
           },
           [&](const ab::ObstacleRegistered& o) {
-            dispatch(r, kObstacle, [&](lua_State* L) {
+            deliver(r, Event::Obstacle, [&](lua_State* L) {
               lua::setInteger(L, "id", o.id);
               lua::setInteger(L, "x", o.x);
               lua::setInteger(L, "y", o.y);
@@ -150,19 +144,19 @@ void received(Robot& r, const ab::Response& response) {
             });
           },
           [&](const ab::MapSize& m) {
-            dispatch(r, kMapSize, [&](lua_State* L) {
+            deliver(r, Event::MapSize, [&](lua_State* L) {
               lua::setInteger(L, "length", m.length);
               lua::setInteger(L, "width", m.width);
             });
           },
           [&](const ab::AnchorPosition& a) {
-            dispatch(r, kAnchor, [&](lua_State* L) {
+            deliver(r, Event::Anchor, [&](lua_State* L) {
               lua::setInteger(L, "id", a.id);
               lua::setInteger(L, "x", a.x);
               lua::setInteger(L, "y", a.y);
             });
           },
-          [&](const ab::CalibrationFinished&) { dispatch(r, kCalibrated, [](lua_State*) {}); },
+          [&](const ab::CalibrationFinished&) { deliver(r, Event::Calibrated, [](lua_State*) {}); },
       },
       response);
 }
@@ -171,13 +165,13 @@ void hook(Robot& r) {
   Alphabot& m = *r.model;
   m.onResponse = [&r](const ab::Response& response) { received(r, response); };
   m.onConnection = [&r](bool up, const std::string& reason) {
-    if (up) return dispatch(r, kConnect, [](lua_State*) {});
+    if (up) return deliver(r, Event::Connect, [](lua_State*) {});
     // onDisconnect follows a connection, not a failed attempt
     if (!r.model->state().everConnected) return;
-    dispatch(r, kDisconnect, [&](lua_State* L) { lua::setString(L, "reason", reason); });
+    deliver(r, Event::Disconnect, [&](lua_State* L) { lua::setString(L, "reason", reason); });
   };
   m.onMalformed = [&r](const std::string& error) {
-    dispatch(r, kMalformed, [&](lua_State* L) { lua::setString(L, "error", error); });
+    deliver(r, Event::Malformed, [&](lua_State* L) { lua::setString(L, "error", error); });
   };
 }
 
@@ -341,30 +335,15 @@ int index(lua_State* L) {
   return lua::indexObject(L, [&](std::string_view key) { return pushField(L, r, key); });
 }
 
+const lua::ObjectType& robotType();
+
 int newindex(lua_State* L) {
+  // A closed robot has no more events: setting a handler on it is a mistake worth saying.
   Robot& r = robotAt(L, 1);
-  if (lua_type(L, 2) == LUA_TSTRING) {
-    std::string key = lua_tostring(L, 2);
-    int e = -1;
-    for (int i = 0; i < kEventCount; ++i)
-      if (key == kEventNames[static_cast<std::size_t>(i)]) e = i;
-    if (e >= 0) {
-      lua::checkHandler(L, "alphabot", key);
-      if (r.closed()) {
-        if (!lua_isnil(L, 3)) throw LuaError(r.label + " is closed: it has no more events");
-        return 0;
-      }
-      luaL_unref(L, LUA_REGISTRYINDEX, r.handlers[static_cast<std::size_t>(e)]);
-      r.handlers[static_cast<std::size_t>(e)] = LUA_NOREF;
-      if (lua_isfunction(L, 3)) {
-        lua_pushvalue(L, 3);
-        r.handlers[static_cast<std::size_t>(e)] = luaL_ref(L, LUA_REGISTRYINDEX);
-      }
-      return 0;
-    }
-    lua::refuseReserved(L, "alphabot", key, kFieldNames, kEventNames);
-  }
-  return lua::storeOwnField(L);
+  if (r.closed() && lua_isfunction(L, 3) && lua_type(L, 2) == LUA_TSTRING &&
+      events().find(lua_tostring(L, 2)) >= 0)
+    throw LuaError(r.label + " is closed: it has no more events");
+  return lua::newindexObject(L, robotType(), r.slots);
 }
 
 int tostring(lua_State* L) {
@@ -450,7 +429,7 @@ int newRobot(lua_State* L) {
   return 1;
 }
 
-void registerType(lua_State* L) {
+const lua::ObjectType& robotType() {
   static const luaL_Reg methods[] = {{"drive", lua::guarded<drive>},
                                      {"stop", lua::guarded<stop>},
                                      {"measureDistance", lua::guarded<measureDistance>},
@@ -465,10 +444,16 @@ void registerType(lua_State* L) {
                                      {"clearObstacles", lua::guarded<clearObstacles>},
                                      {"close", lua::guarded<close>},
                                      {nullptr, nullptr}};
-  static const lua::EventNames events(kEventNames);
-  lua::registerObjectType(
-      L, {kMetatable, "alphabot", methods, kFieldNames, events, lua::guarded<index>,
-          lua::guarded<newindex>, lua::guarded<tostring>, gc});
+  static const lua::ObjectType type{kMetatable,
+                                    "alphabot",
+                                    methods,
+                                    kFieldNames,
+                                    events(),
+                                    lua::guarded<index>,
+                                    lua::guarded<newindex>,
+                                    lua::guarded<tostring>,
+                                    gc};
+  return type;
 }
 
 }  // namespace
@@ -492,7 +477,7 @@ end)";
 
 void openAlphabotModule(ScriptHost& host) {
   lua_State* L = host.state();
-  registerType(L);
+  lua::registerObjectType(L, robotType());
   luaL_getmetatable(L, kMetatable);
   lua_getfield(L, -1, "__methods");
   if (luaL_loadbufferx(L, kPingWaits, std::strlen(kPingWaits), "=alphabot ping", "t") != LUA_OK)

@@ -48,4 +48,19 @@ void finishEvent(const EventSource& source, std::size_t e, int tableRef) {
   host.callAboveHandler(2, source.names.handlerWhat(e), source.who);
 }
 
+bool pushCallee(const EventSource& source, std::size_t e, bool hub) {
+  const int ref = hub ? source.slots.hub(e) : source.slots.handler(e);
+  if (ref == LUA_NOREF) return false;
+  lua_State* L = source.host.state();
+  lua_pushcfunction(L, traceback);
+  lua_rawgeti(L, LUA_REGISTRYINDEX, ref);
+  lua_rawgeti(L, LUA_REGISTRYINDEX, source.selfRef);
+  return true;
+}
+
+void callCallee(const EventSource& source, std::size_t e, bool hub, int nargs) {
+  source.host.callAboveHandler(
+      1 + nargs, hub ? source.names.listenersWhat(e) : source.names.handlerWhat(e), source.who);
+}
+
 }  // namespace pitwall::lua

@@ -4,7 +4,8 @@
 // one list each (ObjectType); each object is a full userdata whose table (its uservalue 1) keeps
 // the script's own fields. An object owns the Lua functions its events call (EventSlots: the
 // handler the script set, and the hub that runs the library's listeners), and every binding
-// delivers an event the same way (emit): the listeners first, then the handler, with one table.
+// delivers an event the same way (emit): the listeners first, then the handler, with one table
+// (emitArgs: with positional arguments, for the events whose handlers always took them).
 #include <lua.hpp>
 
 #include <array>
@@ -126,6 +127,18 @@ void emit(const EventSource& source, std::size_t e, int tableRef, Fill&& fill) {
   finishEvent(source, e, tableRef);
 }
 
+// The same for an event whose functions take positional arguments instead of a table,
+// fn(object, args…) (the MindRoad's onLost(robot, reason)): `push(L)` pushes them and returns how
+// many. It runs once per function called (the hub, then the handler), so each gets its own.
+bool pushCallee(const EventSource& source, std::size_t e, bool hub);
+void callCallee(const EventSource& source, std::size_t e, bool hub, int nargs);
+
+template <class Push>
+void emitArgs(const EventSource& source, std::size_t e, Push&& push) {
+  for (bool hub : {true, false})
+    if (pushCallee(source, e, hub)) callCallee(source, e, hub, push(source.host.state()));
+}
+
 // A userdata type seen from Lua: one metatable under `metatable` in the registry.
 struct ObjectType {
   const char* metatable;  // registry key, "pitwall.car"
@@ -137,6 +150,7 @@ struct ObjectType {
   lua_CFunction newindex;
   lua_CFunction tostring;
   lua_CFunction gc = nullptr;
+  const char* what = nullptr;  // how errors name the object when not by `name` ("robot")
 };
 
 // Registers the type's metatable (once): __index and __newindex as closures over the methods
@@ -197,7 +211,7 @@ int indexObject(lua_State* L, Field&& field) {
 inline int newindexObject(lua_State* L, const ObjectType& type, EventSlots& slots) {
   if (lua_type(L, 2) == LUA_TSTRING) {
     const std::string key = lua_tostring(L, 2);
-    const std::string what = type.name;
+    const std::string what = type.what ? type.what : type.name;
     if (int e = type.events.find(key); e >= 0) {
       if (!lua_isnil(L, 3) && !lua_isfunction(L, 3))
         throw LuaError(what + "." + key + " must be a function or nil, got " + typeName(L, 3));
@@ -241,41 +255,6 @@ inline void setHubOf(lua_State* L, const ObjectType& type, EventSlots& slots,
     throw LuaError(std::string("a listener hub must be a function or nil, got ") +
                    luaL_typename(L, 3));
   slots.setHub(L, static_cast<std::size_t>(e), 3);
-}
-
-// TRANSITIONAL: the robots' bindings' own handler keeping, until they move onto EventSlots.
-// __newindex of a name that is no event: refuses, by name, what is not the script's to set — an
-// onX that is no event (a typo would never be called), a state field, a method. `what` is how
-// errors name the object ("car", "robot").
-inline void refuseReserved(lua_State* L, const std::string& what, const std::string& key,
-                           std::span<const char* const> fields,
-                           std::span<const char* const> events) {
-  if (key.size() > 2 && key[0] == 'o' && key[1] == 'n' &&
-      std::isupper(static_cast<unsigned char>(key[2])))
-    throw LuaError(what + "." + key + " is not an event; the events are " + joinNames(events));
-  for (const char* f : fields)
-    if (key == f)
-      throw LuaError(what + "." + key + " is read-only (it is the " + what + "'s state)");
-  lua_pushvalue(L, 2);
-  bool isMethod = lua_rawget(L, lua_upvalueindex(1)) != LUA_TNIL;
-  lua_pop(L, 1);
-  if (isMethod) throw LuaError(what + ":" + key + " is a method and cannot be replaced");
-}
-
-// A handler set on an event: a function, or nil to remove it.
-inline void checkHandler(lua_State* L, const std::string& what, const std::string& key) {
-  if (!lua_isnil(L, 3) && !lua_isfunction(L, 3))
-    throw LuaError(what + "." + key + " must be a function or nil, got " + typeName(L, 3));
-}
-
-// __newindex's end: object[key] = value in the object's own table (its uservalue 1).
-inline int storeOwnField(lua_State* L) {
-  lua_settop(L, 3);
-  lua_getiuservalue(L, 1, 1);
-  lua_pushvalue(L, 2);
-  lua_pushvalue(L, 3);
-  lua_rawset(L, 4);
-  return 0;
 }
 
 }  // namespace pitwall::lua

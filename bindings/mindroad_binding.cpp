@@ -1,13 +1,12 @@
 // pitwall.mindroad{host=…, port=…}: a MindRoad robot car as a Lua object (docs/robots.md).
-// One full userdata per robot holding its model (engine/vehicles/mindroad_robot.hpp); a uservalue
-// table keeps the event handlers and the script's own fields, as cars do. The object belongs to the
-// Lua world that made it: a registry reference keeps it (and its connection) alive until
-// robot:close() or the end of that world (end of the run, a hot reload), when __gc closes the link
-// — the robot then gets a stop, or stops by its watchdog.
+// One full userdata per robot holding its model (engine/vehicles/mindroad_robot.hpp) and its
+// events' handlers (lua::EventSlots); a uservalue table keeps the script's own fields, as cars do.
+// The object belongs to the Lua world that made it: a registry reference keeps it (and its
+// connection) alive until robot:close() or the end of that world (end of the run, a hot reload),
+// when __gc closes the link — the robot then gets a stop, or stops by its watchdog.
 #include <lua.hpp>
 
 #include <array>
-#include <cctype>
 #include <memory>
 #include <optional>
 #include <string>
@@ -30,7 +29,20 @@ namespace {
 constexpr const char* kMetatable = "pitwall.mindroad";
 constexpr double kConfirmWindow = 5;  // s: shutdown() typed at the REPL must be repeated within it
 
-constexpr std::array<const char*, 2> kEvents = {"onContact", "onLost"};
+// The robot's events, from this one list. Their handlers take positional arguments, not a table:
+// onContact(robot), onLost(robot, reason) (docs/robots.md).
+#define PITWALL_MINDROAD_EVENTS(X) X(Contact) X(Lost)
+
+enum class Event {
+#define PITWALL_MINDROAD_EVENT_ENUM(name) name,
+  PITWALL_MINDROAD_EVENTS(PITWALL_MINDROAD_EVENT_ENUM)
+#undef PITWALL_MINDROAD_EVENT_ENUM
+};
+constexpr const char* kEvents[] = {
+#define PITWALL_MINDROAD_EVENT_NAME(name) "on" #name,
+    PITWALL_MINDROAD_EVENTS(PITWALL_MINDROAD_EVENT_NAME)
+#undef PITWALL_MINDROAD_EVENT_NAME
+};
 constexpr std::array<const char*, 8> kFields = {"connected", "host",  "port",      "udp",
                                                 "watchdog",  "phase", "lastError", "contacts"};
 
@@ -38,9 +50,9 @@ struct Robot {
   std::unique_ptr<MindroadRobot> client;  // closed, not destroyed, by close(): a handler may
                                           // be running in it
   ScriptHost* host = nullptr;
-  int selfRef = LUA_NOREF;            // held while open: events need the object, the script may not
-  std::string label;                  // "mindroad tcp 127.0.0.1:4000"
-  std::string contactWhat, lostWhat;  // how errors in the handlers are reported
+  lua::EventSlots slots;
+  int selfRef = LUA_NOREF;  // held while open: events need the object, the script may not
+  std::string label;        // "mindroad tcp 127.0.0.1:4000"
   std::optional<TimePoint> shutdownAsked;
   MindroadOptions options;  // host, port, … stay readable after close()
 };
@@ -65,27 +77,18 @@ void raiseIfRefused(const MindroadRobot::Sent& sent) {
   if (!sent) throw LuaError(sent.error());
 }
 
-bool isEvent(std::string_view key) {
-  for (auto* e : kEvents)
-    if (key == e) return true;
-  return false;
+const lua::EventNames& events() {
+  static const lua::EventNames names(kEvents);
+  return names;
 }
-// Calls robot.<event>(robot, args…) if the script set it; `push` pushes the extra arguments.
+
+// Calls the listeners and the handler of `e` as fn(robot, args…); `push` pushes the arguments and
+// returns how many.
 template <class Push>
-void dispatch(Robot& r, const char* event, const std::string& what, int nargs, Push push) {
+void deliver(Robot& r, Event e, Push&& push) {
   if (r.selfRef == LUA_NOREF) return;
-  lua_State* L = r.host->state();
-  const int top = lua_gettop(L);
-  lua_rawgeti(L, LUA_REGISTRYINDEX, r.selfRef);
-  lua_getiuservalue(L, -1, 1);
-  if (lua_getfield(L, -1, event) != LUA_TFUNCTION) {
-    lua_settop(L, top);
-    return;
-  }
-  lua_pushvalue(L, top + 1);  // the robot
-  push(L);
-  r.host->call(1 + nargs, 0, what.c_str());
-  lua_settop(L, top);
+  lua::emitArgs({*r.host, r.slots, events(), r.selfRef, r.label}, static_cast<std::size_t>(e),
+                push);
 }
 
 // ---- methods ----
@@ -176,10 +179,9 @@ int shutdown(lua_State* L) {
 
 void closeRobot(lua_State* L, Robot& r) {
   if (r.client) r.client->close();
-  if (r.selfRef != LUA_NOREF) {
-    luaL_unref(L, LUA_REGISTRYINDEX, r.selfRef);
-    r.selfRef = LUA_NOREF;
-  }
+  r.slots.release(L);
+  luaL_unref(L, LUA_REGISTRYINDEX, r.selfRef);
+  r.selfRef = LUA_NOREF;
 }
 
 int close(lua_State* L) {
@@ -190,7 +192,9 @@ int close(lua_State* L) {
 int gc(lua_State* L) {
   auto* r = static_cast<Robot*>(luaL_testudata(L, 1, kMetatable));
   if (r) {
-    if (r->client) r->client->close();  // no unref here: the registry may be going away
+    // The registry is still whole here, even in lua_close: Lua 5.4 runs every finalizer before it
+    // frees anything (luaC_freeallobjects).
+    closeRobot(L, *r);
     r->~Robot();
   }
   return 0;
@@ -236,19 +240,13 @@ int index(lua_State* L) {
   return lua::indexObject(L, [&](std::string_view key) { return pushField(L, r, key); });
 }
 
+const lua::ObjectType& robotType();
+
 int newindex(lua_State* L) {
-  robotAt(L, 1);
-  if (lua_type(L, 2) == LUA_TSTRING) {
-    std::string key = lua_tostring(L, 2);
-    if (isEvent(key))
-      lua::checkHandler(L, "robot", key);  // kept in the robot's own table, read on each event
-    else
-      lua::refuseReserved(L, "robot", key, kFields, kEvents);
-  }
-  return lua::storeOwnField(L);
+  return lua::newindexObject(L, robotType(), robotAt(L, 1).slots);
 }
 
-void registerType(lua_State* L) {
+const lua::ObjectType& robotType() {
   static const luaL_Reg methods[] = {{"steer", lua::guarded<steer>},
                                      {"click", lua::guarded<click>},
                                      {"buttons", lua::guarded<buttons>},
@@ -258,9 +256,17 @@ void registerType(lua_State* L) {
                                      {"shutdown", lua::guarded<shutdown>},
                                      {"close", lua::guarded<close>},
                                      {nullptr, nullptr}};
-  static const lua::EventNames events(kEvents);
-  lua::registerObjectType(L, {kMetatable, "mindroad", methods, kFields, events, lua::guarded<index>,
-                              lua::guarded<newindex>, lua::guarded<tostring>, gc});
+  static const lua::ObjectType type{kMetatable,
+                                    "mindroad",
+                                    methods,
+                                    kFields,
+                                    events(),
+                                    lua::guarded<index>,
+                                    lua::guarded<newindex>,
+                                    lua::guarded<tostring>,
+                                    gc,
+                                    "robot"};
+  return type;
 }
 
 // Reads the options table at idx into o; unknown keys are refused (a typo would silently fall
@@ -318,14 +324,14 @@ int newRobot(lua_State* L) {
   r->client =
       std::make_unique<MindroadRobot>(host.loop(), makeMindroadLink(host.loop(), options), options);
   r->label = "mindroad " + r->client->address();
-  r->contactWhat = "onContact handler of " + r->label;
-  r->lostWhat = "onLost handler of " + r->label;
   lua_pushvalue(L, -1);
   r->selfRef = luaL_ref(L, LUA_REGISTRYINDEX);
-  r->client->onContact = [r] { dispatch(*r, "onContact", r->contactWhat, 0, [](lua_State*) {}); };
+  r->client->onContact = [r] { deliver(*r, Event::Contact, [](lua_State*) { return 0; }); };
   r->client->onLost = [r](const std::string& reason) {
-    dispatch(*r, "onLost", r->lostWhat, 1,
-             [&reason](lua_State* S) { lua_pushlstring(S, reason.data(), reason.size()); });
+    deliver(*r, Event::Lost, [&reason](lua_State* S) {
+      lua_pushlstring(S, reason.data(), reason.size());
+      return 1;
+    });
   };
   if (host.loop().clockKind() == ClockKind::Virtual)
     log::warn("mindroad", r->label +
@@ -338,7 +344,7 @@ int newRobot(lua_State* L) {
 
 void openMindroadModule(ScriptHost& host) {
   lua_State* L = host.state();
-  registerType(L);
+  lua::registerObjectType(L, robotType());
   lua_getglobal(L, "pitwall");
   lua_pushcfunction(L, lua::guarded<newRobot>);
   lua_setfield(L, -2, "mindroad");

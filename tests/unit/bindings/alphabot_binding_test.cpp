@@ -91,6 +91,22 @@ TEST_CASE_FIXTURE(AlphabotFixture, "an alphabot object: name, fields, events and
             "DONE = true") == "");
 }
 
+TEST_CASE_FIXTURE(
+    AlphabotFixture,
+    "a handler reads back as set; a closed robot refuses one, having no more events") {
+  CHECK(run(std::string(kConnect) +
+            "local f = function() end\n"
+            "r.onPing = f; assert(r.onPing == f)\n"
+            "r:close()\n"
+            "local ok, e = pcall(function() r.onPing = print end)\n"
+            "assert(not ok and e:find('alphabot tcp:127.0.0.1:' .. ROBOT_PORT .. "
+            "' is closed: it has no more events', 1, true), e)\n"
+            "r.onPing = nil; assert(r.onPing == nil)\n"
+            "local ok2, e2 = pcall(function() r.onPing = 42 end)\n"
+            "assert(e2:find('must be a function or nil'), e2)\n"
+            "DONE = true") == "");
+}
+
 TEST_CASE_FIXTURE(AlphabotFixture, "every command reaches the robot and every answer is an event") {
   REQUIRE(run(std::string(kConnect) +
               "local got = {}\n"
