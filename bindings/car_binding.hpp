@@ -15,12 +15,13 @@ namespace pitwall {
 class ScriptHost;
 
 // The car's events, in one list: CarEvent::Position is "onPosition", … (docs/lua-api.md).
-#define PITWALL_CAR_EVENTS(X)                                                            \
-  X(Position)                                                                            \
-  X(Transition)                                                                          \
-  X(Intersection)                                                                        \
-  X(Delocalized) X(Offset) X(Battery) X(Version) X(Ping) X(Status) X(Collision) X(Speed) \
-      X(LaneChange) X(Recovery) X(Connect) X(Disconnect) X(Malformed) X(Message)
+#define PITWALL_CAR_EVENTS(X)                                                           \
+  X(Position)                                                                           \
+  X(Transition)                                                                         \
+  X(Intersection)                                                                       \
+  X(Delocalized)                                                                        \
+  X(Offset) X(Battery) X(Version) X(Ping) X(Status) X(Collision) X(Speed) X(LaneChange) \
+      X(Recovery) X(Connect) X(Disconnect) X(Malformed) X(Message)
 
 enum class CarEvent {
 #define PITWALL_CAR_EVENT_ENUM(name) name,

@@ -21,8 +21,8 @@
 #include "engine/core/error_flood.hpp"
 #include "engine/core/loop.hpp"
 #include "engine/core/result.hpp"
-#include "engine/sim/world.hpp"
 #include "engine/fleet/fleet.hpp"
+#include "engine/sim/world.hpp"
 
 namespace pitwall {
 

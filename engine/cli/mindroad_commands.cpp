@@ -15,8 +15,8 @@
 #include "engine/protocol/mindroad/codec.hpp"
 #include "engine/protocol/mindroad/command_text.hpp"
 #include "engine/protocol/mindroad/message_json.hpp"
-#include "engine/sim/mindroad_robot_server.hpp"
 #include "engine/record/recorder.hpp"
+#include "engine/sim/mindroad_robot_server.hpp"
 
 namespace pitwall::cli {
 

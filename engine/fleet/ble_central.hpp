@@ -18,9 +18,9 @@
 #include <string>
 #include <vector>
 
+#include "engine/fleet/fleet.hpp"
 #include "engine/transport/ble_link.hpp"
 #include "engine/transport/bluez.hpp"
-#include "engine/fleet/fleet.hpp"
 
 namespace pitwall::ble {
 

@@ -28,10 +28,10 @@
 #include <string>
 #include <vector>
 
+#include "engine/fleet/fleet.hpp"
 #include "engine/mqtt/throttle.hpp"
 #include "engine/mqtt/topics.hpp"
 #include "engine/transport/mqtt_client.hpp"
-#include "engine/fleet/fleet.hpp"
 
 namespace pitwall {
 

@@ -9,8 +9,8 @@
 #include <tuple>
 
 #include "engine/core/hex.hpp"
-#include "engine/core/overload.hpp"
 #include "engine/core/numbers.hpp"
+#include "engine/core/overload.hpp"
 #include "engine/mqtt/payload.hpp"
 #include "engine/mqtt/topics.hpp"
 #include "engine/protocol/anki/codec.hpp"

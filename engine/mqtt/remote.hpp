@@ -27,10 +27,10 @@
 #include <set>
 #include <string>
 
+#include "engine/fleet/fleet.hpp"
 #include "engine/mqtt/throttle.hpp"
 #include "engine/mqtt/topics.hpp"
 #include "engine/transport/mqtt_client.hpp"
-#include "engine/fleet/fleet.hpp"
 
 namespace pitwall {
 

@@ -16,9 +16,9 @@
 #include <vector>
 
 #include "engine/core/loop.hpp"
-#include "engine/transport/replay_link.hpp"
 #include "engine/fleet/fleet.hpp"
 #include "engine/record/record_reader.hpp"
+#include "engine/transport/replay_link.hpp"
 
 namespace pitwall {
 

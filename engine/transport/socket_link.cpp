@@ -43,7 +43,8 @@ struct SocketLink::State : std::enable_shared_from_this<SocketLink::State> {
 
   bool isUdp() const { return options.protocol == SocketLinkOptions::Protocol::Udp; }
   std::string where() const {
-    return std::string(isUdp() ? "udp:" : "tcp:") + options.host + ":" + std::to_string(options.port);
+    return std::string(isUdp() ? "udp:" : "tcp:") + options.host + ":" +
+           std::to_string(options.port);
   }
 
   void cancelTimer() {

@@ -13,8 +13,8 @@
 #include <string>
 
 #include "engine/core/loop.hpp"
-#include "engine/sim/track.hpp"
 #include "engine/fleet/fleet.hpp"
+#include "engine/sim/track.hpp"
 #include "engine/view/tracker.hpp"
 
 namespace pitwall::view {

@@ -43,10 +43,10 @@
 #include <sdbus-c++/sdbus-c++.h>
 
 #include "bindings/script_host.hpp"
-#include "engine/protocol/anki/codec.hpp"
-#include "engine/transport/ble_link.hpp"
 #include "engine/fleet/ble_central.hpp"
 #include "engine/fleet/fleet.hpp"
+#include "engine/protocol/anki/codec.hpp"
+#include "engine/transport/ble_link.hpp"
 #include "tests/bench/frames.hpp"
 #include "tests/bench/latency.hpp"
 #include "tests/fake_bluez/fake_bluez.hpp"

@@ -18,8 +18,8 @@
 
 #include "bindings/lua_args.hpp"
 #include "bindings/script_host.hpp"
-#include "engine/protocol/anki/codec.hpp"
 #include "engine/fleet/fleet.hpp"
+#include "engine/protocol/anki/codec.hpp"
 #include "tests/bench/frames.hpp"
 
 namespace {

@@ -52,12 +52,12 @@
 #include <vector>
 
 #include "bindings/script_host.hpp"
+#include "engine/fleet/fleet.hpp"
 #include "engine/mqtt/bridge.hpp"
 #include "engine/mqtt/remote.hpp"
 #include "engine/mqtt/topics.hpp"
 #include "engine/protocol/anki/codec.hpp"
 #include "engine/transport/mqtt_client.hpp"
-#include "engine/fleet/fleet.hpp"
 #include "tests/bench/frames.hpp"
 #include "tests/bench/latency.hpp"
 #include "tests/support/mosquitto_broker.hpp"

@@ -15,11 +15,11 @@
 
 #include "bindings/car_binding.hpp"
 #include "bindings/script_host.hpp"
+#include "engine/fleet/fleet.hpp"
 #include "engine/protocol/anki/advertisement.hpp"
 #include "engine/sim/grid.hpp"
 #include "engine/sim/track.hpp"
 #include "engine/sim/world.hpp"
-#include "engine/fleet/fleet.hpp"
 #include "tests/support/sim_cars.hpp"
 
 namespace {

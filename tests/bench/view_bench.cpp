@@ -21,8 +21,8 @@
 #include <thread>
 
 #include "bindings/script_host.hpp"
-#include "engine/sim/track.hpp"
 #include "engine/fleet/fleet.hpp"
+#include "engine/sim/track.hpp"
 #include "engine/view/server.hpp"
 #include "tests/bench/frames.hpp"
 

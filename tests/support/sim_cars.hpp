@@ -3,9 +3,9 @@
 // in the world, reached through a SimLink, connected once the fleet listens to it.
 #include <memory>
 
+#include "engine/fleet/fleet.hpp"
 #include "engine/sim/world.hpp"
 #include "engine/transport/sim_link.hpp"
-#include "engine/fleet/fleet.hpp"
 
 namespace pitwall::testing {
 

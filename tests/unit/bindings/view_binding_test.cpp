@@ -6,8 +6,8 @@
 #include <algorithm>
 
 #include "bindings/script_host.hpp"
-#include "engine/sim/grid.hpp"
 #include "engine/fleet/fleet.hpp"
+#include "engine/sim/grid.hpp"
 #include "engine/view/feed.hpp"
 #include "tests/support/sim_cars.hpp"
 

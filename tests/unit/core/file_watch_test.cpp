@@ -212,7 +212,8 @@ TEST_CASE_FIXTURE(Watching, "a save lost in an overflow of the kernel's queue is
   // a loaded machine.
   for (long i = 0; i < queue / 2 + 100; ++i) folder.write("noise.txt", std::to_string(i));
   folder.write("race.lua", "print(2)");
-  REQUIRE(testing::runUntil(loop, [&] { return !reports.empty(); }, 30s));
+  REQUIRE(testing::runUntil(
+      loop, [&] { return !reports.empty(); }, 30s));
   CHECK(reports[0].paths == std::vector<std::string>{script});
   CHECK(reports[0].texts[0] == "print(2)");
 }

@@ -6,8 +6,8 @@
 #include <cmath>
 
 #include "engine/core/log.hpp"
-#include "engine/sim/world.hpp"
 #include "engine/fleet/fleet.hpp"
+#include "engine/sim/world.hpp"
 #include "engine/view/feed.hpp"
 #include "engine/view/geometry.hpp"
 #include "tests/support/sim_cars.hpp"

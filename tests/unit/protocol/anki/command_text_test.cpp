@@ -100,7 +100,8 @@ TEST_CASE("the codec's own names are accepted for the short forms") {
 TEST_CASE("an out-of-range number is refused with word, value and range") {
   CHECK(refusal("set-speed 2000") == "speed 2000 mm/s is out of range 0..1500 mm/s");
   CHECK(refusal("set-speed -5") == "speed -5 mm/s is out of range 0..1500 mm/s");
-  CHECK(refusal("set-speed 500 30000") == "acceleration 30000 mm/s² is out of range 0..25000 mm/s²");
+  CHECK(refusal("set-speed 500 30000") ==
+        "acceleration 30000 mm/s² is out of range 0..25000 mm/s²");
   CHECK(refusal("change-lane 300 300 150") ==
         "offset 150 mm is out of range -70..70 mm (beyond it the car leaves the road)");
   CHECK(refusal("change-lane 300 300 -75") ==
