@@ -444,15 +444,16 @@ const lua::ObjectType& robotType() {
                                      {"clearObstacles", lua::guarded<clearObstacles>},
                                      {"close", lua::guarded<close>},
                                      {nullptr, nullptr}};
-  static const lua::ObjectType type{kMetatable,
-                                    "alphabot",
-                                    methods,
-                                    kFieldNames,
-                                    events(),
-                                    lua::guarded<index>,
-                                    lua::guarded<newindex>,
-                                    lua::guarded<tostring>,
-                                    gc};
+  static const lua::ObjectType type{
+      kMetatable, "alphabot", methods, kFieldNames, events(), lua::guarded<index>,
+      lua::guarded<newindex>, lua::guarded<tostring>, gc, nullptr,
+      // listeners: not on a closed robot (it has no more events)
+      [](lua_State* L, int idx) -> lua::EventSlots& {
+        Robot& r = robotAt(L, idx);
+        if (r.closed() && lua_isfunction(L, 3))
+          throw LuaError(r.label + " is closed: it has no more events");
+        return r.slots;
+      }};
   return type;
 }
 

@@ -373,25 +373,25 @@ const lua::ObjectType& carType() {
                                      {"version", lua::guarded<version>},
                                      {"disconnect", lua::guarded<disconnect>},
                                      {nullptr, nullptr}};
-  static const lua::ObjectType type{kMetatable,
-                                    "car",
-                                    methods,
-                                    kFieldNames,
-                                    carEvents(),
-                                    lua::guarded<index>,
-                                    lua::guarded<newindex>,
-                                    lua::guarded<tostring>};
+  static const lua::ObjectType type{
+      kMetatable,
+      "car",
+      methods,
+      kFieldNames,
+      carEvents(),
+      lua::guarded<index>,
+      lua::guarded<newindex>,
+      lua::guarded<tostring>,
+      nullptr,
+      nullptr,
+      [](lua_State* L, int idx) -> lua::EventSlots& { return proxyAt(L, idx).slots; },
+      "onMessage"};
   return type;
 }
 }  // namespace
 
 void CarBinding::registerType(lua_State* L) {
   lua::registerObjectType(L, carType());
-}
-
-int CarBinding::setHub(lua_State* L) {
-  lua::setHubOf(L, carType(), proxyAt(L, 1).slots, "onMessage");
-  return 0;
 }
 
 AnkiCar& CarBinding::check(lua_State* L, int idx) {

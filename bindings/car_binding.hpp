@@ -15,13 +15,14 @@ namespace pitwall {
 class ScriptHost;
 
 // The car's events, in one list: CarEvent::Position is "onPosition", … (docs/lua-api.md).
-#define PITWALL_CAR_EVENTS(X)                                                           \
-  X(Position)                                                                           \
-  X(Transition)                                                                         \
-  X(Intersection)                                                                       \
-  X(Delocalized)                                                                        \
-  X(Offset) X(Battery) X(Version) X(Ping) X(Status) X(Collision) X(Speed) X(LaneChange) \
-      X(Recovery) X(Connect) X(Disconnect) X(Malformed) X(Message)
+#define PITWALL_CAR_EVENTS(X)                                                             \
+  X(Position)                                                                             \
+  X(Transition)                                                                           \
+  X(Intersection)                                                                         \
+  X(Delocalized)                                                                          \
+  X(Offset)                                                                               \
+  X(Battery) X(Version) X(Ping) X(Status) X(Collision) X(Speed) X(LaneChange) X(Recovery) \
+      X(Connect) X(Disconnect) X(Malformed) X(Message)
 
 enum class CarEvent {
 #define PITWALL_CAR_EVENT_ENUM(name) name,
@@ -49,9 +50,6 @@ class CarBinding {
   static AnkiCar& check(lua_State* L, int idx);
   // The car at idx, or nullptr when the value is not a car.
   static AnkiCar* test(lua_State* L, int idx);
-  // pitwall._setHub(car, "onPosition", fn | nil): the function that runs the library's
-  // listeners of that event (scripts/pitwall/core.lua, pitwall.listen).
-  static int setHub(lua_State* L);
 
   struct Proxy;
 

@@ -63,4 +63,16 @@ void callCallee(const EventSource& source, std::size_t e, bool hub, int nargs) {
       1 + nargs, hub ? source.names.listenersWhat(e) : source.names.handlerWhat(e), source.who);
 }
 
+int setHub(lua_State* L) {
+  const ObjectType* type = nullptr;
+  if (luaL_getmetafield(L, 1, "__objecttype") != LUA_TNIL) {
+    type = static_cast<const ObjectType*>(lua_touserdata(L, -1));
+    lua_pop(L, 1);
+  }
+  if (!type || !type->slotsOf)
+    throw LuaError("expected a car or a robot (an object with events), got " + typeName(L, 1));
+  setHubOf(L, *type, type->slotsOf(L, 1), type->unlistened);
+  return 0;
+}
+
 }  // namespace pitwall::lua

@@ -151,6 +151,10 @@ struct ObjectType {
   lua_CFunction tostring;
   lua_CFunction gc = nullptr;
   const char* what = nullptr;  // how errors name the object when not by `name` ("robot")
+  // The object's event slots, for pitwall._setHub (listeners); it may refuse (throw LuaError),
+  // e.g. a hub for a closed object. nullptr: the type takes no listeners.
+  EventSlots& (*slotsOf)(lua_State* L, int idx) = nullptr;
+  const char* unlistened = nullptr;  // an event that takes no listeners (the car's onMessage)
 };
 
 // Registers the type's metatable (once): __index and __newindex as closures over the methods
@@ -187,6 +191,9 @@ inline void registerObjectType(lua_State* L, const ObjectType& type) {
   }
   lua_pushstring(L, type.name);
   lua_setfield(L, -2, "__name");
+  // The type itself, for what works on every object type (setHub).
+  lua_pushlightuserdata(L, const_cast<ObjectType*>(&type));
+  lua_setfield(L, -2, "__objecttype");
   lua_pop(L, 1);
 }
 
@@ -238,8 +245,12 @@ inline int newindexObject(lua_State* L, const ObjectType& type, EventSlots& slot
   return 0;
 }
 
-// pitwall._setHub(object, "onX", fn | nil) for any object type: the function that runs the
-// library's listeners of that event. `except` names an event that takes no listeners (the car's
+// pitwall._setHub(object, "onX", fn | nil): the function that runs the library's listeners of
+// that event (scripts/pitwall/core.lua, pitwall.listen), for an object of any type registered
+// with slotsOf: cars, remote cars, robots.
+int setHub(lua_State* L);
+
+// setHub's work for a type: `except` names an event that takes no listeners (the car's
 // onMessage: only through car.onMessage).
 inline void setHubOf(lua_State* L, const ObjectType& type, EventSlots& slots,
                      const char* except = nullptr) {

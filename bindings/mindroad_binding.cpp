@@ -256,16 +256,16 @@ const lua::ObjectType& robotType() {
                                      {"shutdown", lua::guarded<shutdown>},
                                      {"close", lua::guarded<close>},
                                      {nullptr, nullptr}};
-  static const lua::ObjectType type{kMetatable,
-                                    "mindroad",
-                                    methods,
-                                    kFields,
-                                    events(),
-                                    lua::guarded<index>,
-                                    lua::guarded<newindex>,
-                                    lua::guarded<tostring>,
-                                    gc,
-                                    "robot"};
+  static const lua::ObjectType type{
+      kMetatable, "mindroad", methods, kFields, events(), lua::guarded<index>,
+      lua::guarded<newindex>, lua::guarded<tostring>, gc, "robot",
+      // listeners: not on a closed robot (it has no more events)
+      [](lua_State* L, int idx) -> lua::EventSlots& {
+        Robot& r = robotAt(L, idx);
+        if (!isOpen(r) && lua_isfunction(L, 3))
+          throw LuaError(r.label + " is closed: it has no more events");
+        return r.slots;
+      }};
   return type;
 }
 

@@ -10,6 +10,7 @@
 
 #include "bindings/car_binding.hpp"
 #include "bindings/lua_args.hpp"
+#include "bindings/lua_object.hpp"
 #include "bindings/results.hpp"
 #include "bindings/script_host.hpp"
 #include "engine/core/console.hpp"
@@ -293,7 +294,7 @@ void openPitwallModule(ScriptHost& host) {
                                        {"piece", lua::guarded<piece>},
                                        {"writeResults", lua::guarded<writeResults>},
                                        {"terminal", terminal},
-                                       {"_setHub", lua::guarded<&CarBinding::setHub>},
+                                       {"_setHub", lua::guarded<&lua::setHub>},
                                        {"_reportError", lua::guarded<reportError>},
                                        {nullptr, nullptr}};
   luaL_newlib(L, functions);

@@ -276,3 +276,25 @@ TEST_CASE_FIXTURE(AlphabotFixture, "in a callback pitwall.alphabot returns at on
               "end)") == "");
   CHECK(global("AT_ONCE") == "false");
 }
+
+TEST_CASE_FIXTURE(AlphabotFixture,
+                  "pitwall.listen follows an alphabot's events, before its handler, as a car's") {
+  REQUIRE(run(std::string(kConnect) +
+              "local order = {}\n"
+              "local sub = pitwall.listen(r, 'onPing', function(robot, ev)\n"
+              "  assert(robot == r and type(ev.rtt) == 'number')\n"
+              "  order[#order + 1] = 'listener'\n"
+              "end)\n"
+              "r.onPing = function() order[#order + 1] = 'handler' end\n"
+              "r:ping()\n"
+              "assert(table.concat(order, ',') == 'listener,handler', table.concat(order, ','))\n"
+              "assert(sub:cancel())\n"
+              "r:ping()\n"
+              "assert(table.concat(order, ',') == 'listener,handler,handler')\n"
+              "local ok, e = pcall(pitwall.listen, r, 'onPong', print)\n"
+              "assert(not ok and e:find(\"cannot listen to 'onPong'; the events are onDistance\"), e)\n"
+              "r:close()\n"
+              "ok, e = pcall(pitwall.listen, r, 'onPing', print)\n"
+              "assert(not ok and e:find('is closed: it has no more events'), e)\n"
+              "DONE = true") == "");
+}

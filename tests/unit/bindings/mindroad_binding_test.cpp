@@ -308,3 +308,28 @@ TEST_CASE_FIXTURE(RobotLua, "mindroad: in a callback pitwall.mindroad returns at
   REQUIRE(waitFor("done"));
   CHECK(string("phaseAtOnce") == "connecting");
 }
+
+TEST_CASE_FIXTURE(RobotLua, "mindroad: pitwall.listen follows a robot's events before its handler") {
+  start(R"(
+    order = {}
+    pitwall.after(0, function()  -- in a callback: the robot is returned before its first contact
+      robot = pitwall.mindroad{port = PORT}
+      sub = pitwall.listen(robot, "onContact", function(r) order[#order + 1] = "listener" end)
+      robot.onContact = function(r)
+        order[#order + 1] = "handler"
+        contact = true
+      end
+    end)
+  )");
+  REQUIRE(waitFor("contact"));
+  start(R"(
+    result = table.concat(order, ",")
+    cancelled = sub:cancel()
+    robot:close()
+    local ok, e = pcall(pitwall.listen, robot, "onLost", print)
+    refused = e
+  )");
+  CHECK(string("result") == "listener,handler");
+  CHECK(global("cancelled"));
+  CHECK(string("refused").find("is closed: it has no more events") != std::string::npos);
+}
