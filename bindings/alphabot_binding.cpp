@@ -28,7 +28,6 @@ using lua::LuaError;
 namespace {
 
 constexpr const char* kMetatable = "pitwall.alphabot";
-constexpr const char* kComponent = "alphabot";
 
 // The robot's events, from this one list: each handler is called as fn(robot, ev), ev.time
 // being the loop's seconds.
