@@ -193,9 +193,10 @@ void MindroadRobot::lose(const std::string& reason) {
   }
 }
 
-void MindroadRobot::write(const Instruction& instruction) {
+bool MindroadRobot::write(const Instruction& instruction) {
+  if (!link_->send(encode(instruction).span())) return false;
   ++instructionsSent_;
-  link_->send(encode(instruction).span());
+  return true;
 }
 
 void MindroadRobot::close() {
@@ -223,7 +224,11 @@ MindroadRobot::Sent MindroadRobot::send(const Instruction& instruction) {
     return Unexpected{"mindroad " + address() + " has no contact (" + why + "); " +
                       std::string(name(instruction)) + " not sent"};
   }
-  write(instruction);
+  if (!write(instruction)) {
+    const std::string why = link_->refusal();
+    return Unexpected{"mindroad " + address() + ": " + std::string(name(instruction)) +
+                      " was not sent: " + (why.empty() ? "the link refused it" : why)};
+  }
   return true;
 }
 

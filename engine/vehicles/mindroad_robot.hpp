@@ -97,7 +97,8 @@ class MindroadRobot {
   void probe();
   void fail(const std::string& reason);  // contact failed while the link is up
   void lose(const std::string& reason);  // the link went down
-  void write(const mindroad::Instruction& instruction);
+  // Hands the instruction to the link; false (not counted) when the link refused it.
+  bool write(const mindroad::Instruction& instruction);
   void cancelTimers();
   template <class F>
   Loop::TimerId after(double seconds, F fn);

@@ -78,15 +78,22 @@ namespace {
 struct MindroadRig {
   QuietLog quiet;
   Loop loop{ClockKind::Real};
-  sim::MindroadRobotServer server{loop, {}};
+  sim::MindroadRobotServer server;
   MindroadOptions options;
   FaultyLink* faulty = nullptr;
   std::unique_ptr<MindroadRobot> robot;
   int contacts = 0;
   std::vector<std::string> lost;
 
-  explicit MindroadRig(Faults faults) {
+  static sim::MindroadServerOptions serverOptions(bool udp) {
+    sim::MindroadServerOptions o;
+    o.udp = udp;
+    return o;
+  }
+
+  explicit MindroadRig(Faults faults, bool udp = false) : server(loop, serverOptions(udp)) {
     options.port = server.port();
+    options.udp = udp;
     options.backoffFirst = 0.05;
     auto link = std::make_unique<FaultyLink>(makeMindroadLink(loop, options), faults);
     faulty = link.get();
@@ -112,6 +119,28 @@ TEST_CASE("faults: a MindRoad robot's refused connections are one outage, then c
   REQUIRE(runUntil(rig.loop, [&] { return rig.contacts == 1; }));
   REQUIRE(rig.lost.size() == 1);  // once per outage
   CHECK(rig.lost[0] == "injected fault: connection 1 refused");
+}
+
+TEST_CASE("faults: over UDP too, a dropped link is lost contact, then regained") {
+  MindroadRig rig(Faults{.dropAfterFrames = 1}, /*udp=*/true);
+  REQUIRE(runUntil(rig.loop, [&] { return rig.contacts == 2; }));
+  REQUIRE(rig.lost.size() == 1);
+  CHECK(rig.lost[0] == "injected fault: dropped after 1 frames");
+  CHECK(rig.robot->connected());
+}
+
+TEST_CASE("faults: over UDP, a failed send is refused and a command says why") {
+  MindroadRig rig(Faults{}, /*udp=*/true);
+  REQUIRE(runUntil(rig.loop, [&] { return rig.contacts == 1; }));
+  rig.faulty->faults().failSend = rig.faulty->sends() + 1;
+  const auto before = rig.robot->instructionsSent();
+  auto sent = rig.robot->stop();
+  REQUIRE_FALSE(sent);
+  CHECK(sent.error() == "mindroad udp 127.0.0.1:" + std::to_string(rig.server.port()) +
+                            ": stop was not sent: injected fault: send " +
+                            std::to_string(rig.faulty->sends()) + " failed");
+  CHECK(rig.robot->instructionsSent() == before);  // not counted as sent
+  CHECK(rig.robot->stop());                        // the next one goes
 }
 
 TEST_CASE("faults: a failed send to a MindRoad robot is refused by its link") {
