@@ -177,9 +177,32 @@ class Car:
             self.waiters.remove(waiter)
 
 
+async def forget(adapter, address):
+    """BlueZ keeps a device that an earlier scan found (`pitwall scan`, just before), and bleak
+    reports only devices added or changed while it scans: a cached car whose properties do not
+    change (btvirt's RSSI does not move) was never reported, now and then. py-drivesdk starts on
+    a machine that has not just scanned; so does this client: the car is forgotten first."""
+    from dbus_fast import BusType, Message, MessageType
+    from dbus_fast.aio import MessageBus
+
+    bus = await MessageBus(bus_type=BusType.SYSTEM).connect()
+    try:
+        device = f"/org/bluez/{adapter}/dev_" + address.upper().replace(":", "_")
+        reply = await bus.call(
+            Message(destination="org.bluez", path=f"/org/bluez/{adapter}",
+                    interface="org.bluez.Adapter1", member="RemoveDevice", signature="o",
+                    body=[device]))
+        if reply.message_type == MessageType.ERROR and reply.error_name != "org.bluez.Error.DoesNotExist":
+            say(f"could not forget {address} on {adapter}: {reply.error_name} {reply.body}")
+    finally:
+        bus.disconnect()
+
+
 async def find_car(adapter, address):
     """The first advertiser py-drivesdk would take for a car that also advertises the Anki service;
     fails at once when `address` advertises a name py-drivesdk would pass over."""
+    if address:
+        await forget(adapter, address)
     loop = asyncio.get_running_loop()
     found = loop.create_future()
 
