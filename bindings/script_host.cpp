@@ -7,11 +7,8 @@
 #include "bindings/lua_args.hpp"
 #include "bindings/pitwall_module.hpp"
 #include "engine/core/console.hpp"
+#include "engine/core/data_dir.hpp"
 #include "engine/core/log.hpp"
-
-#ifndef PITWALL_SCRIPTS_DIR
-#define PITWALL_SCRIPTS_DIR "scripts"
-#endif
 
 namespace pitwall {
 
@@ -98,9 +95,13 @@ int scriptExit(lua_State* L) {
   return 0;
 }
 
+// The shipped library: $PITWALL_SCRIPTS (the tests' source tree), else scripts/ in the data
+// folder found beside the binary (engine/core/data_dir.hpp).
 std::string scriptsDir() {
-  if (const char* env = std::getenv("PITWALL_SCRIPTS")) return env;
-  return PITWALL_SCRIPTS_DIR;
+  if (const char* env = std::getenv("PITWALL_SCRIPTS"); env && *env) return env;
+  auto data = dataDir();
+  if (!data) throw std::runtime_error(data.error());
+  return (*data / "scripts").string();
 }
 }  // namespace
 

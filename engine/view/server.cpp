@@ -12,6 +12,7 @@
 #include <list>
 #include <sstream>
 
+#include "engine/core/data_dir.hpp"
 #include "engine/core/log.hpp"
 
 namespace pitwall::view {
@@ -464,15 +465,7 @@ Result<ServerOptions, std::string> parseEndpoint(const std::string& text) {
 Result<std::filesystem::path, std::string> findAssets() {
   std::vector<std::filesystem::path> places;
   if (const char* env = std::getenv("PITWALL_VIEW_DIR"); env && *env) places.emplace_back(env);
-  char exe[4096];
-  if (ssize_t n = ::readlink("/proc/self/exe", exe, sizeof exe - 1); n > 0) {
-    exe[n] = 0;
-    places.push_back(std::filesystem::path(exe).parent_path() / ".." / "share" / "pitwall" /
-                     "view");
-  }
-#ifdef PITWALL_VIEW_BUILD_DIR
-  places.emplace_back(PITWALL_VIEW_BUILD_DIR);
-#endif
+  for (const auto& data : dataDirCandidates()) places.push_back(data / "web");
   std::string looked;
   for (const auto& p : places) {
     std::error_code ec;
@@ -480,8 +473,9 @@ Result<std::filesystem::path, std::string> findAssets() {
       return std::filesystem::weakly_canonical(p, ec);
     looked += (looked.empty() ? "" : ", ") + p.string();
   }
-  return Unexpected{"the race view's page is not installed (looked in " + looked +
-                    "); build it (./dev build) or set PITWALL_VIEW_DIR to its folder"};
+  return Unexpected{
+      "the race view's page is not installed (looked in " + looked +
+      "); build it (./dev build), install pitwall, or set PITWALL_VIEW_DIR to its folder"};
 }
 
 }  // namespace pitwall::view

@@ -28,8 +28,9 @@ struct ServerOptions {
 // was wrong and what to write.
 inline constexpr std::uint16_t kDefaultPort = 8080;
 Result<ServerOptions, std::string> parseEndpoint(const std::string& text);
-// Where the page's assets are: $PITWALL_VIEW_DIR, the installed data folder beside the binary
-// (../share/pitwall/view), or the build tree's copy. The error names the places looked at.
+// Where the page's assets are: $PITWALL_VIEW_DIR, else web/ in each place pitwall's data may be
+// (engine/core/data_dir.hpp: $PITWALL_DATA, the installed or the build tree's share/pitwall).
+// The error names the places looked at.
 Result<std::filesystem::path, std::string> findAssets();
 
 class Server {
