@@ -4,6 +4,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "engine/core/suggest.hpp"
 #include "engine/sim/track.hpp"
 
 namespace pitwall::sim {
@@ -62,7 +63,8 @@ Result<Track, std::string> loadLayout(std::string_view nameOrPath) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
     return fail("layout '" + std::string(nameOrPath) + "' is neither a named layout (" +
-                namesList() + ") nor a file that exists; give a name or the path of a layout file");
+                namesList() + ") nor a file that exists" + didYouMean(nameOrPath, layoutNames()) +
+                " (give a name or the path of a layout file)");
   std::ifstream in(path);
   if (!in) return fail("cannot read layout file '" + path.string() + "'; check its permissions");
   std::stringstream text;

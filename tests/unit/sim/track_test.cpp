@@ -130,6 +130,10 @@ TEST_CASE("loadLayout takes a name or a file, and says when it finds neither") {
   auto missing = loadLayout("/nonexistent/track.txt");
   REQUIRE_FALSE(missing.ok());
   CHECK(contains(missing.error(), "'/nonexistent/track.txt' is neither a named layout"));
+  CHECK_FALSE(contains(missing.error(), "did you mean"));
+  auto typo = loadLayout("ovl");
+  REQUIRE_FALSE(typo.ok());
+  CHECK(contains(typo.error(), "nor a file that exists; did you mean oval?"));
 
   auto path = std::filesystem::temp_directory_path() / "pitwall_track_test_loop.layout";
   {
