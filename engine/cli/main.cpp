@@ -21,7 +21,8 @@ int main(int argc, char** argv) {
       cli::addRunCommand(app),      cli::addReplCommand(app),   cli::addBridgeCommand(app),
       cli::addViewCommand(app),     cli::addScanCommand(app),   cli::addEmulateCommand(app),
       cli::addSimRobotCommand(app), cli::addTestCommand(app),   cli::addReplayCommand(app),
-      cli::addTrackCommand(app),    cli::addDecodeCommand(app), cli::addEncodeCommand(app)};
+      cli::addTrackCommand(app),    cli::addDecodeCommand(app), cli::addEncodeCommand(app),
+      cli::addTypesCommand(app)};
 
   try {
     app.parse(argc, argv);
