@@ -335,6 +335,122 @@ function Handle:stop() end]],
 @return boolean]],
     },
   },
+  -- the drivers shipped (pitwall.drivers.<name>) ------------------------------------------
+  {
+    file = "pitwall/drivers/cruiser.lua",
+    text = [[
+---Options of cruiser.new (every driver built on a cruiser takes them too).
+---@class pitwall.drivers.CruiserOptions
+---@field speed? number mm/s on straights (default 1000)
+---@field lateral? number mm/s², the curve speed is at most √(lateral · r) (default 7000)
+---@field accel? number mm/s² (default 2000)
+---@field decel? number mm/s², braking before a curve (default 5000)
+
+---A cruiser: its speed on straights, slower in curves, capped by ctx.limit.
+---@class pitwall.drivers.Cruiser: pitwall.drivers.Driver
+local Cruiser = {}
+
+---The speed it would drive now, without sending it (for other drivers).
+---@param car pitwall.Car
+---@param ctx pitwall.drivers.Context
+---@return number
+function Cruiser:target(car, ctx) end]],
+  },
+  {
+    file = "pitwall/drivers/cruiser.lua",
+    class = "pitwall.drivers.cruiser",
+    declare = "local cruiser",
+    live = module("pitwall.drivers.cruiser"),
+    returns = "cruiser",
+    doc = [[Drives at a target speed, slower in curves (require "pitwall.drivers.cruiser", drivers.load "cruiser").]],
+    fields = { name = { "string", "\"cruiser\"" } },
+    functions = {
+      new = [[A cruiser.
+@param options? pitwall.drivers.CruiserOptions
+@return pitwall.drivers.Cruiser]],
+    },
+  },
+  {
+    file = "pitwall/drivers/follower.lua",
+    text = [[
+---Options of follower.new; the cruiser's options go to its cruiser.
+---@class pitwall.drivers.FollowerOptions: pitwall.drivers.CruiserOptions
+---@field gap? number s kept behind the car ahead in its lane (default 1.0)
+---@field margin? number (default 0.1)
+---@field standstill? number mm (default 100)
+---@field range? number mm
+
+---@class pitwall.drivers.Follower: pitwall.drivers.Driver]],
+  },
+  {
+    file = "pitwall/drivers/follower.lua",
+    class = "pitwall.drivers.follower",
+    declare = "local follower",
+    live = module("pitwall.drivers.follower"),
+    returns = "follower",
+    doc = [[Cruises, but keeps at least `gap` seconds behind the car ahead in its lane (require "pitwall.drivers.follower").]],
+    fields = { name = { "string", "\"follower\"" } },
+    functions = {
+      new = [[A follower.
+@param options? pitwall.drivers.FollowerOptions
+@return pitwall.drivers.Follower]],
+    },
+  },
+  {
+    file = "pitwall/drivers/lanekeeper.lua",
+    text = [[
+---Options of lanekeeper.new; the rest go to the inner driver.
+---@class pitwall.drivers.LanekeeperOptions: pitwall.drivers.CruiserOptions
+---@field offset? number the lane, mm (default 23)
+---@field tolerance? number mm (default 10)
+---@field driver? string|pitwall.drivers.Class|pitwall.drivers.Driver the inner driver (default a cruiser)
+---@field retry? number s between lane-change requests (default 1)
+---@field lateralSpeed? number mm/s (default 300)
+
+---@class pitwall.drivers.Lanekeeper: pitwall.drivers.Driver]],
+  },
+  {
+    file = "pitwall/drivers/lanekeeper.lua",
+    class = "pitwall.drivers.lanekeeper",
+    declare = "local lanekeeper",
+    live = module("pitwall.drivers.lanekeeper"),
+    returns = "lanekeeper",
+    doc = [[Keeps the car in a lane while an inner driver drives the speed (require "pitwall.drivers.lanekeeper").]],
+    fields = { name = { "string", "\"lanekeeper\"" } },
+    functions = {
+      new = [[A lane keeper.
+@param options? pitwall.drivers.LanekeeperOptions
+@return pitwall.drivers.Lanekeeper]],
+    },
+  },
+  {
+    file = "pitwall/drivers/overtaker.lua",
+    text = [[
+---Options of overtaker.new; the rest go to its follower.
+---@class pitwall.drivers.OvertakerOptions: pitwall.drivers.FollowerOptions
+---@field lanes? number[] its lane and the passing lane, mm (default {-68, 68})
+---@field margin? number mm (default 250)
+---@field range? number mm (default 900)
+---@field slower? number mm/s (default 50)
+---@field lateralSpeed? number mm/s (default 500)
+
+---@class pitwall.drivers.Overtaker: pitwall.drivers.Driver
+---@field passes integer passes so far]],
+  },
+  {
+    file = "pitwall/drivers/overtaker.lua",
+    class = "pitwall.drivers.overtaker",
+    declare = "local overtaker",
+    live = module("pitwall.drivers.overtaker"),
+    returns = "overtaker",
+    doc = [[Cruises in its lane and passes slower cars in another (require "pitwall.drivers.overtaker").]],
+    fields = { name = { "string", "\"overtaker\"" } },
+    functions = {
+      new = [[An overtaker.
+@param options? pitwall.drivers.OvertakerOptions
+@return pitwall.drivers.Overtaker]],
+    },
+  },
   -- pitwall.board ---------------------------------------------------------------------------
   {
     file = "pitwall/board.lua",
