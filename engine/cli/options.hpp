@@ -30,6 +30,7 @@ Command addReplayCommand(CLI::App& app);
 Command addTrackCommand(CLI::App& app);  // `track show`
 Command addDecodeCommand(CLI::App& app);
 Command addEncodeCommand(CLI::App& app);
+Command addTypesCommand(CLI::App& app);       // `types [DIR]`: LuaLS definitions (docs/editor.md)
 Command addCompletionCommand(CLI::App& app);  // `completion bash|zsh`
 
 // --seed, --cars, --track, --ble and its companions, --budget, --lua-memory (run, repl, bridge);

@@ -1,0 +1,30 @@
+#include "bindings/object_types.hpp"
+
+#include <cstring>
+
+namespace pitwall::lua {
+
+namespace {
+constexpr const char* kTimerMetatable = "pitwall.timer";  // bindings/pitwall_module.cpp
+}
+
+void pushObjectTypes(lua_State* L) {
+  lua_newtable(L);
+  const int out = lua_gettop(L);
+  lua_pushnil(L);
+  while (lua_next(L, LUA_REGISTRYINDEX)) {
+    // key at -2, value at -1
+    if (lua_type(L, -2) == LUA_TSTRING && lua_istable(L, -1)) {
+      const bool object = lua_getfield(L, -1, "__objecttype") != LUA_TNIL;
+      lua_pop(L, 1);
+      if (object || std::strcmp(lua_tostring(L, -2), kTimerMetatable) == 0) {
+        lua_pushvalue(L, -2);
+        lua_pushvalue(L, -2);
+        lua_rawset(L, out);
+      }
+    }
+    lua_pop(L, 1);
+  }
+}
+
+}  // namespace pitwall::lua

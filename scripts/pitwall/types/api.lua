@@ -1,0 +1,209 @@
+-- Annotations of the `pitwall` table, its timers and listeners, pitwall.view and `expect`, for
+-- the LuaLS definitions (scripts/pitwall/types.lua, docs/editor.md). Each function: its doc
+-- line(s), then @param/@return lines; each field: {type, doc}. Every name here must exist in
+-- the binary and every name there must be here: the generator says which do not.
+return {
+  {
+    metatable = "pitwall.timer",
+    class = "pitwall.Timer",
+    localName = "Timer",
+    doc = "A timer from pitwall.after or pitwall.every.",
+    methods = {
+      cancel = [[Stops the timer; false if it had already fired or was cancelled.
+@return boolean cancelled]],
+    },
+  },
+  {
+    text = [[
+---A subscription from pitwall.listen.
+---@class pitwall.Listener
+---@field car pitwall.Car|pitwall.Mindroad|pitwall.Alphabot the object listened to
+---@field event string the event's name ("onPosition", …)
+local Listener = {}
+
+---Ends the subscription; true if it was active.
+---@return boolean
+function Listener:cancel() end
+
+---What pitwall.terminal() returns.
+---@class pitwall.Terminal
+---@field tty boolean stdout is a terminal a script may redraw (false while a REPL prompt is on it)
+---@field columns integer its width (COLUMNS, else 80)
+---@field output integer how many writes reached the terminal so far
+
+---What pitwall.piece(id) returns.
+---@class pitwall.PieceInfo
+---@field id integer road piece id
+---@field type "start-long"|"start-short"|"straight"|"curve"|"intersection"|string
+---@field length number centre-line length, mm
+---@field radius? number centre radius of a curve, mm
+
+---A file-like object for the console (pitwall.stdout).
+---@class pitwall.Stdout
+local Stdout = {}
+
+---Writes strings and numbers to the console (stdout, or above the REPL's prompt).
+---@param ... string|number
+---@return pitwall.Stdout
+function Stdout:write(...) end
+
+---@return pitwall.Stdout
+function Stdout:flush() end
+
+---The second argument of pitwall.onReload.
+---@class pitwall.ReloadInfo
+---@field reloads integer how many times the script was reloaded
+---@field files string[] the files that changed]],
+  },
+  {
+    class = "pitwall",
+    declare = "pitwall",
+    returns = "pitwall", -- require "pitwall" gives it too
+    live = function() return pitwall end,
+    doc = [[The engine: cars, timers, tasks, the clock (docs/lua-api.md).]],
+    fields = {
+      virtualTime = { "boolean", "true when the clock is virtual (--fast, tests)" },
+      seed = { "integer", "the run's seed (--seed); math.random is seeded with it" },
+      persist = { "table", "survives hot reloads: plain data and cars, copied into each new version" },
+      reloads = { "integer", "how many times the script was reloaded: 0 in the first version" },
+      resultsFile = { "string?", "the --results FILE of the run, or nil", sometimes = true },
+      stdout = { "pitwall.Stdout", "a file-like object (:write, :flush) for the console" },
+      sim = { "pitwall.sim?", "the simulator's API: present when the run uses the built-in simulator" },
+      view = { "pitwall.view", "what the race view shows (docs/view.md)" },
+    },
+    settable = {
+      onCar = { "fun(car: pitwall.Car)", "called when a car joins after the script started" },
+      onError = { "fun(message: string, where: string)",
+        "takes the errors raised in callbacks, timers and tasks instead of the log" },
+      onUnload = { "fun(persist: table)",
+        "with --watch: called in the running version before a new one starts" },
+      onReload = { "fun(persist: table, info: pitwall.ReloadInfo)",
+        "with --watch: called in a new version after its main chunk first ran; an error refuses it" },
+    },
+    functions = {
+      cars = [[A new list of every car of the run, in join order (cars[1] is car number 1).
+@return pitwall.Car[] ]],
+      car = [[The car with that number or name, or nil.
+@param which integer|string a car number or name
+@return pitwall.Car?]],
+      now = [[Engine clock, seconds since the run started.
+@return number seconds]],
+      after = [[Calls fn() once after `delay` ≥ 0 seconds.
+@param delay number seconds
+@param fn fun()
+@return pitwall.Timer]],
+      every = [[Calls fn() every `period` ≥ 0.001 seconds (no drift; missed ticks are skipped).
+@param period number seconds
+@param fn fun()
+@return pitwall.Timer]],
+      cancel = [[Stops a timer; false if it had already fired or was cancelled.
+@param timer pitwall.Timer
+@return boolean cancelled]],
+      spawn = [[Starts a task (a coroutine) now; it runs until its first pitwall.sleep.
+@param fn fun()
+@param name? string how errors name the task (default: the file and line)]],
+      sleep = [[Inside a task: resumes after `seconds` ≥ 0 of engine time. Outside a task it raises an error.
+@param seconds number]],
+      waitUntil = [[Inside a task: checks cond() every `step` (0.01) s; true once it holds, false after `timeout` s.
+@param cond fun(): any
+@param timeout? number seconds (default: no limit)
+@param step? number seconds between checks (default 0.01)
+@return boolean held]],
+      stop = [[Ends the run: stops every car, then exits (status 0).]],
+      log = [[A log line on stderr with the script's file and line; a first argument "debug", "info", "warn" or "error" sets the level.
+@param ... any]],
+      copy = [[A shallow copy of a table (event tables are reused: keep a copy to store one).
+@generic T: table
+@param t T
+@return T]],
+      listen = [[Calls fn(object, ev) on every `event` of a car or robot, before its own handler. Not "onMessage".
+@param object pitwall.Car|pitwall.Mindroad|pitwall.Alphabot
+@param event string an event name: "onPosition", …
+@param fn fun(object: any, ev: any, ...: any)
+@return pitwall.Listener]],
+      piece = [[What a road piece is, or nil for an unknown id.
+@param id integer road piece id
+@return pitwall.PieceInfo?]],
+      writeResults = [[Writes rows (tables) with the fields named in `columns` as JSON or CSV (by the extension) to `path` or --results FILE.
+@param rows table[]
+@param columns string[]
+@param path? string
+@return string path]],
+      terminal = [[The console: is it a terminal that may be redrawn, and how wide.
+@return pitwall.Terminal]],
+      mindroad = [[A MindRoad robot car over TCP or UDP (docs/robots.md); in a task it waits for contact.
+@param options? pitwall.MindroadOptions
+@return pitwall.Mindroad]],
+      alphabot = [[An Alphabot over WLAN (TCP) or Bluetooth LE (docs/robots.md); in a task it waits until connected.
+@param options pitwall.AlphabotOptions
+@return pitwall.Alphabot]],
+    },
+  },
+  {
+    class = "pitwall.view",
+    declare = "pitwall.view",
+    live = function() return pitwall.view end,
+    doc = [[What the race view shows (docs/view.md); without --view the calls do nothing visible.]],
+    fields = {
+      active = { "boolean", "true when the run serves the race view (--view)" },
+    },
+    functions = {
+      race = [[The race's state for the view: a table of plain data (at most 16 deep), or nil for none.
+@param state table?]],
+      track = [[Draws a pitwall.track map (real cars; the simulator's layout stays).
+@param map pitwall.track.Map]],
+      event = [[A line in the view's event log.
+@param text string
+@param level? "info"|"warn"|"error" (default "info")]],
+    },
+  },
+  {
+    class = "pitwall.expect",
+    declare = "expect",
+    live = function() return expect end,
+    doc = [[Expectations for scenario tests (`pitwall test` only): each failure names the file and
+line of the expectation and the values compared, then ends the scenario. `what` names the value.]],
+    functions = {
+      eq = [[actual == expected.
+@param actual any
+@param expected any
+@param what? string]],
+      ne = [[actual ~= other.
+@param actual any
+@param other any
+@param what? string]],
+      near = [[|actual − expected| ≤ tolerance.
+@param actual number
+@param expected number
+@param tolerance number
+@param what? string]],
+      lt = [[a < b.
+@param a number
+@param b number
+@param what? string]],
+      le = [[a <= b.
+@param a number
+@param b number
+@param what? string]],
+      gt = [[a > b.
+@param a number
+@param b number
+@param what? string]],
+      ge = [[a >= b.
+@param a number
+@param b number
+@param what? string]],
+      truthy = [[v is neither false nor nil.
+@param v any
+@param what? string]],
+      falsy = [[v is false or nil.
+@param v any
+@param what? string]],
+      fails = [[fn() must raise an error whose message contains `pattern` (plain text); returns the error.
+@param fn fun()
+@param pattern? string
+@param what? string
+@return any err]],
+    },
+  },
+}

@@ -1,0 +1,63 @@
+# The LuaLS definitions (docs/editor.md): types/ in the repository is what this binary generates
+# from its own metadata (so it cannot drift), and `pitwall types DIR` writes them with a
+# .luarc.json for a user's project, merging into one that exists.
+source "$(dirname "$0")/lib.sh"
+
+# 1. the checked-in definitions are the binary's
+mkdir -p "$TMP/gen"
+out=$($PITWALL types "$TMP/gen" 2>&1); rc=$?
+check "pitwall types exit status" 0 "$rc"
+contains "pitwall types says what it wrote" "definition files to $TMP/gen/types" "$out"
+if diff -ru "$SRC/types" "$TMP/gen/types" >"$TMP/types.diff"; then
+  echo "ok: types/ is what the binary generates"
+else
+  cat "$TMP/types.diff"
+  fail "types/ differs from what the binary generates (the diff above); regenerate it from the repository root with: build/pitwall types --no-luarc . (docs/editor.md)"
+fi
+out=$($PITWALL types --check "$SRC" 2>&1); rc=$?
+check "types --check on the repository" 0 "$rc"
+
+# 2. --check names a file that differs, and how to regenerate
+cp -r "$SRC/types" "$TMP/stale-types"
+mkdir -p "$TMP/stale" && mv "$TMP/stale-types" "$TMP/stale/types"
+echo "-- edited by hand" >>"$TMP/stale/types/pitwall/race.lua"
+echo "---@meta" >"$TMP/stale/types/pitwall/gone.lua"
+out=$($PITWALL types --check "$TMP/stale" 2>&1); rc=$?
+check "types --check on edited definitions" 1 "$rc"
+contains "names the file that differs" "differs: $TMP/stale/types/pitwall/race.lua" "$out"
+contains "names a file not generated" "not generated (stale): $TMP/stale/types/pitwall/gone.lua" "$out"
+contains "says how to regenerate" "regenerate with \`pitwall types $TMP/stale\`" "$out"
+
+# 3. a project's .luarc.json: made, kept, merged, or left alone when it is not JSON
+json() { python3 -c "import json,sys; c=json.load(open(sys.argv[1])); print($2)" "$1"; }
+check ".luarc.json library" "['types']" "$(json "$TMP/gen/.luarc.json" "c['workspace']['library']")"
+check ".luarc.json runtime" "Lua 5.4" "$(json "$TMP/gen/.luarc.json" "c['runtime']['version']")"
+out=$($PITWALL types "$TMP/gen" 2>&1)
+contains "a second run keeps .luarc.json" "kept $TMP/gen/.luarc.json" "$out"
+
+mkdir -p "$TMP/user"
+printf '{\n  // mine\n  "diagnostics": {"globals": ["love"]},\n  "workspace": {"library": ["lib"]}\n}\n' >"$TMP/user/.luarc.json"
+out=$($PITWALL types "$TMP/user" 2>&1); rc=$?
+check "merging exit status" 0 "$rc"
+contains "says it updated" "updated $TMP/user/.luarc.json" "$out"
+check "merged library" "['lib', 'types']" "$(json "$TMP/user/.luarc.json" "c['workspace']['library']")"
+check "the user's settings stay" "['love']" "$(json "$TMP/user/.luarc.json" "c['diagnostics']['globals']")"
+
+mkdir -p "$TMP/broken"
+echo "not json" >"$TMP/broken/.luarc.json"
+out=$($PITWALL types "$TMP/broken" 2>&1); rc=$?
+check "a .luarc.json that is not JSON: exit status" 1 "$rc"
+contains "says it left it" "is not a JSON object: left as it is" "$out"
+check "it is left as it was" "not json" "$(cat "$TMP/broken/.luarc.json")"
+[ -f "$TMP/broken/types/pitwall.lua" ] && echo "ok: the definitions are written all the same" ||
+  fail "no definitions in $TMP/broken/types"
+
+out=$($PITWALL types "$TMP/nowhere" 2>&1); rc=$?
+check "a folder that does not exist: exit status" 2 "$rc"
+contains "names it" "$TMP/nowhere is not a folder" "$out"
+
+# 4. examples/ uses the repository's definitions
+check "examples/.luarc.json library" "['../types']" "$(json "$SRC/examples/.luarc.json" "c['workspace']['library']")"
+check "examples/.luarc.json runtime" "Lua 5.4" "$(json "$SRC/examples/.luarc.json" "c['runtime']['version']")"
+
+finish
