@@ -17,7 +17,7 @@ namespace pitwall::cli {
 
 namespace {
 
-enum class Kind { Text, Files, LuaFiles, Layout, Words };
+enum class Kind { Text, Files, LuaFiles, Dirs, Layout, Words };
 struct Values {
   Kind kind = Kind::Text;
   std::vector<std::string> words;
@@ -36,6 +36,7 @@ const std::map<std::string, Values>& valuesByName() {
       {"--mqtt-password-file", {Kind::Files, {}}},
       {"--mqtt-ca", {Kind::Files, {}}},
       {"file", {Kind::Files, {}}},
+      {"dir", {Kind::Dirs, {}}},
       {"script", {Kind::LuaFiles, {}}},
       {"paths", {Kind::LuaFiles, {}}},
       {"kind", {Kind::Words, {"mindroad", "alphabot"}}},
@@ -124,6 +125,8 @@ std::string bashValues(const Values& v) {
       return "_pitwall_files";
     case Kind::LuaFiles:
       return "_pitwall_files lua";
+    case Kind::Dirs:
+      return "_pitwall_files /";
     case Kind::Text:
       break;
   }
@@ -136,7 +139,7 @@ std::string bash(const Cmd& root) {
     << "): do not edit\n"
     << "_pitwall_layouts=\"" << join(sim::layoutNames()) << "\"\n\n"
     << "_pitwall_words() { COMPREPLY+=($(compgen -W \"$1\" -- \"$cur\")); }\n"
-    << "# files (only *.EXT with an extension) and folders, completed as paths\n"
+    << "# files (only *.EXT given an extension, none given /) and folders, completed as paths\n"
     << "_pitwall_files() {\n"
     << "  compopt -o filenames 2>/dev/null\n"
     << "  local f\n"
@@ -256,6 +259,8 @@ std::string zshAction(const Values& v) {
       return "_files";
     case Kind::LuaFiles:
       return "_files -g \"*.lua(-.)\"";
+    case Kind::Dirs:
+      return "_files -/";
     case Kind::Text:
       break;
   }

@@ -28,7 +28,7 @@ contains "--version names the data folder" "data: " "$(echo "$out" | sed -n 4p)"
 # bare pitwall: every command with one line
 out=$($PITWALL); rc=$?
 check "bare pitwall exit status" 0 "$rc"
-for c in run repl bridge view scan emulate-car sim-robot test replay track decode encode completion; do
+for c in run repl bridge view scan emulate-car sim-robot test replay track decode encode types completion; do
   if echo "$out" | grep -qE "^  $c +[A-Z]"; then echo "ok: bare pitwall lists $c"; else fail "bare pitwall does not list $c: $out"; fi
 done
 
@@ -81,6 +81,7 @@ check "bash: after an option's value, the script" "grand.lua" "$(ask pitwall run
 check "bash: log levels" "warn" "$(ask pitwall --log-level w)"
 check "bash: the protocol of decode" "anki" "$(ask pitwall decode an)"
 check "bash: subcommands" "show" "$(ask pitwall track "")"
+check "bash: folders only for types" "races/" "$(ask pitwall types "")"
 
 # zsh: loads from fpath with compinit and completes at a real prompt (python3-pexpect)
 $PITWALL completion zsh >"$TMP/_pitwall"
