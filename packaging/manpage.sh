@@ -52,6 +52,10 @@ The documentation: README.md and docs/.
 SECTIONS
 } >"$include"
 
-help2man --no-info --no-discard-stderr --section=1 \
+# --version's first line only (the rest is about the machine that built the page); roff's own
+# dash for the em dash, whatever the reader's locale.
+help2man --locale=C.UTF-8 --no-info --no-discard-stderr --section=1 \
+  --version-string="$("$pitwall" --version | head -1 | awk '{print $2}')" \
   --name="an automation engine for robot race cars, scripted in Lua" \
   --include="$include" --output="$out" "$pitwall"
+sed -i 's/\xe2\x80\x94/\\(em/g; s/\xe2\x80\xa6/.../g' "$out"

@@ -104,6 +104,10 @@ if [ -f "$man" ]; then
   if command -v man >/dev/null; then
     out=$(MANWIDTH=100 man -l "$man" 2>&1); rc=$?
     check "man -l renders the page" 0 "$rc"
+    case "$out" in
+      *"???"*) fail "the man page lost characters to '???' (help2man read the help in the C locale)" ;;
+      *) echo "ok: the man page keeps every character" ;;
+    esac
   fi
 else
   fail "no man page at $man (the build makes it with help2man)"
