@@ -1,0 +1,91 @@
+// Option tables (`sim.addCar{…}`, `car:lights{…}`, `pitwall.mindroad{…}`): a key that is no
+// option is a typo that would silently fall back to a default, so it is refused by name, with
+// the option it was probably meant to be (engine/core/suggest.hpp).
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "bindings/lua_args.hpp"
+#include "engine/core/suggest.hpp"
+
+namespace pitwall::lua {
+
+namespace {
+
+// A key as an error may show it: printable ASCII as it is, other bytes (control characters,
+// invalid UTF-8) as \xNN, and at most 40 characters of it.
+std::string printable(std::string_view key) {
+  constexpr std::size_t kMax = 40;
+  std::string out;
+  for (std::size_t i = 0; i < key.size() && i < kMax; ++i) {
+    auto c = static_cast<unsigned char>(key[i]);
+    if (c >= 0x20 && c < 0x7f) {
+      out += static_cast<char>(c);
+    } else {
+      char hex[5];
+      std::snprintf(hex, sizeof hex, "\\x%02x", c);
+      out += hex;
+    }
+  }
+  if (key.size() > kMax) out += "… (" + std::to_string(key.size()) + " bytes)";
+  return out;
+}
+
+// "the number key 1", "the boolean key true", "a table key" (no __tostring is called: it could
+// raise an error through this C++ frame).
+std::string keyShown(lua_State* L, int idx) {
+  const std::string type = luaL_typename(L, idx);
+  switch (lua_type(L, idx)) {
+    case LUA_TNUMBER:
+      return "the number key " +
+             (lua_isinteger(L, idx) ? std::to_string(lua_tointeger(L, idx))
+                                    : show(lua_tonumber(L, idx))) +
+             " (a list where the options go?)";
+    case LUA_TBOOLEAN:
+      return std::string("the boolean key ") + (lua_toboolean(L, idx) ? "true" : "false");
+    default:
+      return "a " + type + " key";
+  }
+}
+
+}  // namespace
+
+void checkOptions(lua_State* L, int idx, std::string_view fn, std::span<const char* const> known) {
+  if (lua_type(L, idx) != LUA_TTABLE) return;
+  idx = lua_absindex(L, idx);
+  luaL_checkstack(L, 3, "option table");
+  std::string problem;
+  std::string key;
+  lua_pushnil(L);
+  while (lua_next(L, idx) != 0) {
+    lua_pop(L, 1);  // the value
+    if (lua_type(L, -1) != LUA_TSTRING) {
+      // (a number key is never turned into a string here: lua_tostring would confuse next)
+      problem = "option names are strings, got " + keyShown(L, -1);
+      lua_pop(L, 1);
+      break;
+    }
+    std::size_t n = 0;
+    const char* s = lua_tolstring(L, -1, &n);
+    std::string_view k(s, n);
+    bool found = false;
+    for (const char* name : known)
+      if (k == name) found = true;
+    if (!found) {
+      key.assign(s, n);
+      lua_pop(L, 1);
+      break;
+    }
+  }
+  if (problem.empty() && key.empty()) return;
+  if (problem.empty()) {
+    std::vector<std::string> names(known.begin(), known.end());
+    // (a key far longer than any option is no typo of one: no edit distance over megabytes)
+    problem = "unknown option " + printable(key) + (key.size() <= 64 ? didYouMean(key, names) : "");
+  }
+  std::string all;
+  for (const char* name : known) all += (all.empty() ? "" : ", ") + std::string(name);
+  throw LuaError(std::string(fn) + ": " + problem + " (the options are " + all + ")");
+}
+
+}  // namespace pitwall::lua
