@@ -104,6 +104,10 @@ TEST_CASE("the option checker refuses hostile keys with a clear error and never 
   CHECK(run("return check{[print] = 1}").find("got a function key") != std::string::npos);
   CHECK(run("return check{['\\0\\xff\\n'] = 1}") ==
         "race.laps: unknown option \\x00\\xff\\x0a (the options are laps, minutes)");
+  CHECK(run("return check{['vitésse'] = 1}") ==
+        "race.laps: unknown option vitésse (the options are laps, minutes)");
+  CHECK(run("return check{['\\xe9t\\xc3'] = 1}") ==  // Latin-1, a cut character
+        "race.laps: unknown option \\xe9t\\xc3 (the options are laps, minutes)");
   std::string huge = run("return check{[string.rep('é', 500000)] = 1}");
   CHECK(huge.size() < 400);
   CHECK(huge.find("… (1000000 bytes)") != std::string::npos);
