@@ -9,6 +9,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "bindings/lua_object.hpp"
 #include "bindings/pitwall_module.hpp"
@@ -16,6 +17,7 @@
 #include "engine/core/log.hpp"
 #include "engine/core/numbers.hpp"
 #include "engine/core/overload.hpp"
+#include "engine/core/suggest.hpp"
 #include "engine/protocol/alphabot/command_text.hpp"
 #include "engine/protocol/alphabot/toggles.hpp"
 #include "engine/vehicles/alphabot.hpp"
@@ -186,7 +188,7 @@ Alphabot& model(lua_State* L, int idx) {
 
 int drive(lua_State* L) {
   auto& m = model(L, 1);
-  raiseIfRefused(m.drive(lua::checkInteger(L, 2, "speed"), lua::checkInteger(L, 3, "steer")));
+  raiseIfRefused(m.drive(lua::checkRounded(L, 2, "speed"), lua::checkRounded(L, 3, "steer")));
   return 0;
 }
 int stop(lua_State* L) {
@@ -195,7 +197,7 @@ int stop(lua_State* L) {
 }
 int measureDistance(lua_State* L) {
   auto& m = model(L, 1);
-  raiseIfRefused(m.measureDistance(lua::checkInteger(L, 2, "degree")));
+  raiseIfRefused(m.measureDistance(lua::checkRounded(L, 2, "degree")));
   return 0;
 }
 int calibrateSteering(lua_State* L) {
@@ -219,7 +221,17 @@ int set(lua_State* L) {
                      " key; names: " + ab::toggleNames());
     std::string name = lua_tostring(L, -2);
     const ab::ToggleBit* bit = ab::findToggle(name);
-    if (!bit) throw LuaError("set: unknown toggle '" + name + "'; names: " + ab::toggleNames());
+    if (!bit) {
+      std::vector<std::string> names;  // "a, b, c" → {a, b, c}
+      std::string all = ab::toggleNames();
+      for (std::size_t at = 0; at < all.size();) {
+        auto comma = all.find(", ", at);
+        names.push_back(all.substr(at, comma - at));
+        at = comma == std::string::npos ? all.size() : comma + 2;
+      }
+      throw LuaError("set: unknown toggle '" + name + "'" + didYouMean(name, names) +
+                     "; names: " + all);
+    }
     if (!lua_isboolean(L, -1))
       throw LuaError("set: toggle " + name + " must be true or false, got " + lua::typeName(L, -1));
     ab::setBit(next, *bit, lua_toboolean(L, -1));
@@ -236,20 +248,20 @@ int ping(lua_State* L) {
 int setAnchor(lua_State* L) {
   auto& m = model(L, 1);
   raiseIfRefused(m.setAnchor(lua::checkInteger(L, 2, "anchor id"),
-                             lua::checkInteger(L, 3, "x (cm)"), lua::checkInteger(L, 4, "y (cm)")));
+                             lua::checkRounded(L, 3, "x (cm)"), lua::checkRounded(L, 4, "y (cm)")));
   return 0;
 }
 int navigateTo(lua_State* L) {
   auto& m = model(L, 1);
   raiseIfRefused(
-      m.navigateTo(lua::checkInteger(L, 2, "x (cm)"), lua::checkInteger(L, 3, "y (cm)")));
+      m.navigateTo(lua::checkRounded(L, 2, "x (cm)"), lua::checkRounded(L, 3, "y (cm)")));
   return 0;
 }
 int addObstacle(lua_State* L) {
   auto& m = model(L, 1);
-  raiseIfRefused(m.addObstacle(lua::checkInteger(L, 2, "x (cm)"), lua::checkInteger(L, 3, "y (cm)"),
-                               lua::checkInteger(L, 4, "width (cm)"),
-                               lua::checkInteger(L, 5, "height (cm)")));
+  raiseIfRefused(m.addObstacle(lua::checkRounded(L, 2, "x (cm)"), lua::checkRounded(L, 3, "y (cm)"),
+                               lua::checkRounded(L, 4, "width (cm)"),
+                               lua::checkRounded(L, 5, "height (cm)")));
   return 0;
 }
 int removeObstacle(lua_State* L) {
@@ -258,7 +270,7 @@ int removeObstacle(lua_State* L) {
     raiseIfRefused(m.removeObstacle(lua::checkInteger(L, 2, "obstacle id")));
   else
     raiseIfRefused(
-        m.removeObstacleAt(lua::checkInteger(L, 2, "x (cm)"), lua::checkInteger(L, 3, "y (cm)")));
+        m.removeObstacleAt(lua::checkRounded(L, 2, "x (cm)"), lua::checkRounded(L, 3, "y (cm)")));
   return 0;
 }
 int clearObstacles(lua_State* L) {
@@ -368,6 +380,8 @@ int newRobot(lua_State* L) {
     throw LuaError(
         "pitwall.alphabot takes a table: {host = \"127.0.0.1\", port = 4000} or "
         "{ble = \"AA:BB:CC:DD:EE:FF\"}");
+  static constexpr std::array<const char*, 4> kOptions = {"host", "port", "connectTimeout", "ble"};
+  lua::checkOptions(L, 1, "pitwall.alphabot", kOptions);
   std::string host, ble;
   long long port = 0;
   double timeout = 3.0;

@@ -64,8 +64,8 @@ void raiseIfRefused(const AnkiCar::Sent& sent) {
 // ---- methods ----
 int setSpeed(lua_State* L) {
   AnkiCar& car = CarBinding::check(L, 1);
-  auto speed = lua::checkInteger(L, 2, "speed (mm/s)");
-  auto accel = lua::optInteger(L, 3, "acceleration (mm/s²)", kDefaultAccel);
+  auto speed = lua::checkRounded(L, 2, "speed (mm/s)");
+  auto accel = lua::optRounded(L, 3, "acceleration (mm/s²)", kDefaultAccel);
   bool limit = lua_toboolean(L, 4);
   raiseIfRefused(car.setSpeed(toInt(speed), toInt(accel), limit));
   return 0;
@@ -77,8 +77,8 @@ int stop(lua_State* L) {
 int changeLane(lua_State* L) {
   AnkiCar& car = CarBinding::check(L, 1);
   double offset = lua::checkNumber(L, 2, "offset (mm)");
-  auto speed = lua::optInteger(L, 3, "lane-change speed (mm/s)", kDefaultLaneSpeed);
-  auto accel = lua::optInteger(L, 4, "lane-change acceleration (mm/s²)", kDefaultLaneAccel);
+  auto speed = lua::optRounded(L, 3, "lane-change speed (mm/s)", kDefaultLaneSpeed);
+  auto accel = lua::optRounded(L, 4, "lane-change acceleration (mm/s²)", kDefaultLaneAccel);
   raiseIfRefused(car.changeLane(offset, toInt(speed), toInt(accel)));
   return 0;
 }
@@ -129,6 +129,7 @@ int lights(lua_State* L) {
     // {headlights=true, brake=false, front=…, engine=…}: touched lights in the low nibble,
     // their values in the high nibble (anki-overdrive.md, set lights).
     static constexpr std::array<const char*, 4> kNames = {"headlights", "brake", "front", "engine"};
+    lua::checkOptions(L, 2, "car:lights", kNames);
     int mask = 0;
     for (int bit = 0; bit < 4; ++bit) {
       int type = lua_getfield(L, 2, kNames[bit]);
@@ -180,6 +181,9 @@ int lightsPattern(lua_State* L) {
     int t = lua_gettop(L);
     if (!lua_istable(L, t))
       throw LuaError("lightsPattern channel " + std::to_string(i) + " must be a table");
+    static constexpr std::array<const char*, 5> kOptions = {"channel", "effect", "from", "to",
+                                                            "cycles"};
+    lua::checkOptions(L, t, "car:lightsPattern", kOptions);
     auto& c = p.channels[i - 1];
     lua_getfield(L, t, "channel");
     c.channel = static_cast<uint8_t>(nameOrNumber(

@@ -6,6 +6,7 @@
 // the exception into a Lua error only after every C++ object of the body is destroyed.
 #include <lua.hpp>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -27,6 +28,12 @@ inline std::string show(double v) {
   return formatNumber(v);
 }
 
+// Pushes "file:line: " of the script's code that called into pitwall: the nearest Lua function
+// on the stack that is not part of the shipped library (scripts/pitwall/), so that an error
+// raised for a bad argument names the user's line even when it was passed through library
+// functions (race.laps → drivers → car:setSpeed). "" when no such function is on the stack.
+void pushUserWhere(lua_State* L);
+
 template <int (*Body)(lua_State*)>
 int guarded(lua_State* L) {
   int results = 0;
@@ -38,8 +45,8 @@ int guarded(lua_State* L) {
     failed = true;
   }
   if (failed) {
-    // Prefix "file:line:" of the Lua code that called us, as luaL_error does.
-    luaL_where(L, 1);
+    // Prefix "file:line:" of the script's line that called us (userWhere), as luaL_error does.
+    pushUserWhere(L);
     lua_insert(L, -2);
     lua_concat(L, 2);
     return lua_error(L);
@@ -85,6 +92,28 @@ inline long long checkInteger(lua_State* L, int idx, const char* what) {
 inline long long optInteger(lua_State* L, int idx, const char* what, long long fallback) {
   return lua_isnoneornil(L, idx) ? fallback : checkInteger(L, idx, what);
 }
+
+// A whole quantity a script may well compute (a speed, an acceleration, a coordinate):
+// a number that is not whole is rounded half away from zero (600.5 → 601, -0.5 → -1), the
+// command's range check then sees the rounded value (docs/lua-api.md "Numbers").
+inline long long checkRounded(lua_State* L, int idx, const char* what) {
+  int isint = 0;
+  lua_Integer v = lua_tointegerx(L, idx, &isint);
+  if (isint) return v;
+  double d = checkNumber(L, idx, what);
+  // beyond ±1e15 no command's range reaches: clamp before converting (no overflow)
+  return static_cast<long long>(std::round(std::clamp(d, -1e15, 1e15)));
+}
+
+inline long long optRounded(lua_State* L, int idx, const char* what, long long fallback) {
+  return lua_isnoneornil(L, idx) ? fallback : checkRounded(L, idx, what);
+}
+
+// An option table (`sim.addCar{…}`, `car:lights{…}`) at stack index idx holds only the keys in
+// `known`: else raises "<fn>: unknown option <key>; did you mean <nearest>? (the options are …)".
+// A key that is not a string (`{3}`, `{[true] = 1}`) is refused by its type and value; a key too
+// long or not printable is shown shortened and escaped. Nothing happens when idx is not a table.
+void checkOptions(lua_State* L, int idx, std::string_view fn, std::span<const char* const> known);
 
 inline std::string checkString(lua_State* L, int idx, const char* what) {
   if (lua_type(L, idx) != LUA_TSTRING)

@@ -11,6 +11,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "bindings/interrupt.hpp"
 #include "bindings/lua_object.hpp"
@@ -18,6 +19,7 @@
 #include "bindings/script_host.hpp"
 #include "engine/core/console.hpp"
 #include "engine/core/log.hpp"
+#include "engine/core/suggest.hpp"
 #include "engine/vehicles/mindroad_robot.hpp"
 
 namespace pitwall {
@@ -94,21 +96,23 @@ void deliver(Robot& r, Event e, Push&& push) {
 // ---- methods ----
 int steer(lua_State* L) {
   auto& c = open(L, 1);
-  raiseIfRefused(c.steer(lua::checkInteger(L, 2, "steer x (forward/backward)"),
-                         lua::checkInteger(L, 3, "steer y (right/left)")));
+  raiseIfRefused(c.steer(lua::checkRounded(L, 2, "steer x (forward/backward)"),
+                         lua::checkRounded(L, 3, "steer y (right/left)")));
   return 0;
 }
 
 int click(lua_State* L) {
   auto& c = open(L, 1);
-  raiseIfRefused(c.click(lua::checkInteger(L, 2, "click x"), lua::checkInteger(L, 3, "click y")));
+  raiseIfRefused(c.click(lua::checkRounded(L, 2, "click x"), lua::checkRounded(L, 3, "click y")));
   return 0;
 }
 
 std::uint8_t buttonByName(const std::string& name) {
   if (auto b = mindroad::buttonFromName(name)) return static_cast<std::uint8_t>(*b);
-  throw LuaError("button '" + name +
-                 "' is unknown; use manual, automatic, sensitivity-up or sensitivity-down");
+  static const std::vector<std::string> kButtons = {"manual", "automatic", "sensitivity-up",
+                                                    "sensitivity-down"};
+  throw LuaError("button '" + name + "' is unknown" + didYouMean(name, kButtons) +
+                 " (use manual, automatic, sensitivity-up or sensitivity-down)");
 }
 
 // buttons("automatic"): the byte is that button's id (seed table 2); buttons{"manual",
@@ -277,11 +281,12 @@ MindroadOptions readOptions(lua_State* L, int idx) {
   if (!lua_istable(L, idx))
     throw LuaError("pitwall.mindroad takes a table {host=, port=, udp=, watchdog=}, got " +
                    lua::typeName(L, idx));
+  static constexpr std::array<const char*, 5> kOptions = {"host", "port", "udp", "watchdog",
+                                                          "contactTimeout"};
+  lua::checkOptions(L, idx, "pitwall.mindroad", kOptions);
   lua_pushnil(L);
   while (lua_next(L, idx)) {
     const int v = lua_gettop(L);
-    if (lua_type(L, v - 1) != LUA_TSTRING)
-      throw LuaError("pitwall.mindroad: option names are strings, got " + lua::typeName(L, v - 1));
     const std::string key = lua_tostring(L, v - 1);
     if (key == "host") {
       o.host = lua::checkString(L, v, "host");
@@ -303,9 +308,6 @@ MindroadOptions readOptions(lua_State* L, int idx) {
       if (o.contactTimeout < 0.1 || o.contactTimeout > 600)
         throw LuaError("contactTimeout " + lua::show(o.contactTimeout) +
                        " s is out of range 0.1..600 s");
-    } else {
-      throw LuaError("pitwall.mindroad: unknown option '" + key +
-                     "'; the options are host, port, udp, watchdog, contactTimeout");
     }
     lua_pop(L, 1);
   }

@@ -7,6 +7,9 @@
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
 
 #include "bindings/car_binding.hpp"
 #include "bindings/lua_args.hpp"
@@ -15,6 +18,7 @@
 #include "bindings/script_host.hpp"
 #include "engine/core/console.hpp"
 #include "engine/core/log.hpp"
+#include "engine/core/suggest.hpp"
 #include "engine/protocol/anki/pieces.hpp"
 
 namespace pitwall {
@@ -170,6 +174,78 @@ int reportError(lua_State* L) {
   return 0;
 }
 
+// pitwall._raise(message): the Lua library's error(), naming the script's line that called into
+// the library (lua::pushUserWhere), however deep inside the library it was raised.
+int raise(lua_State* L) {
+  throw LuaError(luaL_tolstring(L, 1, nullptr));
+}
+
+// The strings of the list at idx (other values are skipped).
+std::vector<std::string> stringList(lua_State* L, int idx, const char* what) {
+  if (!lua_istable(L, idx)) throw LuaError(std::string(what) + " must be a list of names");
+  std::vector<std::string> out;
+  for (lua_Integer i = 1, n = luaL_len(L, idx); i <= n; ++i) {
+    if (lua_geti(L, idx, i) == LUA_TSTRING) out.emplace_back(lua_tostring(L, -1));
+    lua_pop(L, 1);
+  }
+  return out;
+}
+
+// pitwall._nearest(word, names): the name `word` was probably meant to be (a typo of it), or
+// nil — engine/core/suggest.hpp, for the Lua library's errors.
+int nearestName(lua_State* L) {
+  std::string word = lua::checkString(L, 1, "word");
+  auto names = stringList(L, 2, "names");
+  auto found = nearest(word, names);
+  if (!found) return 0;
+  lua_pushlstring(L, found->data(), found->size());
+  return 1;
+}
+
+// pitwall._modulesIn("pitwall.drivers"): the sorted names of the Lua modules `require` finds
+// under that prefix — the files <dir>/pitwall/drivers/*.lua for every <dir>/?.lua of
+// package.path (drivers.load lists them when a name is not found).
+int modulesIn(lua_State* L) {
+  namespace fs = std::filesystem;
+  std::string prefix = lua::checkString(L, 1, "module prefix");
+  std::replace(prefix.begin(), prefix.end(), '.', '/');
+  lua_getglobal(L, "package");
+  std::string path = lua_istable(L, -1) && lua_getfield(L, -1, "path") == LUA_TSTRING
+                         ? lua_tostring(L, -1)
+                         : std::string();
+  std::vector<std::string> names;
+  for (std::size_t at = 0; at <= path.size();) {
+    auto end = path.find(';', at);
+    if (end == std::string::npos) end = path.size();
+    std::string entry = path.substr(at, end - at);
+    at = end + 1;
+    if (!entry.ends_with("?.lua")) continue;
+    fs::path folder = fs::path(entry.substr(0, entry.size() - 5)) / prefix;
+    std::error_code ec;
+    for (fs::directory_iterator it(folder, ec), done; !ec && it != done; it.increment(ec))
+      if (it->path().extension() == ".lua") names.push_back(it->path().stem().string());
+  }
+  std::sort(names.begin(), names.end());
+  names.erase(std::unique(names.begin(), names.end()), names.end());
+  lua_createtable(L, static_cast<int>(names.size()), 0);
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    lua_pushlstring(L, names[i].data(), names[i].size());
+    lua_rawseti(L, -2, static_cast<lua_Integer>(i + 1));
+  }
+  return 1;
+}
+
+// pitwall._checkOptions(fnName, options, known): the Lua library's option tables, checked as the
+// bindings' are (lua::checkOptions): an unknown key is an error on the script's line.
+int checkOptionsOf(lua_State* L) {
+  std::string fn = lua::checkString(L, 1, "function name");
+  auto names = stringList(L, 3, "known options");
+  std::vector<const char*> known;
+  for (const auto& n : names) known.push_back(n.c_str());
+  lua::checkOptions(L, 2, fn, known);
+  return 0;
+}
+
 // pitwall.piece(id): what a road piece is (docs/lua-api.md "Track pieces"), nil when unknown.
 int piece(lua_State* L) {
   auto id = lua::checkInteger(L, 1, "piece id");
@@ -206,8 +282,12 @@ int piece(lua_State* L) {
 // pitwall.writeResults(rows, columns [, path]): rows (tables) as JSON or CSV, by the path's
 // extension; the path defaults to --results.
 int writeResults(lua_State* L) {
-  luaL_checktype(L, 1, LUA_TTABLE);
-  luaL_checktype(L, 2, LUA_TTABLE);
+  if (!lua_istable(L, 1))
+    throw LuaError("pitwall.writeResults: rows must be a list of tables, got " +
+                   lua::typeName(L, 1));
+  if (!lua_istable(L, 2))
+    throw LuaError("pitwall.writeResults: columns must be a list of names, got " +
+                   lua::typeName(L, 2));
   results::Table table;
   for (lua_Integer i = 1, n = luaL_len(L, 2); i <= n; ++i) {
     if (lua_geti(L, 2, i) != LUA_TSTRING)
@@ -273,6 +353,8 @@ int timerToString(lua_State* L) {
 void openPitwallModule(ScriptHost& host) {
   lua_State* L = host.state();
   luaL_newmetatable(L, kTimerMetatable);
+  lua_pushstring(L, "timer");  // how errors name it ("timer has no method cancle; …")
+  lua_setfield(L, -2, "__name");
   lua_newtable(L);
   lua_pushcfunction(L, lua::guarded<cancelTimer>);
   lua_setfield(L, -2, "cancel");
@@ -296,6 +378,10 @@ void openPitwallModule(ScriptHost& host) {
                                        {"terminal", terminal},
                                        {"_setHub", lua::guarded<&lua::setHub>},
                                        {"_reportError", lua::guarded<reportError>},
+                                       {"_raise", lua::guarded<raise>},
+                                       {"_nearest", lua::guarded<nearestName>},
+                                       {"_modulesIn", lua::guarded<modulesIn>},
+                                       {"_checkOptions", lua::guarded<checkOptionsOf>},
                                        {nullptr, nullptr}};
   luaL_newlib(L, functions);
   lua_pushboolean(L, host.loop().clockKind() == ClockKind::Virtual);

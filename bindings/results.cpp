@@ -23,9 +23,22 @@ bool whole(double v) {
   return std::isfinite(v) && v == std::floor(v) && std::fabs(v) < 1e15;
 }
 
+// Times (seconds) are results to the millisecond: every number with a fraction is written
+// rounded to three decimals (62.3456789 → 62.346), whatever its size.
+double toMillis(double v) {
+  if (!std::isfinite(v) || std::fabs(v) >= 1e12) return v;
+  return std::round(v * 1000) / 1000;
+}
+
 std::string number(double v) {
+  v = toMillis(v);
   if (whole(v)) return std::to_string(static_cast<long long>(v));
-  return formatNumber(v, 6);
+  if (!std::isfinite(v) || std::fabs(v) >= 1e12) return formatNumber(v, 6);
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.3f", v);
+  std::string text = buf;
+  while (text.back() == '0') text.pop_back();  // a fraction is there: never reaches the point
+  return text;
 }
 
 std::string csvField(const std::string& s) {
@@ -56,10 +69,11 @@ std::string render(const Table& table, Format format) {
       nlohmann::ordered_json o = nlohmann::ordered_json::object();
       for (std::size_t i = 0; i < table.columns.size(); ++i) {
         const Cell& c = i < row.size() ? row[i] : Cell{};
-        if (auto* d = std::get_if<double>(&c))
-          o[table.columns[i]] = whole(*d) ? nlohmann::ordered_json(static_cast<long long>(*d))
-                                          : nlohmann::ordered_json(*d);
-        else if (auto* s = std::get_if<std::string>(&c))
+        if (auto* d = std::get_if<double>(&c)) {
+          const double v = toMillis(*d);
+          o[table.columns[i]] = whole(v) ? nlohmann::ordered_json(static_cast<long long>(v))
+                                         : nlohmann::ordered_json(v);
+        } else if (auto* s = std::get_if<std::string>(&c))
           o[table.columns[i]] = *s;
         else if (auto* b = std::get_if<bool>(&c))
           o[table.columns[i]] = *b;

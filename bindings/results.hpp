@@ -22,7 +22,8 @@ struct Table {
 };
 
 // JSON: an array of objects keyed by column, in column order; CSV: a header line, then one line
-// per row (RFC 4180 quoting). Numbers that are whole print without a fraction.
+// per row (RFC 4180 quoting). Numbers are rounded to the millisecond (three decimals: times are
+// seconds); those that are whole then print without a fraction.
 std::string render(const Table& table, Format format);
 // The path has a known extension and its folder takes a new file (checked before a race, so a
 // typo does not cost the results afterwards); a sentence naming the problem otherwise.

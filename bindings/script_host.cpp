@@ -5,12 +5,25 @@
 #include "bindings/car_binding.hpp"
 #include "bindings/interrupt.hpp"
 #include "bindings/lua_args.hpp"
+#include "bindings/misspelled_method.hpp"
 #include "bindings/pitwall_module.hpp"
+#include "bindings/script_file.hpp"
 #include "engine/core/console.hpp"
 #include "engine/core/data_dir.hpp"
 #include "engine/core/log.hpp"
 
 namespace pitwall {
+
+namespace {
+// The shipped library: $PITWALL_SCRIPTS (the tests' source tree), else scripts/ in the data
+// folder found beside the binary (engine/core/data_dir.hpp).
+std::string scriptsDir() {
+  if (const char* env = std::getenv("PITWALL_SCRIPTS"); env && *env) return env;
+  auto data = dataDir();
+  if (!data) throw std::runtime_error(data.error());
+  return (*data / "scripts").string();
+}
+}  // namespace
 
 namespace lua {
 int traceback(lua_State* L) {
@@ -18,9 +31,25 @@ int traceback(lua_State* L) {
   if (!msg) {
     if (luaL_callmeta(L, 1, "__tostring") && lua_type(L, -1) == LUA_TSTRING) return 1;
     msg = lua_pushfstring(L, "(error object is a %s value)", luaL_typename(L, 1));
+  } else if (auto explained = explainMissingMethod(L, 1, msg)) {
+    msg = lua_pushlstring(L, explained->data(), explained->size());
   }
   luaL_traceback(L, L, msg, 1);
   return 1;
+}
+
+void pushUserWhere(lua_State* L) {
+  // The library's modules are loaded through package.path as <scripts>/pitwall/….lua
+  // (openLibraries), so their chunk names start with this.
+  const std::string library = "@" + scriptsDir() + "/pitwall/";
+  lua_Debug ar;
+  for (int level = 1; lua_getstack(L, level, &ar); ++level) {
+    if (!lua_getinfo(L, "Sl", &ar) || ar.currentline <= 0) continue;  // C functions
+    if (std::string_view(ar.source).starts_with(library)) continue;
+    lua_pushfstring(L, "%s:%d: ", ar.short_src, ar.currentline);
+    return;
+  }
+  luaL_where(L, 1);  // only the library on the stack (an engine call into it): its own line
 }
 }  // namespace lua
 
@@ -95,14 +124,6 @@ int scriptExit(lua_State* L) {
   return 0;
 }
 
-// The shipped library: $PITWALL_SCRIPTS (the tests' source tree), else scripts/ in the data
-// folder found beside the binary (engine/core/data_dir.hpp).
-std::string scriptsDir() {
-  if (const char* env = std::getenv("PITWALL_SCRIPTS"); env && *env) return env;
-  auto data = dataDir();
-  if (!data) throw std::runtime_error(data.error());
-  return (*data / "scripts").string();
-}
 }  // namespace
 
 ScriptHost::ScriptHost(Loop& loop, Fleet& fleet, SimSession* sim, HostOptions options)
@@ -420,9 +441,9 @@ Result<bool, std::string> ScriptHost::startLoaded(int status) {
 Result<bool, std::string> ScriptHost::loadFile(const std::string& path) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) return Unexpected{"cannot open " + path + ": no such file"};
-  // The script's own folder joins the front of the require path.
-  fs::path folder = fs::path(path).parent_path();
+  // The script's own folder joins the front of the require path (as messages show it: its
+  // modules are named relative to the current folder too).
+  fs::path folder = fs::path(script_file::shownPath(path)).parent_path();
   const std::string dir = folder.empty() ? std::string(".") : folder.string();
   lua_getglobal(L_, "package");
   lua_getfield(L_, -1, "path");
@@ -431,11 +452,7 @@ Result<bool, std::string> ScriptHost::loadFile(const std::string& path) {
   lua_pushlstring(L_, p.data(), p.size());
   lua_setfield(L_, -2, "path");
   lua_pop(L_, 1);
-  if (luaL_loadfilex(L_, path.c_str(), "t") != LUA_OK) {
-    std::string err = lua_tostring(L_, -1) ? lua_tostring(L_, -1) : "cannot load the script";
-    lua_pop(L_, 1);
-    return Unexpected{err};
-  }
+  if (auto loaded = script_file::load(L_, path); !loaded) return loaded;
   loadedFiles_.push_back(fs::absolute(path, ec).lexically_normal().string());
   return true;
 }

@@ -3,6 +3,7 @@
 // engine times (docs/testing.md "Hot reload in scenarios"). The scenario watches from outside:
 // while the script under test runs it has the cars' events, and the scenario goes by the
 // simulator's ground truth (pitwall.sim.truth).
+#include <array>
 #include <filesystem>
 #include <memory>
 
@@ -89,6 +90,8 @@ int create(lua_State* L) {
   options.detached = false;
   options.results.clear();
   if (lua_istable(L, 2)) {
+    static constexpr std::array<const char*, 2> kOptions = {"results", "name"};
+    lua::checkOptions(L, 2, "sim.script", kOptions);
     if (lua_getfield(L, 2, "results") == LUA_TSTRING) options.results = lua_tostring(L, -1);
     lua_pop(L, 1);
     if (lua_getfield(L, 2, "name") == LUA_TSTRING) name = lua_tostring(L, -1);

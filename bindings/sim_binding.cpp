@@ -1,6 +1,7 @@
 // pitwall.sim: the simulated world as a script sees it — its track, its cars, ground truth and
 // noise. Scenario tests build their world with it; `require "pitwall.sim"` returns it.
 #include <algorithm>
+#include <array>
 #include <cctype>
 
 #include "bindings/car_binding.hpp"
@@ -117,6 +118,9 @@ int addCar(lua_State* L) {
     lua_settop(L, 0);
     lua_newtable(L);
   }
+  static constexpr std::array<const char*, 8> kOptions = {"name", "model",  "piece",   "distance",
+                                                          "lane", "offset", "battery", "version"};
+  lua::checkOptions(L, 1, "sim.addCar", kOptions);
   const sim::Track& track = s.world->track();
   int index = static_cast<int>(s.world->cars().size());
   sim::CarSpec spec = sim::gridSpec(track, index);
@@ -225,6 +229,8 @@ int noise(lua_State* L) {
   sim::Noise n = s.world->noise();
   if (!lua_isnoneornil(L, 1)) {
     if (!lua_istable(L, 1)) throw LuaError("sim.noise takes a table {drop=, late=, lateBy=}");
+    static constexpr std::array<const char*, 3> kOptions = {"drop", "late", "lateBy"};
+    lua::checkOptions(L, 1, "sim.noise", kOptions);
     auto prob = [L](const char* key, double& out) {
       if (lua_getfield(L, 1, key) != LUA_TNIL) {
         double v = lua::checkNumber(L, -1, key);

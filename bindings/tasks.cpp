@@ -1,6 +1,7 @@
 #include "bindings/tasks.hpp"
 
 #include "bindings/interrupt.hpp"
+#include "bindings/misspelled_method.hpp"
 #include "bindings/script_host.hpp"
 
 namespace pitwall {
@@ -77,6 +78,9 @@ void Tasks::resume(lua_State* co, int nargs) {
     error = sandbox::memoryMessage(host_.memory());
   } else if (status != LUA_OK) {
     const char* msg = lua_tostring(co, -1);
+    std::optional<std::string> explained;
+    if (msg) explained = lua::explainMissingMethod(co, 0, msg);  // car:setSped → a suggestion
+    if (explained) msg = explained->c_str();
     luaL_traceback(L, co, msg ? msg : "(error without a message)", 0);
     error = lua_tostring(L, -1);
     lua_pop(L, 1);

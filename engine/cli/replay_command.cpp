@@ -11,6 +11,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "bindings/script_file.hpp"
 #include "engine/cli/commands.hpp"
 #include "engine/cli/options.hpp"
 #include "engine/cli/session.hpp"
@@ -100,6 +101,12 @@ void control(RecordPlayer& player, const nlohmann::json& message) {
 
 int replay(const ReplayOptions& options) {
   const std::string& file = options.file;
+  if (!options.script.empty()) {  // refused before the record is read
+    if (auto problem = script_file::check(options.script)) {
+      std::cerr << "pitwall replay: " << *problem << "\n";
+      return 2;
+    }
+  }
   std::error_code ec;
   if (std::filesystem::is_directory(file, ec)) {
     std::cerr << "pitwall replay: " << file << " is a folder; give a --record file\n";

@@ -1,10 +1,12 @@
 // pitwall run SCRIPT: a script driving simulated cars (real or virtual time), or real cars over
 // Bluetooth LE with --ble.
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 
 #include "bindings/results.hpp"
+#include "bindings/script_file.hpp"
 #include "engine/cli/commands.hpp"
 #include "engine/cli/options.hpp"
 #include "engine/cli/repl.hpp"
@@ -29,6 +31,17 @@ std::string simulatedTime(double seconds) {
 }  // namespace
 
 int run(const RunOptions& options) {
+  // The script is read and compiled before any car is connected: a missing one (status 2) or one
+  // that does not compile (status 1) is refused at once, not after a Bluetooth scan. With
+  // --watch a script that does not compile yet is waited for, as before.
+  if (auto problem = script_file::check(options.script)) {
+    std::error_code ec;
+    const bool missing = !std::filesystem::is_regular_file(options.script, ec);
+    if (missing || !options.watch) {
+      std::cerr << "pitwall run: " << *problem << "\n";
+      return missing ? 2 : 1;
+    }
+  }
   if (!options.results.empty()) {  // refused now, not after the race
     auto checked = results::writable(options.results);
     if (!checked) {

@@ -19,6 +19,7 @@
 -- stdout is not a terminal (a file, a CI log) only `final` prints, so logs stay readable.
 local Board = {}
 Board.__index = Board
+Board.__name = "board" -- (how errors name it: "board has no method …")
 
 --- "1:02.345" from seconds (minutes only from a minute on: "4.125"); "-" for nil.
 function Board.time(seconds)
@@ -44,10 +45,14 @@ end
 --- pitwall.terminal()) are for tests.
 function Board.new(spec)
   if type(spec) ~= "table" or type(spec.columns) ~= "table" or #spec.columns == 0 then
-    error("Board.new needs {columns = {{key = …, title = …}, …}}", 2)
+    pitwall._raise("Board.new needs {columns = {{key = …, title = …}, …}}")
   end
+  pitwall._checkOptions("Board.new", spec, { "title", "columns", "out", "tty" })
   for i, c in ipairs(spec.columns) do
-    if type(c.key) ~= "string" then error("Board.new: column " .. i .. " has no key", 2) end
+    if type(c) ~= "table" or type(c.key) ~= "string" then
+      pitwall._raise("Board.new: column " .. i .. " has no key")
+    end
+    pitwall._checkOptions("Board.new: column " .. i, c, { "key", "title", "align", "format" })
   end
   local tty = spec.tty
   if tty == nil then tty = pitwall.terminal().tty end

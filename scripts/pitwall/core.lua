@@ -2,11 +2,31 @@
 -- See docs/lua-api.md.
 local pitwall = pitwall
 
+-- Errors the library raises name the script's line that called into it, never a line of the
+-- library: pitwall._raise(message) (C++, bindings/lua_args.hpp pushUserWhere) walks out of
+-- scripts/pitwall/ however deep the library called itself. raise is the library's error().
+local raise = pitwall._raise
+
+--- Re-raises `err` (an error caught inside the library) with `prefix`, naming the script's line:
+--- the position it carried (a line of the library, or the script's already) is dropped.
+function pitwall._rethrow(prefix, err)
+  if type(err) == "string" then err = err:gsub("^[^\n]-:%d+: ", "", 1) end
+  raise((prefix or "") .. tostring(err))
+end
+
+--- Checks the option table `options` of `fnName` ("race.laps"): every key must be one of
+--- `known`, else an error on the script's line: "race.laps: unknown option lapz; did you mean
+--- laps? (the options are …)". A non-table `options` is left to the caller.
+function pitwall._checkOptionsOf(fnName, options, known)
+  if type(options) == "table" then pitwall._checkOptions(fnName, options, known) end
+  return options
+end
+
 --- Waits inside a task until cond() is true, checking every `step` seconds (default 0.01) of
 --- engine time. Returns true when it became true, false when `timeout` seconds passed first.
 function pitwall.waitUntil(cond, timeout, step)
   if type(cond) ~= "function" then
-    error("pitwall.waitUntil needs a function that returns true when done, got " .. type(cond), 2)
+    raise("pitwall.waitUntil needs a function that returns true when done, got " .. type(cond))
   end
   step = step or 0.01
   local deadline = timeout and pitwall.now() + timeout
@@ -57,10 +77,10 @@ end
 --- car's own handler. Returns a subscription: sub:cancel() ends it.
 function pitwall.listen(car, event, fn)
   if type(event) ~= "string" then
-    error("pitwall.listen: the event is a name such as \"onPosition\", got " .. type(event), 2)
+    raise("pitwall.listen: the event is a name such as \"onPosition\", got " .. type(event))
   end
   if type(fn) ~= "function" then
-    error("pitwall.listen: the listener must be a function, got " .. type(fn), 2)
+    raise("pitwall.listen: the listener must be a function, got " .. type(fn))
   end
   local byEvent = listeners[car]
   local list = byEvent and byEvent[event]
@@ -78,7 +98,7 @@ function pitwall.listen(car, event, fn)
         end
       end
     end)
-    if not ok then error("pitwall.listen: " .. tostring(err), 2) end
+    if not ok then pitwall._rethrow("pitwall.listen: ", err) end
     byEvent = byEvent or {}
     listeners[car] = byEvent
     list = {}
@@ -100,7 +120,7 @@ pitwall._carried = {}
 
 --- Registers `save`, which returns module `name`'s state for the next version.
 function pitwall._carry(name, save)
-  if carriers[name] then error("pitwall._carry: '" .. tostring(name) .. "' is carried already", 2) end
+  if carriers[name] then raise("pitwall._carry: '" .. tostring(name) .. "' is carried already") end
   carriers[name] = save
 end
 
@@ -184,11 +204,8 @@ end
 local function readyWhenMade(make, timeoutKey, notReady)
   return function(options)
     local ok, robot = pcall(make, options)
-    if not ok then
-      -- the error names the script's line, not this one
-      if type(robot) == "string" then robot = robot:gsub("^[^\n]-pitwall[/\\]core%.lua:%d+: ", "") end
-      error(robot, 2)
-    end
+    -- (its error already names the script's line: the binding walks out of the library)
+    if not ok then error(robot, 0) end
     if not coroutine.isyieldable() then return robot end
     local timeout = type(options) == "table" and options[timeoutKey] or 3
     if pitwall.waitUntil(function() return robot.connected end, timeout, 0.005) then
@@ -196,7 +213,7 @@ local function readyWhenMade(make, timeoutKey, notReady)
     end
     local what = notReady(robot)
     robot:close()
-    error(string.format("%s after %g s (%s): %s", what.name, timeout, timeoutKey, what.why), 2)
+    raise(string.format("%s after %g s (%s): %s", what.name, timeout, timeoutKey, what.why))
   end
 end
 if pitwall.mindroad then
@@ -220,7 +237,7 @@ if sim then
     local car = sim._addCar(spec)
     if coroutine.isyieldable() then
       if not pitwall.waitUntil(function() return car.connected end, 5) then
-        error("simulated car " .. tostring(car) .. " did not connect within 5 s", 2)
+        raise("simulated car " .. tostring(car) .. " did not connect within 5 s")
       end
     end
     return car
@@ -232,7 +249,7 @@ if sim then
   package.loaded["pitwall.sim"] = sim
 else
   package.preload["pitwall.sim"] = function()
-    error("pitwall.sim is only available when the run uses the built-in simulator", 2)
+    raise("pitwall.sim is only available when the run uses the built-in simulator")
   end
 end
 

@@ -34,17 +34,58 @@ local drivers = {}
 function drivers.load(x)
   if type(x) == "table" then
     if type(x.new) ~= "function" then
-      error("drivers.load: a driver class needs a function `new`", 2)
+      pitwall._raise("drivers.load: a driver class needs a function `new`")
     end
     return x
   end
   if type(x) ~= "string" then
-    error("drivers.load: give a driver name (\"cruiser\") or a driver class table, got "
-      .. type(x), 2)
+    pitwall._raise("drivers.load: give a driver name (\"cruiser\") or a driver class table, got "
+      .. type(x))
   end
-  local ok, cls = pcall(require, "pitwall.drivers." .. x)
-  if not ok then error("drivers.load: no driver '" .. x .. "': " .. tostring(cls), 2) end
+  local module = "pitwall.drivers." .. x
+  if not package.loaded[module] and not package.preload[module]
+    and not package.searchpath(module, package.path) then
+    -- not 22 lines of package.path: the drivers there are, and the one probably meant
+    local names = drivers.names()
+    local near = pitwall._nearest(x, names)
+    pitwall._raise("drivers.load: no driver " .. x
+      .. (near and ("; did you mean " .. near .. "? The") or "; the") .. " drivers are "
+      .. table.concat(names, ", ") .. " (a driver of your own is a module "
+      .. "pitwall.drivers.<name>: pitwall/drivers/<name>.lua beside your script)")
+  end
+  local ok, cls = pcall(require, module)
+  if not ok then pitwall._rethrow("drivers.load: driver " .. x .. " does not load: ", cls) end
   return cls
+end
+
+--- The names of the drivers drivers.load finds (pitwall/drivers/*.lua along package.path),
+--- sorted.
+function drivers.names()
+  return pitwall._modulesIn("pitwall.drivers")
+end
+
+--- Checks a driver's options: every key must be one of `known` (the driver's options and those
+--- of the drivers inside it), else an error on the script's line naming `name` ("cruiser.new").
+function drivers.checkOptions(name, options, known)
+  return pitwall._checkOptionsOf(name, options, known)
+end
+
+--- The options of `options` that are in `known` (what a driver hands to the driver inside it).
+function drivers.pick(options, known)
+  local out = {}
+  for _, k in ipairs(known) do out[k] = options[k] end
+  return out
+end
+
+--- A list of the names in all the lists given, in order, each once.
+function drivers.optionList(...)
+  local out, seen = {}, {}
+  for _, list in ipairs { ... } do
+    for _, k in ipairs(list) do
+      if not seen[k] then out[#out + 1], seen[k] = k, true end
+    end
+  end
+  return out
 end
 
 -- Signed centre-line mm from a to b on a lap of length lap, in (−lap/2, lap/2].
@@ -56,6 +97,7 @@ end
 
 local Context = {}
 Context.__index = Context
+Context.__name = "driver context"
 
 -- The field's entries as (car, loc), skipping our own car.
 function Context:_each()
@@ -138,6 +180,7 @@ end
 --- limit (mm/s).
 function drivers.context(car, map, field, options)
   options = options or {}
+  pitwall._checkOptionsOf("drivers.context", options, { "period", "limit" })
   for _, f in ipairs(field or {}) do -- follow bare cars from now on
     if not (type(f) == "table" and f.car) then localize.follow(f, map) end
   end
@@ -222,7 +265,8 @@ drivers.call = call
 --- is reported (pitwall.onError or the log) and the driver keeps being called.
 function drivers.run(car, driver, ctx)
   if type(driver) ~= "table" or type(driver.update) ~= "function" then
-    error("drivers.run: a driver is a table with an update method (make one with Class.new)", 2)
+    pitwall._raise("drivers.run: a driver is a table with an update method (make one with "
+      .. "Class.new)")
   end
   local handle = { running = true, updates = 0 }
   pitwall.spawn(function()

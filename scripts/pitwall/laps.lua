@@ -29,6 +29,7 @@ laps.onBestLap = nil
 
 local Timer = {}
 Timer.__index = Timer
+Timer.__name = "lap timer" -- (how errors name it: "lap timer has no method …")
 
 --- The default sectors of `map`: a list of the piece indices where each sector begins. The
 --- first begins at the finish line; a new one begins on each straight that follows a curve,
@@ -60,7 +61,7 @@ local function checkSectors(sectors, n)
       end
     end
   end
-  if problem then error("laps.timer: options.sectors " .. problem, 3) end
+  if problem then pitwall._raise("laps.timer: options.sectors " .. problem) end
 end
 
 --- A lap timer for `car` on `map`. options: sectors (a list of start indices, default
@@ -68,6 +69,7 @@ end
 --- settable as timer.onLap / timer.onBestLap).
 function laps.timer(car, map, options)
   options = options or {}
+  pitwall._checkOptionsOf("laps.timer", options, { "sectors", "minCoverage", "onLap", "onBestLap" })
   local loc = localize.follow(car, map)
   local sectors = options.sectors or laps.sectors(map)
   checkSectors(sectors, #map.pieces)

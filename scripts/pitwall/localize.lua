@@ -33,6 +33,7 @@ local LONG_GAP = 1.5       -- s without events after which the reckoning is not 
 
 local Tracker = {}
 Tracker.__index = Tracker
+Tracker.__name = "tracker" -- (how errors name it: "tracker has no method …")
 
 local followed = setmetatable({}, { __mode = "k" }) -- car → { [map] = tracker }
 
@@ -294,9 +295,10 @@ end
 --- position is extrapolated (default 3; at 300 mm/s two lost frames leave a gap over 1 s).
 function localize.follow(car, map, options)
   if type(map) ~= "table" or type(map.pieces) ~= "table" or not map.lapLength then
-    error("localize.follow(car, map): map must be a track map from pitwall.track (track.scan or "
-      .. "track.fromSim), got " .. type(map), 2)
+    pitwall._raise("localize.follow(car, map): map must be a track map from pitwall.track "
+      .. "(track.scan or track.fromSim), got " .. type(map))
   end
+  pitwall._checkOptionsOf("localize.follow", options, { "horizon" })
   local byMap = followed[car]
   if byMap and byMap[map] then return byMap[map] end
   local now = pitwall.now()
@@ -307,7 +309,7 @@ function localize.follow(car, map, options)
     horizon = options and options.horizon or 3, watchers = {},
   }, Tracker)
   local ok, err = pcall(listenTo, self)
-  if not ok then error("localize.follow: " .. tostring(err), 2) end
+  if not ok then pitwall._rethrow("localize.follow: ", err) end
   followed[car] = byMap or {}
   followed[car][map] = self
   return self

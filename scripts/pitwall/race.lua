@@ -31,6 +31,7 @@ race.columns = { "position", "car", "number", "laps", "totalTime", "bestLap", "l
 -- pitwall.drivers has no "cruiser".
 local Steady = { name = "steady" }
 Steady.__index = Steady
+Steady.__name = "steady driver" -- (how errors name it: "steady driver has no method …")
 function Steady.new(options)
   options = options or {}
   return setmetatable({ speed = options.speed or 600, accel = options.accel or 1000 }, Steady)
@@ -46,6 +47,7 @@ race.time = Board.time
 
 local Race = {}
 Race.__index = Race
+Race.__name = "race" -- (a misspelled method names it: "race has no method …")
 
 -- car → the kind of its last event ("position", "transition"): whether car.piece is still
 -- where it is (kept for the whole run, from a car's first session on, across reloads)
@@ -95,6 +97,12 @@ end)
 local MODES = { practice = "Free practice", qualifying = "Qualifying", laps = "Race",
   timed = "Timed race" }
 
+-- Every option a session takes (docs/racing.md "Options"): any other key is a typo.
+race.options = { "mode", "laps", "minutes", "seconds", "cars", "map", "scan", "drivers", "grid",
+  "lights", "lightInterval", "hold", "falseStartPenalty", "safety", "cooldown", "finishTimeout",
+  "period", "gridSpeed", "gridTimeout", "board", "title", "redraw", "results", "onLap",
+  "onFinish", "onPositionChange", "onFalseStart", "onLights", "onEnd" }
+
 local function report(where, err)
   if pitwall._reportError then pitwall._reportError(where, err)
   else pitwall.log("error", where .. ": " .. tostring(err)) end
@@ -121,8 +129,8 @@ local function makeDriver(spec, car, i)
     spec = spec.new {}
   end
   if type(spec) ~= "table" or type(spec.update) ~= "function" then
-    error("race: the driver of " .. tostring(car) .. " must be a name, a driver class (with new) "
-      .. "or a driver (with update), got " .. type(spec), 0)
+    pitwall._raise("race: the driver of " .. tostring(car) .. " must be a name, a driver class "
+      .. "(with new) or a driver (with update), got " .. type(spec))
   end
   return spec
 end
@@ -130,16 +138,31 @@ end
 --- A session, not started yet: race.new{mode = "laps" | "timed" | "qualifying" | "practice", …}.
 function race.new(options)
   options = options or {}
+  if type(options) ~= "table" then
+    pitwall._raise("race: the options are a table such as {laps = 5}, got " .. type(options))
+  end
   local mode = options.mode or "laps"
-  if not MODES[mode] then error("race.new: unknown mode '" .. tostring(mode) .. "'", 2) end
+  if not MODES[mode] then
+    local names = { "laps", "timed", "qualifying", "practice" }
+    local near = pitwall._nearest(tostring(mode), names)
+    pitwall._raise("race.new: unknown mode '" .. tostring(mode) .. "'"
+      .. (near and ("; did you mean " .. near .. "?") or "")
+      .. " (the modes are laps, timed, qualifying, practice)")
+  end
+  pitwall._checkOptions("race." .. mode, options, race.options)
+  if type(options.safety) == "table" then
+    pitwall._checkOptions("race." .. mode .. ": safety", options.safety, { "distance", "speed" })
+  end
   local seconds = options.seconds or (options.minutes and options.minutes * 60)
-  if mode == "laps" and not options.laps then error("race.laps: give laps = N", 2) end
-  if mode == "timed" and not seconds then error("race.timed: give minutes = M (or seconds)", 2) end
+  if mode == "laps" and not options.laps then pitwall._raise("race.laps: give laps = N") end
+  if mode == "timed" and not seconds then
+    pitwall._raise("race.timed: give minutes = M (or seconds)")
+  end
   if (mode == "qualifying" or mode == "practice") and not seconds and not options.laps then
-    error("race." .. mode .. ": give minutes = M (or seconds, or laps)", 2)
+    pitwall._raise("race." .. mode .. ": give minutes = M (or seconds, or laps)")
   end
   local cars = options.cars or pitwall.cars()
-  if #cars == 0 then error("race: no cars", 2) end
+  if #cars == 0 then pitwall._raise("race: no cars") end
   return setmetatable({
     mode = mode, options = options, cars = cars, seconds = seconds, laps = options.laps,
     period = options.period or 0.1, state = "new", entries = {}, order = {},
@@ -656,8 +679,8 @@ end
 --- the script interrupted is taken up where it was by the same call in the new version.
 function Race:run()
   if not coroutine.isyieldable() then
-    error("race: a session drives and waits: run it inside a task (the main chunk or "
-      .. "pitwall.spawn), not in a handler", 2)
+    pitwall._raise("race: a session drives and waits: run it inside a task (the main chunk or "
+      .. "pitwall.spawn), not in a handler")
   end
   self.lastKind = lastKind
   runs = runs + 1
@@ -678,6 +701,9 @@ end
 for mode in pairs(MODES) do
   race[mode] = function(options)
     options = options or {}
+    if type(options) ~= "table" then
+      pitwall._raise("race: the options are a table such as {laps = 5}, got " .. type(options))
+    end
     options.mode = mode
     return race.new(options):run()
   end

@@ -95,10 +95,10 @@ function Start:_toGrid()
         if e.car.connected then pcall(e.car.stop, e.car) end
       end
     end
-    error(string.format("race: %d car(s) did not reach the grid (piece 34) in %g s — %s. The "
-      .. "cars are stopped: check that each is on the track and can drive (a car blocked in its "
-      .. "lane: put it in a lane of its own), or raise gridTimeout", #why, timeout,
-      table.concat(why, "; ")), 0)
+    pitwall._raise(string.format("race: %d car(s) did not reach the grid (piece 34) in %g s — %s. "
+      .. "The cars are stopped: check that each is on the track and can drive (a car blocked in "
+      .. "its lane: put it in a lane of its own), or raise gridTimeout", #why, timeout,
+      table.concat(why, "; ")))
   end
   -- settled: a car still rolling at the first light would be a false start
   self.settleUntil = pitwall.now() + 1

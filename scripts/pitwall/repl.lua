@@ -184,6 +184,7 @@ end
 --- several lines.
 function M.pretty(value, opts)
   if type(opts) ~= "table" then opts = {} end
+  pitwall._checkOptions("repl.pretty", opts, { "width", "depth", "maxItems" })
   local o = {
     depth = tonumber(rawget(opts, "depth")) or 3,
     maxItems = tonumber(rawget(opts, "maxItems")) or 50,

@@ -20,6 +20,7 @@ local track = {}
 
 local Piece = {}
 Piece.__index = Piece
+Piece.__name = "track piece" -- (how errors name it: "track piece has no method …")
 
 --- Length in mm along the lane at `offset` (mm right of the centre, map frame; default 0).
 --- Straights are the same on every lane; a curve's outer lane is longer.
@@ -36,6 +37,7 @@ end
 
 local Map = {}
 Map.__index = Map
+Map.__name = "track map" -- (how errors name it: "track map has no method …")
 
 --- Length in mm of one lap along the lane at `offset` (default 0: the centre line).
 function Map:lapLength(offset)
@@ -116,7 +118,7 @@ function track.fromSim()
       measured = p.length }
   end
   if entries[1].id ~= 33 or entries[n].id ~= 34 then
-    error("track.fromSim: the simulator's track " .. t.name .. " has no start pair 34 → 33", 2)
+    pitwall._raise("track.fromSim: the simulator's track " .. t.name .. " has no start pair 34 → 33")
   end
   return build(entries, { name = t.name, source = "sim" })
 end
@@ -253,20 +255,21 @@ end
 function track.scan(car, options)
   options = options or {}
   if not coroutine.isyieldable() then
-    error("track.scan drives a lap and waits for it: call it inside a task (the script's main "
-      .. "chunk or pitwall.spawn), not in a handler or timer", 2)
+    pitwall._raise("track.scan drives a lap and waits for it: call it inside a task (the "
+      .. "script's main chunk or pitwall.spawn), not in a handler or timer")
   end
   if type(options) ~= "table" then
-    error("track.scan: options must be a table such as {speed = 350}, got " .. type(options), 2)
+    pitwall._raise("track.scan: options must be a table such as {speed = 350}, got " .. type(options))
   end
+  pitwall._checkOptions("track.scan", options, { "speed", "offset", "timeout", "stop" })
   local speed = options.speed or 350
   local timeout = options.timeout or 120
   if type(speed) ~= "number" or speed < 100 or speed > 1000 then
-    error("track.scan: speed " .. tostring(speed) .. " mm/s is outside 100..1000 (a scan drives "
-      .. "slowly so that no position update is missed; 300–400 is a good choice)", 2)
+    pitwall._raise("track.scan: speed " .. tostring(speed) .. " mm/s is outside 100..1000 (a scan "
+      .. "drives slowly so that no position update is missed; 300–400 is a good choice)")
   end
   if not car.connected then
-    error("track.scan: " .. tostring(car) .. " is not connected", 2)
+    pitwall._raise("track.scan: " .. tostring(car) .. " is not connected")
   end
 
   -- The scan's state is one table, so that a reload of the script takes it up where it was
@@ -320,9 +323,9 @@ function track.scan(car, options)
     local function waitFor(cond, what)
       local left = st.deadline - pitwall.now()
       if left <= 0 or not pitwall.waitUntil(cond, left) then
-        error(string.format("track.scan: %s within %g s with %s (%d pieces crossed); give a longer "
-          .. "timeout, or check that the car drives and the layout has the start pieces 34 and 33",
-          what, timeout, tostring(car), #st.segs), 0)
+        pitwall._raise(string.format("track.scan: %s within %g s with %s (%d pieces crossed); "
+          .. "give a longer timeout, or check that the car drives and the layout has the start "
+          .. "pieces 34 and 33", what, timeout, tostring(car), #st.segs))
       end
     end
     if st.phase == "start" then
@@ -344,14 +347,14 @@ function track.scan(car, options)
     local ids, run
     waitFor(function()
       if st.delocalized then
-        error("track.scan: " .. tostring(car) .. " left the track during the scan; put it back "
-          .. "and scan again, slower", 0)
+        pitwall._raise("track.scan: " .. tostring(car) .. " left the track during the scan; put it "
+          .. "back and scan again, slower")
       end
       if st.reversed and (not st.turnedAt or pitwall.now() - st.turnedAt > 1) then
         -- It drives reversed: turn it round (once more if that did not take within 1 s).
         st.uturns = st.uturns + 1
         if st.uturns > 3 then
-          error("track.scan: " .. tostring(car) .. " keeps driving reversed after 3 U-turns", 0)
+          pitwall._raise("track.scan: " .. tostring(car) .. " keeps driving reversed after 3 U-turns")
         end
         car:uturn()
         st.turnedAt = pitwall.now()
@@ -388,7 +391,8 @@ function track.scan(car, options)
     return map
   end)
   cancel()
-  if not ok then error(result, 2) end
+  -- (its errors name the script's line already: pitwall._raise, the bindings)
+  if not ok then error(result, 0) end
   return result
 end
 

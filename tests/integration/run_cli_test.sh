@@ -9,7 +9,7 @@ check "syntax error exit status" 1 "$rc"
 contains "syntax error names file and line" "broken.lua:2:" "$err"
 
 err=$($PITWALL run "$TMP/missing.lua" --fast 2>&1 >/dev/null); rc=$?
-check "missing script exit status" 1 "$rc"
+check "missing script exit status" 2 "$rc"
 contains "missing script is named" "missing.lua" "$err"
 
 err=$($PITWALL run "$SRC/examples/lap_times.lua" --track nowhere 2>&1 >/dev/null); rc=$?

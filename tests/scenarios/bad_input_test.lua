@@ -34,7 +34,7 @@ expect.eq(pitwall.car(7), nil)
 
 -- Car commands: types and ranges, and nothing sent.
 local frames = car.frames
-expect.fails(function() car:setSpeed(600.5) end, "whole number")
+expect.fails(function() car:setSpeed(1500.5) end, "1501") -- rounded, then range-checked
 expect.fails(function() car:setSpeed(-1) end, "0..1500")
 expect.fails(function() car:setSpeed(600, 30000) end, "0..25000")
 expect.fails(function() car:setOffset(0 / 0) end, "finite")

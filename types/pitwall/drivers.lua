@@ -108,6 +108,12 @@ function drivers.cap(ctx, v) end
 ---@return boolean
 function drivers.changing(car) end
 
+---Checks a driver's options: every key must be one of `known`, else an error on the script's line naming `name` ("cruiser.new: unknown option spede; did you mean speed?").
+---@param name string
+---@param options table|nil
+---@param known string[]
+function drivers.checkOptions(name, options, known) end
+
 ---The context a driver drives `car` with; `field` lists every racing car ({car =, loc =} or a bare car).
 ---@param car pitwall.Car
 ---@param map pitwall.track.Map
@@ -126,6 +132,21 @@ function drivers.load(x) end
 ---@param within? number
 ---@return boolean
 function drivers.moving(car, within) end
+
+---The names of the drivers drivers.load finds (pitwall/drivers/*.lua along package.path), sorted.
+---@return string[]
+function drivers.names() end
+
+---A list of the names in all the lists given, in order, each once.
+---@param ... string[]
+---@return string[]
+function drivers.optionList(...) end
+
+---The options of `options` that are in `known` (what a driver hands to the driver inside it).
+---@param options table
+---@param known string[]
+---@return table
+function drivers.pick(options, known) end
 
 ---Drives `car` with `driver` in a task of its own until handle:stop().
 ---@param car pitwall.Car

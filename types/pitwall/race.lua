@@ -105,6 +105,7 @@ function Session:abort() end
 ---@class pitwall.race
 ---@field Steady pitwall.race.Steady a driver that holds one speed: race.Steady.new{speed =}
 ---@field columns string[] the columns written to the results file, in order
+---@field options string[] the option names a session takes (race.laps{…} and the others)
 ---@field onFalseStart? fun(car: pitwall.Car, session: pitwall.race.Session)
 ---@field onFinish? fun(car: pitwall.Car, rank: integer, session: pitwall.race.Session)
 ---@field onLap? fun(car: pitwall.Car, lap: pitwall.laps.Lap, session: pitwall.race.Session) every session's laps, after the session's own

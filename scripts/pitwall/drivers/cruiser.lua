@@ -11,9 +11,14 @@ local drivers = require "pitwall.drivers"
 local cruiser = { name = "cruiser" }
 local Cruiser = {}
 Cruiser.__index = Cruiser
+Cruiser.__name = "cruiser" -- (how errors name it: "cruiser has no method …")
+
+--- Its options (docs/racing.md "The drivers"); other keys are refused as typos.
+cruiser.options = { "speed", "lateral", "accel", "decel" }
 
 function cruiser.new(options)
   options = options or {}
+  pitwall._checkOptionsOf("cruiser.new", options, cruiser.options)
   return setmetatable({
     name = "cruiser",
     speed = options.speed or 1000,

@@ -18,10 +18,16 @@ local follower = { name = "follower" }
 local STICKY = 500 -- mm: how far behind a followed car in our lane may be reckoned
 local Follower = {}
 Follower.__index = Follower
+Follower.__name = "follower" -- (how errors name it: "follower has no method …")
+
+--- Its options and the cruiser's inside it (docs/racing.md "The drivers").
+follower.options = drivers.optionList({ "gap", "margin", "standstill", "range", "accel", "decel" },
+  cruiser.options)
 
 function follower.new(options)
   options = options or {}
-  local o = pitwall.copy(options)
+  drivers.checkOptions("follower.new", options, follower.options)
+  local o = drivers.pick(options, cruiser.options)
   o.decel = o.decel or 6000
   return setmetatable({
     name = "follower",

@@ -13,12 +13,25 @@ local drivers = require "pitwall.drivers"
 local lanekeeper = { name = "lanekeeper" }
 local Keeper = {}
 Keeper.__index = Keeper
+Keeper.__name = "lanekeeper" -- (how errors name it: "lanekeeper has no method …")
+
+--- Its own options; those of the driver inside it (a cruiser by default) are taken too.
+lanekeeper.options = { "driver", "offset", "tolerance", "retry", "lateralSpeed" }
 
 function lanekeeper.new(options)
   options = options or {}
   local inner = options.driver or "cruiser"
   if type(inner) == "string" or (type(inner) == "table" and not inner.update) then
-    inner = drivers.load(inner).new(options)
+    local cls = drivers.load(inner)
+    if type(cls.options) == "table" then -- (a class of the script's own may not list them)
+      drivers.checkOptions("lanekeeper.new", options, drivers.optionList(lanekeeper.options,
+        cls.options))
+      inner = cls.new(drivers.pick(options, cls.options))
+    else
+      inner = cls.new(options)
+    end
+  else
+    drivers.checkOptions("lanekeeper.new", options, lanekeeper.options)
   end
   return setmetatable({
     name = "lanekeeper",

@@ -19,10 +19,16 @@ local follower = require "pitwall.drivers.follower"
 local overtaker = { name = "overtaker" }
 local Overtaker = {}
 Overtaker.__index = Overtaker
+Overtaker.__name = "overtaker" -- (how errors name it: "overtaker has no method …")
+
+--- Its options and the follower's inside it (docs/racing.md "The drivers").
+overtaker.options = drivers.optionList({ "lanes", "margin", "range", "slower", "lateralSpeed",
+  "gap" }, follower.options)
 
 function overtaker.new(options)
   options = options or {}
-  local o = pitwall.copy(options)
+  drivers.checkOptions("overtaker.new", options, overtaker.options)
+  local o = drivers.pick(options, follower.options)
   o.gap = o.gap or 0.4
   local lanes = options.lanes or { -68, 68 }
   return setmetatable({

@@ -291,6 +291,19 @@ function Handle:stop() end]],
     returns = "drivers",
     doc = [[Autonomous drivers and their context (require "pitwall.drivers"; docs/racing.md "Drivers").]],
     functions = {
+      names = [=[The names of the drivers drivers.load finds (pitwall/drivers/*.lua along package.path), sorted.
+@return string[]]=],
+      checkOptions = [=[Checks a driver's options: every key must be one of `known`, else an error on the script's line naming `name` ("cruiser.new: unknown option spede; did you mean speed?").
+@param name string
+@param options table|nil
+@param known string[]]=],
+      pick = [=[The options of `options` that are in `known` (what a driver hands to the driver inside it).
+@param options table
+@param known string[]
+@return table]=],
+      optionList = [=[A list of the names in all the lists given, in order, each once.
+@param ... string[]
+@return string[]]=],
       load = [[The driver class named `x` (pitwall.drivers.<x>: "cruiser", "follower", "lanekeeper", "overtaker"), or `x` itself when it is a table.
 @param x string|pitwall.drivers.Class
 @return pitwall.drivers.Class]],
@@ -363,7 +376,10 @@ function Cruiser:target(car, ctx) end]],
     live = module("pitwall.drivers.cruiser"),
     returns = "cruiser",
     doc = [[Drives at a target speed, slower in curves (require "pitwall.drivers.cruiser", drivers.load "cruiser").]],
-    fields = { name = { "string", "\"cruiser\"" } },
+    fields = {
+      name = { "string", "\"cruiser\"" },
+      options = { "string[]", "the option names new takes (its own and those of the drivers inside it)" },
+    },
     functions = {
       new = [[A cruiser.
 @param options? pitwall.drivers.CruiserOptions
@@ -389,7 +405,10 @@ function Cruiser:target(car, ctx) end]],
     live = module("pitwall.drivers.follower"),
     returns = "follower",
     doc = [[Cruises, but keeps at least `gap` seconds behind the car ahead in its lane (require "pitwall.drivers.follower").]],
-    fields = { name = { "string", "\"follower\"" } },
+    fields = {
+      name = { "string", "\"follower\"" },
+      options = { "string[]", "the option names new takes (its own and those of the drivers inside it)" },
+    },
     functions = {
       new = [[A follower.
 @param options? pitwall.drivers.FollowerOptions
@@ -416,7 +435,10 @@ function Cruiser:target(car, ctx) end]],
     live = module("pitwall.drivers.lanekeeper"),
     returns = "lanekeeper",
     doc = [[Keeps the car in a lane while an inner driver drives the speed (require "pitwall.drivers.lanekeeper").]],
-    fields = { name = { "string", "\"lanekeeper\"" } },
+    fields = {
+      name = { "string", "\"lanekeeper\"" },
+      options = { "string[]", "the option names new takes (its own and those of the drivers inside it)" },
+    },
     functions = {
       new = [[A lane keeper.
 @param options? pitwall.drivers.LanekeeperOptions
@@ -444,7 +466,10 @@ function Cruiser:target(car, ctx) end]],
     live = module("pitwall.drivers.overtaker"),
     returns = "overtaker",
     doc = [[Cruises in its lane and passes slower cars in another (require "pitwall.drivers.overtaker").]],
-    fields = { name = { "string", "\"overtaker\"" } },
+    fields = {
+      name = { "string", "\"overtaker\"" },
+      options = { "string[]", "the option names new takes (its own and those of the drivers inside it)" },
+    },
     functions = {
       new = [[An overtaker.
 @param options? pitwall.drivers.OvertakerOptions
@@ -610,6 +635,7 @@ function Session:abort() end
 runs a whole session inside a task and returns it when every car has stopped.]],
     fields = {
       columns = { "string[]", "the columns written to the results file, in order" },
+      options = { "string[]", "the option names a session takes (race.laps{…} and the others)" },
       Steady = { "pitwall.race.Steady", "a driver that holds one speed: race.Steady.new{speed =}" },
     },
     settable = {

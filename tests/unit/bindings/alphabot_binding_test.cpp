@@ -149,7 +149,7 @@ TEST_CASE_FIXTURE(AlphabotFixture, "bad input raises an error naming the range a
       "local function err(f, ...) local ok, e = pcall(f, r, ...); assert(not ok); return e end\n"
       "e1 = err(r.drive, 200, 0)\n"
       "e2 = err(r.drive, 0, -129)\n"
-      "e3 = err(r.drive, 1.5, 0)\n"
+      "e3 = err(r.drive, 128.5, 0)\n"
       "e4 = err(r.set, {warpDrive = true})\n"
       "e5 = err(r.set, {positioning = 1})\n"
       "e6 = err(r.addObstacle, 1, 2, 0, 4)\n"
@@ -160,7 +160,8 @@ TEST_CASE_FIXTURE(AlphabotFixture, "bad input raises an error naming the range a
   REQUIRE(run(code) == "");
   CHECK(global("e1").find("speed 200 is out of range -128..127") != std::string::npos);
   CHECK(global("e2").find("steer -129 is out of range -128..127") != std::string::npos);
-  CHECK(global("e3").find("must be a whole number") != std::string::npos);
+  // a computed value is rounded half away from zero, then range-checked: 128.5 → 129
+  CHECK(global("e3").find("speed 129 is out of range -128..127") != std::string::npos);
   CHECK(global("e4").find("unknown toggle 'warpDrive'; names: compassCalibration, invite") !=
         std::string::npos);
   CHECK(global("e5").find("must be true or false") != std::string::npos);
@@ -184,8 +185,11 @@ TEST_CASE_FIXTURE(AlphabotFixture, "constructor options are checked") {
   CHECK(err("{host = '127.0.0.1'}").find("needs a port") != std::string::npos);
   CHECK(err("{host = '127.0.0.1', port = 70000}").find("port 70000 is out of range 1..65535") !=
         std::string::npos);
-  CHECK(err("{host = 'h', port = 1, colour = 'red'}").find("unknown option 'colour'") !=
+  CHECK(err("{host = 'h', port = 1, colour = 'red'}").find("unknown option colour (the options") !=
         std::string::npos);
+  CHECK(err("{hots = 'h', port = 1}")
+            .find("pitwall.alphabot: unknown option hots; did you mean "
+                  "host?") != std::string::npos);
 }
 
 TEST_CASE_FIXTURE(AlphabotFixture,
@@ -279,22 +283,23 @@ TEST_CASE_FIXTURE(AlphabotFixture, "in a callback pitwall.alphabot returns at on
 
 TEST_CASE_FIXTURE(AlphabotFixture,
                   "pitwall.listen follows an alphabot's events, before its handler, as a car's") {
-  REQUIRE(run(std::string(kConnect) +
-              "local order = {}\n"
-              "local sub = pitwall.listen(r, 'onPing', function(robot, ev)\n"
-              "  assert(robot == r and type(ev.rtt) == 'number')\n"
-              "  order[#order + 1] = 'listener'\n"
-              "end)\n"
-              "r.onPing = function() order[#order + 1] = 'handler' end\n"
-              "r:ping()\n"
-              "assert(table.concat(order, ',') == 'listener,handler', table.concat(order, ','))\n"
-              "assert(sub:cancel())\n"
-              "r:ping()\n"
-              "assert(table.concat(order, ',') == 'listener,handler,handler')\n"
-              "local ok, e = pcall(pitwall.listen, r, 'onPong', print)\n"
-              "assert(not ok and e:find(\"cannot listen to 'onPong'; the events are onDistance\"), e)\n"
-              "r:close()\n"
-              "ok, e = pcall(pitwall.listen, r, 'onPing', print)\n"
-              "assert(not ok and e:find('is closed: it has no more events'), e)\n"
-              "DONE = true") == "");
+  REQUIRE(
+      run(std::string(kConnect) +
+          "local order = {}\n"
+          "local sub = pitwall.listen(r, 'onPing', function(robot, ev)\n"
+          "  assert(robot == r and type(ev.rtt) == 'number')\n"
+          "  order[#order + 1] = 'listener'\n"
+          "end)\n"
+          "r.onPing = function() order[#order + 1] = 'handler' end\n"
+          "r:ping()\n"
+          "assert(table.concat(order, ',') == 'listener,handler', table.concat(order, ','))\n"
+          "assert(sub:cancel())\n"
+          "r:ping()\n"
+          "assert(table.concat(order, ',') == 'listener,handler,handler')\n"
+          "local ok, e = pcall(pitwall.listen, r, 'onPong', print)\n"
+          "assert(not ok and e:find(\"cannot listen to 'onPong'; the events are onDistance\"), e)\n"
+          "r:close()\n"
+          "ok, e = pcall(pitwall.listen, r, 'onPing', print)\n"
+          "assert(not ok and e:find('is closed: it has no more events'), e)\n"
+          "DONE = true") == "");
 }

@@ -70,8 +70,9 @@ TEST_CASE_FIXTURE(LuaFixture,
   CHECK(err.find("test.lua:1:") != std::string::npos);
   CHECK(err.find("0..1500") != std::string::npos);
   CHECK(link->sent.empty());
-  CHECK(run("pitwall.cars()[1]:setSpeed('fast')").find("must be a whole number") !=
-        std::string::npos);
+  CHECK(
+      run("pitwall.cars()[1]:setSpeed('fast')").find("speed (mm/s) must be a number, got string") !=
+      std::string::npos);
   CHECK(run("pitwall.cars()[1]:turn('sideways')").find("left, right, uturn") != std::string::npos);
 }
 

@@ -56,6 +56,20 @@ TEST_CASE("results: CSV has a header and quotes what needs quoting") {
         "2,\"say \"\"hi\"\", then go\",9,,false\n");
 }
 
+TEST_CASE("results: times are written to the millisecond, in JSON and in CSV") {
+  results::Table t;
+  t.columns = {"totalTime", "bestLap", "gap", "laps"};
+  t.rows.push_back({Cell{1234.56789}, Cell{62.3454999}, Cell{-0.0004}, Cell{10.0}});
+  t.rows.push_back({Cell{59.9996}, Cell{0.1 + 0.2}, Cell{1e20}, Cell{2.5}});
+  auto j = nlohmann::ordered_json::parse(results::render(t, results::Format::Json));
+  CHECK(j[0].dump() == R"({"totalTime":1234.568,"bestLap":62.345,"gap":0,"laps":10})");
+  CHECK(j[1].dump() == R"({"totalTime":60,"bestLap":0.3,"gap":1e+20,"laps":2.5})");
+  CHECK(results::render(t, results::Format::Csv) ==
+        "totalTime,bestLap,gap,laps\n"
+        "1234.568,62.345,0,10\n"
+        "60,0.3,1e+20,2.5\n");
+}
+
 TEST_CASE("results: a folder that does not exist is refused before anything is written") {
   auto w = results::writable("/nonexistent-pitwall-dir/race.json");
   REQUIRE_FALSE(w);

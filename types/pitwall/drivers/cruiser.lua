@@ -22,6 +22,7 @@ function Cruiser:target(car, ctx) end
 ---Drives at a target speed, slower in curves (require "pitwall.drivers.cruiser", drivers.load "cruiser").
 ---@class pitwall.drivers.cruiser
 ---@field name string "cruiser"
+---@field options string[] the option names new takes (its own and those of the drivers inside it)
 local cruiser = {}
 
 ---A cruiser.

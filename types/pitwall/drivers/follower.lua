@@ -14,6 +14,7 @@
 ---Cruises, but keeps at least `gap` seconds behind the car ahead in its lane (require "pitwall.drivers.follower").
 ---@class pitwall.drivers.follower
 ---@field name string "follower"
+---@field options string[] the option names new takes (its own and those of the drivers inside it)
 local follower = {}
 
 ---A follower.

@@ -15,6 +15,7 @@
 ---Keeps the car in a lane while an inner driver drives the speed (require "pitwall.drivers.lanekeeper").
 ---@class pitwall.drivers.lanekeeper
 ---@field name string "lanekeeper"
+---@field options string[] the option names new takes (its own and those of the drivers inside it)
 local lanekeeper = {}
 
 ---A lane keeper.

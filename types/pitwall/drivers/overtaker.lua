@@ -16,6 +16,7 @@
 ---Cruises in its lane and passes slower cars in another (require "pitwall.drivers.overtaker").
 ---@class pitwall.drivers.overtaker
 ---@field name string "overtaker"
+---@field options string[] the option names new takes (its own and those of the drivers inside it)
 local overtaker = {}
 
 ---An overtaker.

@@ -1,0 +1,23 @@
+#pragma once
+// A misspelled method, `car:setSped(300)`: Lua itself says "attempt to call a nil value (method
+// 'setSped')". The host's error handlers (lua::traceback, a task's error) rewrite that sentence
+// to "car has no method setSped; did you mean setSpeed?" — after the fact, from the stack of the
+// call that failed, so that reading a field (`if car.someOwnField then`) stays plain Lua: nothing
+// answers a missing name with anything but nil (docs/lua-api.md "Misspelled methods").
+#include <lua.hpp>
+
+#include <optional>
+#include <string>
+
+namespace pitwall::lua {
+
+// When `message` is Lua's error for calling a missing method, the same message with that
+// sentence replaced, naming the object's type and the nearest method. The object is found on
+// the stack of `thread` at `level` (the function whose call failed): the method's register is a
+// nil temporary, the object the one after it. Types: those with a `__methods` table in their
+// metatable (cars, robots) and Lua classes (a metatable with `__name` and an `__index` table:
+// the race, the board, …). nullopt when it is no such error, or no such object is found.
+std::optional<std::string> explainMissingMethod(lua_State* thread, int level,
+                                                const std::string& message);
+
+}  // namespace pitwall::lua
