@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "engine/core/hex.hpp"
+#include "engine/core/printable.hpp"
 
 namespace pitwall {
 
@@ -16,28 +17,8 @@ namespace {
 
 using nlohmann::json;
 
-// Text from the file, made fit to print in one line of an error: bytes that are not printable
-// ASCII are shown as \xNN (the line may not be UTF-8), and a long text is cut.
-std::string printable(std::string_view text, std::size_t max = 80) {
-  std::string out;
-  for (unsigned char c : text) {
-    if (out.size() >= max) {
-      out += "…";
-      break;
-    }
-    if (c >= 0x20 && c < 0x7f) {
-      out += static_cast<char>(c);
-    } else {
-      char esc[8];
-      std::snprintf(esc, sizeof esc, "\\x%02x", c);
-      out += esc;
-    }
-  }
-  return out;
-}
-
 std::string shown(const json& value) {
-  return printable(value.dump(-1, ' ', false, json::error_handler_t::replace));
+  return printable(value.dump(-1, ' ', false, json::error_handler_t::replace), 80);
 }
 
 // nlohmann's "[json.exception.parse_error.101] parse error at line 1, column 5: syntax error
@@ -94,7 +75,7 @@ std::variant<std::vector<std::uint8_t>, std::string> hexBytes(const std::string&
     if (c != ' ') digits += c;
   if (digits.empty()) return std::string("\"hex\" is empty: no frame");
   auto bytes = fromHex(digits);
-  if (!bytes) return "\"hex\": " + printable(bytes.error());
+  if (!bytes) return "\"hex\": " + printable(bytes.error(), 80);
   return std::move(*bytes);
 }
 
@@ -113,7 +94,7 @@ std::variant<RecordedFrame, std::string> parseRecordLine(std::string_view line, 
   } catch (const json::exception& e) {  // the check above let it through: never, but not a crash
     return "not JSON: " + parseErrorText(e.what());
   }
-  if (!j.is_object()) return "not a JSON object but " + printable(j.type_name());
+  if (!j.is_object()) return "not a JSON object but " + printable(j.type_name(), 80);
 
   RecordedFrame frame;
   auto t = j.find("t");

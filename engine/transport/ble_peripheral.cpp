@@ -8,6 +8,7 @@
 
 #include "engine/core/hex.hpp"
 #include "engine/core/log.hpp"
+#include "engine/core/printable.hpp"
 #include "engine/transport/bluez_api.hpp"
 
 namespace pitwall {
@@ -31,21 +32,6 @@ using Options = std::map<std::string, sdbus::Variant>;
 // string (UTF-8, no NUL): emulate-car gives the name's layout with control characters for the
 // zeros (anki::localNameText), or the plain user name (anki-overdrive.md "Advertisement").
 enum class NameForm { RawData, LocalName, None };
-
-// The name for a log line: control characters as \xNN.
-std::string printable(const std::string& text) {
-  std::string out;
-  for (unsigned char c : text) {
-    if (c < 0x20 || c == 0x7f) {
-      char esc[8];
-      std::snprintf(esc, sizeof esc, "\\x%02x", c);
-      out += esc;
-    } else {
-      out += static_cast<char>(c);
-    }
-  }
-  return out;
-}
 
 std::string formDescription(NameForm form, const PeripheralSpec& spec) {
   switch (form) {

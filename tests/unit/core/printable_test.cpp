@@ -1,0 +1,27 @@
+#include "engine/core/printable.hpp"
+
+#include <doctest/doctest.h>
+
+#include <string>
+
+using namespace pitwall;
+
+TEST_CASE("printable keeps printable ASCII and well-formed UTF-8, and shows other bytes as \\xNN") {
+  CHECK(printable("speed") == "speed");
+  CHECK(printable("vitésse") == "vitésse");
+  CHECK(printable(std::string("a\0b\n", 4)) == "a\\x00b\\x0a");
+  CHECK(printable("\x7f") == "\\x7f");
+  CHECK(printable("\xc3") == "\\xc3");                    // a UTF-8 start with nothing after it
+  CHECK(printable("\xc0\xaf") == "\\xc0\\xaf");           // an overlong form
+  CHECK(printable("\xed\xa0\x80") == "\\xed\\xa0\\x80");  // a surrogate
+  CHECK(printable("\xf4\x90\x80\x80") == "\\xf4\\x90\\x80\\x80");  // beyond U+10FFFF
+  CHECK(printable("\xf0\x9f\x8f\x81") == "\xf0\x9f\x8f\x81");      // 🏁
+}
+
+TEST_CASE("printable cuts a long text after maxBytes of it, and says so") {
+  CHECK(printable(std::string(100, 'x'), 10) == std::string(10, 'x') + "…");
+  CHECK(printable("short", 10) == "short");
+  CHECK(printable("exactly10!", 10) == "exactly10!");
+  CHECK(utf8Length("é") == 2);
+  CHECK(utf8Length("e") == 0);
+}
