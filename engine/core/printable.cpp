@@ -21,20 +21,23 @@ std::size_t utf8Length(std::string_view s) {
 std::string printable(std::string_view text, std::size_t maxBytes) {
   std::string out;
   std::size_t i = 0;
-  while (i < text.size() && i < maxBytes) {
+  while (i < text.size()) {
     auto c = static_cast<unsigned char>(text[i]);
+    std::string piece;
+    std::size_t n = 1;
     if (c >= 0x20 && c < 0x7f) {
-      out += static_cast<char>(c);
-      ++i;
-    } else if (std::size_t n = c >= 0x80 ? utf8Length(text.substr(i)) : 0; n > 0) {
-      out.append(text.substr(i, n));
-      i += n;
+      piece = static_cast<char>(c);
+    } else if (n = c >= 0x80 ? utf8Length(text.substr(i)) : 0; n > 0) {
+      piece = text.substr(i, n);
     } else {
+      n = 1;
       char hex[5];
       std::snprintf(hex, sizeof hex, "\\x%02x", c);
-      out += hex;
-      ++i;
+      piece = hex;
     }
+    if (out.size() + piece.size() > maxBytes) break;
+    out += piece;
+    i += n;
   }
   if (i < text.size()) out += "…";
   return out;

@@ -12,7 +12,8 @@ namespace pitwall {
 std::size_t utf8Length(std::string_view s);
 
 // Printable ASCII and well-formed UTF-8 as they are (`vitésse`), every other byte (control
-// characters, bytes that are not UTF-8) as \xNN; at most `maxBytes` bytes of the text, then "…".
+// characters, bytes that are not UTF-8) as \xNN; at most `maxBytes` bytes of that (so an error
+// stays short however hostile the text), then "…" when some of the text was left out.
 std::string printable(std::string_view text, std::size_t maxBytes = std::string_view::npos);
 
 }  // namespace pitwall

@@ -22,6 +22,9 @@ TEST_CASE("printable cuts a long text after maxBytes of it, and says so") {
   CHECK(printable(std::string(100, 'x'), 10) == std::string(10, 'x') + "…");
   CHECK(printable("short", 10) == "short");
   CHECK(printable("exactly10!", 10) == "exactly10!");
+  // the limit is on what is shown: escapes count four bytes each
+  CHECK(printable(std::string(100, '\x01'), 20) == "\\x01\\x01\\x01\\x01\\x01…");
+  CHECK(printable("ééé", 5) == "éé…");
   CHECK(utf8Length("é") == 2);
   CHECK(utf8Length("e") == 0);
 }
