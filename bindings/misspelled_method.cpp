@@ -1,5 +1,6 @@
 #include "bindings/misspelled_method.hpp"
 
+#include <algorithm>
 #include <string_view>
 #include <vector>
 
@@ -27,16 +28,24 @@ void addFunctionKeys(lua_State* L, int table, std::vector<std::string>& out) {
   }
 }
 
-// The kind of the object on top of L's stack, when it has methods; pops nothing.
+// t[key] without metamethods (t at index t): nothing of the script runs inside an error handler.
+int rawField(lua_State* L, int t, const char* key) {
+  t = lua_absindex(L, t);
+  lua_pushstring(L, key);
+  return lua_rawget(L, t);
+}
+
+// The kind of the object on top of L's stack, when it has methods; pops nothing. Only raw reads:
+// a metatable's own __index (a "strict" guard, a loop) never runs here.
 std::optional<Kind> kindOf(lua_State* L) {
   if (!lua_checkstack(L, 8)) return std::nullopt;
   const int obj = lua_gettop(L);
   if (!lua_getmetatable(L, obj)) return std::nullopt;
   const int mt = lua_gettop(L);
   std::optional<Kind> kind;
-  if (lua_getfield(L, mt, "__name") == LUA_TSTRING) {
+  if (rawField(L, mt, "__name") == LUA_TSTRING) {
     kind = Kind{lua_tostring(L, -1), {}};
-    if (lua_getfield(L, mt, "__methods") == LUA_TTABLE) {
+    if (rawField(L, mt, "__methods") == LUA_TTABLE) {
       addFunctionKeys(L, lua_gettop(L), kind->methods);
     } else {
       // a Lua class: the functions of its __index chain (a few levels of inheritance)
@@ -44,7 +53,7 @@ std::optional<Kind> kindOf(lua_State* L) {
       if (lua_type(L, obj) == LUA_TTABLE) addFunctionKeys(L, obj, kind->methods);
       lua_pushvalue(L, mt);
       for (int depth = 0; depth < 8; ++depth) {
-        if (lua_getfield(L, -1, "__index") != LUA_TTABLE) {
+        if (rawField(L, -1, "__index") != LUA_TTABLE) {
           lua_pop(L, 1);
           break;
         }
@@ -75,7 +84,9 @@ std::optional<std::string> explainMissingMethod(lua_State* thread, int level,
   if (!lua_getstack(thread, level, &ar)) return std::nullopt;
   if (!lua_checkstack(thread, 4)) return std::nullopt;
   // Candidates: a nil temporary (the method's register) followed by an object with methods
-  // (its `self`). The first whose type has a method near the name wins, else the first.
+  // (its `self`); pending arguments of an outer call may form such pairs too. A type that has the
+  // method is never named; of the others, the first whose type has a method near the name wins,
+  // else the first.
   std::optional<Kind> chosen;
   std::optional<std::string> suggestion;
   bool previousNil = false;
@@ -84,7 +95,9 @@ std::optional<std::string> explainMissingMethod(lua_State* thread, int level,
     if (!name) break;
     const bool temporary = name[0] == '(';
     if (temporary && previousNil) {
-      if (auto kind = kindOf(thread)) {
+      auto kind = kindOf(thread);
+      if (kind &&
+          std::find(kind->methods.begin(), kind->methods.end(), method) == kind->methods.end()) {
         auto near = nearest(method, kind->methods);
         if (!chosen || (near && !suggestion)) {
           chosen = std::move(kind);

@@ -378,6 +378,7 @@ void openPitwallModule(ScriptHost& host) {
                                        {"terminal", terminal},
                                        {"_setHub", lua::guarded<&lua::setHub>},
                                        {"_reportError", lua::guarded<reportError>},
+                                       {"_traceback", lua::traceback},
                                        {"_raise", lua::guarded<raise>},
                                        {"_nearest", lua::guarded<nearestName>},
                                        {"_modulesIn", lua::guarded<modulesIn>},

@@ -38,10 +38,13 @@ int traceback(lua_State* L) {
   return 1;
 }
 
+// The library's modules are loaded through package.path as <scripts>/pitwall/….lua
+// (openLibraries), so their chunk names start with this; set when a host opens the library, so
+// an error never looks for the data folder again (it may have moved since).
+std::string libraryChunks = "@scripts/pitwall/";
+
 void pushUserWhere(lua_State* L) {
-  // The library's modules are loaded through package.path as <scripts>/pitwall/….lua
-  // (openLibraries), so their chunk names start with this.
-  const std::string library = "@" + scriptsDir() + "/pitwall/";
+  const std::string& library = libraryChunks;
   lua_Debug ar;
   for (int level = 1; lua_getstack(L, level, &ar); ++level) {
     if (!lua_getinfo(L, "Sl", &ar) || ar.currentline <= 0) continue;  // C functions
@@ -197,6 +200,7 @@ void ScriptHost::openLibraries() {
   std::string path;
   for (const auto& dir : options_.library_paths) path += dir + "/?.lua;" + dir + "/?/init.lua;";
   std::string lib = scriptsDir();
+  lua::libraryChunks = "@" + lib + "/pitwall/";
   path += lib + "/?.lua;" + lib + "/?/init.lua;";
   lua_getglobal(L, "package");
   lua_getfield(L, -1, "path");

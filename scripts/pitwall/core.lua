@@ -91,7 +91,7 @@ function pitwall.listen(car, event, fn)
       for i = 1, #current do
         local e = current[i]
         if e.active then
-          local fine, message = xpcall(e.fn, debug.traceback, c, ev)
+          local fine, message = xpcall(e.fn, pitwall._traceback, c, ev)
           if not fine then
             pitwall._reportError(event .. " listener of " .. tostring(c), message)
           end
@@ -148,7 +148,7 @@ function pitwall._runHandover(i)
   end
   handovers[i] = false
   if fn then
-    local ok, err = xpcall(fn, debug.traceback)
+    local ok, err = xpcall(fn, pitwall._traceback)
     if not ok then pitwall._reportError("handing over into the new version", err) end
   end
   return true
@@ -163,7 +163,7 @@ function pitwall._saveCarried()
     if not carriers[name] then out[name] = state end
   end
   for name, save in pairs(carriers) do
-    local ok, state = xpcall(save, debug.traceback)
+    local ok, state = xpcall(save, pitwall._traceback)
     if ok then
       out[name] = state
     else
@@ -185,7 +185,7 @@ end
 
 function pitwall._lastWords()
   for _, fn in ipairs(lastWords) do
-    local ok, err = xpcall(fn, debug.traceback)
+    local ok, err = xpcall(fn, pitwall._traceback)
     if not ok then pitwall._reportError("the end of the run", err) end
   end
 end

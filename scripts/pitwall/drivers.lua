@@ -252,7 +252,7 @@ local function call(driver, method, car, ctx)
   -- (no driver: a session the library runs until the script's call gives it one)
   local fn = driver and driver[method]
   if not fn then return end
-  local ok, err = xpcall(fn, debug.traceback, driver, car, ctx)
+  local ok, err = xpcall(fn, pitwall._traceback, driver, car, ctx)
   if not ok then
     report(string.format("%s of driver %s of %s", method, tostring(driver.name or "?"),
       tostring(car)), err)

@@ -136,7 +136,7 @@ end
 
 local function call(timer, name, fn, lap)
   if not fn then return end
-  local ok, err = xpcall(fn, debug.traceback, timer.car, lap)
+  local ok, err = xpcall(fn, pitwall._traceback, timer.car, lap)
   if ok then return end
   local where = name .. " handler of " .. tostring(timer.car)
   if pitwall._reportError then

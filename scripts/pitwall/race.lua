@@ -111,7 +111,7 @@ end
 function Race:_emit(name, ...)
   for _, fn in ipairs { self.options[name] or false, race[name] or false } do
     if fn then
-      local ok, err = xpcall(fn, debug.traceback, ...)
+      local ok, err = xpcall(fn, pitwall._traceback, ...)
       if not ok then report(name .. " handler of the race", err) end
     end
   end
@@ -461,7 +461,7 @@ function Race:_drivers()
     e.handover = nil
     if h and e.started and not e.finished and self.phase == "racing" then
       if e.driver.takeover then
-        local fine, err = xpcall(e.driver.takeover, debug.traceback, e.driver, car, e.ctx, h.state,
+        local fine, err = xpcall(e.driver.takeover, pitwall._traceback, e.driver, car, e.ctx, h.state,
           h.name)
         if not fine then report("takeover of driver " .. tostring(e.driver.name or "?") .. " of "
           .. tostring(car), err) end
@@ -583,7 +583,7 @@ function Race:_race()
   if self.phase == "racing" then
     local ticker = pitwall.every(self.period, function()
       if self.done then return end
-      local ok, err = xpcall(self._tick, debug.traceback, self)
+      local ok, err = xpcall(self._tick, pitwall._traceback, self)
       if not ok then report("race director", err) end
     end)
     pitwall.waitUntil(function() return self.done end, nil, self.period)

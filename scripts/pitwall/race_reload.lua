@@ -30,7 +30,7 @@ return function(Race, shared)
         if d.handover and e.started and not e.finished then
           -- the driver's own code: after the session's data is saved, in a call of its own
           pitwall._afterCarry(function()
-            local fine, result = xpcall(d.handover, debug.traceback, d)
+            local fine, result = xpcall(d.handover, pitwall._traceback, d)
             if fine then h.state = result
             else report("handover of driver " .. tostring(d.name or "?") .. " of "
               .. tostring(e.car), result) end

@@ -65,6 +65,27 @@ TEST_CASE_FIXTURE(Host, "at the REPL a misspelled method names the type and the 
       "local t = setmetatable({}, {__name = 'thing', __index = {go = print}})\n"
       "t:og(nil, pitwall.cars()[1])");
   CHECK(err.rfind("stdin:2: thing has no method og; did you mean go?", 0) == 0);
+  // a nil and a car before the call do not mislead it either: the call's own object is named,
+  // and never a type that has the method
+  err = repl(
+      "local car = pitwall.cars()[1]\n"
+      "local t = setmetatable({}, {__name = 'thing', __index = {wave = print}})\n"
+      "print(car.nosuchfield, car, t:wvae())");
+  CHECK(err.rfind("stdin:3: thing has no method wvae; did you mean wave?", 0) == 0);
+  err = repl(
+      "local car = pitwall.cars()[1]\nlocal t = {}\nprint(car.nosuchfield, car, t:setSpeed(1))");
+  CHECK(err.find("car has no method") == std::string::npos);
+  CHECK(err.find("attempt to call a nil value (method 'setSpeed')") != std::string::npos);
+  // a case-only slip gets the method in its case
+  err = repl("local car = pitwall.cars()[1]\ncar:SetSpeed(300)");
+  CHECK(err.rfind("stdin:2: car has no method SetSpeed; did you mean setSpeed?", 0) == 0);
+  // the handler runs nothing of the script's: a metatable whose __index raises or never returns
+  // (a "strict" guard) keeps Lua's own message, and the run goes on
+  for (const char* guard : {"error('strict: ' .. k)", "while true do end"}) {
+    err = repl(std::string("local mt = setmetatable({}, {__index = function(_, k) ") + guard +
+               " end})\nlocal o = setmetatable({}, mt)\no:og()");
+    CHECK(err.rfind("stdin:3: attempt to call a nil value (method 'og')", 0) == 0);
+  }
   // a table without methods, or a call of a nil field, keeps Lua's own words
   CHECK(repl("local t = {}\nt:go()").find("attempt to call a nil value (method 'go')") !=
         std::string::npos);
@@ -93,6 +114,10 @@ TEST_CASE("the option checker refuses hostile keys with a clear error and never 
   };
   CHECK(run("return check{laps = 3, minutes = 2}") == "");
   CHECK(run("return check(42)") == "");  // not a table: the caller's own check says so
+  CHECK(run("return check{[''] = 1}") ==
+        "race.laps: unknown option \"\" (an empty name) (the options are laps, minutes)");
+  CHECK(run("return check{Laps = 3}") ==
+        "race.laps: unknown option Laps; did you mean laps? (the options are laps, minutes)");
   CHECK(run("return check{lapz = 3}") ==
         "race.laps: unknown option lapz; did you mean laps? (the options are laps, minutes)");
   CHECK(run("return check{3}") ==
