@@ -40,6 +40,7 @@ void checkOptions(lua_State* L, int idx, std::string_view fn, std::span<const ch
   luaL_checkstack(L, 3, "option table");
   std::string problem;
   std::string key;
+  bool unknown = false;
   lua_pushnil(L);
   while (lua_next(L, idx) != 0) {
     lua_pop(L, 1);  // the value
@@ -56,16 +57,18 @@ void checkOptions(lua_State* L, int idx, std::string_view fn, std::span<const ch
     for (const char* name : known)
       if (k == name) found = true;
     if (!found) {
+      unknown = true;
       key.assign(s, n);
       lua_pop(L, 1);
       break;
     }
   }
-  if (problem.empty() && key.empty()) return;
+  if (problem.empty() && !unknown) return;
   if (problem.empty()) {
     std::vector<std::string> names(known.begin(), known.end());
     // (a key far longer than any option is no typo of one: no edit distance over megabytes)
-    problem = "unknown option " + printable(key, kMaxKeyShown) +
+    problem = "unknown option " +
+              (key.empty() ? std::string("\"\" (an empty name)") : printable(key, kMaxKeyShown)) +
               (key.size() > kMaxKeyShown ? " (" + std::to_string(key.size()) + " bytes)" : "") +
               (key.size() <= 64 ? didYouMean(key, names) : "");
   }

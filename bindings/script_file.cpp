@@ -7,6 +7,8 @@
 #include <iterator>
 #include <memory>
 
+#include "engine/core/printable.hpp"
+
 namespace pitwall::script_file {
 
 namespace fs = std::filesystem;
@@ -26,10 +28,14 @@ Result<bool, std::string> load(lua_State* L, const std::string& path) {
   const std::string shown = shownPath(path);
   std::error_code ec;
   if (fs::is_directory(path, ec)) return Unexpected{"cannot open " + shown + ": it is a folder"};
+  // A pipe or a device would be read up once by the check and found empty by the run.
+  if (fs::exists(path, ec) && !fs::is_regular_file(path, ec))
+    return Unexpected{"cannot open " + printable(shown, 200) +
+                      ": it is not a file (a pipe or a device); save the script to a file"};
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     const int error = errno;
-    return Unexpected{"cannot open " + shown + ": " +
+    return Unexpected{"cannot open " + printable(shown, 200) + ": " +
                       (error == ENOENT ? std::string("no such file") : std::strerror(error))};
   }
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

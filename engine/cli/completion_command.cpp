@@ -146,7 +146,7 @@ std::string bash(const Cmd& root) {
     << "  while IFS= read -r f; do [ -d \"$f\" ] || COMPREPLY+=(\"$f\"); done < <(\n"
     << "    if [ -n \"${1:-}\" ]; then compgen -f -X \"!*.$1\" -- \"$cur\"; "
        "else compgen -f -- \"$cur\"; fi)\n"
-    << "  COMPREPLY+=($(compgen -d -S / -- \"$cur\"))\n"
+    << "  while IFS= read -r f; do COMPREPLY+=(\"$f\"); done < <(compgen -d -S / -- \"$cur\")\n"
     << "  [ ${#COMPREPLY[@]} -eq 1 ] && [ \"${COMPREPLY[0]: -1}\" = / ] && compopt -o nospace "
        "2>/dev/null\n"
     << "  return 0\n}\n\n";

@@ -4,12 +4,15 @@
 // (engine/cli/usage.hpp).
 #include <CLI/CLI.hpp>
 #include <iostream>
+#include <optional>
+#include <string_view>
 #include <vector>
 
 #include "engine/cli/options.hpp"
 #include "engine/cli/usage.hpp"
 #include "engine/cli/version.hpp"
 #include "engine/core/log.hpp"
+#include "engine/core/printable.hpp"
 
 int main(int argc, char** argv) {
   using namespace pitwall;
@@ -33,6 +36,13 @@ int main(int argc, char** argv) {
       cli::addTrackCommand(app),    cli::addDecodeCommand(app),    cli::addEncodeCommand(app),
       cli::addTypesCommand(app),    cli::addCompletionCommand(app)};
 
+  // --version anywhere on the line answers before anything else is checked
+  // (`pitwall run --version` has no script to ask for).
+  for (int i = 1; i < argc && std::string_view(argv[i]) != "--"; ++i)
+    if (std::string_view(argv[i]) == "--version") {
+      std::cout << cli::versionText() << "\n";
+      return 0;
+    }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -45,21 +55,18 @@ int main(int argc, char** argv) {
     // --help prints and exits 0; every usage error is status 2 (docs/cli.md), not CLI11's own.
     return app.exit(e) == 0 ? 0 : 2;
   }
-  if (version) {
-    std::cout << cli::versionText() << "\n";
-    return 0;
-  }
+  (void)version;  // answered above
   cli::takeViews();
+  std::optional<log::Level> level;
+  if (!logLevel.empty() && !(level = log::parseLevel(logLevel))) {
+    std::cerr << "pitwall: --log-level '" << printable(logLevel, 80)
+              << "' is unknown; use debug, info, warn, error or off\n";
+    return 2;
+  }
 
   for (const auto& command : commands) {
     if (!command.app->parsed()) continue;
-    if (!logLevel.empty()) {
-      auto level = log::parseLevel(logLevel);
-      if (!level) {
-        std::cerr << "pitwall: --log-level '" << logLevel
-                  << "' is unknown; use debug, info, warn, error or off\n";
-        return 2;
-      }
+    if (level) {
       log::setLevel(*level);
     } else if (quiet || command.quiet) {
       log::setLevel(log::Level::Warn);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 
+#include "engine/core/printable.hpp"
 #include "engine/core/suggest.hpp"
 
 namespace pitwall::cli {
@@ -75,8 +76,9 @@ std::optional<std::string> explainRefusal(const CLI::App& app, int argc, const c
       const CLI::Option* o = findOption(*cur, name);
       if (!o) {
         const std::string path = pathOf(*cur);
-        return path + ": unknown option " + name + didYouMean(name, longOptions(*cur)) + " (`" +
-               path + " --help` lists the options)";
+        return path + ": unknown option " + printable(name, 80) +
+               (name.size() <= 80 ? didYouMean(name, longOptions(*cur)) : "") + " (`" + path +
+               " --help` lists the options)";
       }
       if (o->get_expected_min() > 0 && arg.find('=') == std::string::npos) ++i;  // its value
       continue;
@@ -96,7 +98,8 @@ std::optional<std::string> explainRefusal(const CLI::App& app, int argc, const c
     std::vector<std::string> names;
     for (const CLI::App* s : subs) names.push_back(s->get_name());
     const std::string path = pathOf(*cur);
-    return path + ": unknown command '" + arg + "'" + didYouMean(arg, names) + " (`" + path +
+    return path + ": unknown command '" + printable(arg, 80) + "'" +
+           (arg.size() <= 80 ? didYouMean(arg, names) : "") + " (`" + path +
            (cur == &app ? "` lists the commands)" : " --help` lists its commands)");
   }
   return std::nullopt;

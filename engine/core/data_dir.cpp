@@ -24,6 +24,16 @@ std::vector<std::filesystem::path> dataDirCandidates() {
 }
 
 Result<std::filesystem::path, std::string> dataDir() {
+  // $PITWALL_DATA overrides: a wrong one is an error, not a silent fall back to another tree.
+  if (const char* env = std::getenv("PITWALL_DATA"); env && *env) {
+    std::error_code ec;
+    if (std::filesystem::exists(std::filesystem::path(env) / "scripts" / "pitwall" / "core.lua",
+                                ec))
+      return std::filesystem::weakly_canonical(env, ec);
+    return Unexpected{std::string("PITWALL_DATA=") + env +
+                      " holds no scripts/pitwall/core.lua; point it at a folder with pitwall's "
+                      "data (an installed share/pitwall) or unset it"};
+  }
   std::string looked;
   for (const auto& p : dataDirCandidates()) {
     std::error_code ec;

@@ -19,8 +19,8 @@ std::filesystem::path executableDir();
 // <exe>/share/pitwall.
 std::vector<std::filesystem::path> dataDirCandidates();
 
-// The first candidate that holds scripts/pitwall/core.lua (made absolute). The error names the
-// places looked at and what to do.
+// The first candidate that holds scripts/pitwall/core.lua (made absolute); a $PITWALL_DATA that
+// does not is an error of its own. The error names the places looked at and what to do.
 Result<std::filesystem::path, std::string> dataDir();
 
 }  // namespace pitwall

@@ -38,8 +38,8 @@ std::optional<std::string> nearest(std::string_view word, std::span<const std::s
   std::optional<std::string> best;
   std::size_t bestDistance = limit + 1;
   for (const auto& c : candidates) {
+    if (c == word) continue;  // the word itself is no suggestion (in another case it is the best)
     std::size_t d = editDistance(word, c);
-    if (d == 0) continue;  // the word itself (in another case) is no suggestion of a new name
     const bool prefix =
         c.size() > word.size() && std::equal(word.begin(), word.end(), c.begin(),
                                              [](char x, char y) { return lower(x) == lower(y); });

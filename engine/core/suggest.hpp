@@ -11,7 +11,7 @@ namespace pitwall {
 
 // The edit distance between a and b, counting an insertion, a deletion, a substitution or a
 // swap of two neighbouring letters as one edit ("optimal string alignment"); letters compare
-// without case, so `setspeed` is one edit from nothing and `SetSpeed` is as near as `setSpeed`.
+// without case, so `SetSpeed` is no edit from `setSpeed`: the nearest of all.
 std::size_t editDistance(std::string_view a, std::string_view b);
 
 // The candidate nearest to `word`, when it is near enough to be what was meant: at most

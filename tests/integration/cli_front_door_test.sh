@@ -15,7 +15,7 @@ fi
 version=$(sed -n 's/^project(pitwall VERSION \([0-9.]*\).*/\1/p' "$SRC/CMakeLists.txt")
 contains "--version is the project's version" "pitwall $version" "$first"
 if git -C "$SRC" rev-parse --git-dir >/dev/null 2>&1; then
-  contains "--version has git describe" "(git $(git -C "$SRC" rev-parse --short=7 HEAD | cut -c1-7)" "$first"
+  contains "--version has git describe" "(git $(git -C "$SRC" describe --always --tags)" "$first"
 fi
 if [[ "$(echo "$out" | sed -n 2p)" =~ ^Lua\ 5\.4\.[0-9]+,\ sdbus-c\+\+\ [0-9.]+,\ libmosquitto\ [0-9.]+,\ Boost\ [0-9.]+$ ]]; then
   echo "ok: --version names Lua, sdbus-c++, libmosquitto and Boost"
@@ -24,6 +24,10 @@ else
 fi
 contains "--version names BlueZ" "BlueZ" "$(echo "$out" | sed -n 3p)"
 contains "--version names the data folder" "data: " "$(echo "$out" | sed -n 4p)"
+
+check "--version after a command answers too" "$first" "$($PITWALL run --version | head -1)"
+out=$(PITWALL_DATA=/nonexistent $PITWALL --version)
+contains "a PITWALL_DATA without data is named, not passed over" "data: not found (PITWALL_DATA=/nonexistent holds no scripts/pitwall/core.lua" "$out"
 
 # bare pitwall: every command with one line
 out=$($PITWALL); rc=$?
@@ -46,6 +50,12 @@ check "unknown option exit status" 2 "$rc"
 check "unknown option suggests --fast" "pitwall run: unknown option --fsat; did you mean --fast? (\`pitwall run --help\` lists the options)" "$err"
 err=$($PITWALL track shwo oval 2>&1); rc=$?
 check "unknown subcommand suggests show" "pitwall track: unknown command 'shwo'; did you mean show? (\`pitwall track --help\` lists its commands)" "$err"
+err=$($PITWALL $'\e[31mred' 2>&1); rc=$?
+check "a word with control characters is shown escaped" "pitwall: unknown command '\\x1b[31mred' (\`pitwall\` lists the commands)" "$err"
+err=$($PITWALL RUN 2>&1)
+check "a case-only slip gets the command" "pitwall: unknown command 'RUN'; did you mean run? (\`pitwall\` lists the commands)" "$err"
+err=$($PITWALL --log-level loud 2>&1); rc=$?
+check "a bad --log-level without a command: status" 2 "$rc"
 err=$($PITWALL run 2>&1); rc=$?
 check "a missing argument is still CLI11's word, status 2" 2 "$rc"
 contains "a missing argument names it" "script" "$err"
@@ -82,6 +92,13 @@ check "bash: log levels" "warn" "$(ask pitwall --log-level w)"
 check "bash: the protocol of decode" "anki" "$(ask pitwall decode an)"
 check "bash: subcommands" "show" "$(ask pitwall track "")"
 check "bash: folders only for types" "races/" "$(ask pitwall types "")"
+mkdir -p "$TMP/proj/my races" && touch "$TMP/proj/my file.lua"
+ask_lines() {  # one completion per line: names with spaces stay whole
+  (cd "$TMP/proj" && bash -c 'source "$1"; shift; COMP_WORDS=("$@"); COMP_CWORD=$((${#COMP_WORDS[@]} - 1)); _pitwall; printf "%s\n" "${COMPREPLY[@]}" | sort' \
+    ask "$TMP/pitwall.bash" "$@")
+}
+check "bash: names with spaces stay whole" "my file.lua
+my races/" "$(ask_lines pitwall run my)"
 
 # zsh: loads from fpath with compinit and completes at a real prompt (python3-pexpect)
 $PITWALL completion zsh >"$TMP/_pitwall"

@@ -27,7 +27,9 @@ TEST_CASE("nearest suggests only a name near enough to have been meant") {
   CHECK_FALSE(nearest("x", commands));
   CHECK_FALSE(nearest("frobnicate", commands));
   CHECK_FALSE(nearest("", commands));
-  CHECK_FALSE(nearest("run", commands));  // the word itself is no suggestion
+  CHECK_FALSE(nearest("run", commands));     // the word itself is no suggestion
+  CHECK(nearest("RUN", commands) == "run");  // in another case it is the nearest
+  CHECK(nearest("--FAST", std::vector<std::string>{"--fast-cap", "--fast"}) == "--fast");
 
   const std::vector<std::string> methods{"setSpeed", "setLane", "changeLane", "lights"};
   CHECK(didYouMean("setSped", methods) == "; did you mean setSpeed?");
