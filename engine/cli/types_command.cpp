@@ -92,7 +92,17 @@ int writeLuarc(const fs::path& dir) {
   nlohmann::json config = nlohmann::json::object();
   const bool existed = fs::exists(path);
   if (existed) {
-    config = nlohmann::json::parse(readFile(path), nullptr, false, true);
+    const std::string text = readFile(path);
+    config = nlohmann::json::parse(text, nullptr, false, true);
+    // Rewriting would drop the comments: a file that has them is the user's to edit.
+    const bool comments =
+        !config.is_discarded() && nlohmann::json::parse(text, nullptr, false, false).is_discarded();
+    if (comments && config.is_object()) {
+      std::cerr << "pitwall types: " << path.string()
+                << " has comments, which rewriting it would lose: left as it is; add \"types\" "
+                   "to its \"workspace.library\" yourself\n";
+      return 1;
+    }
     if (config.is_discarded() || !config.is_object()) {
       std::cerr << "pitwall types: " << path.string()
                 << " is not a JSON object: left as it is; add \"types\" to its "
@@ -108,9 +118,13 @@ int writeLuarc(const fs::path& dir) {
   try {
     nlohmann::json& library = config.contains("workspace.library") ? config["workspace.library"]
                                                                    : config["workspace"]["library"];
+    // one folder as a string is a list of one: kept, not replaced
+    if (library.is_string()) library = nlohmann::json::array({library});
     if (!library.is_array()) library = nlohmann::json::array();
     for (const auto& entry : library)
-      if (entry == "types" || entry == "./types") listed = true;
+      if (entry.is_string() &&
+          (fs::path(entry.get<std::string>()).lexically_normal() / "").string() == "types/")
+        listed = true;
     if (!listed) library.push_back("types");
     if (!config.contains("runtime.version") &&
         !(config.contains("runtime") && config["runtime"].contains("version")))

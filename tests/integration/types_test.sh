@@ -36,12 +36,26 @@ out=$($PITWALL types "$TMP/gen" 2>&1)
 contains "a second run keeps .luarc.json" "kept $TMP/gen/.luarc.json" "$out"
 
 mkdir -p "$TMP/user"
-printf '{\n  // mine\n  "diagnostics": {"globals": ["love"]},\n  "workspace": {"library": ["lib"]}\n}\n' >"$TMP/user/.luarc.json"
+printf '{\n  "diagnostics": {"globals": ["love"]},\n  "workspace": {"library": ["lib"]}\n}\n' >"$TMP/user/.luarc.json"
 out=$($PITWALL types "$TMP/user" 2>&1); rc=$?
 check "merging exit status" 0 "$rc"
 contains "says it updated" "updated $TMP/user/.luarc.json" "$out"
 check "merged library" "['lib', 'types']" "$(json "$TMP/user/.luarc.json" "c['workspace']['library']")"
 check "the user's settings stay" "['love']" "$(json "$TMP/user/.luarc.json" "c['diagnostics']['globals']")"
+
+mkdir -p "$TMP/one" "$TMP/dot" "$TMP/commented"
+echo '{"workspace.library": "libs"}' >"$TMP/one/.luarc.json"
+$PITWALL types "$TMP/one" >/dev/null 2>&1
+check "a library given as one string is kept beside types" "['libs', 'types']" "$(json "$TMP/one/.luarc.json" "c['workspace.library']")"
+echo '{"workspace": {"library": ["./types/"]}}' >"$TMP/dot/.luarc.json"
+out=$($PITWALL types "$TMP/dot" 2>&1)
+contains "./types/ counts as types" "kept $TMP/dot/.luarc.json" "$out"
+printf '{\n  // mine\n  "workspace": {"library": ["lib"]}\n}\n' >"$TMP/commented/.luarc.json"
+before=$(cat "$TMP/commented/.luarc.json")
+out=$($PITWALL types "$TMP/commented" 2>&1); rc=$?
+check "a .luarc.json with comments: exit status" 1 "$rc"
+contains "a .luarc.json with comments is named" "has comments, which rewriting it would lose" "$out"
+check "a .luarc.json with comments is left as it was" "$before" "$(cat "$TMP/commented/.luarc.json")"
 
 mkdir -p "$TMP/broken"
 echo "not json" >"$TMP/broken/.luarc.json"
