@@ -80,8 +80,15 @@ std::optional<std::string> explainMissingMethod(lua_State* thread, int level,
   if (nameEnd == std::string::npos) return std::nullopt;
   const std::string method = message.substr(nameStart, nameEnd - nameStart);
 
+  // The Lua function that made the call: the first Lua frame from `level` (a failed call may
+  // leave a frame of the called value above it, "[C]: in method 'x'").
   lua_Debug ar;
-  if (!lua_getstack(thread, level, &ar)) return std::nullopt;
+  for (;; ++level) {
+    if (!lua_getstack(thread, level, &ar)) return std::nullopt;
+    if (!lua_getinfo(thread, "S", &ar)) return std::nullopt;
+    if (ar.what[0] != 'C') break;
+    if (level > 8) return std::nullopt;
+  }
   if (!lua_checkstack(thread, 4)) return std::nullopt;
   // Candidates: a nil temporary (the method's register) followed by an object with methods
   // (its `self`); pending arguments of an outer call may form such pairs too. A type that has the

@@ -131,6 +131,14 @@ expectReported(reported(function() car:setSpeed(500); sim.run(0.5) end), handler
   "car has no method stpo; did you mean stop?")
 car.onPosition = nil
 car:stop()
+-- a listener runs under the library's own xpcall (the race's handlers, drivers, laps, too)
+local listenerLine = debug.getinfo(1, "l").currentline + 1
+local listener = function(c) c:stpo() end
+local sub = pitwall.listen(car, "onPosition", listener)
+expectReported(reported(function() car:setSpeed(500); sim.run(0.5) end), listenerLine,
+  "car has no method stpo; did you mean stop?")
+sub:cancel()
+car:stop()
 local timerMethodLine = debug.getinfo(1, "l").currentline + 1
 local cancelTimer = function() timer:cancle() end
 expectReported(reported(function() pitwall.spawn(cancelTimer) end), timerMethodLine,
