@@ -2,11 +2,13 @@
 
 #include <pthread.h>
 #include <signal.h>
+#include <time.h>
 
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 namespace pitwall::interrupt {
@@ -26,10 +28,13 @@ std::atomic<int> g_reason{kNone};            // why the current call is being in
 std::atomic<std::uint64_t> g_reasonCall{0};  // … and which call that is
 std::atomic<long long> g_budgetMs{100};
 std::atomic<pthread_t> g_loopThread{};
+std::atomic<clockid_t> g_loopClock{};  // the CPU-time clock of the loop's thread
+std::atomic<bool> g_haveClock{false};
 char g_message[256] = {};  // abortRunning's message; written on the loop's thread only
 static_assert(std::atomic<lua_State*>::is_always_lock_free);
 static_assert(std::atomic<std::uint64_t>::is_always_lock_free);
 static_assert(std::atomic<pthread_t>::is_always_lock_free);
+static_assert(std::atomic<clockid_t>::is_always_lock_free);
 
 void hook(lua_State* L, lua_Debug*) {
   int reason = g_reason.load(std::memory_order_relaxed);
@@ -73,10 +78,22 @@ void onBudgetSignal(int) {
   errno = saved;
 }
 
-// Wakes a quarter budget apart; a call seen in progress twice, a budget apart, is over budget.
+// The CPU time the loop's thread has used; nullopt when it cannot be read (no thread watched, or
+// the thread has ended).
+std::optional<std::chrono::nanoseconds> loopCpuTime() {
+  if (!g_haveClock.load(std::memory_order_relaxed)) return std::nullopt;
+  timespec ts{};
+  if (clock_gettime(g_loopClock.load(std::memory_order_relaxed), &ts) != 0) return std::nullopt;
+  return std::chrono::seconds(ts.tv_sec) + std::chrono::nanoseconds(ts.tv_nsec);
+}
+
+// Wakes a quarter budget apart; a call seen in progress twice, a budget of the loop thread's CPU
+// time apart, is over budget. CPU time, not the wall clock: a callback is not to blame for a
+// machine busy with other work, a slow disk or a stopped process (a race must not end because the
+// host compiled something), while one that loops uses CPU time at the wall clock's pace.
 void watch() {
   std::uint64_t seen = 0;
-  std::chrono::steady_clock::time_point since{};
+  std::chrono::nanoseconds since{};
   bool sent = false;
   for (;;) {
     long long ms = g_budgetMs.load(std::memory_order_relaxed);
@@ -86,11 +103,12 @@ void watch() {
     bool busy = g_depth.load(std::memory_order_relaxed) > 0 &&
                 g_kind.load(std::memory_order_relaxed) == static_cast<int>(Kind::Callback);
     std::uint64_t call = g_call.load(std::memory_order_relaxed);
-    auto now = std::chrono::steady_clock::now();
-    if (!busy) {
+    auto cpu = loopCpuTime();
+    if (!busy || !cpu) {
       seen = 0;
       continue;
     }
+    auto now = *cpu;
     if (call != seen) {
       seen = call;
       since = now;
@@ -265,6 +283,11 @@ void setBudget(std::chrono::milliseconds budget) {
 
 void watchThisThread() {
   g_loopThread.store(pthread_self(), std::memory_order_relaxed);
+  clockid_t clock{};
+  if (pthread_getcpuclockid(pthread_self(), &clock) == 0) {
+    g_loopClock.store(clock, std::memory_order_relaxed);
+    g_haveClock.store(true, std::memory_order_relaxed);
+  }
   if (g_budgetMs.load(std::memory_order_relaxed) > 0) startWatchdog();
 }
 

@@ -6,8 +6,10 @@
 // cannot pcall its way out (Redis's rule). Nothing is paid on the hot path but two relaxed
 // atomic stores per call into Lua: no count hook runs while nothing is wrong.
 //
-// The budget is watched by one thread that only reads the start time of the call in progress;
-// when a call is over budget it signals the loop's thread (SIGURG), whose handler sets the hook.
+// The budget is watched by one thread that reads which call is in progress and the CPU time the
+// loop's thread has used (its pthread CPU clock): a call that used a budget of CPU time is over
+// budget; time the thread spent preempted, stopped or blocked does not count. The watchdog then
+// signals the loop's thread (SIGURG), whose handler sets the hook.
 #include <lua.hpp>
 
 #include <chrono>
@@ -47,7 +49,8 @@ class Running {
   lua_State* previous_;
 };
 
-// The budget for Kind::Callback calls; zero turns it off. Default 100 ms.
+// The budget for Kind::Callback calls, in CPU time of the loop's thread; zero turns it off.
+// Default 100 ms.
 void setBudget(std::chrono::milliseconds budget);
 std::chrono::milliseconds budget();
 // The calling thread runs the Lua code (ScriptHost's constructor says so): the watchdog signals

@@ -24,7 +24,8 @@ CLI::Option* addCarSource(CLI::App* cmd, CarSource& source, const char* when) {
       ->check(CLI::PositiveNumber)
       ->needs(ble);
   cmd->add_option("--budget", source.budget,
-                  "Seconds a callback may run before it is interrupted (default 0.1; 0: no limit)")
+                  "Seconds of CPU time a callback may use before it is interrupted (default 0.1; "
+                  "0: no limit)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--lua-memory", source.luaMemory,
                   "MB of memory the script's Lua world may hold (default 512; 0: no limit)")

@@ -124,7 +124,8 @@ Command addTestCommand(CLI::App& app) {
   cmd->add_option("--timeout", test->timeout, "Virtual seconds a scenario may run (default 600)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--budget", test->budget,
-                  "Seconds a callback may run before it is interrupted (default 0.1; 0: no limit)")
+                  "Seconds of CPU time a callback may use before it is interrupted (default 0.1; "
+                  "0: no limit)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--lua-memory", test->luaMemory,
                   "MB of memory a scenario's Lua world may hold (default 512; 0: no limit)")

@@ -43,6 +43,8 @@ contains "the cars are placed on the scanned map" " inside " "$result"
 check "the scanned map is the layout the cars drive (ids, types, turns)" "$expected" "${result##* inside }"
 kill -INT "$RUN_PID"
 wait "$RUN_PID"
-check "Ctrl-C: exit status" 130 "$?"
+status=$?
+check "Ctrl-C: exit status" 130 "$status"
+[ "$status" = 130 ] || { echo "the run's log:"; cat "$TMP/run.err"; }
 stop_fake
 finish

@@ -144,6 +144,30 @@ TEST_CASE("a chunk typed at the REPL has no budget") {
   CHECK(lua_tointeger(f.host->state(), -1) == 7);
 }
 
+namespace {
+// Stands for the loop's thread not running: preempted by a busy machine, waiting for a slow disk.
+int stall(lua_State* L) {
+  std::this_thread::sleep_for(std::chrono::milliseconds(luaL_checkinteger(L, 1)));
+  return 0;
+}
+}  // namespace
+
+TEST_CASE("time the loop's thread does not run is not charged to the callback") {
+  // The budget is CPU time: a callback stalled for ten budgets by the machine is not
+  // interrupted (on the wall clock it was, at its next instruction), and one that loops is.
+  RunawayFixture f(20ms);
+  lua_register(f.host->state(), "stall", stall);
+  f.define(
+      "function stalled() stall(200) local n = 0 for i = 1, 1000 do n = n + i end done = n end\n"
+      "function spin() while true do end end");
+  CHECK(f.callback("stalled"));
+  lua_getglobal(f.host->state(), "done");
+  CHECK(lua_tointeger(f.host->state(), -1) == 500500);
+  lua_pop(f.host->state(), 1);
+  CHECK_FALSE(f.callback("spin"));
+  CHECK(f.lastLog().find("still running after 20 ms: interrupted") != std::string::npos);
+}
+
 TEST_CASE("many short callbacks under the budget are never interrupted") {
   RunawayFixture f(20ms);
   f.define("n = 0 function tick() for i = 1, 1000 do n = n + 1 end end");
