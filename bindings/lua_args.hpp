@@ -131,6 +131,14 @@ inline void checkFunction(lua_State* L, int idx, const char* what) {
 // Message handler for lua_pcall: the error text plus a traceback.
 int traceback(lua_State* L);
 
+// Pushes `msg` and a traceback of L1 from `level` onto L, as luaL_traceback does; while
+// `libraryFrames` is off (pitwall test without --verbose) only the script's own frames are
+// listed: the library's (scripts/pitwall/) and C functions' are left out.
+void pushTraceback(lua_State* L, lua_State* L1, const char* msg, int level);
+extern bool libraryFrames;
+// True for a chunk of the shipped library (scripts/pitwall/…): frames the user did not write.
+bool isLibrarySource(const char* source);
+
 // t[key] = value for the table on top of the stack.
 inline void setInteger(lua_State* L, const char* key, lua_Integer v) {
   lua_pushinteger(L, v);

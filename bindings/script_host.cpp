@@ -34,7 +34,7 @@ int traceback(lua_State* L) {
   } else if (auto explained = explainMissingMethod(L, 1, msg)) {
     msg = lua_pushlstring(L, explained->data(), explained->size());
   }
-  luaL_traceback(L, L, msg, 1);
+  pushTraceback(L, L, msg, 1);
   return 1;
 }
 
@@ -44,15 +44,52 @@ int traceback(lua_State* L) {
 std::string libraryChunks = "@scripts/pitwall/";
 
 void pushUserWhere(lua_State* L) {
-  const std::string& library = libraryChunks;
   lua_Debug ar;
   for (int level = 1; lua_getstack(L, level, &ar); ++level) {
     if (!lua_getinfo(L, "Sl", &ar) || ar.currentline <= 0) continue;  // C functions
-    if (std::string_view(ar.source).starts_with(library)) continue;
+    if (isLibrarySource(ar.source)) continue;
     lua_pushfstring(L, "%s:%d: ", ar.short_src, ar.currentline);
     return;
   }
   luaL_where(L, 1);  // only the library on the stack (an engine call into it): its own line
+}
+
+bool isLibrarySource(const char* source) {
+  return std::string_view(source).starts_with(libraryChunks);
+}
+
+bool libraryFrames = true;
+
+void pushTraceback(lua_State* L, lua_State* L1, const char* msg, int level) {
+  if (libraryFrames) return luaL_traceback(L, L1, msg, level);
+  luaL_Buffer b;
+  luaL_buffinit(L, &b);
+  if (msg) {
+    luaL_addstring(&b, msg);
+    luaL_addchar(&b, '\n');
+  }
+  luaL_addstring(&b, "stack traceback:");
+  lua_Debug ar;
+  int listed = 0;
+  for (; lua_getstack(L1, level, &ar); ++level) {
+    if (!lua_getinfo(L1, "Slnt", &ar)) continue;
+    if (ar.currentline <= 0 || isLibrarySource(ar.source)) continue;
+    if (++listed > 20) {
+      luaL_addstring(&b, "\n\t...");
+      break;
+    }
+    lua_pushfstring(L, "\n\t%s:%d: in ", ar.short_src, ar.currentline);
+    luaL_addvalue(&b);
+    if (*ar.what == 'm')
+      lua_pushliteral(L, "main chunk");
+    else if (*ar.namewhat)
+      lua_pushfstring(L, "%s '%s'", ar.namewhat, ar.name);
+    else
+      lua_pushfstring(L, "function <%s:%d>", ar.short_src, ar.linedefined);
+    luaL_addvalue(&b);
+    if (ar.istailcall) luaL_addstring(&b, "\n\t(...tail calls...)");
+  }
+  luaL_pushresult(&b);
 }
 }  // namespace lua
 
@@ -201,6 +238,7 @@ void ScriptHost::openLibraries() {
   for (const auto& dir : options_.library_paths) path += dir + "/?.lua;" + dir + "/?/init.lua;";
   std::string lib = scriptsDir();
   lua::libraryChunks = "@" + lib + "/pitwall/";
+  lua::libraryFrames = options_.library_frames;
   path += lib + "/?.lua;" + lib + "/?/init.lua;";
   lua_getglobal(L, "package");
   lua_getfield(L, -1, "path");

@@ -38,8 +38,9 @@ struct SimSession {
 };
 
 struct HostOptions {
-  bool test_mode = false;                  // callback errors fail the run; `expect` helpers loaded
-  std::uint64_t seed = 1;                  // math.randomseed
+  bool test_mode = false;      // callback errors fail the run; `expect` helpers loaded
+  bool library_frames = true;  // tracebacks list the library's frames (lua::libraryFrames)
+  std::uint64_t seed = 1;      // math.randomseed
   std::vector<std::string> library_paths;  // extra folders searched by require
   std::string results;                     // --results FILE (pitwall.resultsFile), empty: none
   // Made detached: the cars' events reach this world only after attach() (a hot reload's new
@@ -62,6 +63,7 @@ class ScriptHost {
   SimSession* sim() { return sim_; }
   CarBinding& cars() { return *cars_; }
   Tasks& tasks() { return tasks_; }
+  const Tasks& tasks() const { return tasks_; }
   Timers& timers() { return timers_; }
   const HostOptions& options() const { return options_; }
 

@@ -1,8 +1,11 @@
 #include "bindings/tasks.hpp"
 
 #include "bindings/interrupt.hpp"
+#include "bindings/lua_args.hpp"
 #include "bindings/misspelled_method.hpp"
 #include "bindings/script_host.hpp"
+
+#include <algorithm>
 
 namespace pitwall {
 
@@ -31,7 +34,7 @@ void Tasks::spawn(lua_State* L, const std::string& name, bool main) {
   lua_State* co = lua_newthread(L);
   int ref = luaL_ref(L, LUA_REGISTRYINDEX);  // pops the thread, keeps it alive
   lua_xmove(L, co, 1);                       // the function
-  tasks_.emplace(co, Task{ref, main ? name : "task " + name, std::nullopt});
+  tasks_.emplace(co, Task{ref, main ? name : "task " + name, std::nullopt, ++spawned_});
   if (main) main_ = co;
   resume(co, 0);
 }
@@ -45,6 +48,33 @@ void Tasks::sleep(lua_State* co, Duration delay) {
     t->second.wake.reset();
     resume(co, 0);
   });
+}
+
+std::vector<std::string> Tasks::waiting() const {
+  std::vector<std::pair<std::uint64_t, std::string>> found;
+  for (const auto& [co, task] : tasks_) {
+    // The innermost of the script's own frames, and what it called (pitwall.sleep,
+    // sim.runUntil, …): the library's frames and C functions are where, not why, it waits.
+    std::string line = task.name + " waiting";
+    std::string called;
+    lua_Debug ar;
+    for (int level = 0; lua_getstack(co, level, &ar); ++level) {
+      if (!lua_getinfo(co, "Sln", &ar)) continue;
+      bool own = ar.currentline > 0 && !lua::isLibrarySource(ar.source);
+      if (!own) {
+        if (ar.name) called = ar.name;
+        continue;
+      }
+      line += " at " + std::string(ar.short_src) + ":" + std::to_string(ar.currentline);
+      if (!called.empty()) line += " (in " + called + ")";
+      break;
+    }
+    found.emplace_back(task.order, std::move(line));
+  }
+  std::sort(found.begin(), found.end());
+  std::vector<std::string> lines;
+  for (auto& f : found) lines.push_back(std::move(f.second));
+  return lines;
 }
 
 void Tasks::shutDown() {
@@ -81,7 +111,7 @@ void Tasks::resume(lua_State* co, int nargs) {
     std::optional<std::string> explained;
     if (msg) explained = lua::explainMissingMethod(co, 0, msg);  // car:setSped → a suggestion
     if (explained) msg = explained->c_str();
-    luaL_traceback(L, co, msg ? msg : "(error without a message)", 0);
+    lua::pushTraceback(L, co, msg ? msg : "(error without a message)", 0);
     error = lua_tostring(L, -1);
     lua_pop(L, 1);
   }

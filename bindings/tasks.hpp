@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 #include <unordered_map>
+#include <vector>
 
 #include "engine/core/loop.hpp"
 
@@ -29,12 +30,16 @@ class Tasks {
   void sleep(lua_State* co, Duration delay);
   // The run is ending: no task wakes again (each stays asleep for good).
   void shutDown();
+  // One line per task alive, oldest first: "main chunk waiting at stuck_test.lua:4 (in sleep)"
+  // — for a scenario stuck until its timeout.
+  std::vector<std::string> waiting() const;
 
  private:
   struct Task {
     int threadRef = LUA_NOREF;
     std::string name;  // as errors name it: "main chunk", "task lap.lua:12"
     std::optional<Loop::TimerId> wake;
+    std::uint64_t order = 0;  // spawned as the order-th task
   };
   void resume(lua_State* co, int nargs);
   void end(lua_State* co, const std::string& error);  // error empty: it returned
@@ -43,6 +48,7 @@ class Tasks {
   Loop& loop_;  // the host's
   std::unordered_map<lua_State*, Task> tasks_;
   lua_State* main_ = nullptr;
+  std::uint64_t spawned_ = 0;
 };
 
 }  // namespace pitwall

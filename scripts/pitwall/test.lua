@@ -7,7 +7,9 @@ local function show(v)
   return tostring(v)
 end
 
+-- The runner tells a failed expectation from any other error by the message kept here.
 local function fail(message, level)
+  expect._failed = message
   error(message, (level or 2) + 1)
 end
 
