@@ -65,10 +65,16 @@ int repl(const ReplOptions& options);
 
 struct TestOptions {
   std::vector<std::string> paths;
-  std::uint64_t seed = 1;
-  double timeout = 600;  // seconds of virtual time per scenario
-  double budget = 0.1;   // seconds a callback may run (real time) before it is interrupted
-  int luaMemory = 512;   // MB a scenario's Lua world may hold; 0: no limit
+  std::string seed = "1";  // N, or "random": a seed of its own for each scenario
+  double timeout = 600;    // seconds of virtual time per scenario
+  double budget = 0.1;     // seconds of CPU time a callback may use before it is interrupted
+  int luaMemory = 512;     // MB a scenario's Lua world may hold; 0: no limit
+  std::vector<std::string> filters;  // --filter: a scenario runs when one matches
+  bool list = false;
+  int jobs = 0;       // 0: the number of cores
+  std::string junit;  // --junit FILE
+  bool tap = false;
+  bool verbose = false;  // library frames in tracebacks
 };
 int test(const TestOptions& options);
 

@@ -1,17 +1,30 @@
-// pitwall test [PATH…]: scenario scripts in virtual time, each in a world of its own.
+// pitwall test [PATH…]: scenario scripts in virtual time, each in a world and a process of its
+// own: which ones (--filter, --list), how many at once (-j), and the reports (docs/testing.md).
+#include <fnmatch.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <charconv>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <memory>
+#include <random>
+#include <sstream>
 
 #include "bindings/interrupt.hpp"
 #include "bindings/sandbox.hpp"
 #include "engine/cli/commands.hpp"
 #include "engine/cli/options.hpp"
-#include "engine/cli/session.hpp"
-#include "engine/core/log.hpp"
+#include "engine/cli/scenario.hpp"
+#include "engine/cli/test_pool.hpp"
+#include "engine/cli/test_report.hpp"
+#include "engine/core/printable.hpp"
+#include "engine/core/result.hpp"
+#include "engine/core/suggest.hpp"
 
 namespace pitwall::cli {
 
@@ -43,47 +56,88 @@ Result<std::vector<std::string>, std::string> collect(const std::vector<std::str
   return files;
 }
 
-struct Outcome {
-  bool passed = false;
-  std::string message;
-  double simulated = 0;
+// A scenario's tags: `-- tags: race reload` in the comment block at the top of its file.
+std::vector<std::string> tagsOf(const std::string& file) {
+  std::vector<std::string> tags;
+  std::ifstream in(file);
+  std::string line;
+  for (int n = 0; n < 50 && std::getline(in, line); ++n) {
+    auto first = line.find_first_not_of(" \t");
+    if (first == std::string::npos) continue;
+    if (line.compare(first, 2, "--") != 0) break;  // the code begins
+    auto text = line.find_first_not_of("- \t", first);
+    if (text == std::string::npos || line.compare(text, 5, "tags:") != 0) continue;
+    std::istringstream words(line.substr(text + 5));
+    for (std::string w; words >> w;) {
+      while (!w.empty() && w.back() == ',') w.pop_back();
+      if (!w.empty()) tags.push_back(w);
+    }
+  }
+  return tags;
+}
+
+struct Scenario {
+  std::string path;
+  std::string name;  // the file's stem: ping_test
+  std::vector<std::string> tags;
 };
 
-Outcome runScenario(const std::string& file, const TestOptions& options) {
-  Outcome out;
-  auto track = sim::namedLayout("oval");
-  Session session(ClockKind::Virtual, std::move(*track), options.seed);
-  HostOptions host;
-  host.test_mode = true;
-  host.seed = options.seed;
-  try {
-    session.startHost(host);
-  } catch (const std::exception& e) {
-    out.message = e.what();
-    return out;
+bool hasWildcard(const std::string& p) {
+  return p.find_first_of("*?[") != std::string::npos;
+}
+
+// --filter PATTERN: a glob (fnmatch) matched against the path, the name and each tag; without
+// wildcards, a part of the name or a whole tag.
+bool matches(const Scenario& s, const std::string& pattern) {
+  if (hasWildcard(pattern)) {
+    auto glob = [&](const std::string& text) {
+      return fnmatch(pattern.c_str(), text.c_str(), 0) == 0;
+    };
+    if (glob(s.path) || glob(s.name)) return true;
+    return std::any_of(s.tags.begin(), s.tags.end(), glob);
   }
-  Loop& loop = session.loop();
-  bool timedOut = false;
-  loop.after(fromSeconds(options.timeout), [&] {
-    timedOut = true;
-    session.finish();
-  });
-  auto started = session.host().startFile(file);
-  if (!started) {
-    out.message = started.error();
-    return out;
+  if (s.name.find(pattern) != std::string::npos) return true;
+  return std::find(s.tags.begin(), s.tags.end(), pattern) != s.tags.end();
+}
+
+Result<std::vector<Scenario>, std::string> select(const std::vector<std::string>& files,
+                                                  const std::vector<std::string>& filters) {
+  std::vector<Scenario> all, chosen;
+  for (const auto& f : files) all.push_back({f, fs::path(f).stem().string(), tagsOf(f)});
+  if (filters.empty()) return all;
+  for (const auto& s : all)
+    if (std::any_of(filters.begin(), filters.end(), [&](const auto& p) { return matches(s, p); }))
+      chosen.push_back(s);
+  if (!chosen.empty()) return chosen;
+  std::vector<std::string> names;
+  for (const auto& s : all) {
+    names.push_back(s.name);
+    for (const auto& t : s.tags)
+      if (std::find(names.begin(), names.end(), t) == names.end()) names.push_back(t);
   }
-  loop.run();  // ends through Session::finish, which every way out of a run calls
-  out.simulated = loop.seconds();
-  if (auto& failure = session.host().failure()) {
-    out.message = *failure;
-  } else if (timedOut && !session.host().mainFinished()) {
-    out.message = "still running after " + std::to_string(static_cast<int>(options.timeout)) +
-                  " s of virtual time (raise it with --timeout)";
-  } else {
-    out.passed = true;
+  std::string text = "--filter " + printable(filters.front(), 80) + " matches none of the " +
+                     std::to_string(all.size()) + " scenarios";
+  if (!hasWildcard(filters.front())) text += didYouMean(filters.front(), names);
+  return Unexpected{text + " (pitwall test --list shows their names and tags)"};
+}
+
+// --seed N: every scenario runs with N; --seed random: each with a seed of its own, drawn now
+// and printed with its failure.
+Result<std::vector<std::uint64_t>, std::string> seedsFor(const std::string& option,
+                                                         std::size_t count) {
+  if (option == "random") {
+    std::random_device device;
+    std::vector<std::uint64_t> seeds;
+    for (std::size_t i = 0; i < count; ++i)
+      seeds.push_back((static_cast<std::uint64_t>(device()) << 32 | device()) % 1'000'000'000);
+    return seeds;
   }
-  return out;
+  std::uint64_t seed = 0;
+  auto [end, ec] = std::from_chars(option.data(), option.data() + option.size(), seed);
+  if (ec != std::errc() || end != option.data() + option.size() || option.empty())
+    return Unexpected{"--seed " + printable(option, 40) +
+                      ": expected a whole number from 0 to 18446744073709551615, or random"};
+  return std::vector<std::uint64_t>(count, seed);
 }
 
 }  // namespace
@@ -94,25 +148,78 @@ int test(const TestOptions& options) {
     std::cerr << "pitwall test: " << files.error() << "\n";
     return 2;
   }
+  auto scenarios = select(*files, options.filters);
+  if (!scenarios) {
+    std::cerr << "pitwall test: " << scenarios.error() << "\n";
+    return 2;
+  }
+  if (options.list) {
+    for (const auto& s : *scenarios) {
+      std::cout << s.path;
+      if (!s.tags.empty()) {
+        std::cout << "  [";
+        for (std::size_t i = 0; i < s.tags.size(); ++i) std::cout << (i ? " " : "") << s.tags[i];
+        std::cout << "]";
+      }
+      std::cout << "\n";
+    }
+    return 0;
+  }
+  auto seeds = seedsFor(options.seed, scenarios->size());
+  if (!seeds) {
+    std::cerr << "pitwall test: " << seeds.error() << "\n";
+    return 2;
+  }
+  std::ofstream junit;
+  if (!options.junit.empty()) {
+    junit.open(options.junit, std::ios::trunc);
+    if (!junit) {
+      std::cerr << "pitwall test: --junit " << printable(options.junit, 200)
+                << ": cannot write the file: " << std::strerror(errno) << "\n";
+      return 2;
+    }
+  }
   interrupt::setBudget(std::chrono::milliseconds(std::lround(options.budget * 1000)));
   sandbox::setMemoryLimit(static_cast<std::size_t>(options.luaMemory) << 20);
+  int jobs = options.jobs > 0 ? options.jobs : availableCores();
+
+  std::vector<ReportedScenario> reported;
   int passed = 0, failed = 0;
-  for (const auto& file : *files) {
-    auto begin = std::chrono::steady_clock::now();
-    Outcome o = runScenario(file, options);
-    double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
-    char timing[96];
-    std::snprintf(timing, sizeof timing, "(%.1f s simulated in %.0f ms)", o.simulated, wall * 1000);
-    if (o.passed) {
-      ++passed;
-      std::cout << "ok    " << file << " " << timing << "\n";
-    } else {
-      ++failed;
-      std::cout << "FAIL  " << file << " " << timing << "\n      " << o.message << "\n";
+  auto begin = std::chrono::steady_clock::now();
+  if (options.tap) printTapPlan(std::cout, scenarios->size());
+  runInProcesses(
+      scenarios->size(), jobs,
+      [&](std::size_t i) {
+        ScenarioSettings settings;
+        settings.seed = (*seeds)[i];
+        settings.timeout = options.timeout;
+        settings.libraryFrames = options.verbose;
+        return runScenario((*scenarios)[i].path, settings);
+      },
+      [&](std::size_t i, ScenarioResult result) {
+        result.seed = (*seeds)[i];
+        reported.push_back({(*scenarios)[i].path, std::move(result)});
+        const ReportedScenario& s = reported.back();
+        (s.result.passed() ? passed : failed)++;
+        if (options.tap)
+          printTapPoint(std::cout, i + 1, s);
+        else
+          printScenario(std::cout, s, options.verbose);
+      });
+  double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  if (options.tap)
+    std::cout << "# " << passed << " passed, " << failed << " failed\n";
+  else
+    std::cout << passed << " passed, " << failed << " failed\n";
+  if (junit.is_open()) {
+    writeJUnit(junit, reported, wall);
+    junit.close();
+    if (!junit) {
+      std::cerr << "pitwall test: --junit " << printable(options.junit, 200)
+                << ": the report could not be written\n";
+      return 2;
     }
-    std::cout.flush();
   }
-  std::cout << passed << " passed, " << failed << " failed\n";
   return failed ? 1 : 0;
 }
 
@@ -120,7 +227,25 @@ Command addTestCommand(CLI::App& app) {
   auto test = std::make_shared<TestOptions>();
   auto* cmd = app.add_subcommand("test", "Run scenario test scripts in virtual time");
   cmd->add_option("paths", test->paths, "Scenario files, or folders of *_test.lua files");
-  cmd->add_option("--seed", test->seed, "Seed of the simulator's and the scripts' randomness");
+  cmd->add_option("--seed", test->seed,
+                  "Seed of the simulator's and the scripts' randomness: N for every scenario "
+                  "(default 1), or random for a seed of its own each, printed with a failure");
+  cmd->add_option("--filter", test->filters,
+                  "Only the scenarios whose name or tag matches PATTERN: a part of the name, a "
+                  "whole tag, or a glob on name, path or tag ('race_*'); may be given more than "
+                  "once")
+      ->type_name("PATTERN");
+  cmd->add_flag("--list", test->list,
+                "List the scenarios (with --filter: those chosen) and their tags; run none");
+  cmd->add_option(
+         "-j,--jobs", test->jobs,
+         "Scenarios run at once, each in a process of its own (default: the number of cores)")
+      ->check(CLI::Range(1, 256));
+  cmd->add_option("--junit", test->junit, "Also write the results as JUnit XML to FILE (for CI)")
+      ->type_name("FILE");
+  cmd->add_flag("--tap", test->tap, "Print the results as TAP 14 instead of lines for a person");
+  cmd->add_flag("-v,--verbose", test->verbose,
+                "Tracebacks list the library's frames too (scripts/pitwall/) and C functions");
   cmd->add_option("--timeout", test->timeout, "Virtual seconds a scenario may run (default 600)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--budget", test->budget,
