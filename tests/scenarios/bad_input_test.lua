@@ -1,5 +1,6 @@
 -- Bad input from scripts gets a clear error naming the value and what is accepted, and changes
 -- nothing: pitwall.sim set-up, car commands and timers.
+-- tags: errors
 local sim = require "pitwall.sim"
 
 -- The track: by name, by layout text, refused when it does not close or is unknown.

@@ -1,5 +1,6 @@
 -- The live board (pitwall.board): formatting, the table's lines, redrawing in place on a
 -- terminal, and only the final table elsewhere.
+-- tags: ui
 local Board = require "pitwall.board"
 
 expect.eq(Board.time(4.125), "4.125")

@@ -1,5 +1,6 @@
 -- An error in one callback is reported with a traceback; that car's other handlers, the other
 -- cars and later events carry on.
+-- tags: errors
 local sim = require "pitwall.sim"
 
 local errors = {}

@@ -1,5 +1,6 @@
 -- The car behind cannot pass through the car in front on the same lane: it is held behind,
 -- both report the collision, and the one in front keeps its lead.
+-- tags: sim
 local sim = require "pitwall.sim"
 
 local front = sim.addCar { name = "front", lane = 2, piece = 3, distance = 100 }

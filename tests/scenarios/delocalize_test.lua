@@ -1,5 +1,6 @@
 -- Too fast in a curve the car leaves the track: it reports delocalized, stops, and the
 -- simulator agrees. A slower car in the outer lane keeps going.
+-- tags: track sim
 local sim = require "pitwall.sim"
 
 local fast = sim.addCar { lane = 1, name = "fast" }       -- inner lane of the left curves

@@ -1,5 +1,6 @@
 -- A dropped connection: onDisconnect says why, the car stops, commands to it fail with a clear
 -- error instead of vanishing, and the other cars carry on.
+-- tags: sim
 local sim = require "pitwall.sim"
 
 local gone = sim.addCar { lane = 1 }

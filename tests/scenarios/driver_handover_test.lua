@@ -2,6 +2,7 @@
 -- for every car, which takes over (driver:takeover) what the old one handed over
 -- (driver:handover) — here a count of its updates and of the versions it drove in — at the next
 -- update, without a stop or a speed gap. A driver without takeover is started instead.
+-- tags: drivers reload
 local sim = require "pitwall.sim"
 
 local out = os.tmpname()

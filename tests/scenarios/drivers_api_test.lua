@@ -1,6 +1,7 @@
 -- The driver API: loading, the context (ahead, nearby, upcoming, limit, a field that grows),
 -- drivers.run's task (start, update every period, finish on stop), a driver whose update
 -- raises is reported and still called, and ctx.limit caps the cruiser.
+-- tags: drivers
 local sim = require "pitwall.sim"
 local track = require "pitwall.track"
 local drivers = require "pitwall.drivers"

@@ -1,6 +1,7 @@
 -- The cruiser laps the oval's inner lane (−68 mm: 212 mm curve radius) at a 1400 mm/s target
 -- without delocalizing — a constant 1400 mm/s there does — and laps faster than a constant speed
 -- safe for its curves.
+-- tags: drivers
 local sim = require "pitwall.sim"
 local track = require "pitwall.track"
 local drivers = require "pitwall.drivers"

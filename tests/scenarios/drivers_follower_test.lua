@@ -2,6 +2,7 @@
 -- simulator's ground truth every 5 ms tick, it never closes below its gap (centre-line distance
 -- over its own speed), settles close to it, speeds up when the car ahead does, and keeps the
 -- gap when the car ahead slows down again, stops dead, and drives off.
+-- tags: drivers
 local sim = require "pitwall.sim"
 local track = require "pitwall.track"
 local drivers = require "pitwall.drivers"

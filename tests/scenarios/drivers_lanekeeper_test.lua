@@ -1,5 +1,6 @@
 -- A lane keeper (wrapping a cruiser: the composition pattern) brings its car back to its lane
 -- after someone else changed lanes for it and after it was put back on the track elsewhere.
+-- tags: drivers
 local sim = require "pitwall.sim"
 local track = require "pitwall.track"
 local drivers = require "pitwall.drivers"

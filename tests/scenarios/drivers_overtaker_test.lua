@@ -2,6 +2,7 @@
 -- its own laps, without a collision, and returns to its lane. With a third car alongside the
 -- slow one in the passing lane it does not change lanes (it follows) until the way is clear; in
 -- traffic coming faster in the passing lane it never changes into a car.
+-- tags: drivers
 local sim = require "pitwall.sim"
 local track = require "pitwall.track"
 local drivers = require "pitwall.drivers"

@@ -1,5 +1,6 @@
 -- A lane change reaches the target offset: the car reports it (onOffset, position updates) and
 -- the simulator's ground truth agrees.
+-- tags: sim
 local sim = require "pitwall.sim"
 
 local car = sim.addCar { lane = 1 }

@@ -3,6 +3,7 @@
 -- timer counts a crossing only after most of the lap was driven, so where the two must differ
 -- (a car put back behind the line, a car that backed over it and crossed it again) the test
 -- says so.
+-- tags: track sim
 local sim = require "pitwall.sim"
 local track = require "pitwall.track"
 local localize = require "pitwall.localize"

@@ -2,6 +2,7 @@
 -- equal the ground truth's (crossing to crossing) and the lane's length over the speed, at
 -- four speeds in four lanes; sectors add up; onLap and onBestLap carry the laps. Then 5 % of
 -- the frames are lost: the counts stay exact.
+-- tags: track
 local sim = require "pitwall.sim"
 local track = require "pitwall.track"
 local laps = require "pitwall.laps"

@@ -1,5 +1,6 @@
 -- Laps counted from position updates (34 → 33) match the simulator's ground truth on the oval,
 -- at several speeds and lanes, and lap times match lap length / speed.
+-- tags: track
 local sim = require "pitwall.sim"
 
 local cases = {

@@ -2,6 +2,7 @@
 -- piece and the lane of four cars at four speeds in four lanes, sampled every 12.5 ms; then
 -- with 5 % of the frames lost; while stopping; through lane changes; driving reversed; and
 -- after being lifted and put back elsewhere. The figures printed are those in docs/racing.md.
+-- tags: track
 local sim = require "pitwall.sim"
 local track = require "pitwall.track"
 local localize = require "pitwall.localize"

@@ -1,5 +1,6 @@
 -- A ping comes back as onPing with the round-trip time over the simulator link (two hops of the
 -- link's latency); battery and version requests are answered too.
+-- tags: sim
 local sim = require "pitwall.sim"
 
 local car = sim.addCar {}

@@ -1,5 +1,6 @@
 -- The race director, fixed laps: finish order and laps vs the simulator's ground truth; every car
 -- stopped at the end; results rows; positions and gaps.
+-- tags: race
 local sim = require "pitwall.sim"
 local race = require "pitwall.race"
 local track = require "pitwall.track"

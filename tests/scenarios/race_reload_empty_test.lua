@@ -3,6 +3,7 @@
 -- again — it was carried on through the version that never loaded pitwall.race, and finishes
 -- as one race (grand_prix_saves.lua; no car crosses the line in those 0.3 s, so no lap goes
 -- untimed).
+-- tags: race reload
 local sim = require "pitwall.sim"
 local gp = require "grand_prix_saves"
 

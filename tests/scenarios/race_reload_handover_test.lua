@@ -2,6 +2,7 @@
 -- save mid-race still carries the race — the handover runs after the race's own data is saved,
 -- in an engine call of its own, and the callback budget ends it — and the race finishes as one:
 -- every line crossing of a car is a lap of this race (no second grid, no second start).
+-- tags: race reload
 local sim = require "pitwall.sim"
 
 local cars = { sim.addCar {}, sim.addCar {} }

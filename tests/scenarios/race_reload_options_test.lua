@@ -1,6 +1,7 @@
 -- What a save may change in a race under way: more laps make the race longer; fewer than the
 -- leader has done end it at the leader's next crossing; another kind of session (a timed race
 -- instead of laps) is refused with a warning and the race goes on as it was.
+-- tags: race reload
 local sim = require "pitwall.sim"
 
 local cars = {}

@@ -3,6 +3,7 @@
 -- race does not wait for it — it goes on at once, timed and counted, and the script's call takes
 -- it up 3 s later. Every line crossing is a lap of the one race, and the winner's time is the
 -- same as without the save.
+-- tags: race reload
 local sim = require "pitwall.sim"
 
 local cars = {}

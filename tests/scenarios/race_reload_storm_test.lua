@@ -1,6 +1,7 @@
 -- Saved as often as a user likes: the grand prix is saved every 0.37 s of its whole run — scan
 -- lap, grid, lights, race, the end — every seventh save broken, car 1's cruiser slowed to
 -- 600 mm/s from 4 s after green on. It still finishes as one race (grand_prix_saves.lua).
+-- tags: race reload
 local sim = require "pitwall.sim"
 local gp = require "grand_prix_saves"
 

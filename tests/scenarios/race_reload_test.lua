@@ -1,6 +1,7 @@
 -- The grand prix survives saves of itself: during the scan lap, on the way to the grid, during
 -- the lights, a changed driver speed mid-race, a broken version, and one more. Then it finishes
 -- as one race (grand_prix_saves.lua has the checks).
+-- tags: race reload
 local sim = require "pitwall.sim"
 local gp = require "grand_prix_saves"
 

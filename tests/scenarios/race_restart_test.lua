@@ -2,6 +2,7 @@
 -- the session before is used), and the cars are brought to the grid from wherever they stopped —
 -- two of them put in one lane, one behind the other, so that one must move across. Then a car
 -- that cannot get there: the error names it and says why.
+-- tags: race
 local sim = require "pitwall.sim"
 local race = require "pitwall.race"
 

@@ -1,5 +1,6 @@
 -- Qualifying (best lap wins) gives the grid of a race; results as rows, and as CSV and JSON files
 -- that parse back.
+-- tags: race
 local sim = require "pitwall.sim"
 local race = require "pitwall.race"
 local track = require "pitwall.track"

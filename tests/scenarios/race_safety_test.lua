@@ -1,5 +1,6 @@
 -- Safety: when a car leaves the track, the cars behind it within the safety distance are slowed
 -- (ctx.limit, enforced by the director) until it is back; cars ahead of it are not.
+-- tags: race errors
 local sim = require "pitwall.sim"
 local race = require "pitwall.race"
 local track = require "pitwall.track"

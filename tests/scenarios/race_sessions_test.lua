@@ -1,5 +1,6 @@
 -- Free practice and a timed qualifying: no lights in practice, the default driver (cruiser),
 -- each car's lap under way when the time runs out is its last, best lap first; bad options.
+-- tags: race
 local sim = require "pitwall.sim"
 local race = require "pitwall.race"
 local track = require "pitwall.track"

@@ -1,5 +1,6 @@
 -- The start: lights, green, and a false start (a car that moves before green is stopped, held
 -- for the penalty after green, and flagged in the results).
+-- tags: race
 local sim = require "pitwall.sim"
 local race = require "pitwall.race"
 local track = require "pitwall.track"

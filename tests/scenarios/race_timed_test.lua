@@ -1,5 +1,6 @@
 -- The race director, timed race: when the time runs out the leader's lap under way is its last;
 -- every other car finishes at its next crossing after that. Checked against ground truth.
+-- tags: race
 local sim = require "pitwall.sim"
 local race = require "pitwall.race"
 local track = require "pitwall.track"

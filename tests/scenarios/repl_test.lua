@@ -1,5 +1,6 @@
 -- The REPL's Lua half (pitwall.repl): values pretty-printed without running the user's
 -- metamethods, Tab completion from raw keys and the car metatable, and the `cars` global.
+-- tags: ui
 local sim = require "pitwall.sim"
 local repl = require "pitwall.repl"
 local pretty, show, complete = repl.pretty, repl.show, repl.complete

@@ -1,5 +1,6 @@
 -- What a script may touch (docs/safety.md): code loads as text only, nothing can block the loop or
 -- disarm the callback budget, and the memory a world holds is counted.
+-- tags: errors
 
 -- Lua does not verify bytecode: a patched binary chunk crashes the process. Every way in refuses
 -- binary chunks with a sentence that says so.

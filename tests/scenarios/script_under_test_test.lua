@@ -2,6 +2,7 @@
 -- of the loop with the cars' events, replaced at a given engine time, refused versions counted,
 -- a dying script reported, the cars stopped and handed back to the scenario when it stops; bad
 -- arguments refused with what to do.
+-- tags: reload
 local sim = require "pitwall.sim"
 
 expect.fails(function() sim.reload("x = 1") end, "no script under test to reload")

@@ -2,6 +2,7 @@
 -- the scan, in the outer lane and with 5 % of the frames lost, builds its map; a second car is
 -- then followed on it piece by piece, including after it is lifted and put back among the
 -- look-alike curves.
+-- tags: track
 local sim = require "pitwall.sim"
 local track = require "pitwall.track"
 local localize = require "pitwall.localize"

@@ -1,6 +1,7 @@
 -- A scan lap on the oval builds its map: piece ids, types, turns, count, the finish line and
 -- the lengths per lane; the car stops just past the finish line. track.scan refuses to run
 -- outside a task, and track.fromSim gives the same map without driving.
+-- tags: track
 local sim = require "pitwall.sim"
 local track = require "pitwall.track"
 

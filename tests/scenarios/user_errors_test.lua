@@ -1,6 +1,7 @@
 -- Errors that point at the user (issue 18): an error raised by the Lua library or a binding
 -- names the line of this script that made the call — never a line of scripts/pitwall/ — and an
 -- unknown option, a misspelled method or driver says what was probably meant.
+-- tags: errors
 local sim = require "pitwall.sim"
 local race = require "pitwall.race"
 local track = require "pitwall.track"
