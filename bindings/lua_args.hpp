@@ -131,6 +131,11 @@ inline void checkFunction(lua_State* L, int idx, const char* what) {
 // Message handler for lua_pcall: the error text plus a traceback.
 int traceback(lua_State* L);
 
+// The error message at idx as C text for the handlers: a string (or number) with NUL bytes in it
+// is replaced at idx by one with each NUL written \x00, so no part of it is cut off; nullptr
+// when it is no string.
+const char* errorText(lua_State* L, int idx);
+
 // Pushes `msg` and a traceback of L1 from `level` onto L, as luaL_traceback does; while
 // `libraryFrames` is off (pitwall test without --verbose) only the script's own frames are
 // listed: the library's (scripts/pitwall/) and C functions' are left out.

@@ -1,5 +1,6 @@
 #include "bindings/script_host.hpp"
 
+#include <cstring>
 #include <filesystem>
 
 #include "bindings/car_binding.hpp"
@@ -26,8 +27,26 @@ std::string scriptsDir() {
 }  // namespace
 
 namespace lua {
+const char* errorText(lua_State* L, int idx) {
+  idx = lua_absindex(L, idx);
+  std::size_t len = 0;
+  const char* text = lua_tolstring(L, idx, &len);
+  if (!text || std::strlen(text) == len) return text;
+  luaL_Buffer b;
+  luaL_buffinit(L, &b);
+  for (std::size_t i = 0; i < len; ++i) {
+    if (text[i] == '\0')
+      luaL_addstring(&b, "\\x00");
+    else
+      luaL_addchar(&b, text[i]);
+  }
+  luaL_pushresult(&b);
+  lua_replace(L, idx);
+  return lua_tostring(L, idx);
+}
+
 int traceback(lua_State* L) {
-  const char* msg = lua_tostring(L, 1);
+  const char* msg = errorText(L, 1);
   if (!msg) {
     if (luaL_callmeta(L, 1, "__tostring") && lua_type(L, -1) == LUA_TSTRING) return 1;
     msg = lua_pushfstring(L, "(error object is a %s value)", luaL_typename(L, 1));

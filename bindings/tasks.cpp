@@ -107,7 +107,7 @@ void Tasks::resume(lua_State* co, int nargs) {
     host_.checkMemory();
     error = sandbox::memoryMessage(host_.memory());
   } else if (status != LUA_OK) {
-    const char* msg = lua_tostring(co, -1);
+    const char* msg = lua::errorText(co, -1);
     std::optional<std::string> explained;
     if (msg) explained = lua::explainMissingMethod(co, 0, msg);  // car:setSped → a suggestion
     if (explained) msg = explained->c_str();

@@ -139,6 +139,32 @@ contains "JUnit: the stuck one is an error" "stuck_test error S/stuck_test.lua -
 contains "JUnit: the crash is an error" "crash_test error" "$junit"
 contains "JUnit: the failure's message" "message S/beta_test.lua:7: speed: expected 123, got 0" "$junit"
 contains "JUnit: what it printed" "out beta starts" "$junit"
+# hostile text in what a scenario prints and raises: the XML stays well-formed, TAP one line each
+mkdir -p "$TMP/hostile"
+cat > "$TMP/hostile/hostile_test.lua" <<'LUA'
+print("nul\0 esc\27[31m <![CDATA[ ]]> <&>\"' \255\254 vitesse\r\n")
+for i = 1, 20000 do io.write("flood ", i, "\n") end
+error("bad \0 <xml attr=\"x\"> & ]]> \255 \1\2\3", 0)
+LUA
+$PITWALL test "$TMP/hostile" --junit "$TMP/hostile.xml" >"$TMP/hostile.out" 2>&1
+hostile=$(python3 - "$TMP/hostile.xml" <<'PY'
+import sys, xml.etree.ElementTree as ET
+case = ET.parse(sys.argv[1]).getroot().find("testsuite/testcase")
+out = case.find("system-out").text
+print(case.find("error").get("message"))
+print(out.count("flood "), "<![CDATA[ ]]>" in out, "\\x00" in out)
+PY
+)
+contains "hostile text: the JUnit file parses, the message escaped" 'bad \x00 <xml attr="x"> & ]]> \xff \x01\x02\x03' "$hostile"
+contains "hostile text: every line of a flood kept, the rest escaped" "20000 True True" "$hostile"
+check "hostile text: the failure's report has no control byte (what it printed is its own)" "0" \
+  "$(grep -a '^      ' "$TMP/hostile.out" | tr -d '\n' | LC_ALL=C grep -ac '[[:cntrl:]]')"
+contains "hostile text: the whole message, past a NUL byte" 'bad \x00 <xml attr="x"> & ]]> \xff' \
+  "$(cat "$TMP/hostile.out")"
+$PITWALL test "$TMP/hostile" --tap >"$TMP/hostile.tap" 2>&1
+check "hostile text: every TAP line is a comment, a test point, the plan or YAML" "" \
+  "$(grep -vE '^(# |ok |not ok |TAP version |1\.\.|  )' "$TMP/hostile.tap")"
+
 err=$($PITWALL test "$S/alpha_test.lua" --junit "$TMP/no/such/dir/out.xml" 2>&1); rc=$?
 check "--junit into a missing folder: exit status" 2 "$rc"
 contains "--junit into a missing folder: said before running" "cannot write the file" "$err"
