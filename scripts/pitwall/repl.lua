@@ -361,9 +361,13 @@ local function completions(text)
     names = namesOf(v)
   end
 
+  -- The API, not the internals: names that start with `_` (pitwall._raise, pitwall._setHub)
+  -- only once the underscore is typed.
+  local internal = partial:sub(1, 1) == "_"
   local out = {}
   for name, value in next, names do
-    if name:sub(1, #partial) == partial and (sep ~= ":" or type(value) == "function") then
+    if name:sub(1, #partial) == partial and (sep ~= ":" or type(value) == "function")
+      and (internal or name:sub(1, 1) ~= "_") then
       out[#out + 1] = name
     end
   end

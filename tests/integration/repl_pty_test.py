@@ -146,6 +146,20 @@ def main():
     repl.child.sendintr()
     repl.expect("Ctrl-C drops that line", PROMPT)
 
+    # Tab shows the API, not the internals: _names only once the _ is typed.
+    repl.send("pitwall.\t\t")
+    repl.expect("Tab Tab after pitwall. lists its names, then the line again",
+                r"\n" + ESC + r"after\s[^>]*writeResults[^>]*> pitwall\.")
+    if "_" in repl.child.after:
+        fail("session 1: pitwall.<Tab><Tab> lists internals: " + repl.child.after)
+    print("ok: session 1: pitwall.<Tab><Tab> lists no _name")
+    repl.child.sendintr()
+    repl.expect("Ctrl-C drops the line", PROMPT)
+    repl.send("pitwall._setH\t")
+    repl.expect("with the _ typed, Tab completes an internal", "ub", exact=True)
+    repl.child.sendintr()
+    repl.expect("Ctrl-C drops that line", PROMPT)
+
     # Ctrl-C out of an endless loop: the prompt comes back, the program and the cars go on.
     repl.line("print('spinning') while true do end")
     repl.expect("the endless loop is running", value("spinning"))

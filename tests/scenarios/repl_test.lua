@@ -234,3 +234,11 @@ expect.eq(list(complete("trap1.nested.d")), "trap1.nested.deeper")
 expect.eq(#complete("trap1.hidden.x"), 0, "a missing key is not looked up through __index")
 expect.eq(#complete("trap1:v"), 0)
 expect.eq(triggered, 0, "no metamethod triggered while completing")
+
+-- the API, not the internals: names starting with _ only once the underscore is typed
+expect.falsy(list(complete("pitwall.")):find("_", 1, true), "pitwall.<Tab> offers no _name")
+expect.eq(list(complete("pitwall._setH")), "pitwall._setHub", "typed: offered")
+expect.truthy(#complete("pitwall._") >= 5, "pitwall._<Tab> lists the internals")
+_hiddenGlobal = 1
+expect.eq(list(complete("_hidden")), "_hiddenGlobal", "a global whose name starts with _, typed")
+expect.falsy(list(complete("")):find("_hiddenGlobal", 1, true), "not among all the globals")
