@@ -50,6 +50,7 @@ class Car final : public SimCar {
   void disconnect() override;
   void receive(std::span<const std::uint8_t> frame) override;
   Truth truth() const override;
+  double believedOffset() const override { return offset_ * dir_ + bias_; }
   void lift() override;
   void place(std::size_t piece_index, double offset_mm) override;
 
@@ -71,7 +72,6 @@ class Car final : public SimCar {
 
  private:
   const PieceInfo& here() const { return env_.pieces[piece_]; }
-  double believedOffset() const { return offset_ * dir_ + bias_; }
   void move(double lane_mm);
   void crossBoundary();
   void checkDelocalization();

@@ -70,6 +70,9 @@ class SimCar {
   virtual void receive(std::span<const std::uint8_t> frame) = 0;  // controller → vehicle
 
   virtual Truth truth() const = 0;
+  // The offset the car believes it has (what its next report would say): its true offset
+  // until a set offset re-bases the belief (docs/simulator.md "Believed offset").
+  virtual double believedOffset() const = 0;
   // Test hooks: lift the car off the track (it delocalizes and stops reporting) and put it back.
   virtual void lift() = 0;
   virtual void place(std::size_t piece_index, double offset_mm) = 0;

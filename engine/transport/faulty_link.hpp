@@ -40,6 +40,7 @@ class FaultyLink : public Link {
   std::string address() const override { return inner_.address(); }
   std::string refusal() const override;
   std::optional<double> retryIn() const override { return inner_.retryIn(); }
+  std::optional<double> knownOffset() const override { return inner_.knownOffset(); }
 
   Faults& faults() { return faults_; }
   std::size_t sends() const { return sends_; }

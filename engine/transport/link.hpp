@@ -34,6 +34,10 @@ class Link {
   // Why the last send() returned false, when the link knows more than "not connected": one
   // sentence naming what to do, or empty.
   virtual std::string refusal() const { return {}; }
+  // Where the device stands across the road (mm from the centre, as it believes it) before it
+  // has reported it, when the link knows: a simulated car, where it was put. A real car tells
+  // its offset only in its localization updates, which come once it drives: nullopt.
+  virtual std::optional<double> knownOffset() const { return std::nullopt; }
 
   void onFrame(FrameHandler h) { frameHandler_ = std::move(h); }
   void onState(StateHandler h) { stateHandler_ = std::move(h); }

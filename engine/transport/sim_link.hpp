@@ -25,6 +25,7 @@ class SimLink : public Link {
   bool connected() const override { return connected_; }
   void disconnect() override;
   std::string address() const override;
+  std::optional<double> knownOffset() const override { return car_.believedOffset(); }
   sim::SimCar& car() { return car_; }
 
  private:

@@ -17,6 +17,7 @@ AnkiCar::AnkiCar(Loop& loop, Link& link, CarIdentity identity)
   link_.onFrame([this](std::span<const std::uint8_t> f) { receive(f); });
   link_.onState([this](bool up, const std::string& why) { linkStateChanged(up, why); });
   state_.connected = link_.connected();
+  state_.offset_mm = link_.knownOffset().value_or(0);
 }
 
 std::string AnkiCar::label() const {
@@ -130,6 +131,7 @@ AnkiCar::Sent AnkiCar::disconnect() {
 void AnkiCar::rewind() {
   state_ = CarState{};
   state_.connected = link_.connected();
+  state_.offset_mm = link_.knownOffset().value_or(0);
   pingSentAt_.reset();
   lastPingRtt_.reset();
 }
@@ -220,6 +222,10 @@ void AnkiCar::apply(const Message& message) {
 
 void AnkiCar::linkStateChanged(bool up, const std::string& reason) {
   state_.connected = up;
+  // Before its first position update the offset is where the link knows the car stands (a
+  // simulated car placed since it joined), or what it was.
+  if (up && state_.last_position_time < 0)
+    state_.offset_mm = link_.knownOffset().value_or(state_.offset_mm);
   if (up) {
     // Without SDK mode the car ignores speed and lane commands (anki-overdrive.md "GATT").
     if (auto sent = sdkMode(true); !sent) log::warn(label(), sent.error());

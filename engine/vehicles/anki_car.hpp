@@ -44,7 +44,9 @@ struct CarState {
   int piece = -1;             // road piece id, −1 before the first position update
   int prev_piece = -1;        // piece of the position update before the last one
   int location = -1;
-  double offset_mm = 0;                         // from road centre, as the car believes it
+  // From road centre, as the car believes it: from its reports, and before the first one where
+  // the link knows it stands (a simulated car; Link::knownOffset), else 0.
+  double offset_mm = 0;
   std::optional<double> lane_change_target_mm;  // set while a lane change is under way
   int battery_mv = 0;                           // 0 until known
   bool battery_low = false;

@@ -95,6 +95,13 @@ def main():
     repl.expect("banner names the cars", "pitwall repl: 4 cars", exact=True)
     repl.expect("first prompt", PROMPT)
 
+    # Before any car drove, :cars shows where each stands: the grid's lanes, not 0.
+    repl.line(":cars")
+    repl.expect(":cars: car 1 stands at -68 mm before its first position update",
+                r"1\s+groundshock\s+Groundshock\s+0\s+-\s+-68\.0\s+yes")
+    repl.expect(":cars: car 4 at +68 mm", r"4\s+\S+\s+\S+\s+0\s+-\s+68\.0\s+yes")
+    repl.expect("prompt after :cars", PROMPT)
+
     repl.line("=1+2")
     repl.expect("=1+2 prints 3", value("3"))
     repl.expect("prompt after a value", PROMPT)

@@ -13,6 +13,11 @@ check "piped input with a failing chunk: the rest still runs" "1" "$out"
 contains "the error goes to stderr" "stdin:1: boom" "$(cat "$TMP/err")"
 contains "an unknown command is named" "unknown command :nope" "$(cat "$TMP/err")"
 
+# Before any drive the cars stand where the grid put them (docs/simulator.md), not at 0.
+out=$(printf '=cars[1].offset\n=cars[4].offset\n' | $PITWALL repl 2>"$TMP/err"); rc=$?
+check "offsets before any drive: exit status" 0 "$rc"
+check "offsets before any drive: the grid's outer lanes" $'-68.0\n68.0' "$out"
+
 out=$(printf 'function f(\n' | $PITWALL repl 2>"$TMP/err"); rc=$?
 check "an unfinished chunk at the end of input: exit status" 1 "$rc"
 contains "an unfinished chunk at the end of input: its syntax error" "<eof>" "$(cat "$TMP/err")"

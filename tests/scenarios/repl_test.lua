@@ -158,7 +158,8 @@ cars = nil
 expect.eq(repl.bindCars(), bound, "bound again once the script's is gone")
 
 -- a car, pretty-printed from its fields
-expect.eq(pretty(gs), "<car 1 groundshock: speed 0 mm/s, offset 0 mm, connected>", "before its first position")
+expect.eq(pretty(gs), "<car 1 groundshock: speed 0 mm/s, offset -23 mm, connected>",
+  "before its first position: where the simulator put it (lane 2)")
 gs:setSpeed(600)
 expect.truthy(sim.runUntil(function() return gs.piece ~= nil and gs.speed == 600 end, 10), "moving")
 local function mm(n) return (string.format("%.1f", n):gsub("%.0$", "")) end

@@ -229,3 +229,38 @@ TEST_CASE("a car that joins the fleet after haltAll is halted too") {
   CHECK_FALSE(car.setSpeed(600));
   CHECK(lateLink.sent.empty());
 }
+
+namespace {
+// A link that knows where its car stands, as the simulator's does.
+class PlacedLink : public CaptureLink {
+ public:
+  std::optional<double> knownOffset() const override { return where; }
+  std::optional<double> where = -68.0;
+};
+}  // namespace
+
+TEST_CASE(
+    "a car starts at the offset its link knows, until it reports one; a real link knows none") {
+  Loop loop{ClockKind::Virtual};
+  PlacedLink placed;
+  AnkiCar car{loop, placed, CarIdentity{1, "skull", 9, 42}};
+  CHECK(car.state().offset_mm == -68.0);
+  placed.where = 23.0;  // put elsewhere before it connects
+  placed.setConnected(true);
+  CHECK(car.state().offset_mm == 23.0);
+  PositionUpdate p;
+  p.piece_id = 39;
+  p.offset_mm = 22.0f;
+  placed.carSends(p);
+  CHECK(car.state().offset_mm == 22.0);
+  placed.where = -23.0;  // from now on the car's reports tell
+  placed.setConnected(false);
+  placed.setConnected(true);
+  CHECK(car.state().offset_mm == 22.0);
+  car.rewind();  // a replay back at its start
+  CHECK(car.state().offset_mm == -23.0);
+
+  CaptureLink real;
+  AnkiCar unknown{loop, real, CarIdentity{2, "nuke", 9, 43}};
+  CHECK(unknown.state().offset_mm == 0.0);
+}
