@@ -14,10 +14,11 @@ for _, car in ipairs({ fast, slow }) do
   car.onDelocalized = function(car) print(car.name .. " left the track") end
 end
 
-slow:changeLane(-23)
+-- A lane change needs a moving car (docs/lua-api.md): speed first, then the lane.
 slow:setSpeed(450)
-fast:changeLane(-68)
+slow:changeLane(-23)
 fast:setSpeed(750)
+fast:changeLane(-68)
 
 pitwall.spawn(function()
   local side = 68

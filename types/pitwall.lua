@@ -394,7 +394,7 @@ function Car:battery() end
 ---Cancels the lane change under way.
 function Car:cancelLaneChange() end
 
----Changes lane to `offset` mm from the road centre; needs the car to be moving.
+---Changes lane to `offset` mm from the road centre; needs the car to be moving: refused while it stands, with what to do.
 ---@param offset number −70..70 mm (lanes at about −68, −23, +23, +68)
 ---@param speed? integer lateral mm/s, 0..1500 (default 300)
 ---@param accel? integer lateral mm/s², 0..25000 (default 3000)

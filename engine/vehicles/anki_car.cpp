@@ -52,7 +52,10 @@ AnkiCar::Sent AnkiCar::setSpeed(int speed, int accel, bool respect_limit) {
     return Unexpected{*e};
   auto sent =
       send(SetSpeed{static_cast<int16_t>(speed), static_cast<int16_t>(accel), respect_limit});
-  if (sent) state_.target_speed_mm_s = speed;
+  if (sent) {
+    state_.target_speed_mm_s = speed;
+    speedCommanded_ = true;
+  }
   return sent;
 }
 
@@ -74,10 +77,27 @@ AnkiCar::Sent AnkiCar::changeLane(double offset, int h_speed, int h_accel) {
   if (auto e = checkRange("lane-change acceleration", h_accel, limits::kLaneAccelMin,
                           limits::kLaneAccelMax, "mm/s²"))
     return Unexpected{*e};
-  auto sent = send(ChangeLane{static_cast<uint16_t>(h_speed), static_cast<uint16_t>(h_accel),
-                              static_cast<float>(offset), 0, 0});
+  const ChangeLane message{static_cast<uint16_t>(h_speed), static_cast<uint16_t>(h_accel),
+                           static_cast<float>(offset), 0, 0};
+  if (auto problem = limits::validate(message)) return Unexpected{*problem};  // the offset
+  if (auto e = halted_ ? std::nullopt : standing())  // halted: send() says so
+    return Unexpected{*e + "; " + kLaneChangeNeedsMotion};
+  auto sent = send(message);
   if (sent) state_.lane_change_target_mm = offset;
   return sent;
+}
+
+// A car steers only while it rolls (anki-overdrive.md: lane changes need the car to be moving):
+// a lane change sent to a car that stands would be dropped by a real car, or carried out at
+// some later start, so it is refused here. The car stands when it was last told speed 0, or
+// was told no speed and reports none: a car just told to drive (no report yet) is moving.
+std::optional<std::string> AnkiCar::standing() const {
+  if (!state_.connected || state_.target_speed_mm_s > 0 ||
+      (!speedCommanded_ && state_.speed_mm_s > 0))
+    return std::nullopt;  // not connected: send() says so
+  if (state_.speed_mm_s == 0) return label() + " stands (speed 0 mm/s)";
+  return label() + " was told to stop (target speed 0 mm/s; last reported " +
+         std::to_string(state_.speed_mm_s) + " mm/s)";
 }
 
 AnkiCar::Sent AnkiCar::setOffset(double offset) {

@@ -57,6 +57,11 @@ struct CarState {
   std::map<std::string, ExtraBytes, std::less<>> extra_bytes;  // by message name
 };
 
+// Why a lane change to a car that stands is refused, and what to do (docs/lua-api.md).
+inline constexpr const char* kLaneChangeNeedsMotion =
+    "a lane change needs a moving car (real cars steer only while they roll); setSpeed first "
+    "(300 mm/s or more changes lanes reliably), then changeLane";
+
 // Command defaults (docs/lua-api.md)
 inline constexpr int kDefaultAccel = 1000;      // mm/s²
 inline constexpr int kStopAccel = 12500;        // mm/s², brisk but not a crash stop
@@ -123,12 +128,15 @@ class AnkiCar {
   void keepExtra(const anki::Message& message, std::span<const std::uint8_t> extra);
   void linkStateChanged(bool up, const std::string& reason);
   void laneChangeReached();
+  // Why the car counts as standing (a lane change is refused), or nullopt when it moves.
+  std::optional<std::string> standing() const;
 
   Loop& loop_;
   Link& link_;
   CarIdentity identity_;
   CarState state_;
   bool halted_ = false;
+  bool speedCommanded_ = false;  // a set speed was sent: targetSpeed is what the car was told
   std::optional<double> pingSentAt_;
   std::optional<double> lastPingRtt_;
 };

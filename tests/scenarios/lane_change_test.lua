@@ -33,3 +33,30 @@ expect.fails(function() car:changeLane(150) end,
 expect.fails(function() car:changeLane(-70.5) end, "offset -70.5 mm is out of range -70..70 mm")
 expect.fails(function() car:setOffset(90) end, "offset 90 mm is out of range -70..70 mm")
 expect.eq(car.frames, before, "frames after a refused command")
+
+-- A car that stands takes no lane change (real cars steer only while they roll,
+-- anki-overdrive.md): it is refused with the car, its speed and what to do, and nothing is sent,
+-- so the car does not swerve when it starts later.
+local parked = sim.addCar { lane = 1 }
+local label = string.format("car %d (%s)", parked.number, parked.name)
+local sent = parked.frames
+expect.fails(function() parked:changeLane(68) end,
+  label .. " stands (speed 0 mm/s); a lane change needs a moving car (real cars steer only while "
+  .. "they roll); setSpeed first (300 mm/s or more changes lanes reliably), then changeLane")
+expect.eq(parked.frames, sent, "nothing sent to the standing car")
+expect.falsy(parked.laneChanging)
+parked:setSpeed(500)
+expect.truthy(sim.runUntil(function() return parked.speed > 0 end, 2), "it drives")
+sim.run(3)
+expect.near(sim.truth(parked).offset, -68, 1, "the refused lane change was not carried out later")
+
+-- Told to drive, it may change lanes at once (before it reports any speed) …
+parked:stop()
+expect.truthy(sim.runUntil(function() return sim.truth(parked).speed == 0 end, 2), "stopped")
+parked:setSpeed(500)
+parked:changeLane(-23)
+expect.truthy(sim.runUntil(function() return not parked.laneChanging end, 5), "changed lanes")
+expect.near(sim.truth(parked).offset, -23, 1, "in the new lane")
+-- … and once told to stop, it takes none, even if its last report still said it rolled.
+parked:stop()
+expect.fails(function() parked:changeLane(23) end, label .. " was told to stop (target speed 0 mm/s")

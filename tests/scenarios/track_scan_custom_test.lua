@@ -28,8 +28,8 @@ expect.eq(#map:find(17), 6, "piece 17 occurs six times")
 expect.gt(map.pieces[5]:length(-68), map.pieces[5]:length(68), "right curve: the left lane is outer")
 expect.near(map:lapLength(0), sim.track().lapLength, 0.01, "centre lap")
 
--- Follow another car (the scout parks in the inner lane, out of the way).
-scout:changeLane(-68)
+-- Follow another car (the scout stands in the outer lane where the scan stopped it, out of the
+-- way: a standing car takes no lane change).
 sim.run(3)
 scout:stop()
 local car = sim.addCar { name = "runner", lane = 2, piece = 6 }

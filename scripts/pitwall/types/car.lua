@@ -165,7 +165,7 @@ Commands check their arguments: out of range raises an error naming the range, a
 @param accel? integer mm/s², 0..25000 (default 1000)
 @param respectLimit? boolean respect road-piece limits (default false)]],
       stop = [[Speed 0 at 12500 mm/s².]],
-      changeLane = [[Changes lane to `offset` mm from the road centre; needs the car to be moving.
+      changeLane = [[Changes lane to `offset` mm from the road centre; needs the car to be moving: refused while it stands, with what to do.
 @param offset number −70..70 mm (lanes at about −68, −23, +23, +68)
 @param speed? integer lateral mm/s, 0..1500 (default 300)
 @param accel? integer lateral mm/s², 0..25000 (default 3000)]],

@@ -153,6 +153,7 @@ TEST_CASE_FIXTURE(Fixture, "delocalization and car status are tracked") {
 
 TEST_CASE_FIXTURE(Fixture, "a lane change is under way until the offset update arrives") {
   link.setConnected(true);
+  REQUIRE(car.setSpeed(600));
   REQUIRE(car.changeLane(68));
   CHECK(car.state().lane_change_target_mm == doctest::Approx(68.0));
   link.carSends(OffsetUpdate{68.0f, 0});
@@ -163,6 +164,7 @@ TEST_CASE_FIXTURE(Fixture, "a lane change is under way until the offset update a
 TEST_CASE_FIXTURE(Fixture,
                   "a lane change ends when the car reports itself there, offset update or not") {
   link.setConnected(true);
+  REQUIRE(car.setSpeed(600));
   REQUIRE(car.changeLane(23));
   REQUIRE(car.state().lane_change_target_mm);
   PositionUpdate p;
@@ -180,6 +182,48 @@ TEST_CASE_FIXTURE(Fixture,
   REQUIRE(car.changeLane(68));
   link.setConnected(false);
   CHECK_FALSE(car.state().lane_change_target_mm);  // nor one that lost its link
+}
+
+TEST_CASE_FIXTURE(Fixture,
+                  "a lane change to a car that stands is refused, naming the car, its speed and "
+                  "what to do; nothing is sent") {
+  link.setConnected(true);
+  const auto before = link.sent.size();
+  auto refused = car.changeLane(23);
+  REQUIRE_FALSE(refused);
+  CHECK(refused.error() ==
+        "car 1 (skull) stands (speed 0 mm/s); a lane change needs a moving car (real cars steer "
+        "only while they roll); setSpeed first (300 mm/s or more changes lanes reliably), then "
+        "changeLane");
+  CHECK(link.sent.size() == before);
+  CHECK_FALSE(car.state().lane_change_target_mm);
+
+  SUBCASE("told to drive, before any report: it moves") {
+    REQUIRE(car.setSpeed(600));
+    CHECK(car.changeLane(23));
+  }
+  SUBCASE("told to stop, although its last report still says it rolls: refused") {
+    REQUIRE(car.setSpeed(600));
+    link.carSends(SpeedUpdate{600, 1000, 580});
+    REQUIRE(car.stop());
+    const auto sent = link.sent.size();
+    auto stopped = car.changeLane(-23);
+    REQUIRE_FALSE(stopped);
+    CHECK(stopped.error().starts_with(
+        "car 1 (skull) was told to stop (target speed 0 mm/s; last reported 580 mm/s); a lane "
+        "change needs a moving car"));
+    CHECK(link.sent.size() == sent);
+  }
+  SUBCASE("driven by another controller (it reports a speed it was not told here): it moves") {
+    link.carSends(SpeedUpdate{500, 1000, 480});
+    CHECK(car.changeLane(23));
+  }
+  SUBCASE("a car that is not connected is told so, not that it stands") {
+    link.setConnected(false);
+    auto unconnected = car.changeLane(23);
+    REQUIRE_FALSE(unconnected);
+    CHECK(unconnected.error().find("is not connected") != std::string::npos);
+  }
 }
 
 TEST_CASE_FIXTURE(Fixture, "halt sends the stop and then refuses every command but a disconnect") {
