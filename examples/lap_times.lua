@@ -1,8 +1,9 @@
--- Lap timing on the built-in simulator (or real cars with --ble, once that lands):
--- every car drives at its own speed and lane; each crossing of the finish line prints a lap time.
+-- Lap timing on the built-in simulator or on real cars: every car drives at its own speed and
+-- lane; each crossing of the finish line prints a lap time.
 --
 --   build/pitwall run examples/lap_times.lua            -- real time, about 40 s
 --   build/pitwall run examples/lap_times.lua --fast     -- the same race in a blink
+--   build/pitwall run examples/lap_times.lua --ble      -- real cars (docs/bluetooth.md)
 --
 -- A lap ends when a car's position updates go from piece 34 to piece 33: the finish line lies
 -- between them (docs/lua-api.md, "Track pieces").
