@@ -7,6 +7,7 @@
 #include "engine/cli/options.hpp"
 #include "engine/cli/session.hpp"
 #include "engine/core/log.hpp"
+#include "engine/transport/mqtt_client.hpp"
 
 namespace pitwall::cli {
 
@@ -29,10 +30,30 @@ int bridge(const BridgeOptions& options) {
     session.loop().run();
     return status;
   }
-  log::info("pitwall", "bridging " + std::to_string(session.fleet().cars().size()) + " car" +
-                           (session.fleet().cars().size() == 1 ? "" : "s") + " as host " +
-                           session.bridge()->host() + " on " + options.mqtt.url +
-                           "; Ctrl-C to stop");
+  // "bridging" only once the broker has taken the connection: a broker that is down is waited
+  // for (the client retries with backoff), and the log says so.
+  const std::size_t count = session.fleet().cars().size();
+  const std::string cars = std::to_string(count) + (count == 1 ? " car" : " cars");
+  const std::string host = session.bridge()->host();
+  auto bridging = [&options, cars, host] {
+    log::info("pitwall", "bridging " + cars + " as host " + host + " on " + options.mqtt.url +
+                             "; Ctrl-C to stop");
+  };
+  MqttClient& client = *session.mqtt();
+  if (client.state() == MqttClient::State::Connected) {
+    bridging();
+  } else {
+    const std::string& why = client.lastFailure();
+    log::warn("pitwall", "waiting for the broker at " + options.mqtt.url + " (" +
+                             (why.empty() ? std::string("no answer yet") : why) + "), retrying; " +
+                             (count == 1 ? "the car is" : "the " + cars + " are") +
+                             " bridged once it accepts the connection; Ctrl-C to stop");
+    client.onConnected = [bridgeConnected = client.onConnected, bridging, said = false]() mutable {
+      if (bridgeConnected) bridgeConnected();
+      if (!said) bridging();
+      said = true;
+    };
+  }
   if (options.duration)
     session.loop().after(fromSeconds(*options.duration), [&] {
       log::info("pitwall", "the bridge's duration is over: stopping the cars");

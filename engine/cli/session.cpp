@@ -211,9 +211,13 @@ int Session::startBridge(const MqttSettings& settings, const std::string& hostId
     loop_.stop();
   };
   mqtt_->connect();
-  auto timeout = loop_.after(fromSeconds(source_.mqttTimeout), [this] { loop_.stop(); });
-  loop_.run();
-  loop_.cancel(timeout);
+  // A broker that refuses at once (nobody listens on the port) answers inside connect(): the
+  // loop's stop() came before run(), which would forget it.
+  if (!answered) {
+    auto timeout = loop_.after(fromSeconds(source_.mqttTimeout), [this] { loop_.stop(); });
+    loop_.run();
+    loop_.cancel(timeout);
+  }
   mqtt_->onConnected = previousConnected;
   mqtt_->onDisconnected = nullptr;  // the client logs why; it reconnects by itself
   if (interrupted_) return 130;

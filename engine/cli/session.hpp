@@ -45,6 +45,7 @@ class Session {
   int startBridge(const MqttSettings& mqtt, const std::string& hostId, bool readOnly,
                   const char* command);
   MqttBridge* bridge() { return bridge_.get(); }
+  MqttClient* mqtt() { return mqtt_.get(); }  // the broker's client (bridge, remote cars)
   // From here on SIGINT is someone else's (the REPL's); SIGTERM still ends the run.
   void releaseSigint();
   bool interrupted() const { return interrupted_; }

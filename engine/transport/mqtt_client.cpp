@@ -213,7 +213,8 @@ void MqttClient::startAttempt(bool first) {
                  : mosquitto_reconnect_async(mosq_);
   if (rc != MOSQ_ERR_SUCCESS) {
     // a loopback TLS handshake can fail inside connect_async already
-    return lost("cannot connect to the MQTT broker at " + where() + ": " + describe(rc, errno));
+    std::string why = describe(rc, errno);
+    return lost("cannot connect to the MQTT broker at " + where() + ": " + why, why);
   }
   attachSocket();
   tcpPending_ = true;
@@ -223,9 +224,11 @@ void MqttClient::startAttempt(bool first) {
     attemptTimer_ = 0;
     if (state_ != State::Connecting) return;
     detachSocket();  // mosquitto closes it on the next attempt
-    lost("cannot connect to the MQTT broker at " + where() + ": no answer within " +
-         std::to_string(std::chrono::duration_cast<std::chrono::seconds>(kAttemptTimeout).count()) +
-         " s");
+    std::string why =
+        "no answer within " +
+        std::to_string(std::chrono::duration_cast<std::chrono::seconds>(kAttemptTimeout).count()) +
+        " s";
+    lost("cannot connect to the MQTT broker at " + where() + ": " + why, why);
   });
   scheduleMisc();
   service();
@@ -345,7 +348,8 @@ void MqttClient::report(const std::string& reason, bool retrying) {
   if (onDisconnected) onDisconnected(reason, retrying);
 }
 
-void MqttClient::lost(const std::string& reason) {
+void MqttClient::lost(const std::string& reason, const std::string& why) {
+  failure_ = why;
   if (attemptTimer_) loop_.cancel(attemptTimer_), attemptTimer_ = 0;
   state_ = State::WaitingToReconnect;
   unacknowledged_.clear();
@@ -410,6 +414,7 @@ void MqttClient::handleConnect(mosquitto*, void* self, int rc) {
     // The broker closes the connection next; the disconnect callback must not retry.
     c.refused_ = true;
     c.state_ = State::Failed;
+    c.failure_ = std::string("refused: ") + mosquitto_connack_string(rc);
     c.report("the MQTT broker at " + c.where() +
                  " refused the connection: " + mosquitto_connack_string(rc),
              false);
@@ -417,6 +422,7 @@ void MqttClient::handleConnect(mosquitto*, void* self, int rc) {
   }
   c.state_ = State::Connected;
   c.wasConnected_ = true;
+  c.failure_.clear();
   c.backoff_ = kFirstBackoff;
   c.lastReported_.clear();
   // A clean session forgets subscriptions: every connection makes them again.
@@ -443,7 +449,8 @@ void MqttClient::handleDisconnect(mosquitto*, void* self, int rc) {
   std::string why = c.describe(rc, savedErrno);
   c.lost((c.wasConnected_ ? "lost the connection to the MQTT broker at "
                           : "cannot connect to the MQTT broker at ") +
-         c.where() + ": " + why);
+             c.where() + ": " + why,
+         why);
 }
 
 MqttClient::Batch::Batch(MqttClient& client) : client_(client) {

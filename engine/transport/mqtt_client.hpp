@@ -106,6 +106,9 @@ class MqttClient {
 
   State state() const { return state_; }
   const MqttOptions& options() const { return options_; }
+  // Why the last attempt failed, a phrase ("Connection refused", "no answer within 5 s"); empty
+  // before any failure and once connected.
+  const std::string& lastFailure() const { return failure_; }
 
  private:
   static void handleConnect(mosquitto*, void* self, int rc);
@@ -122,7 +125,8 @@ class MqttClient {
   void arm();
   void failed(int rc);  // a loop call failed without the disconnect callback
   void scheduleMisc();
-  void lost(const std::string& reason);
+  // `why`: the phrase of lastFailure(); `reason` the sentence reported
+  void lost(const std::string& reason, const std::string& why);
   void report(const std::string& reason, bool retrying);
   std::string where() const;
   std::string describe(int rc, int savedErrno) const;  // why a connection failed, a phrase
@@ -141,6 +145,7 @@ class MqttClient {
   Loop::TimerId miscTimer_ = 0, retryTimer_ = 0;
   Duration backoff_ = std::chrono::milliseconds(500);
   std::string lastReported_, lastLogError_;
+  std::string failure_;
   std::map<std::string, int> subscriptions_;
   int batchDepth_ = 0;
   std::set<int> unacknowledged_;  // message ids of QoS 1/2 publications awaiting the broker
