@@ -27,16 +27,63 @@ Tasks::~Tasks() {
 }
 
 void Tasks::spawn(lua_State* L, const std::string& name, bool main) {
+  Task task;
+  task.name = main ? name : "task " + name;
+  start(L, std::move(task), main);
+}
+
+lua_State* Tasks::spawnConsole(lua_State* L, Finished finished) {
+  Task task;
+  task.name = "the chunk typed at the prompt";
+  task.kind = interrupt::Kind::Console;
+  task.finished = std::move(finished);
+  lua_State* co = start(L, std::move(task), false);
+  // Ended at once: its thread was let go after `finished`, and nothing made since can have
+  // its address while it was anchored.
+  return co && tasks_.count(co) ? co : nullptr;
+}
+
+lua_State* Tasks::start(lua_State* L, Task task, bool main) {
   if (host_.isShutDown()) {
     lua_pop(L, 1);
-    return;
+    return nullptr;
   }
   lua_State* co = lua_newthread(L);
-  int ref = luaL_ref(L, LUA_REGISTRYINDEX);  // pops the thread, keeps it alive
-  lua_xmove(L, co, 1);                       // the function
-  tasks_.emplace(co, Task{ref, main ? name : "task " + name, std::nullopt, ++spawned_});
+  task.threadRef = luaL_ref(L, LUA_REGISTRYINDEX);  // pops the thread, keeps it alive
+  task.order = ++spawned_;
+  lua_xmove(L, co, 1);  // the function
+  tasks_.emplace(co, std::move(task));
   if (main) main_ = co;
   resume(co, 0);
+  return co;
+}
+
+std::string Tasks::cancel(lua_State* co) {
+  auto it = tasks_.find(co);
+  if (it == tasks_.end()) return {};
+  if (it->second.wake) loop_.cancel(*it->second.wake);
+  lua_State* L = host_.state();
+  // "stdin:1: interrupted while waiting": the typed line it waited at (not the library's)
+  std::string message = "interrupted while waiting";
+  lua_Debug ar;
+  for (int level = 0; lua_getstack(co, level, &ar); ++level) {
+    if (lua_getinfo(co, "Sl", &ar) && ar.currentline > 0 && !lua::isLibrarySource(ar.source)) {
+      message = std::string(ar.short_src) + ":" + std::to_string(ar.currentline) + ": " + message;
+      break;
+    }
+  }
+  lua::pushTraceback(L, co, message.c_str(), 0);
+  std::string where = lua_tostring(L, -1);
+  lua_pop(L, 1);
+  Task task = std::move(it->second);
+  tasks_.erase(it);
+  {
+    // Closing runs the chunk's to-be-closed variables: Lua code, which Ctrl-C must reach too.
+    interrupt::Scope scope(co, task.kind);
+    closeThread(co);
+  }
+  luaL_unref(L, LUA_REGISTRYINDEX, task.threadRef);
+  return where;
 }
 
 void Tasks::sleep(lua_State* co, Duration delay) {
@@ -91,7 +138,7 @@ void Tasks::resume(lua_State* co, int nargs) {
   int nres = 0;
   int status;
   {
-    interrupt::Scope scope(co, interrupt::Kind::Callback);
+    interrupt::Scope scope(co, tasks_.at(co).kind);
     status = lua_resume(co, L, nargs, &nres);
   }
   std::string error;
@@ -108,22 +155,28 @@ void Tasks::resume(lua_State* co, int nargs) {
     error = sandbox::memoryMessage(host_.memory());
   } else if (status != LUA_OK) {
     const char* msg = lua::errorText(co, -1);
+    if (!msg) msg = lua_pushfstring(co, "(error object is a %s value)", luaL_typename(co, -1));
     std::optional<std::string> explained;
-    if (msg) explained = lua::explainMissingMethod(co, 0, msg);  // car:setSped → a suggestion
+    explained = lua::explainMissingMethod(co, 0, msg);  // car:setSped → a suggestion
     if (explained) msg = explained->c_str();
-    lua::pushTraceback(L, co, msg ? msg : "(error without a message)", 0);
+    lua::pushTraceback(L, co, msg, 0);
     error = lua_tostring(L, -1);
     lua_pop(L, 1);
   }
-  end(co, error);
+  end(co, error, status == LUA_OK ? nres : 0);
 }
 
-void Tasks::end(lua_State* co, const std::string& error) {
+void Tasks::end(lua_State* co, const std::string& error, int nresults) {
   auto it = tasks_.find(co);
-  std::string where = it->second.name;
-  closeThread(co);
-  luaL_unref(host_.state(), LUA_REGISTRYINDEX, it->second.threadRef);
+  Task task = std::move(it->second);
   tasks_.erase(it);
+  // The callback may run Lua and start tasks: the task is out of the map by then, its thread
+  // still anchored (its results are read from its stack).
+  if (task.finished) task.finished(co, nresults, error);
+  closeThread(co);
+  luaL_unref(host_.state(), LUA_REGISTRYINDEX, task.threadRef);
+  const std::string& where = task.name;
+  if (task.finished) return;
   if (co == main_) {
     main_ = nullptr;
     host_.mainEnded(where, error);

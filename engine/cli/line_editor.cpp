@@ -163,23 +163,55 @@ void LineEditor::stop() {
   input_.cancel(ignored);
   resize_.cancel(ignored);
   if (tty_ && started_) {
-    bool promptShown = !inHandler_;
+    bool promptShown = !inHandler_ && !paused_;
     rl_callback_handler_remove();  // puts the terminal back as it was
     if (promptShown) write("\n");  // the prompt stays; the shell goes on below it
   }
+}
+
+void LineEditor::pause() {
+  if (paused_ || stopped_ || !started_) return;
+  paused_ = true;
+  boost::system::error_code ignored;
+  input_.cancel(ignored);  // an armed wait ends (its handler sees it aborted)
+  // Removed inside the line handler, readline shows no prompt when the handler returns; it
+  // also puts the terminal back as it was (echo on), as a shell's child finds it.
+  if (tty_) rl_callback_handler_remove();
+}
+
+void LineEditor::resume() {
+  if (!paused_ || stopped_) return;
+  paused_ = false;
+  if (tty_) {
+    if (!atLineStart_) write("\n");  // the prompt starts on a line of its own
+    rl_callback_handler_install(prompt_.c_str(), lineCallback);  // draws the prompt
+    if (resized_) rl_resize_terminal();
+    resized_ = false;
+  }
+  if (!waiting_) waitInput();
+}
+
+int LineEditor::columns() const {
+  if (!tty_) return 0;
+  int rows = 0, cols = 0;
+  rl_get_screen_size(&rows, &cols);
+  return cols;
 }
 
 void LineEditor::setPrompt(std::string prompt) {
   prompt_ = std::move(prompt);
   // Inside the line handler readline shows the new prompt once the handler returns; at the
   // prompt, the next redisplay does.
-  if (tty_ && started_ && !stopped_) rl_set_prompt(prompt_.c_str());
+  if (tty_ && started_ && !stopped_ && !paused_) rl_set_prompt(prompt_.c_str());
 }
 
 void LineEditor::waitInput() {
+  waiting_ = true;
   input_.async_wait(boost::asio::posix::stream_descriptor::wait_read,
                     [this](const boost::system::error_code& ec) {
-                      if (ec == boost::asio::error::operation_aborted || stopped_) return;
+                      waiting_ = false;
+                      if (ec == boost::asio::error::operation_aborted || stopped_ || paused_)
+                        return;
                       // operation_not_supported: stdin is a regular file or /dev/null, which
                       // epoll cannot wait for; reading those never blocks.
                       if (ec && ec != boost::asio::error::operation_not_supported) {
@@ -191,14 +223,17 @@ void LineEditor::waitInput() {
                         readTerminal();
                       else
                         readPlain();
-                      if (!stopped_) waitInput();
+                      if (!stopped_ && !paused_) waitInput();
                     });
 }
 
 void LineEditor::waitResize() {
   resize_.async_wait([this](const boost::system::error_code& ec, int) {
     if (ec || stopped_) return;
-    rl_resize_terminal();  // the loop only runs this at the prompt, never inside a line handler
+    if (paused_)
+      resized_ = true;  // no prompt to redraw: at resume
+    else
+      rl_resize_terminal();  // the loop only runs this at the prompt, never in a line handler
     waitResize();
   });
 }
@@ -213,7 +248,7 @@ void LineEditor::readTerminal() {
   // as readline's callback interface wants, or it would sit there until the next key.
   do {
     rl_callback_read_char();
-  } while (!stopped_ && inputReady());
+  } while (!stopped_ && !paused_ && inputReady());
 }
 
 void LineEditor::readPlain() {
@@ -285,7 +320,7 @@ void LineEditor::write(std::string_view text) {
 
 void LineEditor::printAbove(std::string_view text) {
   if (text.empty()) return;
-  if (!tty_ || !started_ || stopped_ || inHandler_) {  // no prompt on the screen now
+  if (!tty_ || !started_ || stopped_ || inHandler_ || paused_) {  // no prompt on screen now
     write(text);
     return;
   }
@@ -301,7 +336,7 @@ void LineEditor::printAbove(std::string_view text) {
 }
 
 void LineEditor::cancelLine() {
-  if (!tty_ || !started_ || stopped_ || inHandler_) return;
+  if (!tty_ || !started_ || stopped_ || inHandler_ || paused_) return;
   rl_point = rl_end;
   rl_redisplay();  // the cursor after the typed text, where ^C goes
   write("^C\n");

@@ -53,6 +53,15 @@ class LineEditor {
   // Reads no more; the prompt goes away (quit).
   void stop();
   bool stopped() const { return stopped_; }
+  // While a chunk typed at the prompt waits (pitwall.sleep): no prompt, nothing read (at a
+  // terminal what is typed meanwhile stays in the terminal's buffer and is read after resume),
+  // and printAbove prints plainly. Called from the line handler, or at any time on the loop.
+  void pause();
+  // The prompt again, and reading goes on.
+  void resume();
+  bool paused() const { return paused_; }
+  // The terminal's width in columns; 0 when there is no terminal.
+  int columns() const;
   void setPrompt(std::string prompt);
 
   // Text from elsewhere (events, log lines, a script's print): any number of lines, with or
@@ -84,6 +93,9 @@ class LineEditor {
   bool started_ = false;
   bool stopped_ = false;
   bool inHandler_ = false;   // a line is being handled: readline shows no prompt now
+  bool paused_ = false;      // pause(): readline's handler is removed, nothing is read
+  bool waiting_ = false;     // a wait for input is armed
+  bool resized_ = false;     // the window changed size while paused
   bool atLineStart_ = true;  // what we printed last ended with a newline
   bool historyOk_ = false;   // the history file can be appended to
   bool historyAppended_ = false;

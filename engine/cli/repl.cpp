@@ -23,13 +23,16 @@ namespace {
 constexpr const char* kPrompt = "> ";
 constexpr const char* kMorePrompt = ">> ";
 
-int g_wakeFd = -1;  // the write end of the running Repl's self-pipe
+int g_wakeFd = -1;                         // the write end of the running Repl's self-pipe
+volatile sig_atomic_t g_chunkWaiting = 0;  // a typed chunk waits (pitwall.sleep)
 
 // SIGINT: async-signal-safe only. Lua code running now (a typed chunk, a script's callback) is
-// interrupted; with none running, the loop is told to cancel the line being typed.
+// interrupted; with none running, the loop is told to cancel the line being typed. A typed
+// chunk that waits is Ctrl-C's target even while a script's callback runs: the loop ends it.
 void onInterruptSignal(int) {
   int saved = errno;
-  if (!interrupt::requestFromSignal() && g_wakeFd >= 0) {
+  bool toWaitingChunk = g_chunkWaiting && !interrupt::inConsole();
+  if ((toWaitingChunk || !interrupt::requestFromSignal()) && g_wakeFd >= 0) {
     char byte = 1;
     ssize_t written = ::write(g_wakeFd, &byte, 1);  // a full pipe already says it
     (void)written;
@@ -69,14 +72,16 @@ constexpr const char* kHelp =
     "  =expr                    shows the value of expr (an expression alone does too: 1 + 2)\n"
     "  cars[1], cars.groundshock  the cars, by number and by name: cars[1]:setSpeed(600)\n"
     "  an unfinished chunk (function f() …) goes on at the >> prompt until it is complete\n"
+    "  pitwall.sleep(2)         a chunk runs as a task: it may wait; the prompt returns after\n"
     "Commands (at the start of a chunk):\n"
     "  :cars    the cars: number, name, model, speed, piece, lane offset, connected\n"
     "  :help    this text\n"
     "  :quit    stop the cars and leave (also Ctrl-D at an empty prompt)\n"
     "Keys:\n"
-    "  Tab          completes globals, fields, car methods and events\n"
+    "  Tab          completes globals, fields, car methods and events (_names once _ is typed)\n"
     "  Up, Down     history; Ctrl-R searches it\n"
-    "  Ctrl-C       interrupts the chunk or callback running now; at the prompt, drops the line\n"
+    "  Ctrl-C       interrupts the chunk (also one that waits) or callback running now; at the\n"
+    "               prompt, drops the line\n"
     "  Ctrl-D       at an empty prompt: quit; at the >> prompt: drop the unfinished chunk\n"
     "Lines printed by scripts, events and the log appear above the prompt.\n";
 
@@ -105,6 +110,7 @@ Repl::~Repl() {
   ::sigaction(SIGINT, &oldInt_, nullptr);
   if (editor_.interactive()) ::sigaction(SIGTSTP, &oldTstp_, nullptr);
   g_wakeFd = -1;
+  g_chunkWaiting = 0;
   ::close(wakeWrite_);
   if (editor_.interactive()) {
     console::setWriter({});
@@ -155,6 +161,12 @@ void Repl::worldChanged() {
   moduleWarned_ = false;  // the new world loads pitwall.repl afresh
   print("-- the Lua world was reloaded: `cars` is bound in the new one\n");
   bindCars(world_());
+  if (chunk_) {  // it waited in the old world, which is gone with its tasks
+    chunk_.reset();
+    g_chunkWaiting = 0;
+    fail("the chunk that was waiting at the prompt ended with the old Lua world");
+    carryOn();
+  }
 }
 
 void Repl::waitInterrupt() {
@@ -167,6 +179,7 @@ void Repl::waitInterrupt() {
 }
 
 void Repl::cancel() {
+  if (chunk_) return interruptChunk();
   pending_.clear();
   editor_.setPrompt(kPrompt);
   editor_.cancelLine();
@@ -203,6 +216,7 @@ void Repl::line(const std::string& text) {
 }
 
 void Repl::oneLine(const std::string& text) {
+  if (chunk_) return queued_.push_back(text);  // run once the waiting chunk has ended
   // os.exit, pitwall.stop(): the run is ending; what is typed from now on is not run.
   if (world_().isShutDown()) return;
   if (pending_.empty()) {
@@ -235,19 +249,70 @@ void Repl::oneLine(const std::string& text) {
   run(host, top);
 }
 
-// The compiled chunk is on top of the stack, above `top`.
+// The compiled chunk is on top of the stack, above `top`. It runs as a task (the script's main
+// chunk does too): one that waits pauses the prompt until it ends (finished).
 void Repl::run(ScriptHost& host, int top) {
   lua_State* L = host.state();
   bindCars(host);  // cars that joined since the last chunk are there
-  std::string error;
-  if (!host.callInteractive(0, LUA_MULTRET, error)) {
-    lua_settop(L, top);
-    if (host.exitStatus()) return;  // os.exit: the run is ending, and that is no failure
-    return fail(error);
-  }
-  int count = lua_gettop(L) - top;
-  if (count > 0) show(host, top, count);
+  lua_State* co = host.tasks().spawnConsole(
+      L, [this, &host](lua_State* thread, int nresults, const std::string& error) {
+        finished(host, thread, nresults, error);
+      });
   lua_settop(L, top);
+  if (!co) return;  // it ended at once
+  chunk_ = Waiting{&host, co};
+  g_chunkWaiting = 1;
+  editor_.pause();
+}
+
+// A chunk ended: its values are shown (`nresults` on top of `co`'s stack) or its error.
+void Repl::finished(ScriptHost& host, lua_State* co, int nresults, const std::string& error) {
+  lua_State* L = host.state();
+  const int top = lua_gettop(L);
+  if (!error.empty()) {
+    if (!host.exitStatus()) fail(error);  // os.exit: the run is ending, and that is no failure
+  } else if (nresults > 0) {
+    if (!lua_checkstack(L, nresults + LUA_MINSTACK)) {
+      fail("the chunk returned too many values to show (" + std::to_string(nresults) + ")");
+    } else {
+      lua_xmove(co, L, nresults);
+      show(host, top, nresults);
+    }
+  }
+  lua_settop(L, top);
+  if (chunk_ && chunk_->thread == co) {  // it had waited: the prompt is paused
+    chunk_.reset();
+    g_chunkWaiting = 0;
+    carryOn();
+  }
+}
+
+// Ctrl-C while a chunk waits: it ends where it waited, and the prompt comes back.
+void Repl::interruptChunk() {
+  Waiting waiting = *chunk_;
+  chunk_.reset();
+  g_chunkWaiting = 0;
+  std::string where = waiting.host->tasks().cancel(waiting.thread);
+  fail(where.empty() ? std::string("interrupted") : where);
+  if (editor_.interactive()) queued_.clear();  // the rest of a paste goes with it, as a line would
+  carryOn();
+}
+
+// After a chunk that waited: the lines entered meanwhile, one by one as if typed now, then the
+// end of input if it came, then the prompt again.
+void Repl::carryOn() {
+  while (!chunk_ && !quitting_ && !queued_.empty()) {
+    std::string text = std::move(queued_.front());
+    queued_.pop_front();
+    oneLine(text);
+  }
+  if (chunk_ || quitting_) return;
+  if (queuedEnd_) {
+    queuedEnd_ = false;
+    end();
+    if (chunk_ || quitting_) return;
+  }
+  editor_.resume();
 }
 
 // The `count` values above `top`, shown by pitwall.repl (tostring without it).
@@ -266,6 +331,10 @@ void Repl::show(ScriptHost& host, int top, int count) {
 }
 
 void Repl::end() {
+  if (chunk_) {  // the end of piped input while a chunk waits: after it
+    queuedEnd_ = true;
+    return;
+  }
   if (!pending_.empty()) {
     // As lua.c: an unfinished chunk at the end of input is the syntax error it has.
     ScriptHost& host = world_();

@@ -1,7 +1,8 @@
 #pragma once
 // The Lua prompt of `pitwall repl` (docs/repl.md): chunks typed at a LineEditor are compiled the
-// way lua.c does it (repl_chunk.hpp) and run in the current Lua world with Ctrl-C able to
-// interrupt them; values are shown and words completed by the Lua module `pitwall.repl`.
+// way lua.c does it (repl_chunk.hpp) and run as tasks in the current Lua world, so they may
+// wait (pitwall.sleep), with Ctrl-C able to interrupt them; values are shown and words completed
+// by the Lua module `pitwall.repl`.
 //
 // While the prompt is up, everything printed for the operator (a script's print, io.write,
 // pitwall.stdout, the log) goes above the prompt, and SIGINT is the REPL's: it interrupts the Lua
@@ -9,9 +10,13 @@
 // program and never stops the cars.
 #include <signal.h>
 
+#include <lua.hpp>
+
 #include <array>
 #include <boost/asio/posix/stream_descriptor.hpp>
+#include <deque>
 #include <functional>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -65,6 +70,9 @@ class Repl {
   void cancel();
   void fail(std::string_view message);
   void run(ScriptHost& host, int top);
+  void finished(ScriptHost& host, lua_State* co, int nresults, const std::string& error);
+  void interruptChunk();
+  void carryOn();
   void show(ScriptHost& host, int top, int count);
   void command(std::string_view text);
   void help();
@@ -78,6 +86,15 @@ class Repl {
   Options options_;
   LineEditor editor_;
   std::string pending_;  // the lines of an unfinished chunk
+  // A chunk that waits (pitwall.sleep): the prompt is paused until it ends, and what is
+  // entered meanwhile (the rest of a paste, piped lines, the end of input) is kept for then.
+  struct Waiting {
+    ScriptHost* host;
+    lua_State* thread;
+  };
+  std::optional<Waiting> chunk_;
+  std::deque<std::string> queued_;
+  bool queuedEnd_ = false;
   int failures_ = 0;
   bool started_ = false;
   bool quitting_ = false;

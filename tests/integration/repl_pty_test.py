@@ -167,6 +167,37 @@ def main():
     repl.child.sendintr()
     repl.expect("Ctrl-C drops that line", PROMPT)
 
+    # A chunk runs as a task: pitwall.sleep waits, the prompt comes back after it.
+    repl.line("t0 = pitwall.now() pitwall.sleep(0.5) "
+              "print(string.format('slept %.1f s', pitwall.now() - t0))")
+    try:
+        first = repl.child.expect([PROMPT, "slept 0.5 s"])
+    except (pexpect.TIMEOUT, pexpect.EOF):
+        fail("session 1: pitwall.sleep at the prompt: neither the prompt nor the end of the sleep "
+             "came: " + repl.output()[-800:])
+    if first != 1:
+        fail("session 1: the prompt came back before the chunk's sleep ended")
+    print("ok: session 1: pitwall.sleep(0.5) at the prompt waits; the prompt is not back before")
+    repl.expect("the prompt comes back after the sleep", PROMPT)
+    repl.line("=pitwall.sleep(0.2) or 'woke'")
+    repl.expect("an expression that waits shows its value", value('"woke"'))
+    # What is typed while a chunk waits runs once it is over.
+    repl.line("print('waiting') pitwall.sleep(0.5)")
+    repl.expect("the chunk waits", value("waiting"))
+    repl.line("=6*7")
+    repl.expect("the line typed during the wait runs after it", value("42"))
+    repl.expect("and the prompt is back", PROMPT)
+    # Ctrl-C during a sleep ends the chunk where it waits: it is cancelled, not left running.
+    repl.line("woke = false print('sleeping') pitwall.sleep(0.5) woke = true")
+    repl.expect("the chunk sleeps", value("sleeping"))
+    repl.child.sendintr()
+    repl.expect("Ctrl-C interrupts the sleeping chunk, naming the line it waited at",
+                "stdin:1: interrupted while waiting", exact=True)
+    repl.expect("the prompt comes back", PROMPT)
+    repl.line("pitwall.sleep(1) print('woke: ' .. tostring(woke))")
+    repl.expect("the interrupted chunk never woke up (a second sleep at the prompt works too)",
+                value("woke: false"))
+
     # Ctrl-C out of an endless loop: the prompt comes back, the program and the cars go on.
     repl.line("print('spinning') while true do end")
     repl.expect("the endless loop is running", value("spinning"))
@@ -288,6 +319,8 @@ def main():
     repl.expect("the prompt comes up beside the script", PROMPT)
     repl.line("=type(laps) .. ' ' .. type(speedUp)")
     repl.expect("the script's globals are at hand", value('"number function"'))
+    repl.line("pitwall.sleep(0.2) print('slept beside the script')")
+    repl.expect("sleep works beside a script", value("slept beside the script"))
     repl.line("=speedUp(700)")
     repl.expect("the script's function runs and commands its car", value("700"))
     repl.line("laps = 1000")

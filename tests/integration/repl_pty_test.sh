@@ -18,6 +18,14 @@ out=$(printf '=cars[1].offset\n=cars[4].offset\n' | $PITWALL repl 2>"$TMP/err");
 check "offsets before any drive: exit status" 0 "$rc"
 check "offsets before any drive: the grid's outer lanes" $'-68.0\n68.0' "$out"
 
+# A chunk that waits holds the next line until it is over.
+out=$(printf 'pitwall.sleep(0.5)\n=pitwall.now() >= 0.5\n' | $PITWALL repl 2>"$TMP/err"); rc=$?
+check "piped input with a sleep: exit status" 0 "$rc"
+check "piped input with a sleep: the next line ran after it" "true" "$out"
+out=$(printf 'pitwall.sleep(-1)\n=1\n' | $PITWALL repl 2>"$TMP/err"); rc=$?
+check "a chunk whose sleep fails: exit status" 1 "$rc"
+contains "a chunk whose sleep fails: its error" "pitwall.sleep" "$(cat "$TMP/err")"
+
 out=$(printf 'function f(\n' | $PITWALL repl 2>"$TMP/err"); rc=$?
 check "an unfinished chunk at the end of input: exit status" 1 "$rc"
 contains "an unfinished chunk at the end of input: its syntax error" "<eof>" "$(cat "$TMP/err")"
