@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "bindings/interrupt.hpp"
+#include "bindings/object_types.hpp"
 #include "bindings/script_host.hpp"
 #include "engine/cli/repl_chunk.hpp"
 #include "engine/core/console.hpp"
@@ -72,6 +73,8 @@ constexpr const char* kHelp =
     "  =expr                    shows the value of expr (an expression alone does too: 1 + 2)\n"
     "  cars[1], cars.groundshock  the cars, by number and by name: cars[1]:setSpeed(600)\n"
     "  an unfinished chunk (function f() …) goes on at the >> prompt until it is complete\n"
+    "  help(), help(x)          the API, one line each: help(cars[1]), help(pitwall),\n"
+    "                           help(require \"pitwall.race\"), help(pitwall.after)\n"
     "  pitwall.sleep(2)         a chunk runs as a task: it may wait; the prompt returns after\n"
     "Commands (at the start of a chunk):\n"
     "  :cars    the cars: number, name, model, speed, piece, lane offset, connected\n"
@@ -246,7 +249,26 @@ void Repl::oneLine(const std::string& text) {
   editor_.setPrompt(kPrompt);
   editor_.addHistory(code);  // a multi-line chunk is one entry
   if (chunk.status == ChunkStatus::Invalid) return fail(chunk.error);
+  setEnvironment(host);
   run(host, top);
+}
+
+// The compiled chunk on top of the stack gets the prompt's globals as its _ENV
+// (pitwall.repl's environment: the world's globals, read and written through, and `help`,
+// which scripts do not see). Without the module it keeps the world's.
+void Repl::setEnvironment(ScriptHost& host) {
+  lua_State* L = host.state();
+  const int chunk = lua_gettop(L);
+  if (!pushModuleFunction(host, "environment")) return;
+  lua::pushObjectTypes(L);  // for help: which object a userdata is
+  lua_pushinteger(L, editor_.columns());
+  std::string error;
+  if (!host.callInteractive(2, 1, error)) {
+    print("help is not available: " + firstLine(error) + "\n");
+  } else if (lua_istable(L, -1)) {
+    lua_setupvalue(L, chunk, 1);  // a main chunk's one upvalue is _ENV
+  }
+  lua_settop(L, chunk);
 }
 
 // The compiled chunk is on top of the stack, above `top`. It runs as a task (the script's main

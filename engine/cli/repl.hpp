@@ -1,8 +1,8 @@
 #pragma once
 // The Lua prompt of `pitwall repl` (docs/repl.md): chunks typed at a LineEditor are compiled the
 // way lua.c does it (repl_chunk.hpp) and run as tasks in the current Lua world, so they may
-// wait (pitwall.sleep), with Ctrl-C able to interrupt them; values are shown and words completed
-// by the Lua module `pitwall.repl`.
+// wait (pitwall.sleep), with Ctrl-C able to interrupt them; their globals are the world's, and
+// `help`; values are shown, words completed and help given by the Lua module `pitwall.repl`.
 //
 // While the prompt is up, everything printed for the operator (a script's print, io.write,
 // pitwall.stdout, the log) goes above the prompt, and SIGINT is the REPL's: it interrupts the Lua
@@ -70,6 +70,7 @@ class Repl {
   void cancel();
   void fail(std::string_view message);
   void run(ScriptHost& host, int top);
+  void setEnvironment(ScriptHost& host);
   void finished(ScriptHost& host, lua_State* co, int nresults, const std::string& error);
   void interruptChunk();
   void carryOn();

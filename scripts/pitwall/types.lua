@@ -148,6 +148,16 @@ local function moduleClass(problems, spec, live)
   return table.concat(lines, "\n")
 end
 
+--- The live table an annotated table part describes: `part.live()` (pitwall, pitwall.sim, …)
+--- or the library module `part.module` (required when `load` is not false; else only when
+--- already loaded).
+function types.live(part, load)
+  if part.live then return part.live() end
+  if part.module == nil then return nil end
+  if load == false then return package.loaded[part.module] end
+  return require(part.module)
+end
+
 --- The definition files, path → text ("pitwall.lua", "pitwall/race.lua", …), from
 --- `objectTypes` (registry key → metatable: every registered object type, as
 --- bindings/object_types.cpp gives them) and the live tables of this Lua world. `sources`
@@ -177,7 +187,7 @@ function types.generate(objectTypes, sources)
         end
         chunks[#chunks + 1] = objectClass(problems, part, mt)
       else
-        chunks[#chunks + 1] = moduleClass(problems, part, part.live())
+        chunks[#chunks + 1] = moduleClass(problems, part, types.live(part))
       end
       -- what `require` of the file gives comes last, whichever part names it
       if part.returns then returns[file] = "return " .. part.returns end

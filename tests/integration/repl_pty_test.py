@@ -153,6 +153,36 @@ def main():
     repl.child.sendintr()
     repl.expect("Ctrl-C drops that line", PROMPT)
 
+    # help: the API from the binding's metadata and the annotations, one line each.
+    repl.line("help()")
+    repl.expect("help() says where to start", "help(cars[1])", exact=True)
+    repl.expect("help() names Tab", "Tab", exact=True)
+    repl.expect("prompt after help()", PROMPT)
+    repl.line("help(cars[1])")
+    repl.expect("help(cars[1]) names the car and its class", r"<car 1 groundshock: [^>]*>: pitwall\.Car")
+    repl.expect("help(cars[1]) lists setSpeed with its parameters",
+                "setSpeed(speed, accel?, respectLimit?)", exact=True)
+    repl.expect("help(cars[1]) lists the fields", "fields (car.name, read only):", exact=True)
+    repl.expect("help(cars[1]) lists the events", r"onPosition\s+each location code")
+    repl.expect("prompt after help(cars[1])", PROMPT)
+    if "_setHub" in repl.child.before:
+        fail("session 1: help(cars[1]) shows an internal name: " + repl.child.before)
+    for line in repl.child.before.split("\n"):
+        if len(line.rstrip("\r")) > 120:
+            fail(f"session 1: help(cars[1]) wrote a line wider than the terminal: {line!r}")
+    print("ok: session 1: help(cars[1]): no internals, no line wider than the terminal")
+    repl.line("help(pitwall.sim)")
+    repl.expect("help(pitwall.sim) lists addCar", "pitwall.sim.addCar(spec?)", exact=True)
+    repl.expect("prompt after help(pitwall.sim)", PROMPT)
+    repl.line('help(require "pitwall.race")')
+    repl.expect("help of a library module", "race.laps(options)", exact=True)
+    repl.line("help(pitwall.after)")
+    repl.expect("help of one function: in full", "pitwall.after(delay, fn) -> pitwall.Timer",
+                exact=True)
+    repl.line("help(42)")
+    repl.expect("an unknown value gets one line", "help: no help for number 42", exact=True)
+    repl.expect("prompt after help(42)", PROMPT)
+
     # Tab shows the API, not the internals: _names only once the _ is typed.
     repl.send("pitwall.\t\t")
     repl.expect("Tab Tab after pitwall. lists its names, then the line again",
@@ -166,6 +196,10 @@ def main():
     repl.expect("with the _ typed, Tab completes an internal", "ub", exact=True)
     repl.child.sendintr()
     repl.expect("Ctrl-C drops that line", PROMPT)
+    repl.send("hel\t")
+    repl.expect("Tab completes help, the prompt's own global", "p", exact=True)
+    repl.child.sendintr()
+    repl.expect("Ctrl-C drops the help line", PROMPT)
 
     # A chunk runs as a task: pitwall.sleep waits, the prompt comes back after it.
     repl.line("t0 = pitwall.now() pitwall.sleep(0.5) "
@@ -313,12 +347,17 @@ def main():
                 "car:setSpeed(600)\n"
                 "car.onTransition = function() laps = laps + 1 end\n"
                 "function speedUp(s) car:setSpeed(s) return car.targetSpeed end\n"
+                "function scriptSeesHelp() return help end\n"
                 "pitwall.persist.version = 1\n")
     repl = Session(scratch, history, "run --repl --watch",
                    ("run", script, "--repl", "--watch", "--cars", "1"))
     repl.expect("the prompt comes up beside the script", PROMPT)
     repl.line("=type(laps) .. ' ' .. type(speedUp)")
     repl.expect("the script's globals are at hand", value('"number function"'))
+    repl.line("=type(help) .. ' ' .. type(scriptSeesHelp())")
+    repl.expect("help is the prompt's, not the script's", value('"function nil"'))
+    repl.line("help(pitwall)")
+    repl.expect("help works beside a script", "pitwall.after(delay, fn)", exact=True)
     repl.line("pitwall.sleep(0.2) print('slept beside the script')")
     repl.expect("sleep works beside a script", value("slept beside the script"))
     repl.line("=speedUp(700)")

@@ -26,6 +26,16 @@ out=$(printf 'pitwall.sleep(-1)\n=1\n' | $PITWALL repl 2>"$TMP/err"); rc=$?
 check "a chunk whose sleep fails: exit status" 1 "$rc"
 contains "a chunk whose sleep fails: its error" "pitwall.sleep" "$(cat "$TMP/err")"
 
+# help, piped: nothing is cut (no terminal), every method is there
+out=$(printf 'help(cars[1])\nhelp(pitwall._raise)\n' | $PITWALL repl 2>"$TMP/err"); rc=$?
+check "help piped: exit status" 0 "$rc"
+contains "help piped: a method with its parameters" "setSpeed(speed, accel?, respectLimit?)" "$out"
+contains "help piped: the whole description" "needs the car to be moving: refused while it stands, with what to do." "$out"
+contains "help piped: an internal function gets one line" "help: no help for function: [C]" "$out"
+echo 'print("script sees help: " .. tostring(help))' > "$TMP/sees.lua"
+out=$($PITWALL run "$TMP/sees.lua" --fast --duration 1 2>&1)
+contains "a script does not see help" "script sees help: nil" "$out"
+
 out=$(printf 'function f(\n' | $PITWALL repl 2>"$TMP/err"); rc=$?
 check "an unfinished chunk at the end of input: exit status" 1 "$rc"
 contains "an unfinished chunk at the end of input: its syntax error" "<eof>" "$(cat "$TMP/err")"

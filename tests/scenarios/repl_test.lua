@@ -243,3 +243,94 @@ expect.truthy(#complete("pitwall._") >= 5, "pitwall._<Tab> lists the internals")
 _hiddenGlobal = 1
 expect.eq(list(complete("_hidden")), "_hiddenGlobal", "a global whose name starts with _, typed")
 expect.falsy(list(complete("")):find("_hiddenGlobal", 1, true), "not among all the globals")
+
+---------------------------------------------------------------------------------------------------
+-- the prompt's globals: the world's, and help, which scripts do not see
+local types = { ["pitwall.car"] = debug.getmetatable(gs), ["pitwall.timer"] = debug.getmetatable(timer) }
+local env = repl.environment(types, 0)
+expect.eq(rawget(_G, "help"), nil, "help is no global of the world")
+expect.eq(type(env.help), "function", "but the prompt has it")
+expect.eq(env.pitwall, pitwall, "the world's globals read through")
+local chunk = load("promptMade = 42 return help, pitwall.now ~= nil", "=stdin", "t", env)
+local promptHelp, readPitwall = chunk()
+expect.eq(promptMade, 42, "a global made at the prompt is the world's")
+expect.eq(promptHelp, env.help)
+expect.truthy(readPitwall)
+expect.eq(repl.environment(types, 0), env, "one environment per world")
+expect.eq(list(complete("hel")), "help", "Tab offers help at the prompt")
+rawset(_G, "help", function() return "the script's own" end)
+expect.eq(env.help(), "the script's own", "a script's global help wins")
+rawset(_G, "help", nil)
+
+-- help(x): from the binding's metadata and the LuaLS annotations (scripts/pitwall/types/)
+local carHelp = repl.describe(gs, types, 0)
+local function has(text, needle, what)
+  expect.truthy(text:find(needle, 1, true), (what or needle) .. " in:\n" .. text)
+end
+has(carHelp, "<car 1 groundshock", "the car itself")
+has(carHelp, "pitwall.Car", "its class")
+has(carHelp, "methods (car:name(…)):")
+has(carHelp, "setSpeed(speed, accel?, respectLimit?)  Sets the speed (frame 0x24).")
+has(carHelp, "changeLane(offset, speed?, accel?)")
+has(carHelp, "fields (car.name, read only):")
+has(carHelp, "offset            number  offset from the road centre")
+has(carHelp, "events (car.onX = function(car, e) … end):")
+has(carHelp, "onPosition  ")
+-- one line each: every method, field and event of the metatable is there
+local lines = 0
+for _ in carHelp:gmatch("\n  ") do lines = lines + 1 end
+local mt = debug.getmetatable(gs)
+local expected = #mt.__fields + #mt.__events
+for name in pairs(mt.__methods) do if not name:find("^_") then expected = expected + 1 end end
+expect.eq(lines, expected, "one line per method, field and event")
+expect.falsy(carHelp:find("_setHub", 1, true), "no internals")
+
+local pitwallHelp = repl.describe(pitwall, types, 0)
+has(pitwallHelp, "pitwall.after(delay, fn)  ")
+has(pitwallHelp, "pitwall.sleep(seconds)")
+has(pitwallHelp, "pitwall.onCar  ", "a handler a script may set")
+expect.falsy(pitwallHelp:find("_raise", 1, true), "no internals")
+has(repl.describe(pitwall.sim, types, 0), "pitwall.sim.addCar(spec?)")
+local raceHelp = repl.describe(require "pitwall.race", types, 0)
+has(raceHelp, "race.laps(options)")
+expect.eq(repl.describe("pitwall.race", types, 0), raceHelp, "by its module name")
+expect.eq(repl.describe("race", types, 0), raceHelp, "by its short name")
+has(repl.describe(timer, types, 0), "cancel()  Stops the timer")
+
+-- one function in full
+local afterHelp = repl.describe(pitwall.after, types, 0)
+has(afterHelp, "pitwall.after(delay, fn) -> pitwall.Timer")
+has(afterHelp, "Calls fn() once after `delay` ≥ 0 seconds.")
+has(afterHelp, "delay    number seconds")
+has(repl.describe(gs.setSpeed, types, 0), "car:setSpeed(speed, accel?, respectLimit?)  (pitwall.Car)")
+has(repl.describe("changeLane", types, 0), "−70..70 mm", "a method by name")
+has(repl.describe("pitwall.PositionEvent", types, 0), "piece     integer road piece id", "an event table")
+
+-- lines cut to the terminal's width
+local narrow = repl.describe(gs, types, 60)
+for line in narrow:gmatch("[^\n]+") do
+  if line:find("^  ") then expect.le(utf8.len(line), 60, line) end
+end
+has(narrow, "…", "a long description is cut")
+
+-- what help does not know: one clear line
+local function oneLine(text, needle)
+  expect.falsy(text:find("\n", 1, true), "one line: " .. text)
+  has(text, needle)
+end
+oneLine(repl.describe(nil, types, 0), "help: that is nil")
+oneLine(repl.describe(42, types, 0), "help: no help for number 42")
+oneLine(repl.describe({ 1, 2 }, types, 0), "help: no help for this table")
+oneLine(repl.describe(string.format, types, 0), "string.format is Lua's own")
+oneLine(repl.describe(function() end, types, 0), "it is not part of pitwall's API")
+oneLine(repl.describe("nosuchthing", types, 0), 'nothing in pitwall\'s API is called "nosuchthing"')
+oneLine(repl.describe(gs, nil, 0), "help: no help for userdata")
+
+-- help(): where to start
+local overview = repl.overview(0)
+has(overview, "help(cars[1])")
+has(overview, "help(pitwall)")
+has(overview, "help(pitwall.sim)")
+has(overview, 'help "pitwall.race"')
+has(overview, "pitwall.track")
+has(overview, ":help :cars :quit")

@@ -15,6 +15,24 @@ function repl.bindCars() end
 ---@return string[]
 function repl.complete(text) end
 
+---What help(value) prints: an object's or a module's methods, fields and events one line each, one function in full, else one line saying there is no help.
+---@param value any a car, robot, timer, pitwall table, library module, function, or a string naming one
+---@param objectTypes? table registry key → metatable, to recognise objects
+---@param columns? integer cut lines to this width (default: the terminal's; 0: never)
+---@return string
+function repl.describe(value, objectTypes, columns) end
+
+---The _ENV of chunks typed at the prompt: the world's globals, and `help` where the world has none.
+---@param objectTypes? table registry key → metatable, for help
+---@param columns? integer the terminal's width for help (0: none)
+---@return table
+function repl.environment(objectTypes, columns) end
+
+---What help() prints: where to start.
+---@param columns? integer cut lines to this width (default: the terminal's; 0: never)
+---@return string
+function repl.overview(columns) end
+
 ---A readable string of any value; opts.depth (3), opts.maxItems (50), opts.width (100).
 ---@param value any
 ---@param opts? {depth?: integer, maxItems?: integer, width?: integer}

@@ -1,9 +1,8 @@
 -- Annotations of the Lua library's modules (scripts/pitwall/*.lua: track, localize, laps,
 -- drivers, race, board, repl; docs/racing.md, docs/lua-api.md), for the LuaLS definitions
 -- (scripts/pitwall/types.lua). Each module's functions are checked against the module table
--- `require` returns; the classes of the values they return, and the option tables, are
--- written out here.
-local function module(name) return function() return require(name) end end
+-- `require` of its `module` returns; the classes of the values they return, and the option
+-- tables, are written out here.
 
 return {
   -- pitwall.track ---------------------------------------------------------------------------
@@ -68,7 +67,7 @@ function Map:layout(ids) end
     file = "pitwall/track.lua",
     class = "pitwall.track",
     declare = "local track",
-    live = module("pitwall.track"),
+    module = "pitwall.track",
     returns = "track",
     doc = [[Track mapping (require "pitwall.track"; docs/racing.md "Track mapping").]],
     functions = {
@@ -127,7 +126,7 @@ function Tracker:cancel() end]],
     file = "pitwall/localize.lua",
     class = "pitwall.localize",
     declare = "local localize",
-    live = module("pitwall.localize"),
+    module = "pitwall.localize",
     returns = "localize",
     doc = [[Where a car is on a map (require "pitwall.localize"; docs/racing.md "Localization").]],
     functions = {
@@ -185,7 +184,7 @@ function Timer:cancel() end]],
     file = "pitwall/laps.lua",
     class = "pitwall.laps",
     declare = "local laps",
-    live = module("pitwall.laps"),
+    module = "pitwall.laps",
     returns = "laps",
     doc = [[Lap timing (require "pitwall.laps"; docs/racing.md "Lap timing").]],
     settable = {
@@ -287,7 +286,7 @@ function Handle:stop() end]],
     file = "pitwall/drivers.lua",
     class = "pitwall.drivers",
     declare = "local drivers",
-    live = module("pitwall.drivers"),
+    module = "pitwall.drivers",
     returns = "drivers",
     doc = [[Autonomous drivers and their context (require "pitwall.drivers"; docs/racing.md "Drivers").]],
     functions = {
@@ -373,7 +372,7 @@ function Cruiser:target(car, ctx) end]],
     file = "pitwall/drivers/cruiser.lua",
     class = "pitwall.drivers.cruiser",
     declare = "local cruiser",
-    live = module("pitwall.drivers.cruiser"),
+    module = "pitwall.drivers.cruiser",
     returns = "cruiser",
     doc = [[Drives at a target speed, slower in curves (require "pitwall.drivers.cruiser", drivers.load "cruiser").]],
     fields = {
@@ -402,7 +401,7 @@ function Cruiser:target(car, ctx) end]],
     file = "pitwall/drivers/follower.lua",
     class = "pitwall.drivers.follower",
     declare = "local follower",
-    live = module("pitwall.drivers.follower"),
+    module = "pitwall.drivers.follower",
     returns = "follower",
     doc = [[Cruises, but keeps at least `gap` seconds behind the car ahead in its lane (require "pitwall.drivers.follower").]],
     fields = {
@@ -432,7 +431,7 @@ function Cruiser:target(car, ctx) end]],
     file = "pitwall/drivers/lanekeeper.lua",
     class = "pitwall.drivers.lanekeeper",
     declare = "local lanekeeper",
-    live = module("pitwall.drivers.lanekeeper"),
+    module = "pitwall.drivers.lanekeeper",
     returns = "lanekeeper",
     doc = [[Keeps the car in a lane while an inner driver drives the speed (require "pitwall.drivers.lanekeeper").]],
     fields = {
@@ -463,7 +462,7 @@ function Cruiser:target(car, ctx) end]],
     file = "pitwall/drivers/overtaker.lua",
     class = "pitwall.drivers.overtaker",
     declare = "local overtaker",
-    live = module("pitwall.drivers.overtaker"),
+    module = "pitwall.drivers.overtaker",
     returns = "overtaker",
     doc = [[Cruises in its lane and passes slower cars in another (require "pitwall.drivers.overtaker").]],
     fields = {
@@ -498,7 +497,7 @@ function Cruiser:target(car, ctx) end]],
     file = "pitwall/board.lua",
     class = "pitwall.Board",
     declare = "local Board",
-    live = module("pitwall.board"),
+    module = "pitwall.board",
     returns = "Board",
     doc = [[A table on the terminal that redraws in place (require "pitwall.board").]],
     functions = {
@@ -629,7 +628,7 @@ function Session:abort() end
     file = "pitwall/race.lua",
     class = "pitwall.race",
     declare = "local race",
-    live = module("pitwall.race"),
+    module = "pitwall.race",
     returns = "race",
     doc = [[The race director (require "pitwall.race"; docs/racing.md "Races"). Each session call
 runs a whole session inside a task and returns it when every car has stopped.]],
@@ -672,7 +671,7 @@ runs a whole session inside a task and returns it when every car has stopped.]],
     file = "pitwall/repl.lua",
     class = "pitwall.repl",
     declare = "local repl",
-    live = module("pitwall.repl"),
+    module = "pitwall.repl",
     returns = "repl",
     doc = [[The REPL's Lua half (require "pitwall.repl"; docs/lua-api.md).]],
     functions = {
@@ -688,6 +687,18 @@ runs a whole session inside a task and returns it when every car has stopped.]],
 @return string[] ]],
       bindCars = [[Sets the global `cars` to every car, by number and by name; nil when the script made its own.
 @return table?]],
+      describe = [[What help(value) prints: an object's or a module's methods, fields and events one line each, one function in full, else one line saying there is no help.
+@param value any a car, robot, timer, pitwall table, library module, function, or a string naming one
+@param objectTypes? table registry key → metatable, to recognise objects
+@param columns? integer cut lines to this width (default: the terminal's; 0: never)
+@return string]],
+      overview = [[What help() prints: where to start.
+@param columns? integer cut lines to this width (default: the terminal's; 0: never)
+@return string]],
+      environment = [[The _ENV of chunks typed at the prompt: the world's globals, and `help` where the world has none.
+@param objectTypes? table registry key → metatable, for help
+@param columns? integer the terminal's width for help (0: none)
+@return table]],
     },
   },
 }
