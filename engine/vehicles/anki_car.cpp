@@ -1,6 +1,7 @@
 #include "engine/vehicles/anki_car.hpp"
 
 #include <cmath>
+#include <cstdio>
 
 #include "engine/core/hex.hpp"
 #include "engine/core/log.hpp"
@@ -52,10 +53,7 @@ AnkiCar::Sent AnkiCar::setSpeed(int speed, int accel, bool respect_limit) {
     return Unexpected{*e};
   auto sent =
       send(SetSpeed{static_cast<int16_t>(speed), static_cast<int16_t>(accel), respect_limit});
-  if (sent) {
-    state_.target_speed_mm_s = speed;
-    speedCommanded_ = true;
-  }
+  if (sent) state_.target_speed_mm_s = speed;
   return sent;
 }
 
@@ -89,15 +87,22 @@ AnkiCar::Sent AnkiCar::changeLane(double offset, int h_speed, int h_accel) {
 
 // A car steers only while it rolls (anki-overdrive.md: lane changes need the car to be moving):
 // a lane change sent to a car that stands would be dropped by a real car, or carried out at
-// some later start, so it is refused here. The car stands when it was last told speed 0, or
-// was told no speed and reports none: a car just told to drive (no report yet) is moving.
+// some later start, so it is refused here. The car moves when it was told to drive (even before
+// it reports anything), or when it reported a speed above 0 within the last half second (it
+// rolls, also while it brakes behind another car); a car that stops falls silent and its last
+// report stays, so an older one counts as standing — the rule of drivers.moving.
 std::optional<std::string> AnkiCar::standing() const {
-  if (!state_.connected || state_.target_speed_mm_s > 0 ||
-      (!speedCommanded_ && state_.speed_mm_s > 0))
+  constexpr double kRecent = 0.5;  // seconds
+  const double age = loop_.seconds() - speedReportedAt_;
+  const bool rolling = state_.speed_mm_s > 0 && speedReportedAt_ >= 0 && age <= kRecent;
+  if (!state_.connected || state_.target_speed_mm_s > 0 || rolling)
     return std::nullopt;  // not connected: send() says so
   if (state_.speed_mm_s == 0) return label() + " stands (speed 0 mm/s)";
-  return label() + " was told to stop (target speed 0 mm/s; last reported " +
-         std::to_string(state_.speed_mm_s) + " mm/s)";
+  char text[160];
+  std::snprintf(text, sizeof text,
+                " stands (target speed 0 mm/s; its last report, %d mm/s, is %.1f s old)",
+                static_cast<int>(state_.speed_mm_s), age);
+  return label() + text;
 }
 
 AnkiCar::Sent AnkiCar::setOffset(double offset) {
@@ -210,6 +215,7 @@ void AnkiCar::apply(const Message& message) {
     state_.on_track = true;
     state_.delocalized = false;
     state_.last_position_time = loop_.seconds();
+    speedReportedAt_ = loop_.seconds();
     laneChangeReached();
   } else if (auto* t = std::get_if<TransitionUpdate>(&message)) {
     state_.offset_mm = t->offset_mm;
@@ -225,6 +231,7 @@ void AnkiCar::apply(const Message& message) {
     state_.delocalized = false;
   } else if (auto* s = std::get_if<SpeedUpdate>(&message)) {
     state_.speed_mm_s = s->actual_mm_s;
+    speedReportedAt_ = loop_.seconds();
   } else if (auto* b = std::get_if<BatteryResponse>(&message)) {
     state_.battery_mv = b->millivolts;
   } else if (auto* v = std::get_if<VersionResponse>(&message)) {

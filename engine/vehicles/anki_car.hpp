@@ -136,7 +136,7 @@ class AnkiCar {
   CarIdentity identity_;
   CarState state_;
   bool halted_ = false;
-  bool speedCommanded_ = false;  // a set speed was sent: targetSpeed is what the car was told
+  double speedReportedAt_ = -1;  // loop seconds of the last frame that said the car's speed
   std::optional<double> pingSentAt_;
   std::optional<double> lastPingRtt_;
 };

@@ -57,6 +57,11 @@ parked:setSpeed(500)
 parked:changeLane(-23)
 expect.truthy(sim.runUntil(function() return not parked.laneChanging end, 5), "changed lanes")
 expect.near(sim.truth(parked).offset, -23, 1, "in the new lane")
--- … and once told to stop, it takes none, even if its last report still said it rolled.
+-- … told to stop, it still steers while it rolls (a driver braking behind a slower car), and
+-- takes none once it stands.
 parked:stop()
-expect.fails(function() parked:changeLane(23) end, label .. " was told to stop (target speed 0 mm/s")
+expect.gt(parked.speed, 0, "still rolling just after stop()")
+parked:changeLane(-68)
+expect.truthy(sim.runUntil(function() return sim.truth(parked).speed == 0 end, 3), "it stands")
+sim.run(1)  -- a car that stops falls silent: its last report, older than 0.5 s, is stale
+expect.fails(function() parked:changeLane(23) end, label .. " stands (")

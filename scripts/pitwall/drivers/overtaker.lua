@@ -104,7 +104,7 @@ function Overtaker:update(car, ctx)
     end
   elseif self.state == "home" and not drivers.changing(car) then
     local lead = drivers.aheadIn(ctx, self.home, self.range)
-    if lead and (lead.loc.speed or 0) < speed - self.slower and (car.speed or 0) > 0
+    if lead and (lead.loc.speed or 0) < speed - self.slower and drivers.moving(car)
       and not occupied(ctx, self.home, self.pass, -m, lead.gap + m, speed,
         lead.gap + m + self.range, self:passTime(ctx, lead, speed)) then
       car:changeLane(self.pass, self.lateral)
@@ -115,7 +115,8 @@ function Overtaker:update(car, ctx)
     for _, o in ipairs(ctx:nearby(ctx.map:lapLength(0) / 2 - 1)) do
       if o.car == self.passing and o.gap > -m then behind = false end
     end
-    if behind and not drivers.changing(car)
+    -- back home once past, while the car rolls (one that stands takes no lane change)
+    if behind and not drivers.changing(car) and drivers.moving(car)
       and not occupied(ctx, self.pass, self.home, -m, m, car.speed or 0) then
       car:changeLane(self.home, self.lateral)
       self.state = "back"

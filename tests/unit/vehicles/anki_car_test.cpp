@@ -202,16 +202,17 @@ TEST_CASE_FIXTURE(Fixture,
     REQUIRE(car.setSpeed(600));
     CHECK(car.changeLane(23));
   }
-  SUBCASE("told to stop, although its last report still says it rolls: refused") {
+  SUBCASE("told to stop while it still rolls: it moves; once it reports 0: refused") {
     REQUIRE(car.setSpeed(600));
     link.carSends(SpeedUpdate{600, 1000, 580});
     REQUIRE(car.stop());
+    CHECK(car.changeLane(-23));  // braking, as a follower behind a slower car does
+    link.carSends(SpeedUpdate{0, 12500, 0});
     const auto sent = link.sent.size();
-    auto stopped = car.changeLane(-23);
+    auto stopped = car.changeLane(23);
     REQUIRE_FALSE(stopped);
     CHECK(stopped.error().starts_with(
-        "car 1 (skull) was told to stop (target speed 0 mm/s; last reported 580 mm/s); a lane "
-        "change needs a moving car"));
+        "car 1 (skull) stands (speed 0 mm/s); a lane change needs a moving car"));
     CHECK(link.sent.size() == sent);
   }
   SUBCASE("driven by another controller (it reports a speed it was not told here): it moves") {
