@@ -135,6 +135,9 @@ int traceback(lua_State* L);
 // is replaced at idx by one with each NUL written \x00, so no part of it is cut off; nullptr
 // when it is no string.
 const char* errorText(lua_State* L, int idx);
+// An error that is no string, as text pushed onto L: what its __tostring says (called
+// protected), else "(error object is a TYPE value)".
+const char* errorObjectText(lua_State* L, int idx);
 
 // Pushes `msg` and a traceback of L1 from `level` onto L, as luaL_traceback does; while
 // `libraryFrames` is off (pitwall test without --verbose) only the script's own frames are

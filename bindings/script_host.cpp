@@ -45,6 +45,25 @@ const char* errorText(lua_State* L, int idx) {
   return lua_tostring(L, idx);
 }
 
+namespace {
+int toText(lua_State* L) {
+  luaL_tolstring(L, 1, nullptr);
+  return 1;
+}
+}  // namespace
+
+const char* errorObjectText(lua_State* L, int idx) {
+  idx = lua_absindex(L, idx);
+  if (luaL_getmetafield(L, idx, "__tostring") != LUA_TNIL) {
+    lua_pop(L, 1);
+    lua_pushcfunction(L, toText);
+    lua_pushvalue(L, idx);
+    if (lua_pcall(L, 1, 1, 0) == LUA_OK && lua_type(L, -1) == LUA_TSTRING) return errorText(L, -1);
+    lua_pop(L, 1);
+  }
+  return lua_pushfstring(L, "(error object is a %s value)", luaL_typename(L, idx));
+}
+
 int traceback(lua_State* L) {
   const char* msg = errorText(L, 1);
   if (!msg) {

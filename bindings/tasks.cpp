@@ -155,7 +155,14 @@ void Tasks::resume(lua_State* co, int nargs) {
     error = sandbox::memoryMessage(host_.memory());
   } else if (status != LUA_OK) {
     const char* msg = lua::errorText(co, -1);
-    if (!msg) msg = lua_pushfstring(co, "(error object is a %s value)", luaL_typename(co, -1));
+    if (!msg) {  // its __tostring runs on the host's thread: co died with the error
+      lua_pushvalue(co, -1);
+      lua_xmove(co, L, 1);
+      lua::errorObjectText(L, -1);
+      lua_xmove(L, co, 1);  // the text, kept alive on co
+      lua_pop(L, 1);        // the error's copy
+      msg = lua_tostring(co, -1);
+    }
     std::optional<std::string> explained;
     explained = lua::explainMissingMethod(co, 0, msg);  // car:setSped → a suggestion
     if (explained) msg = explained->c_str();

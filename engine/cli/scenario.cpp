@@ -140,6 +140,11 @@ ScenarioResult runScenario(const std::string& file, const ScenarioSettings& sett
     std::string expected = lastExpectation(session.host().state());
     bool expectation = !expected.empty() && std::string_view(out.message).ends_with(expected);
     out.status = expectation ? ScenarioResult::Status::Failed : ScenarioResult::Status::Errored;
+  } else if (auto exit = session.host().exitStatus()) {
+    out.status = ScenarioResult::Status::Errored;
+    out.message = "the scenario called os.exit(" + std::to_string(*exit) +
+                  "): a scenario passes by returning from its main chunk and fails through expect "
+                  "or error";
   } else if (timedOut && !session.host().mainFinished()) {
     out.status = ScenarioResult::Status::TimedOut;
     char text[160];
@@ -147,6 +152,19 @@ ScenarioResult runScenario(const std::string& file, const ScenarioSettings& sett
                   "still running after %g s of virtual time (raise it with --timeout)",
                   settings.timeout);
     out.message = text;
+    // The test's line: where its main chunk (else its oldest task) waits in its own file.
+    for (const auto& w : out.waiting) {
+      auto at = w.find(" waiting at ");
+      if (at == std::string::npos) continue;
+      std::string_view place = std::string_view(w).substr(at + 12);
+      place = place.substr(0, place.find(" (in "));
+      auto [where, line] = splitLocation(place);
+      if (line > 0 && sameFile(where, file)) {
+        out.file = where;
+        out.line = line;
+        break;
+      }
+    }
   } else {
     out.waiting.clear();
   }

@@ -105,6 +105,11 @@ Result<std::vector<Scenario>, std::string> select(const std::vector<std::string>
   std::vector<Scenario> all, chosen;
   for (const auto& f : files) all.push_back({f, fs::path(f).stem().string(), tagsOf(f)});
   if (filters.empty()) return all;
+  for (const auto& p : filters)
+    if (p.empty())
+      return Unexpected{
+          std::string("--filter \"\": an empty pattern matches every scenario; "
+                      "leave --filter out to run them all")};
   for (const auto& s : all)
     if (std::any_of(filters.begin(), filters.end(), [&](const auto& p) { return matches(s, p); }))
       chosen.push_back(s);
@@ -115,9 +120,18 @@ Result<std::vector<Scenario>, std::string> select(const std::vector<std::string>
     for (const auto& t : s.tags)
       if (std::find(names.begin(), names.end(), t) == names.end()) names.push_back(t);
   }
-  std::string text = "--filter " + printable(filters.front(), 80) + " matches none of the " +
-                     std::to_string(all.size()) + " scenarios";
-  if (!hasWildcard(filters.front())) text += didYouMean(filters.front(), names);
+  std::string text = "--filter " + printable(filters.front(), 80);
+  for (std::size_t i = 1; i < filters.size(); ++i) text += ", " + printable(filters[i], 80);
+  text += (filters.size() > 1 ? " match none of the " : " matches none of the ") +
+          std::to_string(all.size()) + (all.size() == 1 ? " scenario" : " scenarios");
+  for (const auto& p : filters) {
+    std::string hint = hasWildcard(p) ? "" : didYouMean(p, names);
+    if (hint.empty()) continue;
+    text += filters.size() > 1
+                ? hint.substr(0, hint.size() - 1) + " (for " + printable(p, 80) + ")?"
+                : hint;
+    break;
+  }
   return Unexpected{text + " (pitwall test --list shows their names and tags)"};
 }
 
@@ -138,6 +152,32 @@ Result<std::vector<std::uint64_t>, std::string> seedsFor(const std::string& opti
     return Unexpected{"--seed " + printable(option, 40) +
                       ": expected a whole number from 0 to 18446744073709551615, or random"};
   return std::vector<std::uint64_t>(count, seed);
+}
+
+// A path as a shell reads it: as it is when it has only safe characters, else in single quotes.
+std::string shellQuoted(const std::string& text) {
+  if (!text.empty() && text.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                              "0123456789_-./+,:=@%") == std::string::npos)
+    return text;
+  std::string out = "'";
+  for (char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+// The options besides the seed that change how a scenario runs, when not their defaults.
+std::string runOptions(const TestOptions& o) {
+  const TestOptions defaults;
+  std::string out;
+  auto number = [](double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", v);
+    return std::string(text);
+  };
+  if (o.timeout != defaults.timeout) out += " --timeout " + number(o.timeout);
+  if (o.budget != defaults.budget) out += " --budget " + number(o.budget);
+  if (o.luaMemory != defaults.luaMemory) out += " --lua-memory " + std::to_string(o.luaMemory);
+  if (o.verbose) out += " --verbose";
+  return out;
 }
 
 }  // namespace
@@ -198,7 +238,9 @@ int test(const TestOptions& options) {
       },
       [&](std::size_t i, ScenarioResult result) {
         result.seed = (*seeds)[i];
-        reported.push_back({(*scenarios)[i].path, std::move(result)});
+        std::string again = "pitwall test " + shellQuoted((*scenarios)[i].path) + " --seed " +
+                            std::to_string((*seeds)[i]) + runOptions(options);
+        reported.push_back({(*scenarios)[i].path, std::move(result), std::move(again)});
         const ReportedScenario& s = reported.back();
         (s.result.passed() ? passed : failed)++;
         if (options.tap)

@@ -140,6 +140,8 @@ void runInProcesses(std::size_t count, int jobs,
     if (pid == 0) {
       dup2(fileno(c.output), STDOUT_FILENO);
       dup2(fileno(c.output), STDERR_FILENO);
+      // Line by line, as on a terminal: what it printed just before a crash is kept.
+      std::setvbuf(stdout, nullptr, _IOLBF, 0);
       ScenarioResult r = run(i);
       std::cout.flush();
       std::cerr.flush();

@@ -36,8 +36,7 @@ std::string timing(const ScenarioResult& r) {
 }
 
 std::string replay(const ReportedScenario& s) {
-  return "seed " + std::to_string(s.result.seed) + ": pitwall test " + s.path + " --seed " +
-         std::to_string(s.result.seed) + " replays it";
+  return "seed " + std::to_string(s.result.seed) + ": " + printable(s.replay) + " replays it";
 }
 
 std::string testLine(const ScenarioResult& r) {
@@ -96,6 +95,10 @@ std::string xml(std::string_view text) {
   std::string out;
   for (auto l : lines(text)) {
     std::string shown = printable(l);
+    // Well-formed UTF-8 that XML 1.0 still forbids: the noncharacters U+FFFE and U+FFFF.
+    for (std::string_view bad : {"\xEF\xBF\xBE", "\xEF\xBF\xBF"})
+      for (auto at = shown.find(bad); at != std::string::npos; at = shown.find(bad, at))
+        shown.replace(at, bad.size(), bad.back() == '\xBE' ? "\\uFFFE" : "\\uFFFF");
     for (char c : shown) {
       switch (c) {
         case '&':
@@ -156,7 +159,10 @@ void printTapPlan(std::ostream& out, std::size_t count) {
 void printTapPoint(std::ostream& out, std::size_t number, const ReportedScenario& s) {
   const ScenarioResult& r = s.result;
   for (auto l : lines(r.output)) out << "# " << printable(l) << "\n";
-  out << (r.passed() ? "ok " : "not ok ") << number << " - " << printable(s.path) << "\n";
+  std::string description = printable(s.path);  // '#' would start a directive: \#
+  for (auto at = description.find('#'); at != std::string::npos; at = description.find('#', at + 2))
+    description.insert(at, 1, '\\');
+  out << (r.passed() ? "ok " : "not ok ") << number << " - " << description << "\n";
   if (!r.passed()) {
     out << "  ---\n";
     out << "  message: " << yamlString(r.message) << "\n";

@@ -14,6 +14,7 @@ namespace pitwall::cli {
 struct ReportedScenario {
   std::string path;  // as collected: the file the test is
   ScenarioResult result;
+  std::string replay;  // the command that runs it again as it ran (its seed, the run's options)
 };
 
 // The person's report of one scenario: its output, `ok`/`FAIL` with the failure, the test's line,

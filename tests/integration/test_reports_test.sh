@@ -38,6 +38,7 @@ cat > "$S/crash_test.lua" <<'LUA'
 -- Spins until the test kills its process (a crash), once it has said so on the fifo READY.
 local ready = os.getenv("READY")
 if ready then
+  print("the last words before the crash")
   local f = assert(io.open(ready, "w"))
   f:write("spinning\n")
   f:close()
@@ -65,6 +66,12 @@ err=$($PITWALL test "$S" --filter smokr 2>&1); rc=$?
 check "--filter matching nothing: exit status" 2 "$rc"
 contains "--filter matching nothing: named, with the nearest" \
   "--filter smokr matches none of the 6 scenarios; did you mean smoke?" "$err"
+err=$($PITWALL test "$S" --filter zzz --filter raec 2>&1)
+contains "two filters matching nothing: the nearest of either" \
+  "--filter zzz, raec match none of the 6 scenarios; did you mean race (for raec)?" "$err"
+err=$($PITWALL test "$S" --filter "" 2>&1); rc=$?
+check "an empty --filter: exit status" 2 "$rc"
+contains "an empty --filter: said" "an empty pattern matches every scenario" "$err"
 
 # one failed expectation: the test's line and the values; no library frames unless --verbose
 out=$($PITWALL test "$S/beta_test.lua" 2>&1); rc=$?
@@ -84,6 +91,7 @@ contains "stuck: the timeout" "still running after 5 s of virtual time" "$out"
 contains "stuck: the virtual time it was stopped at" "at 5.0 s of virtual time:" "$out"
 contains "stuck: the main chunk's line" "main chunk waiting at $S/stuck_test.lua:5 (in sleep)" "$out"
 contains "stuck: the task's line, inside the library's wait" "stuck_test.lua:3 (in runUntil)" "$out"
+contains "stuck: the replay keeps the run's options" "pitwall test $S/stuck_test.lua --seed 1 --timeout 5 replays it" "$out"
 
 # -j: the same report in the same order as one at a time
 one=$($PITWALL test "$S" -j 1 --timeout 5 2>&1 | sed 's/ in [0-9]* ms)/)/')
@@ -106,6 +114,7 @@ crash=$(cat "$TMP/crash.out")
 contains "the crash is reported with its signal" "FAIL  $S/crash_test.lua (0.0 s simulated" "$crash"
 contains "…and its signal" "the scenario's process crashed: signal 11 (Segmentation fault)" "$crash"
 contains "the scenarios before and after it ran" "1 passed, 2 failed" "$(echo "$crash" | tail -1)"
+contains "what it printed just before the crash is kept" "the last words before the crash" "$crash"
 
 # JUnit XML, as CI systems read it
 $PITWALL test "$S" -j 2 --timeout 5 --junit "$TMP/out.xml" >/dev/null 2>&1
@@ -135,14 +144,14 @@ contains "JUnit: counts (6 tests, 2 failed expectations, 3 errors)" "counts 6 2 
 contains "JUnit: a passing case" "alpha_test passed S/alpha_test.lua -" "$junit"
 contains "JUnit: a failed expectation with file and line" "beta_test failure S/beta_test.lua 7" "$junit"
 contains "JUnit: an error at its line in the test" "gamma_test error S/sub/gamma_test.lua 2" "$junit"
-contains "JUnit: the stuck one is an error" "stuck_test error S/stuck_test.lua -" "$junit"
+contains "JUnit: the stuck one is an error at the line its main chunk waits at" "stuck_test error S/stuck_test.lua 5" "$junit"
 contains "JUnit: the crash is an error" "crash_test error" "$junit"
 contains "JUnit: the failure's message" "message S/beta_test.lua:7: speed: expected 123, got 0" "$junit"
 contains "JUnit: what it printed" "out beta starts" "$junit"
 # hostile text in what a scenario prints and raises: the XML stays well-formed, TAP one line each
 mkdir -p "$TMP/hostile"
 cat > "$TMP/hostile/hostile_test.lua" <<'LUA'
-print("nul\0 esc\27[31m <![CDATA[ ]]> <&>\"' \255\254 vitesse\r\n")
+print("nul\0 esc\27[31m <![CDATA[ ]]> <&>\"' \255\254 vitesse\r\n \u{FFFE}\u{FFFF}")
 for i = 1, 20000 do io.write("flood ", i, "\n") end
 error("bad \0 <xml attr=\"x\"> & ]]> \255 \1\2\3", 0)
 LUA
@@ -164,6 +173,24 @@ contains "hostile text: the whole message, past a NUL byte" 'bad \x00 <xml attr=
 $PITWALL test "$TMP/hostile" --tap >"$TMP/hostile.tap" 2>&1
 check "hostile text: every TAP line is a comment, a test point, the plan or YAML" "" \
   "$(grep -vE '^(# |ok |not ok |TAP version |1\.\.|  )' "$TMP/hostile.tap")"
+
+# the ways a scenario may end otherwise: os.exit fails it; an error object is shown by __tostring;
+# a path with '#' and spaces stays one TAP description and one shell word in the replay
+mkdir -p "$TMP/odd #1 dir"
+cat > "$TMP/odd #1 dir/exit_test.lua" <<'LUA'
+pitwall.after(0.5, function() os.exit(0) end)
+pitwall.sleep(1)
+LUA
+cat > "$TMP/odd #1 dir/object_test.lua" <<'LUA'
+error(setmetatable({}, { __tostring = function() return "a custom error object" end }))
+LUA
+odd=$($PITWALL test "$TMP/odd #1 dir" 2>&1); rc=$?
+check "os.exit and an error object: exit status" 1 "$rc"
+contains "os.exit in a scenario fails it" "the scenario called os.exit(0)" "$odd"
+contains "an error object is shown by its __tostring" "a custom error object" "$odd"
+contains "the replay quotes the path" "pitwall test '$TMP/odd #1 dir/exit_test.lua' --seed 1 replays it" "$odd"
+tap=$($PITWALL test "$TMP/odd #1 dir" --tap 2>&1)
+contains "TAP: a '#' in the description is escaped" "not ok 1 - $TMP/odd \#1 dir/exit_test.lua" "$tap"
 
 err=$($PITWALL test "$S/alpha_test.lua" --junit "$TMP/no/such/dir/out.xml" 2>&1); rc=$?
 check "--junit into a missing folder: exit status" 2 "$rc"
