@@ -810,6 +810,13 @@ local function describeValue(value, objectTypes)
         if part then return describeModule(part, candidate) end
       end
     end
+    for _, name in ipairs({ "string", "table", "math", "io", "os", "coroutine", "utf8", "debug",
+      "package" }) do
+      if rawget(_G, name) == value then
+        return string.format("help: %s is Lua's own library: the Lua 5.4 manual, §6 "
+          .. "(https://www.lua.org/manual/5.4/manual.html#6)", name)
+      end
+    end
     return string.format("help: no help for this table (%s): it is not part of pitwall's API; Tab "
       .. "after its name and a dot lists its keys%s", scalar(value):sub(1, 40), NOTHING)
   elseif t == "function" then
@@ -818,6 +825,10 @@ local function describeValue(value, objectTypes)
       local out = {}  -- one function may have two names (pitwall.sim.run is pitwall.sleep)
       for i, f in ipairs(found) do out[i] = describeFunction(f[1], f[2]) end
       return table.concat(out, "\n\n")
+    end
+    if value == PROMPT_NAMES.help then
+      return "help: help() says where to start; help(x) lists what x has, one line each; help(f) "
+        .. "or help \"name\" shows one in full (docs/repl.md)"
     end
     local std = standardName(value)
     if std then
