@@ -34,11 +34,13 @@ may take before the run fails, never a measure of success.
 
 import argparse
 import asyncio
+import contextlib
 import struct
 import sys
 import time
 
 from bleak import BleakClient, BleakScanner
+from bleak.exc import BleakError
 
 SERVICE_UUID = "be15beef-6186-407e-8381-0bd89c4d8df4"
 READ_CHAR_UUID = "be15bee0-6186-407e-8381-0bd89c4d8df4"
@@ -51,6 +53,7 @@ STEADY_UPDATES = 3  # position updates in a row near SPEED
 LANE_TOLERANCE = 1.0  # mm
 STOP_POLLS = 400  # stop() answers awaited before a car still rolling fails the run
 BOUND = 20.0  # seconds one awaited frame may take before the run fails
+CONNECT_ATTEMPTS = 3  # connections tried before the run fails (see connected())
 
 T0 = time.monotonic()
 
@@ -226,6 +229,28 @@ async def find_car(adapter, address):
             raise Failure(f"no car py-drivesdk takes advertised within {BOUND:.0f} s") from None
 
 
+@contextlib.asynccontextmanager
+async def connected(device):
+    """A connection to `device`, tried up to CONNECT_ATTEMPTS times, as BlueZ applications do
+    (Home Assistant's bleak-retry-connector, for one): a BlueZ link can drop while it is being
+    set up, before the peripheral's GATT server sees it. Under btvirt this happened once in
+    many runs ("failed to discover services, device disconnected", and the car logged no
+    central). Each failed attempt is said; only the last one fails the run."""
+    for attempt in range(1, CONNECT_ATTEMPTS + 1):
+        client = BleakClient(device)
+        try:
+            await client.connect()
+            break
+        except (BleakError, asyncio.TimeoutError) as e:
+            if attempt == CONNECT_ATTEMPTS:
+                raise Failure(f"no connection in {CONNECT_ATTEMPTS} attempts; the last: {e!r}")
+            say(f"connection attempt {attempt} failed ({e!r}); trying again")
+    try:
+        yield client
+    finally:
+        await client.disconnect()
+
+
 async def drive(adapter, address):
     device, adv = await find_car(adapter, address)
     state, version, user_name = interpret_local_name(adv.local_name)
@@ -236,7 +261,7 @@ async def drive(adapter, address):
     if user_name != "pitwall":
         raise Failure(f"the user name read as py-drivesdk does is {user_name!r}, not 'pitwall'")
 
-    async with BleakClient(device) as client:
+    async with connected(device) as client:
         service = client.services.get_service(SERVICE_UUID)
         if service is None:
             raise Failure("the car has no Anki service")
