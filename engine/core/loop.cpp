@@ -77,6 +77,10 @@ void Loop::runVirtual() {
   // trip), but with a guard an empty poll() runs the reactor instead — an epoll_wait syscall per
   // pass, measured twice as slow (docs/performance.md).
   while (!stopped_) {
+    if (passCheck_) {
+      passCheck_();
+      if (stopped_) break;
+    }
     std::size_t ran = io_.poll();
     if (stopped_) break;
     if (io_.stopped()) io_.restart();

@@ -52,6 +52,12 @@ class Loop {
   // Runs fn soon on the loop, after what is already ready, without advancing time.
   void post(Callback fn);
 
+  // A virtual run never sleeps: it calls `check` (if set) once per pass, before it polls. This is
+  // how a signal handler's flag reaches a virtual run without an asynchronous read kept pending,
+  // which would turn every poll into an epoll_wait (docs/performance.md, "--fast"). An empty
+  // function removes it. Real runs never call it.
+  void setPassCheck(Callback check) { passCheck_ = std::move(check); }
+
   // Runs until stop() is called, or until nothing is left that could ever run.
   void run();
   // stop() ends run() after the current callback; it can be called from any callback.
@@ -80,6 +86,7 @@ class Loop {
   TimerId nextId_ = 1;
   bool stopped_ = false;
   std::optional<TimePoint> armedFor_;
+  Callback passCheck_;
 };
 
 }  // namespace pitwall

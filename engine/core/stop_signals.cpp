@@ -42,7 +42,7 @@ void onStopSignal(int sig) {
 
 }  // namespace
 
-StopSignals::StopSignals(Loop& loop) : pipe_(loop.io()) {
+StopSignals::StopSignals(Loop& loop) : loop_(loop), pipe_(loop.io()) {
   int fds[2];
   if (::pipe2(fds, O_CLOEXEC | O_NONBLOCK) != 0)
     throw std::runtime_error(std::string("cannot make the signal pipe: ") + std::strerror(errno));
@@ -59,10 +59,14 @@ StopSignals::StopSignals(Loop& loop) : pipe_(loop.io()) {
   sa.sa_flags = 0;
   ::sigaction(SIGINT, &sa, &oldInt_);
   ::sigaction(SIGTERM, &sa, &oldTerm_);
-  await();
+  if (loop.clockKind() == ClockKind::Virtual)
+    loop.setPassCheck([this] { drain(); });
+  else
+    await();
 }
 
 StopSignals::~StopSignals() {
+  if (loop_.clockKind() == ClockKind::Virtual) loop_.setPassCheck({});
   if (!sigintReleased_) ::sigaction(SIGINT, &oldInt_, nullptr);
   ::sigaction(SIGTERM, &oldTerm_, nullptr);
   g_writeFd.store(-1, std::memory_order_relaxed);
@@ -83,12 +87,27 @@ void StopSignals::await() {
   pipe_.async_read_some(boost::asio::buffer(&byte_, 1),
                         [this](const boost::system::error_code& ec, std::size_t n) {
                           if (ec || n == 0) return;
-                          int sig = static_cast<unsigned char>(byte_);
                           await();
-                          if (sig == SIGINT && sigintReleased_) return;
-                          int count = g_acted.fetch_add(1, std::memory_order_relaxed) + 1;
-                          if (onSignal) onSignal(sig, count);
+                          deliver(static_cast<unsigned char>(byte_));
                         });
+}
+
+void StopSignals::drain() {
+  // One relaxed load per pass while no signal came; the handler counts before it writes, so a
+  // count seen ahead of its byte is read on a later pass.
+  if (g_count.load(std::memory_order_relaxed) == drained_) return;
+  char bytes[16];
+  ssize_t n = ::read(pipe_.native_handle(), bytes, sizeof bytes);
+  for (ssize_t i = 0; i < n; ++i) {
+    ++drained_;
+    deliver(static_cast<unsigned char>(bytes[i]));
+  }
+}
+
+void StopSignals::deliver(int sig) {
+  if (sig == SIGINT && sigintReleased_) return;
+  int count = g_acted.fetch_add(1, std::memory_order_relaxed) + 1;
+  if (onSignal) onSignal(sig, count);
 }
 
 }  // namespace pitwall

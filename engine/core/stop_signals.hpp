@@ -2,8 +2,10 @@
 // SIGINT and SIGTERM for a run (docs/safety.md). The handler does only async-signal-safe work:
 // it counts the signal, calls an async-signal-safe hook (the bindings interrupt the Lua code
 // running now, so a busy callback cannot hold Ctrl-C up), and wakes the loop through a pipe; the
-// loop then calls onSignal. A third signal that the loop has not acted on ends the process at
-// once (_exit 130): the last word when the loop itself is wedged.
+// loop then calls onSignal. A virtual loop, which never sleeps, reads the pipe when the handler's
+// count says there is something in it (Loop::setPassCheck) instead of keeping a read pending. A
+// third signal that the loop has not acted on ends the process at once (_exit 130): the last word
+// when the loop itself is wedged.
 #include <boost/asio/posix/stream_descriptor.hpp>
 #include <csignal>
 #include <functional>
@@ -29,12 +31,16 @@ class StopSignals {
 
  private:
   void await();
+  void drain();  // a virtual loop's pass: the signals the handler counted since the last one
+  void deliver(int sig);
+  Loop& loop_;
   boost::asio::posix::stream_descriptor pipe_;
   int writeFd_ = -1;
   struct sigaction oldInt_ {
   }, oldTerm_{};
   bool sigintReleased_ = false;
   char byte_ = 0;
+  int drained_ = 0;  // signals a virtual loop has read
 };
 
 }  // namespace pitwall

@@ -109,6 +109,24 @@ for sig in INT TERM INT2; do
   expect_stopped "SIG$sig" "$TMP/$sig.jsonl" 2
 done
 
+# The same in a --fast run, which never sleeps: the signal reaches it through the loop's pass
+# check (Loop::setPassCheck), not through a read kept pending on the loop. Without the signal the
+# run would go on for 24 simulated hours (--fast-cap), minutes of wall time.
+for sig in INT TERM; do
+  mkfifo "$TMP/fast.$sig"
+  MODE=none $PITWALL run "$NAGGING" --fast --cars 2 --record "$TMP/fast.$sig.jsonl" \
+    >"$TMP/fast.$sig" 2>/dev/null &
+  pid=$!
+  exec 3<"$TMP/fast.$sig"
+  read -r -t 20 line <&3
+  check "--fast, SIG$sig: the run is driving" "driving" "$line"
+  kill -$sig $pid
+  wait $pid
+  check "--fast, SIG$sig: exit status" 130 $?
+  exec 3<&-
+  expect_stopped "--fast, SIG$sig" "$TMP/fast.$sig.jsonl" 2
+done
+
 # A periodic callback slower than its period (50 ms every 10 ms) does not hold up one-shot timers
 # nor Ctrl-C; and with the callback budget off, neither does one that never returns.
 cat > "$TMP/hog.lua" <<'LUA'
@@ -158,5 +176,20 @@ for spin in slow forever; do
     fail "Ctrl-C beside a $spin hog took $took s"
   expect_stopped "Ctrl-C beside a $spin hog" "$TMP/hog.$spin.jsonl" 2
 done
+
+# --fast beside a callback that never returns (budget off): the handler interrupts the Lua code
+# and the virtual loop, which never sleeps, acts on the signal on its next pass.
+mkfifo "$TMP/hog.fast"
+SPIN=forever $PITWALL run "$TMP/hog.lua" --fast --cars 2 --budget 0 --record "$TMP/hog.fast.jsonl" \
+  >"$TMP/hog.fast" 2>"$TMP/hog.fast.err" &
+pid=$!
+exec 3<"$TMP/hog.fast"
+read -r -t 20 line <&3
+check "--fast: a callback that never returns is running" "hogging" "$line"
+kill -INT $pid
+wait $pid
+check "--fast: Ctrl-C beside a hog: exit status" 130 $?
+exec 3<&-
+expect_stopped "--fast: Ctrl-C beside a hog" "$TMP/hog.fast.jsonl" 2
 
 finish

@@ -113,3 +113,22 @@ TEST_CASE("a timer that reschedules itself for now does not starve posted work (
   CHECK(roundsBeforePost >= 0);
   CHECK(roundsBeforePost < 1000);
 }
+
+TEST_CASE("a virtual run calls its pass check once per pass, and may be stopped from it") {
+  Loop loop(ClockKind::Virtual);
+  std::vector<double> checkedAt;
+  int fired = 0;
+  for (int s = 1; s <= 5; ++s) loop.after(std::chrono::seconds(s), [&] { ++fired; });
+  loop.setPassCheck([&] {
+    checkedAt.push_back(loop.seconds());
+    if (fired == 3) loop.stop();
+  });
+  loop.run();
+  CHECK(fired == 3);               // stopped from the check: the timers at 4 s and 5 s wait
+  CHECK(loop.seconds() == 3.0);    // and virtual time did not move on to them
+  REQUIRE(checkedAt.size() >= 4);  // before each timer fired, and once after the third
+  CHECK(checkedAt.front() == 0.0);
+  loop.setPassCheck({});  // removed: the run goes on to the end
+  loop.run();
+  CHECK(fired == 5);
+}

@@ -1,0 +1,48 @@
+#include "engine/core/stop_signals.hpp"
+
+#include <doctest/doctest.h>
+
+#include <csignal>
+#include <utility>
+#include <vector>
+
+using namespace pitwall;
+using namespace std::chrono_literals;
+
+// A virtual loop never sleeps, so StopSignals keeps no read pending on it: the handler's count
+// is looked at on every pass (Loop::setPassCheck). The signal must reach onSignal all the same,
+// at the virtual time it came, and before any later timer.
+TEST_CASE("stop signals reach a virtual run on its next pass, before later timers") {
+  Loop loop(ClockKind::Virtual);
+  StopSignals signals(loop);
+  std::vector<std::pair<int, int>> got;
+  double at = -1;
+  bool later = false;
+  signals.onSignal = [&](int sig, int count) {
+    got.emplace_back(sig, count);
+    at = loop.seconds();
+    if (count == 2) loop.stop();
+  };
+  loop.after(1s, [] { std::raise(SIGTERM); });
+  loop.after(2s, [] { std::raise(SIGTERM); });
+  loop.after(3s, [&] { later = true; });
+  loop.run();
+  CHECK(got == std::vector<std::pair<int, int>>{{SIGTERM, 1}, {SIGTERM, 2}});
+  CHECK(at == 2.0);
+  CHECK_FALSE(later);
+}
+
+TEST_CASE("stop signals reach a real run through the pipe") {
+  Loop loop(ClockKind::Real);
+  StopSignals signals(loop);
+  int got = 0;
+  signals.onSignal = [&](int sig, int count) {
+    got = sig * 100 + count;
+    loop.stop();
+  };
+  loop.after(10ms, [] { std::raise(SIGTERM); });
+  auto guard = loop.after(20s, [&] { loop.stop(); });  // the test's own bound, not expected
+  loop.run();
+  loop.cancel(guard);
+  CHECK(got == SIGTERM * 100 + 1);
+}
