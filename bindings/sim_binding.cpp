@@ -132,6 +132,11 @@ int addCar(lua_State* L) {
                       "an index into the track's pieces");
     spec.piece_index = static_cast<std::size_t>(piece - 1);
     spec.distance_mm = 0;
+  } else if (index >= sim::gridCapacity(track)) {
+    // the next grid slot would be one a car already stands on
+    throw LuaError("the grid of " + track.name() + " is full (" +
+                   std::to_string(sim::gridCapacity(track)) +
+                   " cars, four on each piece); give this car a place with piece= and lane=");
   }
   lua_pop(L, 1);
   if (lua_getfield(L, 1, "distance") != LUA_TNIL) {

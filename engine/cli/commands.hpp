@@ -26,6 +26,7 @@ struct CarSource {
   std::uint64_t seed = 1;  // the simulator's noise and the script's math.random
   int cars = 4;            // simulated cars on the grid
   std::string track = "oval";
+  bool trackGiven = false;  // --track was on the command line (else: an oval that holds `cars`)
   bool ble = false;
   std::vector<std::string> carAddresses;  // --car ADDR (repeatable): only these; empty: all found
   std::vector<std::string> adapters;      // --adapter hciN (repeatable); empty: every adapter

@@ -7,10 +7,12 @@ namespace pitwall::cli {
 CLI::Option* addCarSource(CLI::App* cmd, CarSource& source, const char* when) {
   cmd->add_option("--seed", source.seed, "Seed of the simulator's and the script's randomness");
   auto* cars =
-      cmd->add_option("--cars", source.cars, "Number of simulated cars on the grid (default 4)")
-          ->check(CLI::Range(0, 64));
+      cmd->add_option("--cars", source.cars,
+                      "Number of simulated cars on the grid (default 4, at most 1000)")
+          ->check(CLI::Range(0, 1000));
   auto* track =
-      cmd->add_option("--track", source.track, "Track layout: a name (oval, …) or a layout file");
+      cmd->add_option("--track", source.track, "Track layout: a name (oval, …) or a layout file")
+          ->each([&source](const std::string&) { source.trackGiven = true; });
   auto* ble = cmd->add_flag("--ble", source.ble,
                             "Drive real cars over Bluetooth LE (BlueZ) instead of the simulator");
   ble->excludes(cars)->excludes(track);  // real cars are on a real track

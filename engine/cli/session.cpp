@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <csignal>
 #include <cstdlib>
 #include <fstream>
@@ -59,6 +60,25 @@ std::unique_ptr<Session> Session::open(const CarSource& source, bool fast, const
     if (!track) {
       std::cerr << "pitwall " << command << ": " << track.error() << "\n";
       return nullptr;
+    }
+    if (source.cars > sim::gridCapacity(*track)) {
+      // A grid that wraps would put cars on top of each other (docs/simulator.md "The grid").
+      std::string fits = std::to_string(source.cars) + " cars do not fit the grid of " +
+                         source.track + ", which holds " +
+                         std::to_string(sim::gridCapacity(*track)) + " (four on each piece)";
+      std::string longer = sim::ovalLayoutFor(source.cars);
+      if (source.trackGiven) {
+        std::cerr << "pitwall " << command << ": " << fits
+                  << "; give a layout of at least " << (source.cars + 3) / 4
+                  << " pieces, or leave out --track for an oval that holds them (" << longer
+                  << ")\n";
+        return nullptr;
+      }
+      track = sim::parseLayout(longer, "oval");
+      char lap[32];
+      std::snprintf(lap, sizeof lap, "%.1f m", track->lapLength(0) / 1000);
+      log::info("pitwall", fits + ": racing on an oval of " + std::to_string(track->size()) +
+                               " pieces instead, " + lap + " a lap");
     }
     session = std::make_unique<Session>(fast ? ClockKind::Virtual : ClockKind::Real,
                                         std::move(*track), source.seed);

@@ -24,4 +24,20 @@ CarSpec gridSpec(const Track& track, int index) {
   return spec;
 }
 
+int gridCapacity(const Track& track) {
+  return 4 * static_cast<int>(track.size());
+}
+
+std::string ovalLayoutFor(int cars) {
+  // start (2 pieces) + a straights + 2 curves + (a + 1) straights + 2 curves = 2a + 7 pieces.
+  int rows = (std::max(cars, 0) + 3) / 4;
+  int a = std::max(1, (rows - 7 + 1) / 2);
+  auto straights = [](int n) {
+    std::string out;
+    for (int i = 0; i < n; ++i) out += " S";
+    return out;
+  };
+  return "start" + straights(a) + " L L" + straights(a + 1) + " L L";
+}
+
 }  // namespace pitwall::sim

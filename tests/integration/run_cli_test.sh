@@ -16,6 +16,31 @@ err=$($PITWALL run "$SRC/examples/lap_times.lua" --track nowhere 2>&1 >/dev/null
 check "unknown track exit status" 2 "$rc"
 contains "unknown track is named" "nowhere" "$err"
 
+# More cars than a grid holds (four per piece, 36 on the oval): on the default track an oval
+# long enough, said in one line; with --track given, an error naming what fits; sim.addCar on a
+# full grid asks for a place.
+cat > "$TMP/many.lua" <<'LUA'
+print("cars", #pitwall.cars())
+local ok, err = pcall(pitwall.sim.addCar, {})
+print("addCar on a full grid:", ok, err)
+print("addCar with a place:", pcall(pitwall.sim.addCar, { piece = 3, lane = 1 }) and "ok")
+LUA
+err=$($PITWALL run "$TMP/many.lua" --fast --duration 1 --cars 50 --track kidney 2>&1 >/dev/null); rc=$?
+check "--cars beyond the --track's grid: exit status" 2 "$rc"
+contains "--cars beyond the --track's grid: names what fits" \
+  "50 cars do not fit the grid of kidney, which holds 44 (four on each piece); give a layout of at least 13 pieces, or leave out --track" "$err"
+out=$($PITWALL run "$TMP/many.lua" --fast --duration 1 --cars 1000 2>"$TMP/many.err"); rc=$?
+check "1000 cars: exit status" 0 "$rc"
+contains "1000 cars: all on the track" "cars	1000" "$out"
+contains "1000 cars: the longer oval is said" \
+  "1000 cars do not fit the grid of oval, which holds 36 (four on each piece): racing on an oval of 251 pieces instead" \
+  "$(cat "$TMP/many.err")"
+out=$($PITWALL run "$TMP/many.lua" --fast --duration 1 --cars 36 2>&1); rc=$?
+check "a full grid: exit status" 0 "$rc"
+contains "sim.addCar on a full grid: the error asks for a place" \
+  "the grid of oval is full (36 cars, four on each piece); give this car a place with piece= and lane=" "$out"
+contains "sim.addCar with a place on a full grid" "addCar with a place:	ok" "$out"
+
 # A 10-minute race of 4 cars in virtual time runs to its end.
 cat > "$TMP/race.lua" <<'LUA'
 local laps = 0

@@ -2,9 +2,12 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <set>
+#include <utility>
 #include <vector>
 
 #include "engine/protocol/anki/codec.hpp"
+#include "engine/sim/grid.hpp"
 #include "engine/sim/world.hpp"
 
 using namespace pitwall;
@@ -354,4 +357,47 @@ TEST_CASE("the same seed and commands give the same frames at the same times") {
   CHECK(first.size() > 500);
   CHECK(first == second);
   CHECK(first != run(100));
+}
+
+// The starting grid (docs/simulator.md "The grid"): four cars on each piece. Slot 36 on the
+// 9-piece oval would stand on slot 0, so a run with more cars races on ovalLayoutFor(N).
+TEST_CASE("a grid holds four cars per piece; ovalLayoutFor(N) is the smallest oval that holds N") {
+  Track oval = namedLayout("oval").value();
+  CHECK(gridCapacity(oval) == 36);
+  CHECK(gridSpec(oval, 36).piece_index == gridSpec(oval, 0).piece_index);  // the wrap
+  CHECK(gridSpec(oval, 36).offset_mm == gridSpec(oval, 0).offset_mm);
+  CHECK(parseLayout(ovalLayoutFor(36)).value().size() == oval.size());  // the oval itself
+  for (int n : {1, 4, 36, 37, 40, 41, 64, 100, 999, 1000}) {
+    CAPTURE(n);
+    Track track = parseLayout(ovalLayoutFor(n)).value();  // closes
+    CHECK(gridCapacity(track) >= n);
+    if (n > 36) CHECK(gridCapacity(track) - n < 8);  // one pair of straights more would be 8 cars
+  }
+}
+
+TEST_CASE("1000 cars on the grid of ovalLayoutFor(1000) drive off without touching") {
+  Loop loop{ClockKind::Virtual};
+  Track track = parseLayout(ovalLayoutFor(1000)).value();
+  World world(loop, track, 1);
+  std::vector<SimCar*> cars;
+  std::set<std::pair<std::size_t, double>> slots;
+  for (int i = 0; i < 1000; ++i) {
+    CarSpec spec = gridSpec(track, i);
+    slots.emplace(spec.piece_index, spec.offset_mm);
+    SimCar& car = world.addCar(std::move(spec));
+    car.connect([](std::span<const std::uint8_t>) {}, [] {});
+    car.receive(anki::encode(anki::SdkMode{true, 1}).span());
+    car.receive(anki::encode(anki::SetSpeed{600, 25000}).span());
+    cars.push_back(&car);
+  }
+  CHECK(slots.size() == 1000);  // every car on a place of its own
+  loop.at(10s, [&] { loop.stop(); });
+  loop.run();
+  int collisions = 0, atSpeed = 0;
+  for (SimCar* car : cars) {
+    collisions += car->truth().collisions;
+    atSpeed += car->truth().speed_mm_s == 600 ? 1 : 0;
+  }
+  CHECK(collisions == 0);
+  CHECK(atSpeed == 1000);
 }
