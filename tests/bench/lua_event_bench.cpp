@@ -153,6 +153,21 @@ struct Floor {
   }
 };
 
+// 256 position updates in which piece, location, offset and speed all change from one to the next.
+std::array<anki::Frame, 256> everyFieldFrames() {
+  std::array<anki::Frame, 256> frames;
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    anki::PositionUpdate m;
+    m.location_id = static_cast<std::uint8_t>(i);
+    m.piece_id = static_cast<std::uint8_t>(17 + i % 7);
+    m.offset_mm = -68.0f + static_cast<float>(i % 5) * 0.5f;
+    m.speed_mm_s = static_cast<std::uint16_t>(600 + i % 11);
+    m.parsing_flags = 0x07;
+    frames[i] = anki::encode(m);
+  }
+  return frames;
+}
+
 void BM_FrameToLuaCallback(benchmark::State& state) {
   PathRig rig(kPathHandler);
   if (!rig.healthy()) {
@@ -179,16 +194,7 @@ void BM_FrameToLuaCallbackEveryFieldChanging(benchmark::State& state) {
     state.SkipWithError(rig.error.c_str());
     return;
   }
-  std::array<anki::Frame, 256> frames;
-  for (std::size_t i = 0; i < frames.size(); ++i) {
-    anki::PositionUpdate m;
-    m.location_id = static_cast<std::uint8_t>(i);
-    m.piece_id = static_cast<std::uint8_t>(17 + i % 7);
-    m.offset_mm = -68.0f + static_cast<float>(i % 5) * 0.5f;
-    m.speed_mm_s = static_cast<std::uint16_t>(600 + i % 11);
-    m.parsing_flags = 0x07;
-    frames[i] = anki::encode(m);
-  }
+  auto frames = everyFieldFrames();
   std::size_t i = 0;
   for (auto _ : state) rig.car.receive(frames[i++ & 0xff].span());
   if (!rig.healthy()) state.SkipWithError(rig.error.c_str());
@@ -232,21 +238,26 @@ struct ThreadCpuClock {
 
 // Path and floor interleaved in blocks within one benchmark, so that both see the same machine
 // state (frequency, caches, noisy neighbours), each block timed in thread CPU time. Reports
-// path_ns, floor_ns and ratio = path/floor, and full_floor_ns: the floor doing all the Lua work
-// of the binding (see BM_FrameToLuaFloorFullEvent below).
+// path_ns, floor_ns and ratio = path/floor (the typical event: the location changes), every_ns
+// and every_ratio = every/floor (piece, location, offset and speed all change; the target of
+// issue 20 is against the same floor), and full_floor_ns: the floor doing all the Lua work of
+// the binding (see BM_FrameToLuaFloorFullEvent below).
 void BM_FrameToLuaRatio(benchmark::State& state) {
   using Clock = ThreadCpuClock;
   constexpr int kBlock = 512;
   PathRig rig(kPathHandler);
+  PathRig every(kPathHandler);
   Floor floor(Floor::Fields::Three);
   Floor full(Floor::Fields::Full);
-  if (!rig.healthy() || !floor.error.empty() || !full.error.empty()) {
+  if (!rig.healthy() || !every.healthy() || !floor.error.empty() || !full.error.empty()) {
     state.SkipWithError(!rig.error.empty() ? rig.error.c_str() : "the floor's Lua did not load");
     return;
   }
   anki::Frame frame = positionFrame();
+  auto frames = everyFieldFrames();
   std::uint8_t location = 0;
-  Clock::duration pathTime{}, floorTime{}, fullTime{};
+  std::size_t next = 0;
+  Clock::duration pathTime{}, floorTime{}, fullTime{}, everyTime{};
   bool ok = true;
   for (auto _ : state) {
     auto t0 = Clock::now();
@@ -265,11 +276,14 @@ void BM_FrameToLuaRatio(benchmark::State& state) {
       ok &= full.event(frame.span());
     }
     auto t3 = Clock::now();
+    for (int i = 0; i < kBlock; ++i) every.car.receive(frames[next++ & 0xff].span());
+    auto t4 = Clock::now();
     pathTime += t1 - t0;
     floorTime += t2 - t1;
     fullTime += t3 - t2;
+    everyTime += t4 - t3;
   }
-  if (!ok || !rig.healthy()) {
+  if (!ok || !rig.healthy() || !every.healthy()) {
     state.SkipWithError(ok ? rig.error.c_str() : "the floor's Lua call failed");
     return;
   }
@@ -281,6 +295,8 @@ void BM_FrameToLuaRatio(benchmark::State& state) {
   state.counters["floor_ns"] = perEvent(floorTime);
   state.counters["full_floor_ns"] = perEvent(fullTime);
   state.counters["ratio"] = perEvent(pathTime) / perEvent(floorTime);
+  state.counters["every_ns"] = perEvent(everyTime);
+  state.counters["every_ratio"] = perEvent(everyTime) / perEvent(floorTime);
 }
 BENCHMARK(BM_FrameToLuaRatio);
 

@@ -20,6 +20,7 @@
 #include "engine/sim/grid.hpp"
 #include "engine/sim/track.hpp"
 #include "engine/sim/world.hpp"
+#include "tests/bench/scripts.hpp"
 #include "tests/support/sim_cars.hpp"
 
 namespace {
@@ -159,28 +160,6 @@ void BM_SimulatorLaps(benchmark::State& state) {
 }
 BENCHMARK(BM_SimulatorLaps)->Arg(4)->Arg(64)->UseRealTime()->Unit(benchmark::kMillisecond);
 
-// A realistic script: per car, a lap counter with lap times kept in onPosition handlers.
-constexpr const char* kLapCounter = R"lua(
-laps, best = {}, {}
-for _, car in ipairs(pitwall.cars()) do
-  local last, lapStart = nil, nil
-  laps[car] = 0
-  car.onPosition = function(car, ev)
-    -- the finish line lies between pieces 34 and 33
-    if ev.piece == 33 and last == 34 then
-      if lapStart then
-        local t = ev.time - lapStart
-        if not best[car] or t < best[car] then best[car] = t end
-      end
-      lapStart = ev.time
-      laps[car] = laps[car] + 1
-    end
-    last = ev.piece
-  end
-  car:setSpeed(800)
-end
-)lua";
-
 // Lap counts seen by the script must match the simulator's own (±1: the script counts at the
 // first position update after the line, the simulator at the line).
 void checkLapCounts(SimRig& rig) {
@@ -204,7 +183,7 @@ void checkLapCounts(SimRig& rig) {
 
 void BM_SimulatorLapsWithLua(benchmark::State& state) {
   SimRig rig(static_cast<int>(state.range(0)));
-  if (rig.error.empty()) rig.startScript(kLapCounter);
+  if (rig.error.empty()) rig.startScript(bench::kLapCounter);
   if (rig.error.empty()) rig.runFor(5);
   if (!rig.error.empty()) {
     state.SkipWithError(rig.error.c_str());

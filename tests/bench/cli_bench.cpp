@@ -1,0 +1,177 @@
+// The command line as a user runs it (issue 20): `pitwall run` and `pitwall test` as child
+// processes of this benchmark, measured from outside with wait4's rusage (CPU time user and
+// system, peak memory) and the wall clock. The binary is the one beside this benchmark's build
+// tree (build/pitwall for build/tests/bench/pitwall_bench); it finds its data as usual.
+//
+// BM_CliFast: `pitwall run LAPS --fast --duration 6000 --cars 4 -q`, LAPS the lap-counting script
+//   of BM_SimulatorLapsWithLua/4 (scripts.hpp): counters sim_s_per_cpu_s (to set against the
+//   in-process benchmark's) and sys_share (system time ÷ CPU time).
+// BM_CliRealTime/N: `pitwall run DRIVE --cars N --duration 10 -q` in real time, DRIVE setting
+//   every car to 700 mm/s: cpu_share (CPU time ÷ wall time, 1 = one core) and peak_mb.
+// BM_CliMemory/N: the same in virtual time (--fast, 60 simulated seconds): peak_mb only.
+// BM_ScenarioSuite: `pitwall test tests/scenarios -j 2`: the wall time (manual time).
+#include <benchmark/benchmark.h>
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "tests/bench/scripts.hpp"
+
+extern char** environ;
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Child {
+  bool ok = false;
+  std::string error;
+  double wall = 0, user = 0, sys = 0, peakMb = 0;
+};
+
+fs::path pitwallBinary() {
+  return fs::canonical("/proc/self/exe").parent_path().parent_path().parent_path() / "pitwall";
+}
+
+// Runs `pitwall ARGS…` with stdout and stderr to /dev/null; status 0 expected.
+Child runPitwall(const std::vector<std::string>& args) {
+  Child c;
+  std::string exe = pitwallBinary().string();
+  std::vector<char*> argv{exe.data()};
+  std::vector<std::string> copy = args;
+  for (auto& a : copy) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, 2, "/dev/null", O_WRONLY, 0);
+  auto began = std::chrono::steady_clock::now();
+  pid_t pid = 0;
+  int rc = posix_spawn(&pid, exe.c_str(), &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (rc != 0) {
+    c.error = "cannot start " + exe;
+    return c;
+  }
+  int status = 0;
+  rusage usage{};
+  if (wait4(pid, &status, 0, &usage) != pid) {
+    c.error = "wait4 failed";
+    return c;
+  }
+  c.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
+  c.user = static_cast<double>(usage.ru_utime.tv_sec) + usage.ru_utime.tv_usec / 1e6;
+  c.sys = static_cast<double>(usage.ru_stime.tv_sec) + usage.ru_stime.tv_usec / 1e6;
+  c.peakMb = static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB
+  c.ok = WIFEXITED(status) && WEXITSTATUS(status) == 0;
+  if (!c.ok) c.error = exe + " ended with status " + std::to_string(WEXITSTATUS(status));
+  return c;
+}
+
+// A script file in the temporary folder, removed with the object.
+struct ScriptFile {
+  fs::path path;
+  explicit ScriptFile(const char* name, const char* text)
+      : path(fs::temp_directory_path() / (std::string("pitwall_bench_") + name)) {
+    std::ofstream(path) << text;
+  }
+  ~ScriptFile() {
+    std::error_code ignored;
+    fs::remove(path, ignored);
+  }
+};
+
+constexpr const char* kDrive = "for _, car in ipairs(pitwall.cars()) do car:setSpeed(700) end\n";
+
+void BM_CliFast(benchmark::State& state) {
+  constexpr double kSimSeconds = 6000;
+  ScriptFile script("laps.lua", pitwall::bench::kLapCounter);
+  double cpu = 0, sys = 0, wall = 0;
+  for (auto _ : state) {
+    Child c = runPitwall(
+        {"run", script.path.string(), "--fast", "--duration", "6000", "--cars", "4", "-q"});
+    if (!c.ok) {
+      state.SkipWithError(c.error.c_str());
+      return;
+    }
+    state.SetIterationTime(c.wall);
+    cpu += c.user + c.sys;
+    sys += c.sys;
+    wall += c.wall;
+  }
+  double runs = static_cast<double>(state.iterations());
+  state.counters["sim_s_per_cpu_s"] = kSimSeconds * runs / cpu;
+  state.counters["sys_share"] = sys / cpu;
+  state.counters["cpu_s"] = cpu / runs;
+}
+BENCHMARK(BM_CliFast)->Iterations(3)->UseManualTime()->Unit(benchmark::kMillisecond);
+
+void BM_CliRealTime(benchmark::State& state) {
+  ScriptFile script("drive.lua", kDrive);
+  std::string cars = std::to_string(state.range(0));
+  double cpu = 0, wall = 0, peak = 0;
+  for (auto _ : state) {
+    Child c = runPitwall({"run", script.path.string(), "--cars", cars, "--duration", "10", "-q"});
+    if (!c.ok) {
+      state.SkipWithError(c.error.c_str());
+      return;
+    }
+    state.SetIterationTime(c.wall);
+    cpu += c.user + c.sys;
+    wall += c.wall;
+    peak = std::max(peak, c.peakMb);
+  }
+  state.counters["cpu_share"] = cpu / wall;
+  state.counters["peak_mb"] = peak;
+}
+BENCHMARK(BM_CliRealTime)->Arg(1000)->Iterations(1)->UseManualTime()->Unit(benchmark::kSecond);
+
+void BM_CliMemory(benchmark::State& state) {
+  ScriptFile script("drive.lua", kDrive);
+  std::string cars = std::to_string(state.range(0));
+  double peak = 0;
+  for (auto _ : state) {
+    Child c = runPitwall(
+        {"run", script.path.string(), "--fast", "--cars", cars, "--duration", "60", "-q"});
+    if (!c.ok) {
+      state.SkipWithError(c.error.c_str());
+      return;
+    }
+    state.SetIterationTime(c.wall);
+    peak = std::max(peak, c.peakMb);
+  }
+  state.counters["peak_mb"] = peak;
+}
+BENCHMARK(BM_CliMemory)
+    ->Arg(8)
+    ->Arg(1000)
+    ->Iterations(1)
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond);
+
+void BM_ScenarioSuite(benchmark::State& state) {
+  std::string scenarios = PITWALL_SOURCE_DIR "/tests/scenarios";
+  double cpu = 0;
+  for (auto _ : state) {
+    Child c = runPitwall({"test", scenarios, "-j", "2"});
+    if (!c.ok) {
+      state.SkipWithError(c.error.c_str());
+      return;
+    }
+    state.SetIterationTime(c.wall);
+    cpu += c.user + c.sys;
+  }
+  state.counters["cpu_s"] = cpu / static_cast<double>(state.iterations());
+}
+BENCHMARK(BM_ScenarioSuite)->Iterations(3)->UseManualTime()->Unit(benchmark::kMillisecond);
+
+}  // namespace
