@@ -76,6 +76,8 @@ class Loop {
   void runReal();
 
   ClockKind kind_;
+  // Locking stays on (no BOOST_ASIO_CONCURRENCY_HINT_UNSAFE): asio's resolver completes from a
+  // thread of its own, and with the hint the robots' TCP and UDP links broke.
   boost::asio::io_context io_;
   boost::asio::steady_timer wake_;
   std::chrono::steady_clock::time_point epoch_;
