@@ -17,6 +17,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
@@ -92,64 +93,66 @@ struct ScriptFile {
 
 constexpr const char* kDrive = "for _, car in ipairs(pitwall.cars()) do car:setSpeed(700) end\n";
 
+// What the runs of one benchmark used, summed over its iterations.
+struct Totals {
+  double wall = 0, cpu = 0, sys = 0, peakMb = 0;
+};
+
+// Runs `pitwall ARGS…` once per iteration (the iteration's time is the child's wall time); false,
+// with the benchmark skipped and the reason, when a run failed.
+bool runEach(benchmark::State& state, const std::vector<std::string>& args, Totals& t) {
+  for (auto _ : state) {
+    Child c = runPitwall(args);
+    if (!c.ok) {
+      state.SkipWithError(c.error.c_str());
+      return false;
+    }
+    state.SetIterationTime(c.wall);
+    t.wall += c.wall;
+    t.cpu += c.user + c.sys;
+    t.sys += c.sys;
+    t.peakMb = std::max(t.peakMb, c.peakMb);
+  }
+  return true;
+}
+
 void BM_CliFast(benchmark::State& state) {
   constexpr double kSimSeconds = 6000;
   ScriptFile script("laps.lua", pitwall::bench::kLapCounter);
-  double cpu = 0, sys = 0, wall = 0;
-  for (auto _ : state) {
-    Child c = runPitwall(
-        {"run", script.path.string(), "--fast", "--duration", "6000", "--cars", "4", "-q"});
-    if (!c.ok) {
-      state.SkipWithError(c.error.c_str());
-      return;
-    }
-    state.SetIterationTime(c.wall);
-    cpu += c.user + c.sys;
-    sys += c.sys;
-    wall += c.wall;
-  }
+  Totals t;
+  if (!runEach(state,
+               {"run", script.path.string(), "--fast", "--duration", "6000", "--cars", "4", "-q"},
+               t))
+    return;
   double runs = static_cast<double>(state.iterations());
-  state.counters["sim_s_per_cpu_s"] = kSimSeconds * runs / cpu;
-  state.counters["sys_share"] = sys / cpu;
-  state.counters["cpu_s"] = cpu / runs;
+  state.counters["sim_s_per_cpu_s"] = kSimSeconds * runs / t.cpu;
+  state.counters["sys_share"] = t.sys / t.cpu;
+  state.counters["cpu_s"] = t.cpu / runs;
 }
 BENCHMARK(BM_CliFast)->Iterations(3)->UseManualTime()->Unit(benchmark::kMillisecond);
 
 void BM_CliRealTime(benchmark::State& state) {
   ScriptFile script("drive.lua", kDrive);
-  std::string cars = std::to_string(state.range(0));
-  double cpu = 0, wall = 0, peak = 0;
-  for (auto _ : state) {
-    Child c = runPitwall({"run", script.path.string(), "--cars", cars, "--duration", "10", "-q"});
-    if (!c.ok) {
-      state.SkipWithError(c.error.c_str());
-      return;
-    }
-    state.SetIterationTime(c.wall);
-    cpu += c.user + c.sys;
-    wall += c.wall;
-    peak = std::max(peak, c.peakMb);
-  }
-  state.counters["cpu_share"] = cpu / wall;
-  state.counters["peak_mb"] = peak;
+  Totals t;
+  if (!runEach(state,
+               {"run", script.path.string(), "--cars", std::to_string(state.range(0)), "--duration",
+                "10", "-q"},
+               t))
+    return;
+  state.counters["cpu_share"] = t.cpu / t.wall;
+  state.counters["peak_mb"] = t.peakMb;
 }
 BENCHMARK(BM_CliRealTime)->Arg(1000)->Iterations(1)->UseManualTime()->Unit(benchmark::kSecond);
 
 void BM_CliMemory(benchmark::State& state) {
   ScriptFile script("drive.lua", kDrive);
-  std::string cars = std::to_string(state.range(0));
-  double peak = 0;
-  for (auto _ : state) {
-    Child c = runPitwall(
-        {"run", script.path.string(), "--fast", "--cars", cars, "--duration", "60", "-q"});
-    if (!c.ok) {
-      state.SkipWithError(c.error.c_str());
-      return;
-    }
-    state.SetIterationTime(c.wall);
-    peak = std::max(peak, c.peakMb);
-  }
-  state.counters["peak_mb"] = peak;
+  Totals t;
+  if (!runEach(state,
+               {"run", script.path.string(), "--fast", "--cars", std::to_string(state.range(0)),
+                "--duration", "60", "-q"},
+               t))
+    return;
+  state.counters["peak_mb"] = t.peakMb;
 }
 BENCHMARK(BM_CliMemory)
     ->Arg(8)
@@ -159,18 +162,9 @@ BENCHMARK(BM_CliMemory)
     ->Unit(benchmark::kMillisecond);
 
 void BM_ScenarioSuite(benchmark::State& state) {
-  std::string scenarios = PITWALL_SOURCE_DIR "/tests/scenarios";
-  double cpu = 0;
-  for (auto _ : state) {
-    Child c = runPitwall({"test", scenarios, "-j", "2"});
-    if (!c.ok) {
-      state.SkipWithError(c.error.c_str());
-      return;
-    }
-    state.SetIterationTime(c.wall);
-    cpu += c.user + c.sys;
-  }
-  state.counters["cpu_s"] = cpu / static_cast<double>(state.iterations());
+  Totals t;
+  if (!runEach(state, {"test", PITWALL_SOURCE_DIR "/tests/scenarios", "-j", "2"}, t)) return;
+  state.counters["cpu_s"] = t.cpu / static_cast<double>(state.iterations());
 }
 BENCHMARK(BM_ScenarioSuite)->Iterations(3)->UseManualTime()->Unit(benchmark::kMillisecond);
 

@@ -107,7 +107,7 @@ void TargetReporter::printTargets() const {
       {{"MQTT: vehicle messages/s through the broker", "k/s", false, 50000},
        counter("BM_MqttBridgeThroughput/cars:4/window:64/broker_nodelay:1/iterations:1/manual_time",
                "msg_per_s"),
-       "BM_MqttBridgeThroughput/4/64/1"},
+       "BM_MqttBridgeThroughput/cars:4/window:64/broker_nodelay:1"},
       {{"MQTT: frame on A → Lua on B, p99", "ms", true, 1.0},
        [&]() -> std::optional<double> {
          auto us = counter(
@@ -115,7 +115,7 @@ void TargetReporter::printTargets() const {
          if (!us) return std::nullopt;
          return *us / 1000;
        }(),
-       "BM_MqttFrameToLua/2000/1"},
+       "BM_MqttFrameToLua/samples:2000/broker_nodelay:1"},
       {{"scenario tests (tests/scenarios -j 2), wall", "s", true, 1.0},
        wall("BM_ScenarioSuite/iterations:3/manual_time"),
        "BM_ScenarioSuite"},
