@@ -4,6 +4,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <unordered_map>
 
 #include "bindings/interrupt.hpp"
 
@@ -135,6 +139,44 @@ int dofileText(lua_State* L) {
   return lua_gettop(L) - 1;
 }
 
+// Modules compiled in this process, by file name, with the text they were compiled from. A hot
+// reload makes a new Lua world that requires the same files again; loading the bytecode this
+// process made from the same text skips the parser, which was most of a reload's cost
+// (docs/performance.md "Issue 20"). The bytecode never comes from outside: a file's text is read
+// and compared every time, and any change compiles it afresh. Single-threaded, as the loop.
+struct CompiledModule {
+  std::string text;
+  std::string bytecode;
+};
+
+std::unordered_map<std::string, CompiledModule>& compiledModules() {
+  static std::unordered_map<std::string, CompiledModule> modules;
+  return modules;
+}
+
+int appendBytes(lua_State*, const void* bytes, std::size_t size, void* out) {
+  static_cast<std::string*>(out)->append(static_cast<const char*>(bytes), size);
+  return 0;
+}
+
+// luaL_loadfilex(L, filename, "t"), the same function, through the cache.
+int loadModuleFile(lua_State* L, const char* filename) {
+  std::ifstream in(filename, std::ios::binary);
+  if (!in) return luaL_loadfilex(L, filename, "t");  // Lua's own message for what went wrong
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto& modules = compiledModules();
+  const std::string chunkname = std::string("@") + filename;
+  if (auto it = modules.find(filename); it != modules.end() && it->second.text == text)
+    return luaL_loadbufferx(L, it->second.bytecode.data(), it->second.bytecode.size(),
+                            chunkname.c_str(), "b");
+  int status = luaL_loadfilex(L, filename, "t");
+  if (status != LUA_OK) return status;
+  std::string bytecode;
+  if (lua_dump(L, appendBytes, &bytecode, 0) == 0)
+    modules[filename] = CompiledModule{std::move(text), std::move(bytecode)};
+  return LUA_OK;
+}
+
 // require's searcher for Lua files, text only (Lua's own loads binary files too).
 int searchLuaText(lua_State* L) {
   const char* name = luaL_checkstring(L, 1);
@@ -146,7 +188,7 @@ int searchLuaText(lua_State* L) {
   if (lua_isnil(L, -2)) return 1;  // the "no file …" lines
   lua_pop(L, 1);
   const char* filename = lua_tostring(L, -1);
-  if (luaL_loadfilex(L, filename, "t") != LUA_OK)
+  if (loadModuleFile(L, filename) != LUA_OK)
     return luaL_error(L, "error loading module '%s' from file '%s':\n\t%s", name, filename,
                       lua_tostring(L, -1));
   lua_pushstring(L, filename);

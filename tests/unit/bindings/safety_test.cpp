@@ -2,6 +2,11 @@
 // down runs nothing again, os.exit asks for the end of the run, and the memory cap ends a script
 // that keeps allocating, even behind pcall.
 #include <doctest/doctest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
 
 #include "bindings/interrupt.hpp"
 #include "bindings/sandbox.hpp"
@@ -179,4 +184,41 @@ TEST_CASE("a message handler that never returns is interrupted with the call") {
     CHECK_FALSE(w.host->call(0, 0, "test callback"));
     CHECK(w.logContains("still running after 100 ms: interrupted"));
   }
+}
+
+// require keeps the bytecode it compiled (sandbox.cpp, compiledModules): a new world, as a hot
+// reload makes, loads a module it saw before without parsing it again. It must be the same
+// module — its errors name the same file and line — and an edited file must be compiled afresh.
+TEST_CASE("a module required again in a new world is the same module; an edited one is new") {
+  namespace fs = std::filesystem;
+  fs::path dir = fs::temp_directory_path() / ("pitwall_modules_" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  auto save = [&](const char* text) { std::ofstream(dir / "cached_mod.lua") << text; };
+  const std::string script = "package.path = '" + dir.string() +
+                             "/?.lua;' .. package.path\n"
+                             "local m = require 'cached_mod'\n"
+                             "value = m.value\n"
+                             "ok, err = pcall(m.fail)\n";
+  auto run = [&](lua_Integer& value, std::string& err) {
+    World w;
+    REQUIRE(w.host->startString(script, "modules"));
+    value = w.global("value");
+    lua_getglobal(w.host->state(), "err");
+    err = lua_tostring(w.host->state(), -1) ? lua_tostring(w.host->state(), -1) : "";
+    lua_pop(w.host->state(), 1);
+  };
+  save("local M = {value = 1}\n\nfunction M.fail() error('line three') end\nreturn M\n");
+  lua_Integer first = 0, second = 0, edited = 0;
+  std::string firstErr, secondErr, editedErr;
+  run(first, firstErr);
+  run(second, secondErr);  // from the compiled cache
+  CHECK(first == 1);
+  CHECK(second == 1);
+  CHECK(firstErr.find("cached_mod.lua:3: line three") != std::string::npos);
+  CHECK(secondErr == firstErr);
+  save("local M = {value = 2}\nfunction M.fail() error('line two') end\nreturn M\n");
+  run(edited, editedErr);
+  CHECK(edited == 2);
+  CHECK(editedErr.find("cached_mod.lua:2: line two") != std::string::npos);
+  fs::remove_all(dir);
 }
