@@ -70,8 +70,11 @@ local long = string.rep("laps", 250000) -- a megabyte of a name
 local err = blames(function() race.laps { [long] = 1 } end, "race.laps: unknown option lapslapslaps")
 expect.truthy(#err < 2000 and err:find("(1000000 bytes)", 1, true), "a huge name is shortened: " .. #err)
 pitwall.sleep(0)
+-- 20 000 keys: building 100 000 took 60–110 ms of CPU on a 2-core CI machine, too close to the
+-- 100 ms budget of the section (it failed the scenario now and then).
 local huge = {}
-for i = 1, 100000 do huge["k" .. i] = i end
+for i = 1, 20000 do huge["k" .. i] = i end
+pitwall.sleep(0)
 blames(function() sim.addCar(huge) end, "sim.addCar: unknown option k")
 pitwall.sleep(0)
 blames(function() race.laps("fast") end, "race: the options are a table such as {laps = 5}, got string")
