@@ -1,12 +1,17 @@
 #include "bindings/sandbox.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <atomic>
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
-#include <iterator>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <unordered_map>
 
 #include "bindings/interrupt.hpp"
@@ -142,16 +147,27 @@ int dofileText(lua_State* L) {
 // Modules compiled in this process, by file name, with the text they were compiled from. A hot
 // reload makes a new Lua world that requires the same files again; loading the bytecode this
 // process made from the same text skips the parser, which was most of a reload's cost
-// (docs/performance.md "Issue 20"). The bytecode never comes from outside: a file's text is read
-// and compared every time, and any change compiles it afresh. Single-threaded, as the loop.
+// (docs/performance.md "Issue 20"). The bytecode never comes from outside: the file is read once,
+// its text compiled, and a later load uses the bytecode only when the text read then is the same.
+// Only regular files up to kMaxModule take part, and the cache stops growing at kMaxCache; others
+// load as Lua loads them (streamed, so a huge or endless file fails at its first bad token and
+// costs no memory outside the script's cap). Single-threaded, as the loop.
+constexpr std::size_t kMaxModule = std::size_t{1} << 20;
+constexpr std::size_t kMaxCache = std::size_t{16} << 20;
+
 struct CompiledModule {
   std::string text;
   std::string bytecode;
 };
 
-std::unordered_map<std::string, CompiledModule>& compiledModules() {
-  static std::unordered_map<std::string, CompiledModule> modules;
-  return modules;
+struct ModuleCache {
+  std::unordered_map<std::string, CompiledModule> modules;
+  std::size_t bytes = 0;
+};
+
+ModuleCache& moduleCache() {
+  static ModuleCache cache;
+  return cache;
 }
 
 int appendBytes(lua_State*, const void* bytes, std::size_t size, void* out) {
@@ -159,21 +175,62 @@ int appendBytes(lua_State*, const void* bytes, std::size_t size, void* out) {
   return 0;
 }
 
-// luaL_loadfilex(L, filename, "t"), the same function, through the cache.
+// The whole text of a regular file of at most kMaxModule bytes; nullopt for anything else.
+std::optional<std::string> readSmallFile(const char* filename) {
+  int fd = ::open(filename, O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return std::nullopt;
+  std::optional<std::string> text;
+  struct stat st {};
+  if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) &&
+      static_cast<std::size_t>(st.st_size) <= kMaxModule) {
+    std::string buffer(static_cast<std::size_t>(st.st_size) + 1, '\0');  // +1: sees growth
+    std::size_t got = 0;
+    for (;;) {
+      ssize_t n = ::read(fd, buffer.data() + got, buffer.size() - got);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) break;
+      got += static_cast<std::size_t>(n);
+      if (got == buffer.size()) break;  // grew since fstat: not a module to cache
+    }
+    if (got < buffer.size()) {
+      buffer.resize(got);
+      text = std::move(buffer);
+    }
+  }
+  ::close(fd);
+  return text;
+}
+
+// luaL_loadfilex(L, filename, "t") through the cache. The text is compiled as luaL_loadfilex
+// would: a UTF-8 byte order mark is skipped, and a first line starting with '#' (a shebang) is
+// emptied, keeping its newline so that line numbers stay those of the file.
 int loadModuleFile(lua_State* L, const char* filename) {
-  std::ifstream in(filename, std::ios::binary);
-  if (!in) return luaL_loadfilex(L, filename, "t");  // Lua's own message for what went wrong
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  auto& modules = compiledModules();
+  std::optional<std::string> text = readSmallFile(filename);
+  if (!text) return luaL_loadfilex(L, filename, "t");
+  ModuleCache& cache = moduleCache();
   const std::string chunkname = std::string("@") + filename;
-  if (auto it = modules.find(filename); it != modules.end() && it->second.text == text)
+  if (auto it = cache.modules.find(filename); it != cache.modules.end() && it->second.text == *text)
     return luaL_loadbufferx(L, it->second.bytecode.data(), it->second.bytecode.size(),
                             chunkname.c_str(), "b");
-  int status = luaL_loadfilex(L, filename, "t");
+  std::string_view code(*text);
+  if (code.substr(0, 3) == "\xEF\xBB\xBF") code.remove_prefix(3);
+  if (!code.empty() && code[0] == '#') {
+    auto eol = code.find('\n');
+    code = eol == std::string_view::npos ? std::string_view() : code.substr(eol);
+  }
+  int status = luaL_loadbufferx(L, code.data(), code.size(), chunkname.c_str(), "t");
   if (status != LUA_OK) return status;
   std::string bytecode;
-  if (lua_dump(L, appendBytes, &bytecode, 0) == 0)
-    modules[filename] = CompiledModule{std::move(text), std::move(bytecode)};
+  if (lua_dump(L, appendBytes, &bytecode, 0) != 0) return LUA_OK;
+  if (auto it = cache.modules.find(filename); it != cache.modules.end()) {
+    cache.bytes -= it->second.text.size() + it->second.bytecode.size();
+    cache.modules.erase(it);
+  }
+  const std::size_t size = text->size() + bytecode.size();
+  if (cache.bytes + size <= kMaxCache) {
+    cache.bytes += size;
+    cache.modules[filename] = CompiledModule{std::move(*text), std::move(bytecode)};
+  }
   return LUA_OK;
 }
 

@@ -3,8 +3,8 @@
 #include <unistd.h>
 
 #include <cmath>
-#include <cstdio>
 #include <csignal>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
@@ -68,13 +68,17 @@ std::unique_ptr<Session> Session::open(const CarSource& source, bool fast, const
                          std::to_string(sim::gridCapacity(*track)) + " (four on each piece)";
       std::string longer = sim::ovalLayoutFor(source.cars);
       if (source.trackGiven) {
-        std::cerr << "pitwall " << command << ": " << fits
-                  << "; give a layout of at least " << (source.cars + 3) / 4
+        std::cerr << "pitwall " << command << ": " << fits << "; give a layout of at least "
+                  << (source.cars + 3) / 4
                   << " pieces, or leave out --track for an oval that holds them (" << longer
                   << ")\n";
         return nullptr;
       }
       track = sim::parseLayout(longer, "oval");
+      if (!track) {  // ovalLayoutFor's layouts close (world_test): a bug if this is reached
+        std::cerr << "pitwall " << command << ": internal error: " << track.error() << "\n";
+        return nullptr;
+      }
       char lap[32];
       std::snprintf(lap, sizeof lap, "%.1f m", track->lapLength(0) / 1000);
       log::info("pitwall", fits + ": racing on an oval of " + std::to_string(track->size()) +

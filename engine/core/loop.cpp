@@ -82,7 +82,8 @@ void Loop::runVirtual() {
   // pass, measured twice as slow (docs/performance.md).
   while (!stopped_) {
     if (passCheck_) {
-      passCheck_();
+      Callback check = passCheck_;  // the check may replace or remove itself
+      check();
       if (stopped_) break;
     }
     std::size_t ran = io_.poll();

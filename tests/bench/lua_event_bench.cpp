@@ -250,7 +250,9 @@ void BM_FrameToLuaRatio(benchmark::State& state) {
   Floor floor(Floor::Fields::Three);
   Floor full(Floor::Fields::Full);
   if (!rig.healthy() || !every.healthy() || !floor.error.empty() || !full.error.empty()) {
-    state.SkipWithError(!rig.error.empty() ? rig.error.c_str() : "the floor's Lua did not load");
+    state.SkipWithError(!rig.error.empty()     ? rig.error.c_str()
+                        : !every.error.empty() ? every.error.c_str()
+                                               : "the floor's Lua did not load");
     return;
   }
   anki::Frame frame = positionFrame();
@@ -284,7 +286,9 @@ void BM_FrameToLuaRatio(benchmark::State& state) {
     everyTime += t4 - t3;
   }
   if (!ok || !rig.healthy() || !every.healthy()) {
-    state.SkipWithError(ok ? rig.error.c_str() : "the floor's Lua call failed");
+    state.SkipWithError(!ok                  ? "the floor's Lua call failed"
+                        : !rig.error.empty() ? rig.error.c_str()
+                                             : every.error.c_str());
     return;
   }
   double events = static_cast<double>(state.iterations()) * kBlock;

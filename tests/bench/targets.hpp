@@ -14,6 +14,7 @@ namespace pitwall::bench {
 // Shows the runs as the console reporter does, and keeps their counters for the table.
 class TargetReporter : public benchmark::ConsoleReporter {
  public:
+  explicit TargetReporter(OutputOptions options) : ConsoleReporter(options) {}
   void ReportRuns(const std::vector<Run>& runs) override;
   // The table, printed after RunSpecifiedBenchmarks.
   void printTargets() const;

@@ -26,6 +26,18 @@ expect_stopped() {  # NAME RECORD CARS
   check "$1: the last frame to every car is its stop" "${want%$'\n'}" "$(last_tx_per_car "$2")"
 }
 
+# wait_bounded PID: PID's exit status; a run that outlives 30 s is killed (status 137) so that a
+# signal that never arrives fails the check instead of hanging the test.
+wait_bounded() {
+  (sleep 30 && kill -9 "$1" 2>/dev/null) &
+  local watchdog=$! status
+  wait "$1"
+  status=$?
+  kill "$watchdog" 2>/dev/null
+  wait "$watchdog" 2>/dev/null
+  return $status
+}
+
 # --duration (virtual time)
 MODE=none $PITWALL run "$NAGGING" --fast --duration 5 --cars 3 --record "$TMP/d.jsonl" \
   >"$TMP/d.out" 2>"$TMP/d.err"
@@ -121,7 +133,7 @@ for sig in INT TERM; do
   read -r -t 20 line <&3
   check "--fast, SIG$sig: the run is driving" "driving" "$line"
   kill -$sig $pid
-  wait $pid
+  wait_bounded $pid
   check "--fast, SIG$sig: exit status" 130 $?
   exec 3<&-
   expect_stopped "--fast, SIG$sig" "$TMP/fast.$sig.jsonl" 2
@@ -187,7 +199,7 @@ exec 3<"$TMP/hog.fast"
 read -r -t 20 line <&3
 check "--fast: a callback that never returns is running" "hogging" "$line"
 kill -INT $pid
-wait $pid
+wait_bounded $pid
 check "--fast: Ctrl-C beside a hog: exit status" 130 $?
 exec 3<&-
 expect_stopped "--fast: Ctrl-C beside a hog" "$TMP/hog.fast.jsonl" 2

@@ -222,3 +222,17 @@ TEST_CASE("a module required again in a new world is the same module; an edited 
   CHECK(editedErr.find("cached_mod.lua:2: line two") != std::string::npos);
   fs::remove_all(dir);
 }
+
+// What the cache never holds: a device that never ends (/dev/zero) is loaded as Lua loads it,
+// streamed, and fails at its first bad byte with an error, not with the process's memory.
+TEST_CASE("require of an endless device fails with an error, within the script's memory") {
+  World w(std::size_t{16} << 20);
+  REQUIRE(
+      w.host->startString("package.path = '/dev/?'\n"
+                          "ok, err = pcall(require, 'zero')\n",
+                          "endless"));
+  lua_getglobal(w.host->state(), "err");
+  std::string err = lua_tostring(w.host->state(), -1) ? lua_tostring(w.host->state(), -1) : "";
+  lua_pop(w.host->state(), 1);
+  CHECK(err.find("error loading module 'zero' from file '/dev/zero'") != std::string::npos);
+}
