@@ -161,22 +161,37 @@ chmod +x "$RUN/root/init"
 # ---- boot ----
 # TCG, not KVM: KVM hangs at boot on these machines (docs in the notes). The serial console is
 # the guest's stdout; `quiet` keeps the kernel's own lines out of it.
-echo "qemu: booting (central: $CENTRAL, timeout ${TIMEOUT}s)"
-start=$(date +%s%N)
-timeout --kill-after=5 "$TIMEOUT" qemu-system-x86_64 -accel tcg,thread=multi -cpu max -m 1024 -smp 2 \
-  -nographic -no-reboot -nodefaults -serial stdio -net none \
-  -kernel "$KERNEL/vmlinuz" -initrd "$RUN/initrd" \
-  -append "console=ttyS0 quiet loglevel=3 panic=-1" \
-  -virtfs local,path=/,mount_tag=host,security_model=none,readonly=on,multidevs=remap \
-  </dev/null 2>&1 | tee "$RUN/console"
-qemu_rc=${PIPESTATUS[0]}
-ms=$((($(date +%s%N) - start) / 1000000))
-elapsed=$((ms / 1000)).$(printf %03d $((ms % 1000)))
-status=$(tr -d '\r' <"$RUN/console" | sed -n 's/^PITWALL-QEMU-EXIT=\([0-9]*\)$/\1/p' | tail -n1)
-echo "qemu: guest finished in ${elapsed}s"
+# One boot: its guest's exit status on stdout's last line (empty when it gave none).
+boot() {
+  echo "qemu: booting (central: $CENTRAL, timeout ${TIMEOUT}s)" >&2
+  local start ms elapsed qemu_rc status
+  start=$(date +%s%N)
+  timeout --kill-after=5 "$TIMEOUT" qemu-system-x86_64 -accel tcg,thread=multi -cpu max -m 1024 \
+    -smp 2 -nographic -no-reboot -nodefaults -serial stdio -net none \
+    -kernel "$KERNEL/vmlinuz" -initrd "$RUN/initrd" \
+    -append "console=ttyS0 quiet loglevel=3 panic=-1" \
+    -virtfs local,path=/,mount_tag=host,security_model=none,readonly=on,multidevs=remap \
+    </dev/null 2>&1 | tee "$RUN/console" >&2
+  qemu_rc=${PIPESTATUS[0]}
+  ms=$((($(date +%s%N) - start) / 1000000))
+  elapsed=$((ms / 1000)).$(printf %03d $((ms % 1000)))
+  status=$(tr -d '\r' <"$RUN/console" | sed -n 's/^PITWALL-QEMU-EXIT=\([0-9]*\)$/\1/p' | tail -n1)
+  echo "qemu: guest finished in ${elapsed}s (QEMU status $qemu_rc)" >&2
+  echo "$status"
+}
+
+# The emulated controllers (btvirt under TCG) now and then lose a link being set up, or stop
+# seeing the other's advertisements, on a loaded machine: seen twice in about ten CI runs, never
+# locally, each time before pitwall's code on the central took part. A failed boot is therefore
+# booted once more, its whole output kept above; a real break fails both.
+status=$(boot)
+if [ -n "$status" ] && [ "$status" != 0 ] && [ "$status" != 77 ]; then
+  echo "qemu: the guest's checks failed (status $status); booting once more (btvirt, see above)"
+  status=$(boot)
+fi
 if [ -z "$status" ]; then
-  fail "the guest gave no exit status (QEMU status $qemu_rc: 124 = killed after ${TIMEOUT}s)"
+  fail "the guest gave no exit status (QEMU status 124 = killed after ${TIMEOUT}s)"
 fi
 [ "$status" = 77 ] && exit 77
 [ "$status" = 0 ] && { echo "PASS: central '$CENTRAL' against the real bluetoothd"; exit 0; }
-fail "the guest's checks failed (status $status)"
+fail "the guest's checks failed twice (status $status)"
