@@ -343,7 +343,7 @@ int tostring(lua_State* L) {
 
 }  // namespace
 
-CarBinding::CarBinding(ScriptHost& host) : host_(host), L_(host.state()) {}
+CarBinding::CarBinding(ScriptHost& host) : host_(host), L_(host.state()), names_(carEvents()) {}
 
 CarBinding::~CarBinding() {
   detach();

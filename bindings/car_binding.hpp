@@ -13,6 +13,9 @@
 namespace pitwall {
 
 class ScriptHost;
+namespace lua {
+class EventNames;
+}
 
 // The car's events, in one list: CarEvent::Position is "onPosition", … (docs/lua-api.md).
 #define PITWALL_CAR_EVENTS(X)                                                             \
@@ -21,8 +24,9 @@ class ScriptHost;
   X(Intersection)                                                                         \
   X(Delocalized)                                                                          \
   X(Offset)                                                                               \
-  X(Battery) X(Version) X(Ping) X(Status) X(Collision) X(Speed) X(LaneChange) X(Recovery) \
-      X(Connect) X(Disconnect) X(Malformed) X(Message)
+  X(Battery)                                                                              \
+  X(Version) X(Ping) X(Status) X(Collision) X(Speed) X(LaneChange) X(Recovery) X(Connect) \
+      X(Disconnect) X(Malformed) X(Message)
 
 enum class CarEvent {
 #define PITWALL_CAR_EVENT_ENUM(name) name,
@@ -59,12 +63,15 @@ class CarBinding {
   void hookEvents(Proxy& p);
   void unhookEvents(Proxy& p);
   void dispatch(Proxy& p, const anki::Message& m);
+  void dispatchOther(Proxy& p, const anki::Message& m);   // all but position updates
+  void deliverMessage(Proxy& p, const anki::Message& m);  // onMessage
   // Delivers event e to the car's listeners and handler (lua::emit), in its reused table.
   template <class Fill>
   void deliver(Proxy& p, CarEvent e, Fill&& fill);
 
   ScriptHost& host_;
   lua_State* L_;
+  const lua::EventNames& names_;  // carEvents(), kept: every event names its source with it
   std::unordered_map<AnkiCar*, std::unique_ptr<Proxy>> proxies_;
   bool attached_ = false;
 };

@@ -127,7 +127,7 @@ class CarBinding::EventTable {
 template <class Fill>
 void CarBinding::deliver(Proxy& p, CarEvent e, Fill&& fill) {
   const auto i = static_cast<std::size_t>(e);
-  lua::emit({host_, p.slots, carEvents(), p.selfRef, p.label}, i, p.tables[i], [&](lua_State* L) {
+  lua::emit({host_, p.slots, names_, p.selfRef, p.label}, i, p.tables[i], [&](lua_State* L) {
     EventTable t(L);
     fill(t);
   });
@@ -161,18 +161,26 @@ void CarBinding::unhookEvents(Proxy& p) {
 }
 
 void CarBinding::dispatch(Proxy& p, const Message& m) {
+  if (const auto* pos = std::get_if<PositionUpdate>(&m)) {  // most frames: no visit
+    deliver(p, CarEvent::Position, [&](EventTable& t) {
+      Proxy::Written& w = p.position;
+      t.changedInteger(w, 0, kLocation, pos->location_id);
+      t.changedInteger(w, 1, kPiece, pos->piece_id);
+      t.changedInteger(w, 2, kSpeed, pos->speed_mm_s);
+      t.changed(w, 3, kOffset, pos->offset_mm);
+      t.changedBoolean(w, 4, kReverse, (pos->parsing_flags & 0x20) != 0);
+    });
+  } else {
+    dispatchOther(p, m);
+  }
+  // onMessage sees every message as a fresh table built from its JSON form (for debugging).
+  if (p.slots.handler(static_cast<std::size_t>(CarEvent::Message)) != LUA_NOREF)
+    deliverMessage(p, m);
+}
+
+void CarBinding::dispatchOther(Proxy& p, const Message& m) {
   std::visit(
       Overload{
-          [&](const PositionUpdate& pos) {
-            deliver(p, CarEvent::Position, [&](EventTable& t) {
-              Proxy::Written& w = p.position;
-              t.changedInteger(w, 0, kLocation, pos.location_id);
-              t.changedInteger(w, 1, kPiece, pos.piece_id);
-              t.changedInteger(w, 2, kSpeed, pos.speed_mm_s);
-              t.changed(w, 3, kOffset, pos.offset_mm);
-              t.changedBoolean(w, 4, kReverse, (pos.parsing_flags & 0x20) != 0);
-            });
-          },
           [&](const TransitionUpdate& tr) {
             deliver(p, CarEvent::Transition, [&](EventTable& t) {
               Proxy::Written& w = p.transition;
@@ -255,28 +263,28 @@ void CarBinding::dispatch(Proxy& p, const Message& m) {
           [&](const AutoRecoverySucceeded&) {
             deliver(p, CarEvent::Recovery, [](EventTable& t) { t.boolean(kSucceeded, true); });
           },
-          [](const auto&) {},  // commands, and reports with no event of their own
+          [](const auto&) {},  // commands, position updates (dispatch), reports with no event
       },
       m);
-  // onMessage sees every message as a fresh table built from its JSON form (for debugging).
+}
+
+void CarBinding::deliverMessage(Proxy& p, const Message& m) {
   const auto message = static_cast<std::size_t>(CarEvent::Message);
-  if (p.slots.handler(message) == LUA_NOREF) return;
-  lua::emit(
-      {host_, p.slots, carEvents(), p.selfRef, p.label}, message, LUA_NOREF, [&](lua_State* L) {
-        nlohmann::json j = toJson(m);
-        for (auto& [k, v] : j.items()) {
-          if (v.is_boolean())
-            lua_pushboolean(L, v.get<bool>());
-          else if (v.is_number_integer())
-            lua_pushinteger(L, v.get<lua_Integer>());
-          else if (v.is_number())
-            lua_pushnumber(L, v.get<double>());
-          else
-            lua_pushstring(L, v.is_string() ? v.get<std::string>().c_str() : v.dump().c_str());
-          lua_setfield(L, -2, k.c_str());
-        }
-        lua::setNumber(L, "time", host_.loop().seconds());
-      });
+  lua::emit({host_, p.slots, names_, p.selfRef, p.label}, message, LUA_NOREF, [&](lua_State* L) {
+    nlohmann::json j = toJson(m);
+    for (auto& [k, v] : j.items()) {
+      if (v.is_boolean())
+        lua_pushboolean(L, v.get<bool>());
+      else if (v.is_number_integer())
+        lua_pushinteger(L, v.get<lua_Integer>());
+      else if (v.is_number())
+        lua_pushnumber(L, v.get<double>());
+      else
+        lua_pushstring(L, v.is_string() ? v.get<std::string>().c_str() : v.dump().c_str());
+      lua_setfield(L, -2, k.c_str());
+    }
+    lua::setNumber(L, "time", host_.loop().seconds());
+  });
 }
 
 }  // namespace pitwall

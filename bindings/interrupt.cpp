@@ -13,18 +13,28 @@
 
 namespace pitwall::interrupt {
 
+namespace detail {
+std::atomic<lua_State*> g_running{nullptr};
+std::atomic<int> g_depth{0};
+std::atomic<int> g_kind{0};
+std::atomic<std::uint64_t> g_call{0};
+std::atomic<int> g_reason{kNoReason};
+}  // namespace detail
+
 namespace {
 
-enum Reason : int { kNone = 0, kUser = 1, kBudget = 2, kMessage = 3 };
+enum Reason : int { kNone = detail::kNoReason, kUser = 1, kBudget = 2, kMessage = 3 };
 
 // All of this is written on the loop's thread; the watchdog only reads. The signal handler runs
 // on the loop's thread too (the watchdog sends it there), so it sees the loop's own writes.
-std::atomic<lua_State*> g_running{nullptr};  // the Lua thread running now, if any
-std::atomic<int> g_depth{0};                 // scopes on the stack
-std::atomic<int> g_kind{0};                  // Kind of the outermost scope
-std::atomic<std::uint64_t> g_call{0};        // numbers the outermost scopes
+// Scope's own state (g_running, g_depth, g_kind, g_call, g_reason) is in interrupt.hpp's
+// detail namespace, so that Scope is inline on the event hot path.
+using detail::g_call;
+using detail::g_depth;
+using detail::g_kind;
+using detail::g_reason;
+using detail::g_running;
 std::atomic<std::uint64_t> g_target{0};      // the call the watchdog found over budget
-std::atomic<int> g_reason{kNone};            // why the current call is being interrupted
 std::atomic<std::uint64_t> g_reasonCall{0};  // … and which call that is
 std::atomic<long long> g_budgetMs{100};
 std::atomic<pthread_t> g_loopThread{};
@@ -240,25 +250,6 @@ int trackedWrap(lua_State* L) {
 }
 
 }  // namespace
-
-Scope::Scope(lua_State* running, Kind kind)
-    : outermost_(g_depth.load(std::memory_order_relaxed) == 0),
-      previous_(g_running.load(std::memory_order_relaxed)) {
-  if (outermost_) {
-    g_call.store(g_call.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
-    g_kind.store(static_cast<int>(kind), std::memory_order_relaxed);
-  }
-  g_running.store(running, std::memory_order_relaxed);
-  std::atomic_signal_fence(std::memory_order_seq_cst);
-  g_depth.store(g_depth.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
-}
-
-Scope::~Scope() {
-  g_depth.store(g_depth.load(std::memory_order_relaxed) - 1, std::memory_order_relaxed);
-  std::atomic_signal_fence(std::memory_order_seq_cst);
-  g_running.store(previous_, std::memory_order_relaxed);
-  if (outermost_) g_reason.store(kNone, std::memory_order_relaxed);  // hooks remove themselves
-}
 
 Running::Running(lua_State* co) : previous_(g_running.load(std::memory_order_relaxed)) {
   g_running.store(co, std::memory_order_relaxed);

@@ -12,7 +12,9 @@
 // signals the loop's thread (SIGURG), whose handler sets the hook.
 #include <lua.hpp>
 
+#include <atomic>
 #include <chrono>
+#include <cstdint>
 #include <string>
 
 namespace pitwall::interrupt {
@@ -22,12 +24,41 @@ enum class Kind {
   Console,   // a chunk typed at the REPL: no budget, Ctrl-C interrupts it
 };
 
+namespace detail {
+// What Scope keeps, written only on the loop's thread; the watchdog and the signal handlers
+// (interrupt.cpp) read it. Here so that Scope is inline: it is on the path of every event.
+extern std::atomic<lua_State*> g_running;  // the Lua thread running now, if any
+extern std::atomic<int> g_depth;           // scopes on the stack
+extern std::atomic<int> g_kind;            // Kind of the outermost scope
+extern std::atomic<std::uint64_t> g_call;  // numbers the outermost scopes
+extern std::atomic<int> g_reason;          // why the current call is being interrupted
+inline constexpr int kNoReason = 0;
+}  // namespace detail
+
 // Around every call from the engine into Lua (ScriptHost does this). Only the outermost scope
 // on the stack counts; nested ones (a handler that triggers an event) are free.
 class Scope {
  public:
-  Scope(lua_State* running, Kind kind);
-  ~Scope();
+  Scope(lua_State* running, Kind kind)
+      : outermost_(detail::g_depth.load(std::memory_order_relaxed) == 0),
+        previous_(detail::g_running.load(std::memory_order_relaxed)) {
+    using namespace detail;
+    if (outermost_) {
+      g_call.store(g_call.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+      g_kind.store(static_cast<int>(kind), std::memory_order_relaxed);
+    }
+    g_running.store(running, std::memory_order_relaxed);
+    std::atomic_signal_fence(std::memory_order_seq_cst);
+    g_depth.store(g_depth.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+  }
+  ~Scope() {
+    using namespace detail;
+    g_depth.store(g_depth.load(std::memory_order_relaxed) - 1, std::memory_order_relaxed);
+    std::atomic_signal_fence(std::memory_order_seq_cst);
+    g_running.store(previous_, std::memory_order_relaxed);
+    if (outermost_)
+      g_reason.store(kNoReason, std::memory_order_relaxed);  // hooks remove themselves
+  }
   Scope(const Scope&) = delete;
   Scope& operator=(const Scope&) = delete;
 

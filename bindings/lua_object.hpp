@@ -114,14 +114,33 @@ struct EventSource {
 // `time` (the loop's seconds) and what `fill(L)` writes into it (the table on top of the stack).
 // An error in either is reported by the host, naming the event and `who`; neither stops the
 // other. Nothing is pushed or built when no function wants the event.
-// emit's two halves, out of line. begin pushes the traceback handler, the first function (the
-// hub if any, else the handler), the object and the event table with `time` set, and returns
-// false (nothing pushed) when no function wants the event; finish makes the calls.
+// emit's two halves, out of line, for every case but the hot one (a reused table and the handler
+// alone, no listeners), which emit does inline (docs/performance.md "Issue 20"). begin pushes the
+// traceback handler, the first function (the hub if any, else the handler), the object and the
+// event table with `time` set, and returns false (nothing pushed) when no function wants the event;
+// finish makes the calls.
 bool beginEvent(const EventSource& source, std::size_t e, int tableRef);
 void finishEvent(const EventSource& source, std::size_t e, int tableRef);
 
 template <class Fill>
 void emit(const EventSource& source, std::size_t e, int tableRef, Fill&& fill) {
+  if (tableRef != LUA_NOREF && source.slots.hub(e) == LUA_NOREF) {
+    // The hot path (a reused table, the handler alone, no listeners) in one piece, inline:
+    // what beginEvent and finishEvent do, without their branches and calls.
+    const int handler = source.slots.handler(e);
+    if (handler == LUA_NOREF) return;
+    ScriptHost& host = source.host;
+    lua_State* L = host.state();
+    lua_pushcfunction(L, traceback);
+    lua_rawgeti(L, LUA_REGISTRYINDEX, handler);
+    lua_rawgeti(L, LUA_REGISTRYINDEX, source.selfRef);
+    lua_rawgeti(L, LUA_REGISTRYINDEX, tableRef);
+    lua_pushnumber(L, host.loop().seconds());
+    lua_setfield(L, -2, "time");
+    fill(L);
+    host.callAboveHandler(2, source.names.handlerWhat(e), source.who);
+    return;
+  }
   if (!beginEvent(source, e, tableRef)) return;
   fill(source.host.state());
   finishEvent(source, e, tableRef);

@@ -390,20 +390,7 @@ bool ScriptHost::protectedCall(int nargs, int nresults, std::string& error, bool
   return false;
 }
 
-bool ScriptHost::callAboveHandler(int nargs, const char* what, std::string_view who) {
-  if (shutDown_) {
-    lua_pop(L_, nargs + 2);
-    return false;
-  }
-  int status;
-  {
-    interrupt::Scope scope(L_, interrupt::Kind::Callback);
-    status = lua_pcall(L_, nargs, 0, -(nargs + 2));
-  }
-  if (status == LUA_OK) {
-    lua_pop(L_, 1);  // the handler
-    return true;
-  }
+bool ScriptHost::failedAboveHandler(int status, const char* what, std::string_view who) {
   lua_remove(L_, -2);  // the handler, under the error
   return finishCall(status, what, who);
 }

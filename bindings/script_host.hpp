@@ -15,6 +15,7 @@
 #include <string_view>
 #include <vector>
 
+#include "bindings/interrupt.hpp"
 #include "bindings/sandbox.hpp"
 #include "bindings/tasks.hpp"
 #include "bindings/timers.hpp"
@@ -92,7 +93,22 @@ class ScriptHost {
   bool call(int nargs, int nresults, const char* what, std::string_view who = {});
   // The same with no results, for a caller that pushed lua::traceback itself right under the
   // function (the event hot path: no stack rotation). Pops the handler too.
-  bool callAboveHandler(int nargs, const char* what, std::string_view who = {});
+  bool callAboveHandler(int nargs, const char* what, std::string_view who = {}) {
+    if (shutDown_) {
+      lua_pop(L_, nargs + 2);
+      return false;
+    }
+    int status;
+    {
+      interrupt::Scope scope(L_, interrupt::Kind::Callback);
+      status = lua_pcall(L_, nargs, 0, -(nargs + 2));
+    }
+    if (status == LUA_OK) {
+      lua_pop(L_, 1);  // the handler
+      return true;
+    }
+    return failedAboveHandler(status, what, who);
+  }
   // A chunk typed at the REPL (the function under the top `nargs` values): Ctrl-C interrupts
   // it, the callback budget does not apply. On failure returns false with the message and
   // traceback in `error` (not reported: the REPL prints it). Results are left on the stack.
@@ -155,6 +171,8 @@ class ScriptHost {
   static int searchAndRecord(lua_State* L);
   bool protectedCall(int nargs, int nresults, std::string& error, bool console);
   bool finishCall(int status, const char* what, std::string_view who);
+  // callAboveHandler's error path, out of line: the error over the handler.
+  bool failedAboveHandler(int status, const char* what, std::string_view who);
   Result<bool, std::string> startLoaded(int status);
 
   Loop& loop_;

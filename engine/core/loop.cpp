@@ -7,8 +7,7 @@ namespace pitwall {
 
 Loop::Loop(ClockKind kind) : kind_(kind), wake_(io_), epoch_(std::chrono::steady_clock::now()) {}
 
-TimePoint Loop::now() const {
-  if (kind_ == ClockKind::Virtual) return virtualNow_;
+TimePoint Loop::realNow() const {
   return std::chrono::duration_cast<TimePoint>(std::chrono::steady_clock::now() - epoch_);
 }
 

@@ -39,7 +39,8 @@ class Loop {
   boost::asio::io_context& io() { return io_; }
   ClockKind clockKind() const { return kind_; }
 
-  TimePoint now() const;
+  // Inline: every event reads it (virtual time is a field; real time reads the steady clock).
+  TimePoint now() const { return kind_ == ClockKind::Virtual ? virtualNow_ : realNow(); }
   double seconds() const { return toSeconds(now()); }
 
   // Timers. A callback may schedule or cancel timers, including its own id (no effect).
@@ -70,6 +71,7 @@ class Loop {
     std::uint64_t seq;
     bool operator<(const Key& o) const { return when != o.when ? when < o.when : seq < o.seq; }
   };
+  TimePoint realNow() const;
   bool fireDue();  // fires the timers due now; true when any fired
   void armRealTimer();
   void runVirtual();

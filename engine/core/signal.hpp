@@ -85,7 +85,20 @@ class Signal {
 
   // Calls the slots connected now, in order (see the rules above).
   void emit(Args... args) const {
-    if (list_->slots.empty()) return;    // the hot path of a signal nobody watches
+    if (list_->slots.empty()) return;  // the hot path of a signal nobody watches: inlined
+    emitToSlots(args...);
+  }
+  void operator()(Args... args) const { emit(args...); }
+
+  std::size_t size() const {
+    std::size_t n = 0;
+    for (const auto& e : list_->slots) n += e->live ? 1 : 0;
+    return n;
+  }
+  bool empty() const { return size() == 0; }
+
+ private:
+  [[gnu::noinline]] void emitToSlots(Args... args) const {
     std::shared_ptr<List> list = list_;  // a slot may destroy the signal
     const std::size_t n = list->slots.size();
     ++list->emitting;
@@ -100,16 +113,7 @@ class Signal {
       if (entry->live) entry->fn(args...);
     }
   }
-  void operator()(Args... args) const { emit(args...); }
 
-  std::size_t size() const {
-    std::size_t n = 0;
-    for (const auto& e : list_->slots) n += e->live ? 1 : 0;
-    return n;
-  }
-  bool empty() const { return size() == 0; }
-
- private:
   struct Entry {
     std::uint64_t id;
     Slot fn;

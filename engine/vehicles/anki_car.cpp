@@ -172,7 +172,7 @@ void AnkiCar::receive(std::span<const std::uint8_t> frame) {
     return;
   }
   ++state_.frames_in;
-  if (auto extra = extraBytes(frame); !extra.empty()) keepExtra(*decoded, extra);
+  if (auto extra = extraBytesOfReceived(frame); !extra.empty()) keepExtra(*decoded, extra);
   apply(*decoded);
   if (onFrame) onFrame(Direction::Rx, frame, *decoded);
   if (onMessage) onMessage(*decoded);
@@ -215,7 +215,7 @@ void AnkiCar::apply(const Message& message) {
     state_.on_track = true;
     state_.delocalized = false;
     state_.last_position_time = loop_.seconds();
-    speedReportedAt_ = loop_.seconds();
+    speedReportedAt_ = state_.last_position_time;
     laneChangeReached();
   } else if (auto* t = std::get_if<TransitionUpdate>(&message)) {
     state_.offset_mm = t->offset_mm;

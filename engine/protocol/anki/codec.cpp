@@ -288,6 +288,8 @@ Result<Message, DecodeError> decode(std::span<const std::uint8_t> frame) {
   return decodeAny(frame);
 }
 
+static_assert(Spec<PositionUpdate>::layout.sizes.longer + 1u == kPositionUpdateFrameSize);
+
 std::span<const std::uint8_t> extraBytes(std::span<const std::uint8_t> frame) {
   const std::size_t n = frame.size();
   if (n < 2 || n > Frame::kMax || frame[0] != n - 1) return {};  // decode() refuses it

@@ -34,6 +34,13 @@ Frame encode(const Message& message);
 // Empty when the frame fits its layout, for an unknown id (kept whole in Unknown::raw) and for a
 // frame decode() refuses. A firmware that appends a field to a message sends these.
 std::span<const std::uint8_t> extraBytes(std::span<const std::uint8_t> frame);
+// The same, inline for the frame cars send most (a position update of exactly its layout, the
+// size codec.cpp checks against the layout): every received frame asks.
+inline constexpr std::size_t kPositionUpdateFrameSize = 17;
+inline std::span<const std::uint8_t> extraBytesOfReceived(std::span<const std::uint8_t> frame) {
+  if (frame.size() == kPositionUpdateFrameSize && frame[1] == id::kPositionUpdate) return {};
+  return extraBytes(frame);
+}
 
 // What a car makes of a frame written to it (the vehicle side: simulated and emulated cars):
 // decode(), and also the short command forms real firmware accepts, read with the missing
