@@ -18,15 +18,17 @@ class EventNames;
 }
 
 // The car's events, in one list: CarEvent::Position is "onPosition", … (docs/lua-api.md).
-#define PITWALL_CAR_EVENTS(X)                                                             \
-  X(Position)                                                                             \
-  X(Transition)                                                                           \
-  X(Intersection)                                                                         \
-  X(Delocalized)                                                                          \
-  X(Offset)                                                                               \
-  X(Battery)                                                                              \
-  X(Version) X(Ping) X(Status) X(Collision) X(Speed) X(LaneChange) X(Recovery) X(Connect) \
-      X(Disconnect) X(Malformed) X(Message)
+#define PITWALL_CAR_EVENTS(X)                                                                     \
+  X(Position)                                                                                     \
+  X(Transition)                                                                                   \
+  X(Intersection)                                                                                 \
+  X(Delocalized)                                                                                  \
+  X(Offset)                                                                                       \
+  X(Battery)                                                                                      \
+  X(Version)                                                                                      \
+  X(Ping)                                                                                         \
+  X(Status) X(Collision) X(Speed) X(LaneChange) X(Recovery) X(Connect) X(Disconnect) X(Malformed) \
+      X(Message)
 
 enum class CarEvent {
 #define PITWALL_CAR_EVENT_ENUM(name) name,
@@ -63,6 +65,7 @@ class CarBinding {
   void hookEvents(Proxy& p);
   void unhookEvents(Proxy& p);
   void dispatch(Proxy& p, const anki::Message& m);
+  void deliverPosition(Proxy& p, const anki::PositionUpdate& pos);
   void dispatchOther(Proxy& p, const anki::Message& m);   // all but position updates
   void deliverMessage(Proxy& p, const anki::Message& m);  // onMessage
   // Delivers event e to the car's listeners and handler (lua::emit), in its reused table.

@@ -162,20 +162,25 @@ void CarBinding::unhookEvents(Proxy& p) {
 
 void CarBinding::dispatch(Proxy& p, const Message& m) {
   if (const auto* pos = std::get_if<PositionUpdate>(&m)) {  // most frames: no visit
-    deliver(p, CarEvent::Position, [&](EventTable& t) {
-      Proxy::Written& w = p.position;
-      t.changedInteger(w, 0, kLocation, pos->location_id);
-      t.changedInteger(w, 1, kPiece, pos->piece_id);
-      t.changedInteger(w, 2, kSpeed, pos->speed_mm_s);
-      t.changed(w, 3, kOffset, pos->offset_mm);
-      t.changedBoolean(w, 4, kReverse, (pos->parsing_flags & 0x20) != 0);
-    });
+    deliverPosition(p, *pos);
   } else {
     dispatchOther(p, m);
   }
   // onMessage sees every message as a fresh table built from its JSON form (for debugging).
   if (p.slots.handler(static_cast<std::size_t>(CarEvent::Message)) != LUA_NOREF)
     deliverMessage(p, m);
+}
+
+// The hot path of every run, flattened: the delivery and the protected call inline in one piece.
+[[gnu::flatten]] void CarBinding::deliverPosition(Proxy& p, const PositionUpdate& pos) {
+  deliver(p, CarEvent::Position, [&](EventTable& t) {
+    Proxy::Written& w = p.position;
+    t.changedInteger(w, 0, kLocation, pos.location_id);
+    t.changedInteger(w, 1, kPiece, pos.piece_id);
+    t.changedInteger(w, 2, kSpeed, pos.speed_mm_s);
+    t.changed(w, 3, kOffset, pos.offset_mm);
+    t.changedBoolean(w, 4, kReverse, (pos.parsing_flags & 0x20) != 0);
+  });
 }
 
 void CarBinding::dispatchOther(Proxy& p, const Message& m) {
