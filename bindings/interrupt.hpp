@@ -25,8 +25,9 @@ enum class Kind {
 };
 
 namespace detail {
-// What Scope keeps, written only on the loop's thread; the watchdog and the signal handlers
-// (interrupt.cpp) read it. Here so that Scope is inline: it is on the path of every event.
+// What Scope keeps, written only on the loop's thread (by Scope, and by the signal handlers that
+// run there: arming sets g_reason); the watchdog thread only reads it (interrupt.cpp). Here so that
+// Scope is inline: it is on the path of every event.
 extern std::atomic<lua_State*> g_running;  // the Lua thread running now, if any
 extern std::atomic<int> g_depth;           // scopes on the stack
 extern std::atomic<int> g_kind;            // Kind of the outermost scope

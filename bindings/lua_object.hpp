@@ -115,10 +115,10 @@ struct EventSource {
 // An error in either is reported by the host, naming the event and `who`; neither stops the
 // other. Nothing is pushed or built when no function wants the event.
 // emit's two halves, out of line, for every case but the hot one (a reused table and the handler
-// alone, no listeners), which emit does inline (docs/performance.md "Issue 20"). begin pushes the
-// traceback handler, the first function (the hub if any, else the handler), the object and the
-// event table with `time` set, and returns false (nothing pushed) when no function wants the event;
-// finish makes the calls.
+// alone, no listeners), which emit does inline (docs/performance.md "Frame → Lua: the plumbing cut,
+// and the floor"). begin pushes the traceback handler, the first function (the hub if any, else the
+// handler), the object and the event table with `time` set, and returns false (nothing pushed) when
+// no function wants the event; finish makes the calls.
 bool beginEvent(const EventSource& source, std::size_t e, int tableRef);
 void finishEvent(const EventSource& source, std::size_t e, int tableRef);
 

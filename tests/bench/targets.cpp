@@ -139,7 +139,8 @@ void TargetReporter::printTargets() const {
                           : "NO");
   }
   std::printf("  %d of %d measured targets met (%zu targets)\n", met, measured, rows.size());
-  // Why the every-field target is out of reach (docs/performance.md "Frame → Lua: the floor"):
+  // Why the every-field target is out of reach (docs/performance.md "Frame → Lua: the plumbing
+  // cut, and the floor"):
   // the bare C API doing only what that event must deliver is already above it.
   auto own = counter("BM_FrameToLuaRatio", "every_own_ratio");
   auto floorOfWork = ratioOf(counter("BM_FrameToLuaRatio", "every_floor_ns"),
