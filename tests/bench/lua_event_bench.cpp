@@ -161,37 +161,24 @@ struct Floor {
 // fills the table and tail-calls the handler, so no second C → Lua crossing is paid. A struct of
 // its own, so that Floor's code (the 3-field floor every ratio divides by) is what it was.
 struct LuaFillFloor {
-  lua_State* L = luaL_newstate();
-  int filler = LUA_NOREF, fn = LUA_NOREF, table = LUA_NOREF, car = LUA_NOREF;
-  double time = 0;
-  std::string error;
+  Floor base{Floor::Fields::Every};  // its Lua state, handler, table and car; its event() unused
+  lua_State* L = base.L;
+  int filler = LUA_NOREF;
+  std::string error = base.error;
 
   LuaFillFloor() {
-    luaL_openlibs(L);
-    filler = load(
-        "return function(f, car, ev, time, piece, location, offset, speed)\n"
-        "  ev.time, ev.piece, ev.location, ev.offset, ev.speed = time, piece, location, offset, "
-        "speed\n"
-        "  return f(car, ev)\n"
-        "end\n");
-    fn = load(kFloorCarFunction);
-    lua_createtable(L, 0, 8);
-    table = luaL_ref(L, LUA_REGISTRYINDEX);
-    lua_newuserdatauv(L, sizeof(void*), 1);
-    car = luaL_ref(L, LUA_REGISTRYINDEX);
-  }
-  // The function the chunk returns, as a registry reference (LUA_NOREF and `error` set if not).
-  int load(const char* chunk) {
-    if (luaL_dostring(L, chunk) != LUA_OK) {
+    if (!error.empty()) return;
+    if (luaL_dostring(L,
+                      "return function(f, car, ev, time, piece, location, offset, speed)\n"
+                      "  ev.time, ev.piece, ev.location, ev.offset, ev.speed =\n"
+                      "    time, piece, location, offset, speed\n"
+                      "  return f(car, ev)\n"
+                      "end\n") != LUA_OK) {
       error = lua_tostring(L, -1);
-      lua_pop(L, 1);
-      return LUA_NOREF;
+      return;
     }
-    return luaL_ref(L, LUA_REGISTRYINDEX);
+    filler = luaL_ref(L, LUA_REGISTRYINDEX);
   }
-  ~LuaFillFloor() { lua_close(L); }
-  LuaFillFloor(const LuaFillFloor&) = delete;
-  LuaFillFloor& operator=(const LuaFillFloor&) = delete;
 
   bool event(std::span<const std::uint8_t> frame) {
     auto decoded = anki::decode(frame);
@@ -199,10 +186,10 @@ struct LuaFillFloor {
     if (!pos) return false;
     lua_pushcfunction(L, lua::traceback);
     lua_rawgeti(L, LUA_REGISTRYINDEX, filler);
-    lua_rawgeti(L, LUA_REGISTRYINDEX, fn);
-    lua_rawgeti(L, LUA_REGISTRYINDEX, car);
-    lua_rawgeti(L, LUA_REGISTRYINDEX, table);
-    lua_pushnumber(L, time += 0.001);
+    lua_rawgeti(L, LUA_REGISTRYINDEX, base.fn);
+    lua_rawgeti(L, LUA_REGISTRYINDEX, base.car);
+    lua_rawgeti(L, LUA_REGISTRYINDEX, base.table);
+    lua_pushnumber(L, base.time += 0.001);
     lua_pushinteger(L, pos->piece_id);
     lua_pushinteger(L, pos->location_id);
     lua_pushnumber(L, pos->offset_mm);
