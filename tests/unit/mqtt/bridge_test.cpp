@@ -497,7 +497,10 @@ TEST_CASE_FIXTURE(Bridged, "mqtt bridge: a client of the seed's controller drive
     o.send(one, R"({"ping":true})");
     REQUIRE(runUntil(loop, [&] { return o.has(h.carTopic(0, "S/PingResp")); }));
     CHECK(o.json(h.carTopic(0, "S/PingResp"))["rtt_ms"].is_number());
-    CHECK(o.has(h.carTopic(0, "E/Messages/ANKI_VEHICLE_MSG_V2C_PING_RESPONSE")));
+    // the two are published one after the other: the second may arrive a moment later
+    CHECK(runUntil(loop, [&] {
+      return o.has(h.carTopic(0, "E/Messages/ANKI_VEHICLE_MSG_V2C_PING_RESPONSE"));
+    }));
     o.send("Anki/Car/I", R"({"speed":0,"acceleration":12500})");
     REQUIRE(runUntil(loop, [&] {
       return h.sent<anki::SetSpeed>(0).size() == 2 && h.sent<anki::SetSpeed>(1).size() == 1;
