@@ -20,6 +20,8 @@
 #include "engine/core/log.hpp"
 #include "engine/core/suggest.hpp"
 #include "engine/protocol/anki/pieces.hpp"
+#include "engine/sim/track.hpp"
+#include "engine/sim/world.hpp"
 
 namespace pitwall {
 
@@ -246,36 +248,37 @@ int checkOptionsOf(lua_State* L) {
   return 0;
 }
 
-// pitwall.piece(id): what a road piece is (docs/lua-api.md "Track pieces"), nil when unknown.
+// pitwall.piece(id): what a road piece is (docs/lua-api.md "Track pieces"), nil when unknown:
+// Anki's stock pieces, and the custom pieces of the simulator's track (docs/tracks.md).
 int piece(lua_State* L) {
   auto id = lua::checkInteger(L, 1, "piece id");
   if (id < 0 || id > 255) {
     lua_pushnil(L);
     return 1;
   }
-  auto type = anki::pieceType(static_cast<std::uint8_t>(id));
-  if (type == anki::PieceType::Unknown) {
+  sim::Piece found{static_cast<std::uint8_t>(id), anki::pieceType(static_cast<std::uint8_t>(id))};
+  bool known = found.type != anki::PieceType::Unknown;
+  if (SimSession* s = ScriptHost::from(L).sim(); !known && s && s->world)
+    for (const sim::Piece& p : s->world->track().pieces())
+      if (p.id == id) {  // a custom id: its shape is the layout's
+        found = p;
+        known = true;
+        break;
+      }
+  if (!known) {
     lua_pushnil(L);
     return 1;
   }
-  lua_createtable(L, 0, 4);
+  lua_createtable(L, 0, 6);
   lua::setInteger(L, "id", id);
-  lua::setString(L, "type", anki::pieceTypeName(type));
-  switch (type) {
-    case anki::PieceType::StartLong:
-      lua::setNumber(L, "length", anki::kStartLongLengthMm);
-      break;
-    case anki::PieceType::StartShort:
-      lua::setNumber(L, "length", anki::kStartShortLengthMm);
-      break;
-    case anki::PieceType::Curve:
-      lua::setNumber(L, "length", anki::kCurveRadiusMm * std::acos(-1.0) / 2);
-      lua::setNumber(L, "radius", anki::kCurveRadiusMm);
-      break;
-    default:
-      lua::setNumber(L, "length", anki::kStraightLengthMm);
-      break;
+  lua::setString(L, "type", anki::pieceTypeName(found.type));
+  if (found.type == anki::PieceType::Curve && found.turn == 0) found.turn = 1;  // either way
+  lua::setNumber(L, "length", found.length(0));
+  if (found.turn != 0) {
+    lua::setNumber(L, "radius", found.radius());
+    lua::setNumber(L, "angle", found.angle());
   }
+  if (anki::pieceType(found.id) == anki::PieceType::Unknown) lua::setBoolean(L, "custom", true);
   return 1;
 }
 

@@ -21,9 +21,7 @@ constexpr double kStopDecel = 5000;         // mm/s²: a dropped connection stop
 constexpr double kCoastDecel = 6000;        // mm/s²: a delocalized car coasts ≈190 mm from 1500
 constexpr double kMaxLateralAccel = 9000;   // mm/s²: v²/r above this throws the car off a curve
 constexpr double kOffRoadMm = 100;          // |offset| beyond this is off the road
-constexpr double kRowWidthMm = 12;          // 16 code rows across a 192 mm road
-constexpr int kRows = 16;
-constexpr double kHalfTrackMm = 20;  // wheel distance from the car's centre line
+constexpr double kHalfTrackMm = 20;         // wheel distance from the car's centre line
 constexpr double kDrainMvPerMm = 500.0 / (20 * 60 * kMaxSpeed);  // 500 mV per 20 min flat out
 constexpr double kLowBatteryMv = 3600;
 constexpr double kFullBatteryMv = 4200;
@@ -277,10 +275,13 @@ void Car::move(double lane_mm) {
     double nu = crosses ? (dir_ > 0 ? 1.0 : 0.0) : u_ + dir_ * step / len;
     if (reporting) {
       // At most one code per tick in practice; loop in driving order to be safe.
-      for (int k = 0; k < p.codes; ++k) {
-        int idx = dir_ > 0 ? k : p.codes - 1 - k;
-        double f = p.code_at[idx];
-        if (dir_ > 0 ? (f > u_ && f <= nu) : (f < u_ && f >= nu)) sendPosition(idx);
+      const PieceInfo::Row& row = p.rows[static_cast<std::size_t>(rowAt(p))];
+      const int codes = static_cast<int>(row.code_at.size());
+      for (int k = 0; k < codes; ++k) {
+        int idx = dir_ > 0 ? k : codes - 1 - k;
+        double f = row.code_at[static_cast<std::size_t>(idx)];
+        if (dir_ > 0 ? (f > u_ && f <= nu) : (f < u_ && f >= nu))
+          sendPosition(row.first_location + idx);
       }
     }
     // Wheels run on lanes of their own: in a curve the outer wheel travels further.
@@ -314,7 +315,7 @@ void Car::checkDelocalization() {
   bool thrown = false;
   const Piece& p = here().piece;
   if (p.type == anki::PieceType::Curve && speed_ > 0) {
-    double r = anki::kCurveRadiusMm + p.turn * offset_;
+    double r = p.radius() + p.turn * offset_;
     thrown = r <= 0 || speed_ * speed_ / r > kMaxLateralAccel;
   }
   if (off || thrown) delocalize();
@@ -390,16 +391,18 @@ void Car::sendStatus() {
   emit(anki::CarStatus{on_track_, false, low_battery_, battery_mv_ >= kFullBatteryMv});
 }
 
-void Car::sendPosition(int code_index) {
-  const PieceInfo& p = here();
-  // Rows and codes are read in the car's own frame: driving backwards reverses both.
-  double drive_offset = offset_ * dir_;
-  int row = std::clamp(
-      static_cast<int>(std::floor((drive_offset + kRows / 2 * kRowWidthMm) / kRowWidthMm)), 0,
-      kRows - 1);
-  int along = dir_ > 0 ? code_index : p.codes - 1 - code_index;
+int Car::rowAt(const PieceInfo& p) const {
+  // The code row under the car: rows are numbered in the piece's own frame, so a car driving
+  // it backwards reads the same location ids (seed 000 §4.5.1), in the other order.
+  const int rows = static_cast<int>(p.rows.size());
+  return std::clamp(static_cast<int>(std::floor(offset_ / p.row_pitch_mm + rows / 2.0)), 0,
+                    rows - 1);
+}
+
+void Car::sendPosition(int location_id) {
   anki::PositionUpdate m;
-  m.location_id = static_cast<std::uint8_t>(row * p.codes + along);
+  m.location_id = static_cast<std::uint8_t>(location_id);
+  const PieceInfo& p = here();
   m.piece_id = p.piece.id;
   m.offset_mm = static_cast<float>(believedOffset());
   m.speed_mm_s = clampU16(speed_);

@@ -21,8 +21,14 @@ struct PieceInfo {
   Piece piece;
   double centre_mm = 0;     // length along the centre line
   double lap_start_mm = 0;  // centre-line distance from the finish line to this piece's start
-  int codes = 3;            // location codes along the piece, per lane row
-  std::array<double, 3> code_at{};  // where they lie, as fractions of the piece (forward)
+  // The location codes of each code row (engine/sim/code_layout.hpp): where the car reports
+  // them, as fractions of the piece (forward), and the row's first location id.
+  struct Row {
+    std::vector<double> code_at;
+    int first_location = 0;
+  };
+  std::vector<Row> rows;  // left to right in the piece's forward direction
+  double row_pitch_mm = 12;
 };
 
 // What a car shares with its world. Owned by the world; outlives its cars.
@@ -72,6 +78,7 @@ class Car final : public SimCar {
 
  private:
   const PieceInfo& here() const { return env_.pieces[piece_]; }
+  int rowAt(const PieceInfo& p) const;  // the code row under the car
   void move(double lane_mm);
   void crossBoundary();
   void checkDelocalization();

@@ -7,6 +7,9 @@
 #include <cstdio>
 #include <numbers>
 
+#include "engine/sim/code_layout.hpp"
+#include "engine/sim/footprint.hpp"
+
 namespace pitwall::sim {
 
 namespace {
@@ -23,6 +26,10 @@ constexpr std::array<std::uint8_t, 6> kCurveIds{17, 18, 20, 23, 24, 27};
 
 // How far a layout's end may lie from its start and still count as closed: pieces fit with play.
 constexpr double kClosureToleranceMm = 1.0;
+constexpr double kClosureToleranceDeg = 0.01;
+// Beyond these a custom piece is a mistake (a typo's extra zero), not a piece anyone prints.
+constexpr double kMaxRadiusMm = 5000;
+constexpr double kMaxStraightMm = 5000;
 
 std::string lower(std::string_view s) {
   std::string out(s);
@@ -43,42 +50,70 @@ std::string formatMm(double mm) {
   return buf;
 }
 
-// Position and heading (quarter turns counter-clockwise from the start direction) while walking
-// the centre line; headings stay integers so a closed layout closes exactly.
+std::string formatNumber(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
+
+// Position and heading while walking the centre line.
 struct Walk {
-  double x = 0, y = 0;
-  int quarter = 0;
-  void advance(const Piece& p) {
-    static constexpr int kDx[4] = {1, 0, -1, 0};
-    static constexpr int kDy[4] = {0, 1, 0, -1};
-    int h = ((quarter % 4) + 4) % 4;
-    if (p.turn == 0) {
-      double len = p.length(0);
-      x += kDx[h] * len;
-      y += kDy[h] * len;
-      return;
-    }
-    // A 90° arc moves the car one radius forward and one radius sideways (to the turn side).
-    int side = ((h + p.turn) % 4 + 4) % 4;
-    x += (kDx[h] + kDx[side]) * anki::kCurveRadiusMm;
-    y += (kDy[h] + kDy[side]) * anki::kCurveRadiusMm;
-    quarter += p.turn;
-  }
+  Pose at;
+  void advance(const Piece& p) { at = poseOnPiece(p, at, 1.0, 0); }
 };
+
+// The heading's difference from the start direction, in (−180, 180].
+double headingError(double heading) {
+  double d = std::fmod(heading, 360.0);
+  if (d > 180) d -= 360;
+  if (d <= -180) d += 360;
+  return d;
+}
 
 }  // namespace
 
+Pose poseOnPiece(const Piece& p, const Pose& start, double fraction, double offset_mm) {
+  const double h = start.heading * std::numbers::pi / 180;
+  const double dx = std::cos(h), dy = std::sin(h);
+  const double rx = dy, ry = -dx;  // right of the driving direction
+  if (p.turn == 0) {
+    const double len = p.length(0) * fraction;
+    return {start.x + dx * len + rx * offset_mm, start.y + dy * len + ry * offset_mm,
+            start.heading};
+  }
+  // The arc's centre lies one radius to the turn's side; a lane right of the centre line is
+  // outer in a left curve (turn +1) and inner in a right one.
+  const double R = p.radius(), t = p.turn;
+  const double cx = start.x - t * rx * R, cy = start.y - t * ry * R;
+  const double turned = t * fraction * p.angle();
+  const double phi = turned * std::numbers::pi / 180;
+  // From the centre to the start point, scaled to the lane's radius, turned by phi.
+  const double r = R + t * offset_mm;
+  const double ux = (start.x - cx) / R, uy = (start.y - cy) / R;
+  const double c = std::cos(phi), s = std::sin(phi);
+  return {cx + r * (ux * c - uy * s), cy + r * (ux * s + uy * c), start.heading + turned};
+}
+
+double Piece::radius() const {
+  if (turn == 0) return 0;
+  return radius_mm > 0 ? radius_mm : anki::kCurveRadiusMm;
+}
+
+double Piece::angle() const {
+  if (turn == 0) return 0;
+  return angle_deg > 0 ? angle_deg : 90;
+}
+
 double Piece::length(double offset_mm) const {
+  if (turn != 0)  // a left curve (turn +1) has its centre on the left: lanes right (+) are outer
+    return (radius() + turn * offset_mm) * angle() * std::numbers::pi / 180;
   switch (type) {
     case anki::PieceType::StartLong:
       return anki::kStartLongLengthMm;
     case anki::PieceType::StartShort:
       return anki::kStartShortLengthMm;
-    case anki::PieceType::Curve:
-      // A left curve (turn +1) has its centre on the left, so lanes to the right (+) are outer.
-      return (anki::kCurveRadiusMm + turn * offset_mm) * std::numbers::pi / 2;
     default:
-      return anki::kStraightLengthMm;
+      return straight_mm > 0 ? straight_mm : anki::kStraightLengthMm;
   }
 }
 
@@ -102,9 +137,17 @@ std::string layoutText(const Track& track) {
       ++i;  // the pair is one token
       continue;
     }
-    const char* kind = p.turn > 0 ? "L" : p.turn < 0 ? "R" : "S";
-    out += (out.empty() ? "" : " ") + std::string(kind) + ":" + std::to_string(p.id);
+    out += (out.empty() ? "" : " ") + pieceToken(p);
   }
+  return out;
+}
+
+std::string pieceToken(const Piece& p) {
+  std::string out = p.turn > 0 ? "L" : p.turn < 0 ? "R" : "S";
+  out += ":" + std::to_string(p.id);
+  if (p.straight_mm > 0) out += ",len=" + formatNumber(p.straight_mm);
+  if (p.radius_mm > 0) out += ",r=" + formatNumber(p.radius_mm);
+  if (p.angle_deg > 0) out += ",deg=" + formatNumber(p.angle_deg);
   return out;
 }
 
@@ -114,11 +157,24 @@ double Track::lapLength(double offset_mm) const {
   return sum;
 }
 
-Result<Track, std::string> parseLayout(std::string_view text, std::string name) {
+namespace {
+
+// The pieces of a layout text, each checked on its own (kind, id, keys, code), before the checks
+// of the whole (one start, closed, no overlap).
+struct Parsed {
   std::vector<Piece> pieces;
-  std::size_t straights = 0, curves = 0;
-  int position = 0;
+  std::vector<int> positions;  // of each piece's token, for errors
+  int tokens = 0;
   int startAt = 0;
+};
+
+Result<Parsed, std::string> parseTokens(std::string_view text) {
+  Parsed parsed;
+  auto& pieces = parsed.pieces;
+  auto& positions = parsed.positions;
+  auto& startAt = parsed.startAt;
+  std::size_t straights = 0, curves = 0;
+  int& position = parsed.tokens;
   std::size_t i = 0;
   while (i < text.size()) {
     char c = text[i];
@@ -139,46 +195,87 @@ Result<Track, std::string> parseLayout(std::string_view text, std::string name) 
     ++position;
     std::string at = " at position " + std::to_string(position);
 
-    std::string_view kind = token;
+    std::string_view head = token, keys;
+    if (auto comma = token.find(','); comma != std::string_view::npos) {
+      head = token.substr(0, comma);
+      keys = token.substr(comma + 1);
+    }
+    std::string_view kind = head;
     std::string_view idText;
     bool hasId = false;
-    if (auto colon = token.find(':'); colon != std::string_view::npos) {
-      kind = token.substr(0, colon);
-      idText = token.substr(colon + 1);
+    if (auto colon = head.find(':'); colon != std::string_view::npos) {
+      kind = head.substr(0, colon);
+      idText = head.substr(colon + 1);
       hasId = true;
     }
     std::string k = lower(kind);
+    const std::string named = "'" + std::string(token) + "'" + at;
 
     if (k == "start") {
-      if (hasId)
-        return fail("'" + std::string(token) + "'" + at +
-                    ": start is always pieces 34 and 33 and takes no piece id");
+      if (hasId || !keys.empty())
+        return fail(named + ": start is always pieces 34 and 33 and takes no piece id or keys");
       if (startAt != 0)
         return fail("a second start" + at + " (the first is at position " +
                     std::to_string(startAt) + "); a track has exactly one start");
       startAt = position;
       pieces.push_back({anki::kFinishBefore, anki::PieceType::StartLong, 0});
       pieces.push_back({anki::kFinishAfter, anki::PieceType::StartShort, 0});
+      positions.push_back(position);
+      positions.push_back(position);
       continue;
     }
 
-    int turn = 0;
-    anki::PieceType type = anki::PieceType::Straight;
+    Piece piece;
     if (k == "s" || k == "straight") {
-      type = anki::PieceType::Straight;
+      piece.type = anki::PieceType::Straight;
     } else if (k == "l" || k == "left") {
-      type = anki::PieceType::Curve;
-      turn = 1;
+      piece.type = anki::PieceType::Curve;
+      piece.turn = 1;
     } else if (k == "r" || k == "right") {
-      type = anki::PieceType::Curve;
-      turn = -1;
+      piece.type = anki::PieceType::Curve;
+      piece.turn = -1;
     } else {
       return fail("unknown piece '" + std::string(token) + "'" + at +
                   "; use start, S (straight), L (left) or R (right), optionally with "
                   ":ID such as S:39");
     }
+    const anki::PieceType type = piece.type;
 
-    std::uint8_t id = 0;
+    // Keys: a custom piece's geometry (len for a straight, r and deg for a curve).
+    while (!keys.empty()) {
+      std::string_view kv = keys.substr(0, keys.find(','));
+      keys = kv.size() < keys.size() ? keys.substr(kv.size() + 1) : std::string_view{};
+      auto eq = kv.find('=');
+      std::string key = lower(kv.substr(0, eq));
+      const char* allowed = piece.turn ? "r (centre radius, mm) and deg (angle)" : "len (mm)";
+      double* slot = piece.turn == 0 && key == "len"   ? &piece.straight_mm
+                     : piece.turn != 0 && key == "r"   ? &piece.radius_mm
+                     : piece.turn != 0 && key == "deg" ? &piece.angle_deg
+                                                       : nullptr;
+      if (!slot)
+        return fail(named + ": unknown key '" + std::string(kv.substr(0, eq)) + "'; a " +
+                    (piece.turn ? "curve" : "straight") + " takes " + allowed + ", such as " +
+                    (piece.turn ? "L:61,r=400,deg=45" : "S:60,len=300"));
+      std::string_view valueText = eq == std::string_view::npos ? "" : kv.substr(eq + 1);
+      double value = 0;
+      auto [ptr, ec] =
+          std::from_chars(valueText.data(), valueText.data() + valueText.size(), value);
+      if (valueText.empty() || ec != std::errc() || ptr != valueText.data() + valueText.size() ||
+          !std::isfinite(value) || value <= 0)
+        return fail(named + ": " + key + " '" + std::string(valueText) +
+                    "' is not a positive number" + (key == "deg" ? " of degrees" : " of mm"));
+      if (key == "deg" && value > 180)
+        return fail(named + ": deg=" + formatNumber(value) +
+                    " turns more than 180°; split it into two curves");
+      if (key == "r" && value > kMaxRadiusMm)
+        return fail(named + ": r=" + formatNumber(value) + " mm is more than " +
+                    formatNumber(kMaxRadiusMm) + " mm; use a straight");
+      if (key == "len" && value > kMaxStraightMm)
+        return fail(named + ": len=" + formatNumber(value) + " mm is more than " +
+                    formatNumber(kMaxStraightMm) + " mm; split it into two straights");
+      *slot = value;
+    }
+
     if (hasId) {
       unsigned value = 0;
       auto [ptr, ec] = std::from_chars(idText.data(), idText.data() + idText.size(), value);
@@ -186,25 +283,89 @@ Result<Track, std::string> parseLayout(std::string_view text, std::string name) 
           value > 255)
         return fail("piece id '" + std::string(idText) + "'" + at +
                     " is not a number from 0 to 255");
-      id = static_cast<std::uint8_t>(value);
-      anki::PieceType actual = anki::pieceType(id);
-      if (actual != type) {
+      piece.id = static_cast<std::uint8_t>(value);
+      anki::PieceType actual = anki::pieceType(piece.id);
+      if (actual == anki::PieceType::Unknown) {
+        // A custom piece: an id of its own, which its code must be able to carry.
+        if (value > anki::optical::kMaxId)
+          return fail("piece id " + std::to_string(value) + at +
+                      " does not fit the code's 7 bits; a custom piece takes an id from 0 to " +
+                      std::to_string(anki::optical::kMaxId) + " that Anki does not use");
+      } else if (actual != type) {
         std::string want(anki::pieceTypeName(type));
-        std::string what =
-            actual == anki::PieceType::Unknown
-                ? " is not a known piece"
-                : " is a " + std::string(anki::pieceTypeName(actual)) + " piece, not a " + want;
-        return fail("piece id " + std::to_string(value) + at + what + "; " + want + " ids are " +
-                    (type == anki::PieceType::Straight ? idList(kStraightIds) : idList(kCurveIds)));
+        return fail("piece id " + std::to_string(value) + at + " is a " +
+                    std::string(anki::pieceTypeName(actual)) + " piece, not a " + want + "; " +
+                    want + " ids are " +
+                    (type == anki::PieceType::Straight ? idList(kStraightIds) : idList(kCurveIds)) +
+                    ", and a custom piece takes an id Anki does not use");
+      } else if (piece.custom()) {
+        return fail(named + ": " + std::to_string(value) + " is the id of Anki's stock " +
+                    std::string(anki::pieceTypeName(type)) +
+                    "; a piece of another shape needs an id of its own, one Anki does not use "
+                    "(such as 60)");
       }
+    } else if (piece.custom()) {
+      return fail(named +
+                  ": a custom piece needs an id of its own, one Anki does not use, "
+                  "such as " +
+                  std::string(piece.turn ? "L:61," : "S:60,") +
+                  std::string(token.substr(token.find(',') + 1)));
     } else if (type == anki::PieceType::Straight) {
-      id = kStraightIds[straights++ % kStraightIds.size()];
+      piece.id = kStraightIds[straights++ % kStraightIds.size()];
     } else {
-      id = kCurveIds[curves++ % kCurveIds.size()];
+      piece.id = kCurveIds[curves++ % kCurveIds.size()];
     }
-    pieces.push_back({id, type, turn});
-  }
 
+    // One custom id, one shape: the scan lap and pitwall.piece learn a piece's shape by its id.
+    for (std::size_t j = 0; j < pieces.size(); ++j) {
+      const Piece& o = pieces[j];
+      if (o.id != piece.id) continue;
+      if ((o.turn == 0) != (piece.turn == 0) || o.length(0) != piece.length(0) ||
+          o.angle() != piece.angle())
+        return fail(named + " has id " + std::to_string(piece.id) + ", which " + pieceToken(o) +
+                    " at position " + std::to_string(positions[j]) +
+                    " has with another shape; one id, one shape: give it an id of its own");
+    }
+
+    // Its code must fit: a section on its shortest lane, and location ids within 7 bits.
+    CodeLayout code = codeLayout(piece);
+    double shortest = code.rows.front().length_mm, longest = shortest;
+    for (const CodeRow& row : code.rows) {
+      shortest = std::min(shortest, row.length_mm);
+      longest = std::max(longest, row.length_mm);
+    }
+    const double sectionMm = CodeGeometry{}.section_min_mm;
+    if (shortest < sectionMm)
+      return fail(named + " is too short to carry its code: its shortest lane is " +
+                  formatMm(shortest) + " mm and a code section needs " + formatMm(sectionMm) +
+                  " mm; make it " + (piece.turn ? "wider (r) or turn further (deg)" : "longer"));
+    if (code.locations > anki::optical::kMaxId + 1)
+      return fail(named + " needs " + std::to_string(code.locations) +
+                  " location ids and a 7-bit code carries 128; make it shorter or split it "
+                  "into two pieces");
+    pieces.push_back(piece);
+    positions.push_back(position);
+  }
+  return parsed;
+}
+
+}  // namespace
+
+Result<std::vector<Piece>, std::string> parsePiece(std::string_view token) {
+  auto parsed = parseTokens(token);
+  if (!parsed) return Unexpected<std::string>(parsed.error());
+  if (parsed->tokens != 1)
+    return fail("'" + std::string(token) + "' is " + std::to_string(parsed->tokens) +
+                " pieces; give one, such as S, L:17, start or S:60,len=300");
+  return std::move(parsed->pieces);
+}
+
+Result<Track, std::string> parseLayout(std::string_view text, std::string name) {
+  auto parsed = parseTokens(text);
+  if (!parsed) return Unexpected<std::string>(parsed.error());
+  auto& pieces = parsed->pieces;
+  const auto& positions = parsed->positions;
+  const int startAt = parsed->startAt;
   if (pieces.empty())
     return fail(
         std::string("the layout is empty; list its pieces, for example `start S L L S S L L`"));
@@ -214,19 +375,25 @@ Result<Track, std::string> parseLayout(std::string_view text, std::string name) 
 
   Walk walk;
   for (const Piece& p : pieces) walk.advance(p);
-  double gap = std::hypot(walk.x, walk.y);
-  int heading = ((walk.quarter % 4) + 4) % 4;
-  if (gap > kClosureToleranceMm || heading != 0) {
+  double gap = std::hypot(walk.at.x, walk.at.y);
+  double turned = headingError(walk.at.heading);
+  if (gap > kClosureToleranceMm || std::abs(turned) > kClosureToleranceDeg) {
     std::string why = "the layout does not close: its end is " + formatMm(gap) +
-                      " mm from its start (x " + formatMm(walk.x) + " mm, y " + formatMm(walk.y) +
-                      " mm)";
-    if (heading != 0)
-      why += " and heads " + std::to_string(heading == 2 ? 180 : 90) + "° " +
-             (heading == 1   ? "left of"
-              : heading == 3 ? "right of"
-                             : "away from") +
+                      " mm from its start (x " + formatMm(walk.at.x) + " mm, y " +
+                      formatMm(walk.at.y) + " mm)";
+    if (std::abs(turned) > kClosureToleranceDeg)
+      why += " and heads " + formatNumber(std::round(std::abs(turned) * 100) / 100) + "° " +
+             (std::abs(turned) > 179.99 ? "away from"
+              : turned > 0              ? "left of"
+                                        : "right of") +
              " the start direction";
     return fail(why + "; add or remove pieces until it does");
+  }
+  if (auto overlap = firstOverlap(pieces)) {
+    auto [a, b] = *overlap;
+    return fail("pieces " + pieceToken(pieces[a]) + " at position " + std::to_string(positions[a]) +
+                " and " + pieceToken(pieces[b]) + " at position " + std::to_string(positions[b]) +
+                " overlap; a layout may not cross itself: change the pieces between them");
   }
   return Track(std::move(name), std::move(pieces));
 }

@@ -6,9 +6,13 @@
 //   S | straight     straight, 560 mm
 //   L | left         90° curve turning left, centre radius 280 mm
 //   R | right        90° curve turning right
-// Any token may carry an explicit piece id: `S:39`, `L:18`. A layout must contain exactly one
-// `start` and must close (end where it began, heading the same way); otherwise parsing fails with
-// a sentence saying why.
+// Any token may carry an explicit piece id: `S:39`, `L:18`. A custom piece (docs/tracks.md) has an
+// id of its own (0–127, not one of Anki's) and its geometry as keys after commas:
+//   S:60,len=300     a straight of 300 mm
+//   L:61,r=400,deg=45  a curve of centre radius 400 mm turning 45°
+// A layout must contain exactly one `start`, must close (end where it began, heading the same
+// way), its pieces must not overlap and each must carry a code (docs/tracks.md "Rules");
+// otherwise parsing fails with a sentence naming the piece and saying why.
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -23,10 +27,28 @@ struct Piece {
   std::uint8_t id = 0;
   anki::PieceType type = anki::PieceType::Straight;
   int turn = 0;  // +1 left curve, −1 right curve, 0 straight
+  // A custom piece's geometry; 0 means the stock value of its type.
+  double straight_mm = 0;  // a straight's length
+  double radius_mm = 0;    // a curve's centre radius
+  double angle_deg = 0;    // how far a curve turns
+
+  bool custom() const { return straight_mm > 0 || radius_mm > 0 || angle_deg > 0; }
+  double radius() const;  // a curve's centre radius (stock 280 mm); 0 for a straight
+  double angle() const;   // a curve's turn in degrees (stock 90); 0 for a straight
   // Length of this piece along a lane at `offset_mm` from the road centre (positive = right in
   // driving direction): a left curve is longer on the right (outer) side.
   double length(double offset_mm) const;
 };
+
+// A point on the road and the driving direction there: mm, x to the right and y up, heading in
+// degrees counter-clockwise from +x (the frame of docs/view.md).
+struct Pose {
+  double x = 0, y = 0;
+  double heading = 0;
+};
+// The point `fraction` (0…1) along `piece`, which begins at `start`, `offset_mm` right of its
+// centre line, and the heading there (not normalized).
+Pose poseOnPiece(const Piece& piece, const Pose& start, double fraction, double offset_mm);
 
 class Track {
  public:
@@ -47,9 +69,14 @@ class Track {
 };
 
 Result<Track, std::string> parseLayout(std::string_view text, std::string name = "custom");
+// One token of a layout ("S", "L:17", "S:60,len=300", "start"), checked as parseLayout checks
+// it: its pieces (two for start: 34 and 33).
+Result<std::vector<Piece>, std::string> parsePiece(std::string_view token);
 // The layout text of a track, every piece with its id ("start S:36 L:17 …"): parseLayout reads
 // it back to the same pieces (a record keeps the track it was made on this way).
 std::string layoutText(const Track& track);
+// One piece as a layout token: "S:36", "L:61,r=400,deg=45".
+std::string pieceToken(const Piece& piece);
 // Named layouts: "oval" (the default: start S L L S S L L, ≈4.0 m), and others listed by
 // layoutNames(). loadLayout takes a name or a path to a layout file.
 Result<Track, std::string> namedLayout(std::string_view name);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "engine/sim/code_layout.hpp"
 #include "engine/sim/sim_car.hpp"
 
 namespace pitwall::sim {
@@ -19,26 +20,20 @@ constexpr double kReleaseMm = 5;     // a contact ends once the gap opens by thi
 // Identifiers the world hands out when a spec leaves it 0: recognisable, and stable per index.
 constexpr std::uint32_t kIdentifierBase = 0x51A00000;
 
-// Where the location codes lie along a piece, as fractions of it (docs/simulator.md
-// "Location codes"). Straights and curves: evenly, 3 per row. The start pair places its 2 + 1
-// codes so the spacing stays ≈180 mm between the curve before 34 and the straight after 33.
+// Where the location codes lie along a piece (docs/simulator.md "Location codes"): one per
+// code section, reported at the section's centre, in every row of the piece's code layout.
 PieceInfo describe(const Piece& piece) {
   PieceInfo info;
   info.piece = piece;
   info.centre_mm = piece.length(0);
-  switch (piece.type) {
-    case anki::PieceType::StartLong:
-      info.codes = 2;
-      info.code_at = {0.32, 0.85, 0};
-      break;
-    case anki::PieceType::StartShort:
-      info.codes = 1;
-      info.code_at = {0.6, 0, 0};
-      break;
-    default:
-      info.codes = 3;
-      info.code_at = {1.0 / 6, 3.0 / 6, 5.0 / 6};
-      break;
+  CodeGeometry g;
+  info.row_pitch_mm = g.row_pitch_mm;
+  for (const CodeRow& row : codeLayout(piece, g).rows) {
+    PieceInfo::Row r;
+    r.first_location = row.first_location;
+    for (int k = 0; k < row.sections; ++k)
+      r.code_at.push_back(row.sectionCentre(k) / row.length_mm);
+    info.rows.push_back(std::move(r));
   }
   return info;
 }

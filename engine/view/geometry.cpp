@@ -10,30 +10,9 @@ namespace pitwall::view {
 
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180;
-
 // `fraction` along piece `p` that begins at `start`, `offset_mm` right of its centre line.
 Pose onPiece(const sim::Piece& p, const Pose& start, double fraction, double offset_mm) {
-  const double h = start.heading * kDeg;
-  const double dx = std::cos(h), dy = std::sin(h);
-  const double rx = dy, ry = -dx;  // right of the driving direction
-  if (p.turn == 0) {
-    const double len = p.length(0) * fraction;
-    return {start.x + dx * len + rx * offset_mm, start.y + dy * len + ry * offset_mm,
-            start.heading};
-  }
-  // The arc's centre lies one radius to the turn's side; a lane right of the centre line is
-  // outer in a left curve (turn +1) and inner in a right one.
-  const double R = anki::kCurveRadiusMm;
-  const double t = p.turn;
-  const double cx = start.x - t * rx * R, cy = start.y - t * ry * R;
-  const double phi = t * fraction * std::numbers::pi / 2;
-  // From the centre to the start point, scaled to the lane's radius, turned by phi.
-  const double r = R + t * offset_mm;
-  const double ux = (start.x - cx) / R, uy = (start.y - cy) / R;
-  const double c = std::cos(phi), s = std::sin(phi);
-  return {cx + r * (ux * c - uy * s), cy + r * (ux * s + uy * c),
-          start.heading + t * fraction * 90};
+  return sim::poseOnPiece(p, start, fraction, offset_mm);
 }
 
 double normalize(double degrees) {
@@ -86,7 +65,7 @@ nlohmann::json trackJson(const sim::Track& track, const std::string& source) {
                       {"type", std::string(anki::pieceTypeName(p.type))},
                       {"turn", p.turn},
                       {"length", clean(p.length(0))},
-                      {"radius", p.turn ? nlohmann::json(anki::kCurveRadiusMm) : nullptr},
+                      {"radius", p.turn ? nlohmann::json(p.radius()) : nullptr},
                       {"x", clean(at.x)},
                       {"y", clean(at.y)},
                       {"heading", clean(at.heading)}});
@@ -127,9 +106,10 @@ std::string lanePath(const sim::Track& track, double offset) {
     if (p.turn == 0) {
       d << " L" << b.x << " " << -b.y;
     } else {
-      double r = anki::kCurveRadiusMm + p.turn * offset;
+      double r = p.radius() + p.turn * offset;
       // a left turn is counter-clockwise in y-up, clockwise once y is flipped: sweep flag 0
-      d << " A" << r << " " << r << " 0 0 " << (p.turn > 0 ? 0 : 1) << " " << b.x << " " << -b.y;
+      d << " A" << r << " " << r << " 0 " << (p.angle() > 180 ? 1 : 0) << " "
+        << (p.turn > 0 ? 0 : 1) << " " << b.x << " " << -b.y;
     }
     at = onPiece(p, at, 1.0, 0);
   }
@@ -187,12 +167,23 @@ std::string trackSummary(const sim::Track& track) {
   char line[256];
   std::string out = track.name() + ": " + std::to_string(track.size()) + " pieces\n";
   for (const auto& p : json["pieces"]) {
-    std::snprintf(line, sizeof line, "  %2zu  id %-3d %-11s %s\n", p["index"].get<std::size_t>(),
+    const sim::Piece& piece = track.pieces()[p["index"].get<std::size_t>()];
+    std::snprintf(line, sizeof line, "  %2zu  id %-3d %-11s %s", p["index"].get<std::size_t>(),
                   p["id"].get<int>(), p["type"].get<std::string>().c_str(),
                   p["turn"].get<int>() > 0   ? "left"
                   : p["turn"].get<int>() < 0 ? "right"
                                              : "");
     out += line;
+    if (piece.custom()) {  // its shape, as the layout gives it
+      std::snprintf(line, sizeof line, "%s%.0f mm", piece.turn ? " " : "       ", piece.length(0));
+      out += line;
+      if (piece.turn) {
+        std::snprintf(line, sizeof line, ", r %g mm, %g°", piece.radius(), piece.angle());
+        out += line;
+      }
+    }
+    while (!out.empty() && out.back() == ' ') out.pop_back();
+    out += "\n";
   }
   out += "lap length:";
   for (double o : kLaneOffsetsMm) {

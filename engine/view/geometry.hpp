@@ -6,17 +6,15 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "engine/sim/footprint.hpp"
 #include "engine/sim/track.hpp"
 
 namespace pitwall::view {
 
-inline constexpr double kRoadHalfWidthMm = 96;                   // simulator.md: ±96 mm
-inline constexpr double kLaneOffsetsMm[4] = {-68, -23, 23, 68};  // the four lanes
+inline constexpr double kRoadHalfWidthMm = sim::kRoadHalfWidthMm;  // simulator.md: ±96 mm
+inline constexpr double kLaneOffsetsMm[4] = {-68, -23, 23, 68};    // the four lanes
 
-struct Pose {
-  double x = 0, y = 0;
-  double heading = 0;  // degrees, counter-clockwise from +x
-};
+using Pose = sim::Pose;  // mm; heading in degrees, counter-clockwise from +x
 
 // Where piece `index` begins (its centre line), walking from the start piece.
 Pose pieceStart(const sim::Track& track, std::size_t index);

@@ -2,30 +2,18 @@
 
 #include <algorithm>
 
+#include "engine/sim/code_layout.hpp"
+
 namespace pitwall::view {
 
 namespace {
 
-// Where along a piece a location code lies (simulator.md "Location codes"): codes per row and
-// their fractions. Real pieces carry more codes on curves; the page interpolates between reports.
-double codeFraction(anki::PieceType type, int location, bool reverse) {
-  double f = 0.5;
-  switch (type) {
-    case anki::PieceType::StartLong: {
-      static constexpr double kAt[2] = {0.32, 0.85};
-      f = kAt[location % 2];
-      break;
-    }
-    case anki::PieceType::StartShort:
-      f = 0.6;
-      break;
-    default: {
-      static constexpr double kAt[3] = {1.0 / 6, 0.5, 5.0 / 6};
-      f = kAt[location % 3];
-    }
-  }
-  // codes are read in the car's own frame: driving backwards, they run the other way
-  return reverse ? 1 - f : f;
+// Where along a piece a location code lies (docs/tracks.md "The code"): the centre of its
+// section, as a fraction of the piece in its own forward direction; location ids name the same
+// spot whichever way the car drives. Unknown ids: the middle.
+double codeFraction(const sim::Piece& piece, int location) {
+  auto spot = sim::locateCode(piece, location);
+  return spot ? spot->fraction : 0.5;
 }
 
 }  // namespace
@@ -72,7 +60,11 @@ void CarTracker::update(const anki::Message& message, const CarState& state, dou
     if (p->piece_id == anki::kFinishBefore) crossedSinceStartPiece_ = false;
     lastPieceId_ = p->piece_id;
     index_ = locate(p->piece_id, reverse);
-    fraction_ = codeFraction(anki::pieceType(p->piece_id), p->location_id, reverse);
+    // The piece as the track has it (a custom one's shape), else Anki's stock piece of that id.
+    sim::Piece piece{p->piece_id, anki::pieceType(p->piece_id),
+                     anki::pieceType(p->piece_id) == anki::PieceType::Curve ? 1 : 0};
+    if (track_ && index_) piece = track_->pieces()[*index_];
+    fraction_ = codeFraction(piece, p->location_id);
     positionTime_ = now;
   } else if (std::holds_alternative<anki::TransitionUpdate>(message)) {
     // The car left the piece it last reported: 34 → 33 driving forward is the finish line.

@@ -2,7 +2,7 @@
 --
 --   local track = require "pitwall.track"
 --   local map = track.scan(car)                -- inside a task: one slow lap in a fixed lane
---   map.pieces[i]                               -- {index, id, type, turn, centre, start, radius}
+--   map.pieces[i]                               -- {index, id, type, turn, centre, start, radius, angle}
 --   map.pieces[i]:length(offset)                -- mm along the lane at `offset` (+ right)
 --   map:lapLength(offset)                       -- mm of one lap in that lane
 --
@@ -96,6 +96,7 @@ local function build(entries, fields)
       -- Unknown pieces (specials, jumps): their measured length, the same on every lane.
       centre = spec and spec.length or e.measured or 0,
       radius = spec and spec.radius,
+      angle = spec and spec.angle,
       start = start,
     }, Piece)
     if p.radius then p.turn = e.turn end
@@ -370,7 +371,7 @@ function track.scan(car, options)
       if spec and spec.type == "curve" then
         -- The outer wheel travels further: the right wheel in a left curve.
         e.turn = s.right > s.left and "left" or "right"
-        turns = turns + (e.turn == "left" and 1 or -1)
+        turns = turns + (e.turn == "left" and 1 or -1) * spec.angle
       end
       offsets = offsets + s.offset
       entries[#entries + 1] = e
@@ -381,9 +382,9 @@ function track.scan(car, options)
       scanSpeed = speed,
       scannedBy = car.name,
     })
-    if turns % 4 ~= 0 then
-      pitwall.log("warn", string.format("track.scan: the curves turn %d quarter turns in all; a "
-        .. "closed track turns a multiple of 4: a curve's direction may be wrong", turns))
+    if math.abs((turns + 180) % 360 - 180) > 0.5 then
+      pitwall.log("warn", string.format("track.scan: the curves turn %g° in all; a closed track "
+        .. "turns a multiple of 360°: a curve's direction may be wrong", turns))
     end
     if options.stop ~= false then car:stop() end
     -- the race view draws what was learnt (a simulator's layout stays: pitwall.view.track)

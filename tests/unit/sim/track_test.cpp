@@ -155,10 +155,13 @@ TEST_CASE("loadLayout takes a name or a file, and says when it finds neither") {
   std::filesystem::remove(path);
 }
 
-TEST_CASE("an unknown piece id is refused with the ids that fit") {
+TEST_CASE("a piece id beyond the code's 7 bits, or of another kind, is refused with what fits") {
   CHECK(contains(errorOf("start S:200 L L S S L L"),
-                 "piece id 200 at position 2 is not a known piece; straight ids are 36, 39, 40, "
-                 "48, 51"));
+                 "piece id 200 at position 2 does not fit the code's 7 bits; a custom piece "
+                 "takes an id from 0 to 127 that Anki does not use"));
+  CHECK(contains(errorOf("start S:17 L L S S L L"),
+                 "piece id 17 at position 2 is a curve piece, not a straight; straight ids are "
+                 "36, 39, 40, 48, 51"));
 }
 
 TEST_CASE("layoutText: every layout reads back to the same pieces (what a record keeps)") {
@@ -174,4 +177,81 @@ TEST_CASE("layoutText: every layout reads back to the same pieces (what a record
     }
   }
   CHECK(layoutText(namedLayout("kidney").value()).starts_with("start S:36 L:17"));
+}
+
+TEST_CASE("custom pieces: ids of their own, lengths, radii and angles, read back by layoutText") {
+  // Four 45° curves of 400 mm turn the car round; both sides are 1000 mm long.
+  const char* text =
+      "start S:60,len=440 L:61,r=400,deg=45 L:61,r=400,deg=45 L:61,r=400,deg=45 "
+      "L:61,r=400,deg=45 S:60,len=440 S L:61,r=400,deg=45 L:61,r=400,deg=45 "
+      "L:61,r=400,deg=45 L:61,r=400,deg=45";
+  auto t = parseLayout(text, "custom");
+  if (!t) FAIL(t.error());
+  REQUIRE(t->size() == 13);
+  const Piece& s = t->piece(2);
+  const Piece& c = t->piece(3);
+  CHECK(s.id == 60);
+  CHECK(s.custom());
+  CHECK(s.length(0) == doctest::Approx(440));
+  CHECK(s.length(50) == doctest::Approx(440));
+  CHECK(c.id == 61);
+  CHECK(c.radius() == 400);
+  CHECK(c.angle() == 45);
+  CHECK(c.length(0) == doctest::Approx(400 * std::numbers::pi / 4));
+  CHECK(c.length(68) == doctest::Approx((400 + 68) * std::numbers::pi / 4));  // outer in a left
+  auto again = parseLayout(layoutText(*t), "again");
+  REQUIRE(again);
+  CHECK(layoutText(*again) == layoutText(*t));
+  CHECK(layoutText(*t).starts_with("start S:60,len=440 L:61,r=400,deg=45"));
+  CHECK(again->lapLength(0) == doctest::Approx(t->lapLength(0)));
+  // a lone token: one piece, or the start pair
+  auto one = parsePiece("L:61,r=400,deg=45");
+  REQUIRE(one);
+  REQUIRE(one->size() == 1);
+  CHECK((*one)[0].radius() == 400);
+  auto start = parsePiece("start");
+  REQUIRE(start);
+  CHECK(start->size() == 2);
+  CHECK_FALSE(parsePiece("S L"));
+}
+
+TEST_CASE("invalid custom designs are refused with a sentence naming the piece") {
+  // does not close: an angle that leaves it turned
+  CHECK(contains(errorOf("start S L L S S L L:61,r=280,deg=80"), "does not close"));
+  CHECK(contains(errorOf("start S L L S S L L:61,r=280,deg=80"), "heads 10° right of"));
+  // crosses itself: a full circle after the first straight comes back over it
+  CHECK(contains(errorOf("start S L L L L S L L S S S L L"),
+                 "pieces S:36 at position 2 and L:23 at position 6 overlap"));
+  CHECK(contains(errorOf("start S:60,len=0 L L S S L L"),
+                 "'S:60,len=0' at position 2: len '0' is not a positive number of mm"));
+  CHECK(contains(errorOf("start S:60,len=1e309 L L S S L L"), "is not a positive number"));
+  CHECK(contains(errorOf("start S:60,len=abc L L S S L L"), "is not a positive number"));
+  CHECK(contains(errorOf("start S:60,r=300 L L S S L L"),
+                 "unknown key 'r'; a straight takes len (mm)"));
+  CHECK(contains(errorOf("start S L:61,len=300 L S S L L"),
+                 "unknown key 'len'; a curve takes r (centre radius, mm) and deg (angle)"));
+  CHECK(contains(errorOf("start S:60,len=100 L L S S L L"),
+                 "'S:60,len=100' at position 2 is too short to carry its code: its shortest "
+                 "lane is 100 mm and a code section needs 150 mm"));
+  CHECK(contains(errorOf("start S:60,len=1400 L L S S L L"),
+                 "needs 144 location ids and a 7-bit code carries 128"));
+  CHECK(contains(errorOf("start S,len=300 L L S S L L"),
+                 "a custom piece needs an id of its own, one Anki does not use, such as "
+                 "S:60,len=300"));
+  CHECK(
+      contains(errorOf("start S:36,len=300 L L S S L L"), "36 is the id of Anki's stock straight"));
+  CHECK(contains(errorOf("start L:61,r=400,deg=200 L L S S L L"), "turns more than 180°"));
+  CHECK(contains(errorOf("start S:60,len=300 S:60,len=400 L L S S L L"),
+                 "'S:60,len=400' at position 3 has id 60, which S:60,len=300 at position 2 has "
+                 "with another shape"));
+  CHECK(contains(errorOf("start,len=3 S L L S S L L"), "start is always pieces 34 and 33"));
+  // hostile numbers and text never crash and always say what is wrong
+  for (const char* bad : {"S:60,len=-1", "S:60,len=nan", "S:60,len=inf", "S:60,len=", "S:60,=3",
+                          "S:60,,", "L:61,r=1e300", "L:61,deg=0.0000001", "S:9999999999999999999",
+                          "S:60,len=300,len=300,len=1e9"}) {
+    CAPTURE(bad);
+    auto r = parseLayout(std::string("start ") + bad + " L L S S L L");
+    CHECK_FALSE(r.ok());
+    if (!r.ok()) CHECK_FALSE(r.error().empty());
+  }
 }
