@@ -63,7 +63,8 @@ end
 
 local letters = { straight = "S", curve = "?", intersection = "X" }
 
---- The map as simulator layout text ("start S L L S S L L"); with `ids`, "S:36 L:17 …".
+--- The map as simulator layout text ("start S L L S S L L"); with `ids`, "S:36 L:17 …" and a
+--- custom piece's shape ("S:60,len=300").
 function Map:layout(ids)
   local words = { "start" }
   local n = #self.pieces
@@ -72,7 +73,16 @@ function Map:layout(ids)
     local p = self.pieces[i]
     local letter = p.type == "curve" and (p.turn == "left" and "L" or "R") or letters[p.type]
       or ("?" .. p.type)
-    words[#words + 1] = ids and (letter .. ":" .. p.id) or letter
+    local word = ids and (letter .. ":" .. p.id) or letter
+    -- a custom piece's shape, as a layout gives it (docs/tracks.md)
+    if ids and p.custom then
+      if p.radius then
+        word = string.format("%s,r=%g,deg=%g", word, p.radius, p.angle)
+      else
+        word = string.format("%s,len=%g", word, p.centre)
+      end
+    end
+    words[#words + 1] = word
   end
   return table.concat(words, " ")
 end
@@ -97,6 +107,7 @@ local function build(entries, fields)
       centre = spec and spec.length or e.measured or 0,
       radius = spec and spec.radius,
       angle = spec and spec.angle,
+      custom = spec and spec.custom or nil,
       start = start,
     }, Piece)
     if p.radius then p.turn = e.turn end

@@ -35,6 +35,15 @@ PY
 )
 check "JSON and CSV results parse back" "parsed 4 4" "$parsed"
 
+# On a track of custom pieces (examples/tracks/hairpin.layout, docs/tracks.md): the AI drivers
+# race it to a winner, every car finishing its laps.
+out=$(LAPS=3 $PITWALL run "$SRC/examples/grand_prix.lua" --fast --cars 4 \
+  --track "$SRC/examples/tracks/hairpin.layout" --results "$TMP/hairpin.csv" 2>"$TMP/err"); rc=$?
+check "grand prix on a custom track: exit status" 0 "$rc"
+contains "grand prix on a custom track: the winner" "Winner: " "$out"
+if grep -q "error " "$TMP/err"; then fail "custom track reported an error: $(cat "$TMP/err")"; fi
+check "grand prix on a custom track: every car finished" 4 "$(grep -c ',true,false$' "$TMP/hairpin.csv")"
+
 out=$(LAPS=2 $PITWALL run "$SRC/examples/time_trial.lua" --fast --cars 3 --results "$TMP/tt.csv" 2>/dev/null); rc=$?
 check "time trial exit status" 0 "$rc"
 contains "time trial names the fastest lap" "Fastest lap: " "$out"

@@ -1,12 +1,14 @@
 // The vehicle side of the protocol as a simulated car speaks it (docs/simulator.md).
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
 
 #include "engine/core/log.hpp"
 #include "engine/protocol/anki/codec.hpp"
+#include "engine/sim/code_layout.hpp"
 #include "engine/sim/world.hpp"
 
 using namespace pitwall;
@@ -29,7 +31,12 @@ struct Rig {
   bool dropped = false;
 
   explicit Rig(CarSpec spec = {}, std::string_view layout = "oval")
-      : world(loop, namedLayout(layout).value(), 7), car(world.addCar(std::move(spec))) {
+      : world(
+            loop,
+            (layout.find(' ') == std::string_view::npos ? namedLayout(layout) : parseLayout(layout))
+                .value(),
+            7),
+        car(world.addCar(std::move(spec))) {
     car.connect(
         [this](std::span<const std::uint8_t> f) {
           auto m = anki::decode(f);
@@ -414,4 +421,56 @@ TEST_CASE("a car advertises its model, identifier, version and name") {
   CHECK(name[2] == 0x2b);
   CHECK(std::string(name.begin() + 8, name.end() - 1) == "Blue");
   CHECK(name.back() == 0);
+}
+
+TEST_CASE(
+    "on a custom track a car reports the design's piece ids and every location id of its row") {
+  // docs/tracks.md: one code section per 150 mm of a row; ids count the rows left to right in
+  // the piece's forward direction, and a car driving backwards reads the same ids.
+  const char* layout =
+      "start S:60,len=440 L:61,r=400,deg=45 L:61,r=400,deg=45 L:61,r=400,deg=45 "
+      "L:61,r=400,deg=45 S:60,len=440 S:36 L:62,r=200,deg=90 S:64,len=400 L:62,r=200,deg=90";
+  for (double offset : {-68.0, -23.0, 23.0, 68.0})
+    for (bool backwards : {false, true}) {
+      CAPTURE(offset);
+      CAPTURE(backwards);
+      Rig rig(CarSpec{.name = "car", .piece_index = 2, .offset_mm = offset}, layout);
+      rig.sdk();
+      if (backwards) rig.send(anki::Turn{anki::TurnType::UTurn, anki::TurnTrigger::Immediate});
+      rig.send(anki::SetSpeed{500, 25000});
+      rig.heard.clear();
+      rig.runUntil(12);  // more than a lap (≈ 4.3 m at 500 mm/s)
+      const Track& track = rig.world.track();
+      // What a lap must show: piece by piece in driving order, the row's ids in driving order.
+      const double pieceOffset = rig.car.truth().offset_mm;  // the track frame's offset
+      std::vector<std::pair<int, int>> expected;
+      const std::size_t n = track.size();
+      for (std::size_t k = 0; k < n; ++k) {
+        std::size_t i = backwards ? (2 + n - 1 - k) % n : (2 + k) % n;
+        const Piece& p = track.piece(i);
+        CodeLayout code = codeLayout(p);
+        const CodeRow* row = nullptr;
+        for (const CodeRow& r : code.rows)
+          if (std::abs(r.offset_mm - pieceOffset) <= 6) row = &r;
+        REQUIRE(row);
+        for (int j = 0; j < row->sections; ++j)
+          expected.emplace_back(p.id,
+                                row->first_location + (backwards ? row->sections - 1 - j : j));
+      }
+      std::vector<std::pair<int, int>> seen;
+      for (auto& [t, m] : rig.all<anki::PositionUpdate>())
+        seen.emplace_back(m.piece_id, m.location_id);
+      // the car starts inside piece 2 (and turns there): compare from its next piece on
+      auto firstOther = std::find_if(seen.begin(), seen.end(),
+                                     [&](auto& e) { return e.first != seen.front().first; });
+      REQUIRE(firstOther != seen.end());
+      std::vector<std::pair<int, int>> lap(firstOther, seen.end());
+      auto from =
+          std::find_if(expected.begin(), expected.end(), [&](auto& e) { return e == lap.front(); });
+      REQUIRE(from != expected.end());
+      std::rotate(expected.begin(), from, expected.end());
+      REQUIRE(lap.size() >= expected.size());
+      lap.resize(expected.size());
+      CHECK(lap == expected);
+    }
 }
