@@ -139,6 +139,26 @@ struct TrackShowOptions {
 };
 int trackShow(const TrackShowOptions& options);
 
+// pitwall track print PIECE|FILE --out OUT.pdf|OUT.svg [--paper a4|a3] [--landscape]: printable
+// pieces at 1:1 (docs/cli.md "track print").
+struct TrackPrintOptions {
+  std::string what;  // a piece token, a layout file or a layout name
+  std::string out;
+  std::string paper = "a4";
+  bool landscape = false;
+};
+int trackPrint(const TrackPrintOptions& options);
+
+// pitwall track verify FILE.svg [--dpi N] [--blur MM] [--misalign MM]: reads a printed piece back
+// as a car's sensor would; 0 all as designed, 1 not, 2 bad input.
+struct TrackVerifyOptions {
+  std::string file;
+  double dpi = 300;
+  double blur_mm = 0.25;
+  double misalign_mm = 0.5;
+};
+int trackVerify(const TrackVerifyOptions& options);
+
 int decode(const std::string& protocol, const std::vector<std::string>& hex);
 int encode(const std::string& protocol, const std::vector<std::string>& words);
 

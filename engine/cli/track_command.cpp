@@ -1,13 +1,20 @@
 // pitwall track show LAYOUT|FILE [--svg OUT]: a layout as the race view draws it (docs/view.md),
-// to preview a track file before racing on it.
+// to preview a track file before racing on it. pitwall track print PIECE|FILE --out OUT: its
+// pieces to print at 1:1 (engine/print); pitwall track verify FILE.svg: a printed piece read back
+// as a car's sensor would (docs/cli.md).
 #include <cerrno>
 #include <cstring>
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <string_view>
 
 #include "engine/cli/commands.hpp"
 #include "engine/cli/options.hpp"
+#include "engine/core/printable.hpp"
+#include "engine/print/print.hpp"
+#include "engine/print/raster.hpp"
+#include "engine/print/sensor.hpp"
 #include "engine/sim/track.hpp"
 #include "engine/view/geometry.hpp"
 
@@ -39,16 +46,151 @@ int trackShow(const TrackShowOptions& options) {
   return 0;
 }
 
+namespace {
+
+bool endsWith(std::string_view s, std::string_view tail) {
+  return s.size() >= tail.size() && s.substr(s.size() - tail.size()) == tail;
+}
+
+bool writeFile(const std::string& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (out) out << text;
+  if (out) out.close();
+  if (!out) {
+    std::cerr << "pitwall track print: cannot write " << path << ": " << std::strerror(errno)
+              << "\n";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+int trackPrint(const TrackPrintOptions& options) {
+  const bool pdf = endsWith(options.out, ".pdf"), svg = endsWith(options.out, ".svg");
+  if (!pdf && !svg) {
+    std::cerr << "pitwall track print: --out '" << printable(options.out, 80)
+              << "' names neither a .pdf nor a .svg file: end it in .pdf (tiled pages) or .svg "
+                 "(one whole piece)\n";
+    return 2;
+  }
+  auto paper = print::paperNamed(options.paper, options.landscape);
+  if (!paper) {
+    std::cerr << "pitwall track print: --paper: " << paper.error() << "\n";
+    return 2;
+  }
+  auto pieces = print::piecesOf(options.what);
+  if (!pieces) {
+    std::cerr << "pitwall track print: " << pieces.error() << "\n";
+    return 2;
+  }
+  if (pdf) {
+    auto pages = print::writePdf(options.out, *pieces, *paper);
+    if (!pages) {
+      std::cerr << "pitwall track print: " << pages.error() << "\n";
+      return 2;
+    }
+    std::cerr << "wrote " << options.out << ": " << pieces->size()
+              << (pieces->size() == 1 ? " piece" : " pieces") << " on " << *pages << " "
+              << paper->name << (options.landscape ? " landscape" : "") << " pages; print at "
+              << "100 % (actual size) and check the 100 mm ruler\n";
+    return 0;
+  }
+  // SVG: one whole piece per file; several pieces make OUT-1.svg, OUT-2.svg, … in order.
+  const std::string stem = options.out.substr(0, options.out.size() - 4);
+  for (std::size_t i = 0; i < pieces->size(); ++i) {
+    auto text = print::pieceSvg((*pieces)[i]);
+    if (!text) {
+      std::cerr << "pitwall track print: " << text.error() << "\n";
+      return 2;
+    }
+    const std::string path =
+        pieces->size() == 1 ? options.out : stem + "-" + std::to_string(i + 1) + ".svg";
+    if (!writeFile(path, *text)) return 2;
+    std::cerr << "wrote " << path << ": " << print::pieceName((*pieces)[i]) << " (piece "
+              << int((*pieces)[i].id) << ")\n";
+  }
+  return 0;
+}
+
+int trackVerify(const TrackVerifyOptions& options) {
+  auto loaded = print::loadPieceSvg(options.file, options.dpi);
+  if (!loaded) {
+    std::cerr << "pitwall track verify: " << loaded.error() << "\n";
+    return 2;
+  }
+  auto& [raster, meta] = *loaded;
+  // The piece the metadata names: its token, and which of the token's pieces ("start" is two).
+  auto pieces = sim::parsePiece(meta.token);
+  const sim::Piece* piece = nullptr;
+  if (pieces)
+    for (const auto& p : *pieces)
+      if (p.id == meta.piece_id) piece = &p;
+  if (!piece) {
+    std::cerr << "pitwall track verify: " << options.file << " names the piece '"
+              << printable(meta.token, 80) << "' with id " << meta.piece_id << ", which "
+              << (pieces ? std::string("is not among its pieces")
+                         : "is not a piece: " + pieces.error())
+              << "; print the piece again with `pitwall track print`\n";
+    return 2;
+  }
+  print::SensorModel model;
+  model.blur_mm = options.blur_mm;
+  model.misalign_mm = options.misalign_mm;
+  std::cerr << "reading " << options.file << " at " << options.dpi
+            << " dpi: " << print::pieceName(*piece) << " (piece " << int(piece->id) << "), blur "
+            << model.blur_mm << " mm, misalignment up to " << model.misalign_mm << " mm\n";
+  const auto result = print::readBack(raster, *piece, {}, model);
+  std::cout << print::report(result, *piece, options.file);
+  return result.ok() ? 0 : 1;
+}
+
 Command addTrackCommand(CLI::App& app) {
   auto show = std::make_shared<TrackShowOptions>();
-  auto* track = app.add_subcommand("track", "Track layouts");
+  auto printing = std::make_shared<TrackPrintOptions>();
+  auto verify = std::make_shared<TrackVerifyOptions>();
+  auto* track = app.add_subcommand("track", "Track layouts: show, print and verify pieces");
   track->require_subcommand(1);
-  auto* cmd = track->add_subcommand(
+  auto* showCmd = track->add_subcommand(
       "show", "Describe a layout and draw it as the race view does: pitwall track show oval");
-  cmd->add_option("layout", show->layout, "A layout name (oval, kidney, long) or a layout file")
+  showCmd->add_option("layout", show->layout, "A layout name (oval, kidney, long) or a layout file")
       ->required();
-  cmd->add_option("--svg", show->svg, "Write the drawing as SVG to OUT (- : stdout)");
-  return {cmd, [show] { return cli::trackShow(*show); }};
+  showCmd->add_option("--svg", show->svg, "Write the drawing as SVG to OUT (- : stdout)");
+
+  auto* printCmd = track->add_subcommand(
+      "print",
+      "Pieces to print at 1:1 with their code: pitwall track print S:60,len=300 --out p.pdf");
+  printCmd
+      ->add_option("piece", printing->what,
+                   "A piece (S, L:17, start, S:60,len=300, L:61,r=400,deg=45) or a layout file")
+      ->required();
+  printCmd
+      ->add_option("--out,-o", printing->out,
+                   "OUT.pdf: tiled pages of every piece; OUT.svg: one whole piece per file "
+                   "(OUT-1.svg, OUT-2.svg, … for several)")
+      ->required();
+  printCmd->add_option("--paper", printing->paper, "Paper for the PDF: a4 (default) or a3");
+  printCmd->add_flag("--landscape", printing->landscape, "Pages in landscape");
+
+  auto* verifyCmd = track->add_subcommand(
+      "verify",
+      "Read a printed piece's SVG back as a car's sensor would: pitwall track verify p.svg");
+  verifyCmd->add_option("file", verify->file, "A piece SVG written by pitwall track print")
+      ->required();
+  verifyCmd->add_option("--dpi", verify->dpi, "The printer's resolution (default 300)")
+      ->check(CLI::Range(50.0, 1200.0));
+  verifyCmd->add_option("--blur", verify->blur_mm, "The sensor's blur, σ in mm (default 0.25)")
+      ->check(CLI::Range(0.0, 1.0));
+  verifyCmd
+      ->add_option("--misalign", verify->misalign_mm,
+                   "How far the sensor weaves beside the line, mm (default 0.5)")
+      ->check(CLI::Range(0.0, 2.0));
+
+  return {track, [=] {
+            if (printCmd->parsed()) return cli::trackPrint(*printing);
+            if (verifyCmd->parsed()) return cli::trackVerify(*verify);
+            return cli::trackShow(*show);
+          }};
 }
 
 }  // namespace pitwall::cli
