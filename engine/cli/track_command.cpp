@@ -3,6 +3,7 @@
 // pieces to print at 1:1 (engine/print); pitwall track verify FILE.svg: a printed piece read back
 // as a car's sensor would (docs/cli.md).
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <iostream>
@@ -114,6 +115,14 @@ int trackPrint(const TrackPrintOptions& options) {
 }
 
 int trackVerify(const TrackVerifyOptions& options) {
+  // CLI11's ranges let NaN through (no comparison with it is true).
+  for (auto [name, value] : {std::pair{"--dpi", options.dpi}, std::pair{"--blur", options.blur_mm},
+                             std::pair{"--misalign", options.misalign_mm}})
+    if (!std::isfinite(value)) {
+      std::cerr << "pitwall track verify: " << name << " " << value
+                << " is not a number; give one in the range `pitwall track verify --help` shows\n";
+      return 2;
+    }
   auto loaded = print::loadPieceSvg(options.file, options.dpi);
   if (!loaded) {
     std::cerr << "pitwall track verify: " << loaded.error() << "\n";

@@ -34,6 +34,17 @@ struct Drawer {
     for (int i = n; i >= 0; --i) point(f0 + (f1 - f0) * i / n, offset_b, true);
     cairo_close_path(cr);
   }
+  // Whether a stroke between f0 and f1 beside `offset` may reach into `w`: its ends and middle
+  // on the line, with room for its width and the arc's bulge.
+  bool reaches(double f0, double f1, double offset, const Window& w) const {
+    constexpr double kRoom = 8;
+    for (double f : {f0, (f0 + f1) / 2, f1}) {
+      const sim::Pose p = sim::poseOnPiece(piece, {}, f, offset);
+      const double x = sheet.sheetX(p.x), y = sheet.sheetY(p.y);
+      if (x > w.x0 - kRoom && x < w.x1 + kRoom && y > w.y0 - kRoom && y < w.y1 + kRoom) return true;
+    }
+    return false;
+  }
   void line(double f0, double f1, double offset) const {
     const int n = piece.turn == 0
                       ? 1
@@ -154,6 +165,7 @@ void drawPiece(cairo_t* cr, const sim::Piece& piece, const Sheet& sheet, const s
           const auto& s = strokes[static_cast<std::size_t>(j)];
           const double w = g.width(left ? s.left : s.right);
           if (w <= 0) continue;
+          if (options.window && !d.reaches(f0, f1, row.offset_mm, *options.window)) continue;
           if (left)
             d.band(f0, f1, row.offset_mm - inner - w, row.offset_mm - inner);
           else

@@ -42,9 +42,16 @@ struct StrokeRef {
   bool left = true;  // the piece side
 };
 
+// A part of the sheet (mm): a PDF tile draws only the strokes that reach into its window, so a
+// large piece's pages do not each carry all of it.
+struct Window {
+  double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+};
+
 struct DrawOptions {
   bool label = true;
   std::optional<StrokeRef> omit;  // leave this stroke white
+  std::optional<Window> window;   // draw only the strokes that reach into it
 };
 
 // Draws `piece` in sheet coordinates (the context's user space: mm, y down).

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <numbers>
 #include <system_error>
 
 #include "engine/print/piece_drawing.hpp"
@@ -18,8 +19,9 @@ namespace {
 constexpr double kPointsPerMm = 72 / 25.4;
 constexpr double kRulerMm = 100;
 
+// Light cyan: plain to see, lighter than a reader's threshold (a mark on the road is no code).
 void setMarkColour(cairo_t* cr) {
-  cairo_set_source_rgb(cr, 0.1, 0.45, 0.85);
+  cairo_set_source_rgb(cr, 0.2, 0.8, 1.0);
 }
 
 void cross(cairo_t* cr, double x, double y) {
@@ -28,7 +30,7 @@ void cross(cairo_t* cr, double x, double y) {
   cairo_move_to(cr, x, y - 2);
   cairo_line_to(cr, x, y + 2);
   cairo_stroke(cr);
-  cairo_arc(cr, x, y, 1.2, 0, 2 * 3.14159265358979);
+  cairo_arc(cr, x, y, 1.2, 0, 2 * std::numbers::pi);
   cairo_stroke(cr);
 }
 
@@ -62,8 +64,11 @@ void page(cairo_t* cr, const sim::Piece& piece, const Sheet& sheet, const sim::C
   cairo_save(cr);
   cairo_rectangle(cr, m, m, pw, ph);
   cairo_clip(cr);
-  cairo_translate(cr, m - column * t.step_x_mm, m - row * t.step_y_mm);
-  drawPiece(cr, piece, sheet, g);
+  const double x0 = column * t.step_x_mm, y0 = row * t.step_y_mm;
+  cairo_translate(cr, m - x0, m - y0);
+  DrawOptions options;
+  options.window = Window{x0, y0, x0 + pw, y0 + ph};
+  drawPiece(cr, piece, sheet, g, options);
   cairo_restore(cr);
 
   // Cut lines where this tile's edge is laid over its neighbour (left, top); dashed lines where

@@ -415,7 +415,8 @@ std::string report(const ReadBack& result, const sim::Piece& piece, std::string_
     std::string head = std::string(name) + ": row " + std::to_string(p.row + 1) +
                        (p.reversed ? " backward: " : " forward:  ");
     if (p.problems.empty()) {
-      out += head + "OK, " + std::to_string(p.sections_read) + " sections\n";
+      out += head + "OK, " + std::to_string(p.sections_read) +
+             (p.sections_read == 1 ? " section\n" : " sections\n");
       continue;
     }
     ++failed;

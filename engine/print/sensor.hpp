@@ -22,7 +22,7 @@ struct SensorModel {
   double misalign_mm = 0.5;       // the sensor weaves up to this far beside the line
   double yaw_deg = 1.0;           // and looks across it this much askew
   double step_mm = 0.5;           // between readings along the row
-  double sample_mm = 0.05;        // between samples across it
+  double sample_mm = 0.1;         // between samples across it
   double window_mm = 5.5;         // half the width it sees across the line
   double scale_tolerance = 0.01;  // stroke spacing off the design by more: "the page was scaled"
 };

@@ -127,6 +127,7 @@ bad "verify an SVG naming no piece" "badtoken.svg names the piece 'Q:999'" verif
 sed 's/width="324mm" height="208mm"/width="90000mm" height="90000mm"/' piece.svg >huge.svg
 bad "verify a huge SVG" "use a lower --dpi" verify huge.svg
 bad "verify --dpi 0" "--dpi" verify piece.svg --dpi 0
+bad "verify --blur nan" "--blur nan is not a number" verify piece.svg --blur nan
 bad "print a bad token" "Q:9" print Q:9 --out q.pdf
 bad "print onto unknown paper" "unknown paper 'letter': use a4 or a3" print S --paper letter --out s.pdf
 bad "print to neither PDF nor SVG" "--out 's.png' names neither a .pdf nor a .svg file" print S --out s.png

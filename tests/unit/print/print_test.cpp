@@ -188,3 +188,29 @@ TEST_CASE("print: a PDF has a page per tile of every piece") {
   REQUIRE_FALSE(unwritable.ok());
   CHECK(unwritable.error().find("cannot write") == 0);
 }
+
+TEST_CASE("print: a tile's window leaves out only strokes that lie outside it") {
+  for (const std::string token : {"S:36", "L:17", "L:61,r=400,deg=45"}) {
+    CAPTURE(token);
+    const sim::Piece piece = print::piecesOf(token)->front();
+    const print::Sheet sheet = print::sheetFor(piece);
+    const print::Raster whole = print::renderPiece(piece, 4);
+    print::DrawOptions options;
+    const double cut = sheet.width_mm / 2;
+    options.window = print::Window{0, 0, cut, sheet.height_mm};
+    const print::Raster half = print::renderPiece(piece, 4, {}, options);
+    REQUIRE(half.width == whole.width);
+    long inside_differ = 0, outside_whole = 0, outside_half = 0;
+    for (int y = 0; y < whole.height; ++y)
+      for (int x = 0; x < whole.width; ++x) {
+        const auto i = static_cast<std::size_t>(y) * whole.width + x;
+        if (x < cut * 4)
+          inside_differ += whole.dark[i] != half.dark[i];
+        else if (x > (cut + 10) * 4)
+          outside_whole += whole.dark[i] > 128, outside_half += half.dark[i] > 128;
+      }
+    CHECK(inside_differ == 0);
+    // The strokes far outside were left out (the lane lines, about as dark as they, stay).
+    CHECK(outside_half < outside_whole * 3 / 4);
+  }
+}
