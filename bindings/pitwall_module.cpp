@@ -249,7 +249,8 @@ int checkOptionsOf(lua_State* L) {
 }
 
 // pitwall.piece(id): what a road piece is (docs/lua-api.md "Track pieces"), nil when unknown:
-// Anki's stock pieces, and the custom pieces of the simulator's track (docs/tracks.md).
+// Anki's stock pieces, and the custom pieces of the simulator's track or of --ble --track's
+// layout (docs/tracks.md).
 int piece(lua_State* L) {
   auto id = lua::checkInteger(L, 1, "piece id");
   if (id < 0 || id > 255) {
@@ -258,8 +259,11 @@ int piece(lua_State* L) {
   }
   sim::Piece found{static_cast<std::uint8_t>(id), anki::pieceType(static_cast<std::uint8_t>(id))};
   bool known = found.type != anki::PieceType::Unknown;
-  if (SimSession* s = ScriptHost::from(L).sim(); !known && s && s->world)
-    for (const sim::Piece& p : s->world->track().pieces())
+  ScriptHost& host = ScriptHost::from(L);
+  const sim::Track* layout =
+      host.sim() && host.sim()->world ? &host.sim()->world->track() : host.options().design;
+  if (!known && layout)
+    for (const sim::Piece& p : layout->pieces())
       if (p.id == id) {  // a custom id: its shape is the layout's
         found = p;
         known = true;

@@ -49,6 +49,9 @@ struct HostOptions {
   bool detached = false;
   // The race view's feed (--view): pitwall.view reports to it; none: pitwall.view does nothing.
   view::Feed* view = nullptr;
+  // --ble --track FILE: the layout of the pieces the real cars are on; pitwall.piece knows its
+  // custom pieces' shapes (docs/tracks.md). With the simulator, its own track serves.
+  const sim::Track* design = nullptr;
 };
 
 class ScriptHost {

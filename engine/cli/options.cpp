@@ -6,16 +6,16 @@ namespace pitwall::cli {
 
 CLI::Option* addCarSource(CLI::App* cmd, CarSource& source, const char* when) {
   cmd->add_option("--seed", source.seed, "Seed of the simulator's and the script's randomness");
-  auto* cars =
-      cmd->add_option("--cars", source.cars,
-                      "Number of simulated cars on the grid (default 4, at most 1000)")
-          ->check(CLI::Range(0, 1000));
-  auto* track =
-      cmd->add_option("--track", source.track, "Track layout: a name (oval, …) or a layout file")
-          ->each([&source](const std::string&) { source.trackGiven = true; });
+  auto* cars = cmd->add_option("--cars", source.cars,
+                               "Number of simulated cars on the grid (default 4, at most 1000)")
+                   ->check(CLI::Range(0, 1000));
+  cmd->add_option("--track", source.track,
+                  "Track layout: a name (oval, …) or a layout file; with --ble, the layout the "
+                  "cars are on (its custom pieces' shapes, docs/tracks.md)")
+      ->each([&source](const std::string&) { source.trackGiven = true; });
   auto* ble = cmd->add_flag("--ble", source.ble,
                             "Drive real cars over Bluetooth LE (BlueZ) instead of the simulator");
-  ble->excludes(cars)->excludes(track);  // real cars are on a real track
+  ble->excludes(cars);  // real cars are the cars there are
   cmd->add_option("--car", source.carAddresses, "With --ble: only this car (repeatable)")
       ->needs(ble);
   cmd->add_option("--adapter", source.adapters,

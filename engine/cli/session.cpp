@@ -87,12 +87,23 @@ std::unique_ptr<Session> Session::open(const CarSource& source, bool fast, const
     session = std::make_unique<Session>(fast ? ClockKind::Virtual : ClockKind::Real,
                                         std::move(*track), source.seed);
   } else {
+    // Real cars on printed pieces: the layout tells the scripts the custom pieces' shapes.
+    std::optional<sim::Track> design;
+    if (source.trackGiven) {
+      auto track = sim::loadLayout(source.track);
+      if (!track) {
+        std::cerr << "pitwall " << command << ": " << track.error() << "\n";
+        return nullptr;
+      }
+      design = std::move(*track);
+    }
     ble::CentralOptions central;
     central.adapters = source.adapters;
     central.cars = source.carAddresses;
     central.scan = fromSeconds(source.scanTimeout);
     try {
       session = std::make_unique<Session>(std::move(central));
+      session->design_ = std::move(design);
     } catch (const ble::BleError& e) {
       std::cerr << "pitwall " << command << ": " << e.what() << "\n";
       return nullptr;
@@ -419,6 +430,7 @@ std::optional<std::string> Session::connectRealCars() {
 }
 
 void Session::startHost(HostOptions options) {
+  if (!sim_.world && design_) options.design = &*design_;
   scripts_ =
       std::make_unique<Reloader>(loop_, fleet_, sim_.world ? &sim_ : nullptr, std::move(options));
   scripts_->onStopRequested = [this] { finish(); };
@@ -459,7 +471,10 @@ int Session::startView(const std::string& endpoint, const std::string& source,
 view::Feed& Session::startFeed(const std::string& source) {
   if (!feed_) {
     feed_ = std::make_unique<view::Feed>(loop_, fleet_, source);
-    if (sim_.world) feed_->setTrack(sim_.world->track(), "layout");
+    if (sim_.world)
+      feed_->setTrack(sim_.world->track(), "layout");
+    else if (design_)
+      feed_->setTrack(*design_, "layout");
   }
   return *feed_;
 }

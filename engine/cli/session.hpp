@@ -2,6 +2,7 @@
 // One run, as `pitwall run` and `pitwall test` set it up: the loop, the cars (simulated in a
 // world, or real ones over Bluetooth LE) and the Lua host, destroyed in the right order.
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "bindings/reloader.hpp"
@@ -13,6 +14,7 @@
 #include "engine/mqtt/bridge.hpp"
 #include "engine/mqtt/remote.hpp"
 #include "engine/record/recorder.hpp"
+#include "engine/sim/track.hpp"
 #include "engine/transport/mqtt_client.hpp"
 #include "engine/view/feed.hpp"
 #include "engine/view/server.hpp"
@@ -84,6 +86,7 @@ class Session {
  private:
   Loop loop_;  // first made, last destroyed: everything below schedules on it
   SimSession sim_;
+  std::optional<sim::Track> design_;  // --ble --track: the layout the real cars are on
   Fleet fleet_;
   std::unique_ptr<Recorder> recorder_;
   Subscription recording_;                 // the fleet's frames into recorder_ (--record)

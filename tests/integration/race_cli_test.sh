@@ -72,4 +72,24 @@ check "grand prix over --ble: a row per car" 5 "$(wc -l < "$TMP/ble.csv" | tr -d
 check "grand prix over --ble: every car finished its lap" 4 "$(grep -c ',1,[0-9.]*,[0-9.]*,[0-9.]*,true,false$' "$TMP/ble.csv")"
 stop_fake
 check "grand prix over --ble: every car stopped" 4 "$(grep -c 'connected=false target=0 ' "$TMP/fake.out")"
+
+# Real cars on printed pieces: the fake BlueZ's cars drive the custom layout, and --track tells
+# the run its custom pieces' shapes, so the scan lap maps them and the race is timed on them.
+start_fake --adapters 1 --cars 2 --track "$SRC/examples/tracks/hairpin.layout"
+out=$(LAPS=1 $PITWALL run "$SRC/examples/grand_prix.lua" --ble --scan-timeout 1 \
+  --track "$SRC/examples/tracks/hairpin.layout" --results "$TMP/ble-hairpin.csv" \
+  2>"$TMP/ble-hairpin.err"); rc=$?
+check "custom track over --ble: exit status" 0 "$rc"
+contains "custom track over --ble: the winner" "Winner: " "$out"
+if grep -q "error " "$TMP/ble-hairpin.err"; then fail "custom track over --ble reported an error: $(cat "$TMP/ble-hairpin.err")"; fi
+check "custom track over --ble: every car finished its lap" 2 "$(grep -c ',1,[0-9.]*,[0-9.]*,[0-9.]*,true,false$' "$TMP/ble-hairpin.csv")"
+echo 'local p = pitwall.piece(61) print(p and string.format("%s r=%g deg=%g", p.type, p.radius, p.angle)) pitwall.stop()' >"$TMP/piece.lua"
+out=$($PITWALL run "$TMP/piece.lua" --ble --scan-timeout 1 --track "$SRC/examples/tracks/hairpin.layout" 2>/dev/null)
+check "--ble --track: pitwall.piece knows a custom piece" "curve r=400 deg=45" "$out"
+out=$($PITWALL run "$TMP/piece.lua" --ble --scan-timeout 1 2>/dev/null)
+check "--ble without --track: a custom id is unknown" "nil" "$out"
+stop_fake
+out=$($PITWALL run "$SRC/examples/grand_prix.lua" --ble --track "$TMP/none.layout" 2>&1); rc=$?
+check "--ble with a missing --track file: exit status" 2 "$rc"
+contains "--ble with a missing --track file: says so" "none.layout" "$out"
 finish
