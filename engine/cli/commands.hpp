@@ -146,6 +146,7 @@ struct TrackPrintOptions {
   std::string out;
   std::string paper = "a4";
   bool landscape = false;
+  bool custom = false;  // only the pieces with an id of their own (not Anki's stock ones)
 };
 int trackPrint(const TrackPrintOptions& options);
 

@@ -85,6 +85,17 @@ int trackPrint(const TrackPrintOptions& options) {
     std::cerr << "pitwall track print: " << pieces.error() << "\n";
     return 2;
   }
+  if (options.custom) {  // the pieces a starter kit does not have
+    std::erase_if(*pieces, [](const sim::Piece& p) {
+      return anki::pieceType(p.id) != anki::PieceType::Unknown;
+    });
+    if (pieces->empty()) {
+      std::cerr << "pitwall track print: " << printable(options.what, 80)
+                << " has no custom pieces (ids of their own); leave out --custom to print "
+                   "Anki's pieces too\n";
+      return 2;
+    }
+  }
   if (pdf) {
     auto pages = print::writePdf(options.out, *pieces, *paper);
     if (!pages) {
@@ -180,6 +191,8 @@ Command addTrackCommand(CLI::App& app) {
       ->required();
   printCmd->add_option("--paper", printing->paper, "Paper for the PDF: a4 (default) or a3");
   printCmd->add_flag("--landscape", printing->landscape, "Pages in landscape");
+  printCmd->add_flag("--custom", printing->custom,
+                     "Only the custom pieces (ids of their own), not Anki's stock ones");
 
   auto* verifyCmd = track->add_subcommand(
       "verify",

@@ -88,9 +88,7 @@ void drawLabel(cairo_t* cr, const sim::Piece& piece, const Sheet& sheet, double 
 }  // namespace
 
 std::string pieceName(const sim::Piece& piece) {
-  if (piece.type == anki::PieceType::StartLong || piece.type == anki::PieceType::StartShort)
-    return "start";
-  return sim::pieceToken(piece);
+  return sim::pieceToken(piece);  // "start" for either start piece
 }
 
 double roadHalfWidth(const sim::CodeGeometry& g) {

@@ -143,6 +143,8 @@ std::string layoutText(const Track& track) {
 }
 
 std::string pieceToken(const Piece& p) {
+  if (p.type == anki::PieceType::StartLong || p.type == anki::PieceType::StartShort)
+    return "start";  // the pair is one token
   std::string out = p.turn > 0 ? "L" : p.turn < 0 ? "R" : "S";
   out += ":" + std::to_string(p.id);
   if (p.straight_mm > 0) out += ",len=" + formatNumber(p.straight_mm);

@@ -75,7 +75,7 @@ Result<std::vector<Piece>, std::string> parsePiece(std::string_view token);
 // The layout text of a track, every piece with its id ("start S:36 L:17 …"): parseLayout reads
 // it back to the same pieces (a record keeps the track it was made on this way).
 std::string layoutText(const Track& track);
-// One piece as a layout token: "S:36", "L:61,r=400,deg=45".
+// One piece as a layout token: "S:36", "L:61,r=400,deg=45"; "start" for either start piece.
 std::string pieceToken(const Piece& piece);
 // Named layouts: "oval" (the default: start S L L S S L L, ≈4.0 m), and others listed by
 // layoutNames(). loadLayout takes a name or a path to a layout file.

@@ -29,6 +29,10 @@ out=$($PITWALL track print oval.txt --out oval.pdf 2>&1); rc=$?
 check "print a layout file: exit status" 0 "$rc"
 contains "a layout file: every piece" "wrote oval.pdf: 9 pieces on" "$out"
 contains "the PDF's pages are what it says" "on $(pdf_pages oval.pdf) A4 pages" "$out"
+# --custom: only the pieces a starter kit does not have (the hairpin's 9 of 12)
+out=$($PITWALL track print "$SRC/examples/tracks/hairpin.layout" --custom --out custom.pdf 2>&1); rc=$?
+check "print --custom: exit status" 0 "$rc"
+contains "print --custom: the custom pieces only" "wrote custom.pdf: 9 pieces on" "$out"
 
 # 2. the ruler on a page rasterized at 300 dpi: 100 mm = 1181 px (± 3). Rows that cross only the
 # 10 mm ticks show 11 evenly spaced dark runs; from the first to the last is the ruler.
@@ -133,5 +137,6 @@ bad "print onto unknown paper" "unknown paper 'letter': use a4 or a3" print S --
 bad "print to neither PDF nor SVG" "--out 's.png' names neither a .pdf nor a .svg file" print S --out s.png
 bad "print into a missing folder" "cannot write no/such/s.svg" print S --out no/such/s.svg
 bad "print into a missing folder (PDF)" "cannot write no/such/s.pdf" print S --out no/such/s.pdf
+bad "print --custom of stock pieces" "oval.txt has no custom pieces" print oval.txt --custom --out c.pdf
 
 finish
