@@ -2,7 +2,9 @@
 
 // GCC 12 warns inside Boost.Geometry's intersection (rescale_policy's `factor`): a known false
 // positive of -Wmaybe-uninitialized in Boost 1.74's headers, not about this file's code.
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 #include <boost/geometry.hpp>
 #include <boost/geometry/geometries/point_xy.hpp>
 #include <boost/geometry/geometries/polygon.hpp>
