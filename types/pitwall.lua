@@ -32,6 +32,8 @@ function Listener:cancel() end
 ---@field type "start-long"|"start-short"|"straight"|"curve"|"intersection"|string
 ---@field length number centre-line length, mm
 ---@field radius? number centre radius of a curve, mm
+---@field angle? number how far a curve turns, degrees
+---@field custom? boolean a custom piece of the track in use (docs/tracks.md)
 
 ---A file-like object for the console (pitwall.stdout).
 ---@class pitwall.Stdout
@@ -631,6 +633,8 @@ function Alphabot:stop() end
 ---@field type string
 ---@field turn integer +1 left, −1 right, 0 straight
 ---@field length number mm
+---@field radius? number a curve's centre radius, mm
+---@field angle? number how far a curve turns, degrees
 
 ---@class pitwall.sim.Track
 ---@field name string

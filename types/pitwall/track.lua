@@ -11,6 +11,8 @@
 ---@field centre number centre-line length, mm
 ---@field start number centre-line distance from the finish line to the piece's start, mm
 ---@field radius? number centre radius of a curve, mm
+---@field angle? number how far a curve turns, degrees
+---@field custom? boolean a custom piece (docs/tracks.md)
 local Piece = {}
 
 ---Length in mm along the lane at `offset` (mm right of the centre; default 0).

@@ -37,6 +37,8 @@ function Listener:cancel() end
 ---@field type "start-long"|"start-short"|"straight"|"curve"|"intersection"|string
 ---@field length number centre-line length, mm
 ---@field radius? number centre radius of a curve, mm
+---@field angle? number how far a curve turns, degrees
+---@field custom? boolean a custom piece of the track in use (docs/tracks.md)
 
 ---A file-like object for the console (pitwall.stdout).
 ---@class pitwall.Stdout

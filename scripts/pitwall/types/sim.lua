@@ -19,6 +19,8 @@ return {
 ---@field type string
 ---@field turn integer +1 left, −1 right, 0 straight
 ---@field length number mm
+---@field radius? number a curve's centre radius, mm
+---@field angle? number how far a curve turns, degrees
 
 ---@class pitwall.sim.Track
 ---@field name string
