@@ -139,24 +139,27 @@ struct TrackShowOptions {
 };
 int trackShow(const TrackShowOptions& options);
 
-// pitwall track print PIECE|FILE --out OUT.pdf|OUT.svg [--paper a4|a3] [--landscape]: printable
-// pieces at 1:1 (docs/cli.md "track print").
+// pitwall track print PIECE|FILE --out OUT.pdf|OUT.svg [--paper a4|a3] [--landscape]
+// [--code NAME=VALUE]…: printable pieces at 1:1 (docs/cli.md "track print").
 struct TrackPrintOptions {
   std::string what;  // a piece token, a layout file or a layout name
   std::string out;
   std::string paper = "a4";
   bool landscape = false;
-  bool custom = false;  // only the pieces with an id of their own (not Anki's stock ones)
+  bool custom = false;            // only the pieces with an id of their own (not Anki's stock ones)
+  std::vector<std::string> code;  // --code NAME=VALUE: stroke dimensions (print/code_options.hpp)
 };
 int trackPrint(const TrackPrintOptions& options);
 
-// pitwall track verify FILE.svg [--dpi N] [--blur MM] [--misalign MM]: reads a printed piece back
+// pitwall track verify FILE.svg [--dpi N] [--blur MM] [--misalign MM] [--code NAME=VALUE]…:
+// reads a printed piece back with the code dimensions its metadata gives (or --code's)
 // as a car's sensor would; 0 all as designed, 1 not, 2 bad input.
 struct TrackVerifyOptions {
   std::string file;
   double dpi = 300;
   double blur_mm = 0.25;
   double misalign_mm = 0.5;
+  std::vector<std::string> code;  // over the file's own dimensions
 };
 int trackVerify(const TrackVerifyOptions& options);
 

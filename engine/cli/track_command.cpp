@@ -13,6 +13,7 @@
 #include "engine/cli/commands.hpp"
 #include "engine/cli/options.hpp"
 #include "engine/core/printable.hpp"
+#include "engine/print/code_options.hpp"
 #include "engine/print/print.hpp"
 #include "engine/print/raster.hpp"
 #include "engine/print/sensor.hpp"
@@ -80,6 +81,11 @@ int trackPrint(const TrackPrintOptions& options) {
     std::cerr << "pitwall track print: --paper: " << paper.error() << "\n";
     return 2;
   }
+  auto code = print::withOverrides({}, options.code);
+  if (!code) {
+    std::cerr << "pitwall track print: " << code.error() << "\n";
+    return 2;
+  }
   auto pieces = print::piecesOf(options.what);
   if (!pieces) {
     std::cerr << "pitwall track print: " << pieces.error() << "\n";
@@ -97,7 +103,7 @@ int trackPrint(const TrackPrintOptions& options) {
     }
   }
   if (pdf) {
-    auto pages = print::writePdf(options.out, *pieces, *paper);
+    auto pages = print::writePdf(options.out, *pieces, *paper, *code);
     if (!pages) {
       std::cerr << "pitwall track print: " << pages.error() << "\n";
       return 2;
@@ -106,12 +112,14 @@ int trackPrint(const TrackPrintOptions& options) {
               << (pieces->size() == 1 ? " piece" : " pieces") << " on " << *pages << " "
               << paper->name << (options.landscape ? " landscape" : "") << " pages; print at "
               << "100 % (actual size) and check the 100 mm ruler\n";
+    if (const std::string changed = print::codeDifferences(*code); !changed.empty())
+      std::cerr << "code: " << changed << "\n";
     return 0;
   }
   // SVG: one whole piece per file; several pieces make OUT-1.svg, OUT-2.svg, … in order.
   const std::string stem = options.out.substr(0, options.out.size() - 4);
   for (std::size_t i = 0; i < pieces->size(); ++i) {
-    auto text = print::pieceSvg((*pieces)[i]);
+    auto text = print::pieceSvg((*pieces)[i], *code);
     if (!text) {
       std::cerr << "pitwall track print: " << text.error() << "\n";
       return 2;
@@ -140,6 +148,11 @@ int trackVerify(const TrackVerifyOptions& options) {
     return 2;
   }
   auto& [raster, meta] = *loaded;
+  auto code = print::withOverrides(meta.code, options.code);
+  if (!code) {
+    std::cerr << "pitwall track verify: " << code.error() << "\n";
+    return 2;
+  }
   // The piece the metadata names: its token, and which of the token's pieces ("start" is two).
   auto pieces = sim::parsePiece(meta.token);
   const sim::Piece* piece = nullptr;
@@ -159,8 +172,11 @@ int trackVerify(const TrackVerifyOptions& options) {
   model.misalign_mm = options.misalign_mm;
   std::cerr << "reading " << options.file << " at " << options.dpi
             << " dpi: " << print::pieceName(*piece) << " (piece " << int(piece->id) << "), blur "
-            << model.blur_mm << " mm, misalignment up to " << model.misalign_mm << " mm\n";
-  const auto result = print::readBack(raster, *piece, {}, model);
+            << model.blur_mm << " mm, misalignment up to " << model.misalign_mm << " mm";
+  if (const std::string changed = print::codeDifferences(*code); !changed.empty())
+    std::cerr << ", code " << changed;
+  std::cerr << "\n";
+  const auto result = print::readBack(raster, *piece, *code, model);
   std::cout << print::report(result, *piece, options.file);
   return result.ok() ? 0 : 1;
 }
@@ -193,6 +209,13 @@ Command addTrackCommand(CLI::App& app) {
   printCmd->add_flag("--landscape", printing->landscape, "Pages in landscape");
   printCmd->add_flag("--custom", printing->custom,
                      "Only the custom pieces (ids of their own), not Anki's stock ones");
+  printCmd
+      ->add_option("--code", printing->code,
+                   "A stroke dimension in mm, NAME=VALUE, repeatable (the last wins): "
+                   "stroke_pitch, stroke_length, line_width, gap, thin, thick, wide "
+                   "(docs/cli.md)")
+      ->allow_extra_args(false)
+      ->type_name("NAME=MM");
 
   auto* verifyCmd = track->add_subcommand(
       "verify",
@@ -207,6 +230,12 @@ Command addTrackCommand(CLI::App& app) {
       ->add_option("--misalign", verify->misalign_mm,
                    "How far the sensor weaves beside the line, mm (default 0.5)")
       ->check(CLI::Range(0.0, 2.0));
+  verifyCmd
+      ->add_option("--code", verify->code,
+                   "Read with this stroke dimension instead of the file's, NAME=VALUE in mm, "
+                   "repeatable (as track print --code)")
+      ->allow_extra_args(false)
+      ->type_name("NAME=MM");
 
   return {track, [=] {
             if (printCmd->parsed()) return cli::trackPrint(*printing);

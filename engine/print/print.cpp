@@ -9,6 +9,7 @@
 #include <numbers>
 #include <system_error>
 
+#include "engine/print/code_options.hpp"
 #include "engine/print/piece_drawing.hpp"
 #include "engine/print/svg_metadata.hpp"
 
@@ -53,6 +54,16 @@ void text(cairo_t* cr, double x, double y, double size, const std::string& s) {
   cairo_set_font_size(cr, size);
   cairo_move_to(cr, x, y);
   cairo_show_text(cr, s.c_str());
+}
+
+// `s` at `size`, or smaller so that it fits `width` (mm).
+void textWithin(cairo_t* cr, double x, double y, double size, double width, const std::string& s) {
+  cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
+  cairo_set_font_size(cr, size);
+  cairo_text_extents_t e;
+  cairo_text_extents(cr, s.c_str(), &e);
+  if (e.x_advance > width) size *= width / e.x_advance;
+  text(cr, x, y, size, s);
 }
 
 // One tile: the drawing's window at (column, row), then the marks and the band.
@@ -113,10 +124,13 @@ void page(cairo_t* cr, const sim::Piece& piece, const Sheet& sheet, const sim::C
   // The band: what this page is, and the ruler that shows whether it was printed at 1:1.
   cairo_set_source_rgb(cr, 0, 0, 0);
   const double band = paper.height_mm - m - paper.band_mm;
-  text(cr, m, band + 4.5, 2.8,
+  text(cr, m, band + 3.5, 2.8,
        title + ": tile " + std::to_string(row + 1) + "×" + std::to_string(column + 1) + " of " +
            std::to_string(t.rows) + "×" + std::to_string(t.columns) + " (row×column)");
-  text(cr, m, band + 8.5, 2.8, "print at 100 % / actual size: the ruler must measure 100 mm");
+  text(cr, m, band + 7, 2.8, "print at 100 % / actual size: the ruler must measure 100 mm");
+  // A page drawn with calibrated strokes says so (code_options.hpp): which, and how wide.
+  const std::string changed = codeDifferences(g);
+  if (!changed.empty()) textWithin(cr, m, band + 10.5, 2.4, pw - kRulerMm - 3, "code: " + changed);
   ruler(cr, right - kRulerMm - 1, paper.height_mm - m - 0.5);
 }
 
@@ -214,7 +228,7 @@ Result<std::string, std::string> pieceSvg(const sim::Piece& piece, const sim::Co
   if (status != CAIRO_STATUS_SUCCESS)
     return Unexpected<std::string>(std::string("cannot draw the SVG: ") +
                                    cairo_status_to_string(status));
-  return withMetadata(svg, {pieceName(piece), piece.id, sheet});
+  return withMetadata(svg, {pieceName(piece), piece.id, sheet, g});
 }
 
 }  // namespace pitwall::print

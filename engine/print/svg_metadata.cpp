@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "engine/print/code_options.hpp"
+
 namespace pitwall::print {
 
 namespace {
@@ -28,11 +30,26 @@ bool attribute(std::string_view element, std::string_view name, std::string& out
   return true;
 }
 
+// code-NAME-mm, '_' as '-': "code-stroke-pitch-mm".
+std::string codeAttribute(std::string_view name) {
+  std::string out = "code-" + std::string(name) + "-mm";
+  for (char& c : out)
+    if (c == '_') c = '-';
+  return out;
+}
+
 bool attribute(std::string_view element, std::string_view name, double& out) {
   std::string s;
   if (!attribute(element, name, s)) return false;
   const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
   return ec == std::errc() && end == s.data() + s.size() && std::isfinite(out);
+}
+
+std::string codeAttributes(const sim::CodeGeometry& g) {
+  std::string out;
+  for (const auto& d : codeDimensions())
+    out += " " + codeAttribute(d.name) + "=\"" + number(g.*(d.field)) + "\"";
+  return out;
 }
 
 }  // namespace
@@ -46,7 +63,8 @@ std::string withMetadata(std::string_view svg, const PieceSvg& piece) {
       piece.token + "\" piece-id=\"" + std::to_string(piece.piece_id) + "\" width-mm=\"" +
       number(piece.sheet.width_mm) + "\" height-mm=\"" + number(piece.sheet.height_mm) +
       "\" start-x-mm=\"" + number(piece.sheet.origin_x_mm) + "\" start-y-mm=\"" +
-      number(piece.sheet.origin_y_mm) + "\" start-heading=\"+x\"/></metadata>\n";
+      number(piece.sheet.origin_y_mm) + "\" start-heading=\"+x\"" + codeAttributes(piece.code) +
+      "/></metadata>\n";
   const auto svgTag = svg.find("<svg");
   const auto close = svgTag == std::string_view::npos ? svg.npos : svg.find('>', svgTag);
   if (close == std::string_view::npos) return std::string(svg);
@@ -82,6 +100,20 @@ Result<PieceSvg, std::string> readMetadata(std::string_view svg) {
                                      name);
   if (p.sheet.width_mm <= 0 || p.sheet.height_mm <= 0)
     return Unexpected<std::string>(std::string("its pitwall piece metadata gives an empty sheet"));
+  // The code's dimensions: each one absent keeps its default (an SVG from before they were
+  // written); one present must be a number, and together they must be readable.
+  for (const auto& d : codeDimensions()) {
+    const std::string name = codeAttribute(d.name);
+    std::string raw;
+    if (!attribute(element, name, raw)) continue;
+    if (!attribute(element, name, p.code.*(d.field)))
+      return Unexpected<std::string>("its pitwall piece metadata has no number " + name);
+  }
+  if (auto problem = codeProblem(p.code))
+    return Unexpected<std::string>(
+        "its pitwall piece metadata gives code dimensions no sensor "
+        "reads: " +
+        *problem);
   return p;
 }
 

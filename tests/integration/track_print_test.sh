@@ -139,4 +139,32 @@ bad "print into a missing folder" "cannot write no/such/s.svg" print S --out no/
 bad "print into a missing folder (PDF)" "cannot write no/such/s.pdf" print S --out no/such/s.pdf
 bad "print --custom of stock pieces" "oval.txt has no custom pieces" print oval.txt --custom --out c.pdf
 
+# 6. --code: calibrated strokes, recorded in the SVG and read back with them; the PDF says so
+out=$($PITWALL track print S:60,len=300 --code thick=1.5 --code stroke_pitch=16 --out code.svg 2>&1); rc=$?
+check "print --code: exit status" 0 "$rc"
+contains "print --code: the SVG records the dimensions" 'code-thick-mm="1.5000"' "$(grep -o 'code-thick-mm="[^"]*"' code.svg)"
+out=$($PITWALL track verify code.svg 2>&1); rc=$?
+check "verify a --code print: exit status" 0 "$rc"
+contains "verify a --code print: reads with the file's dimensions" "code stroke_pitch 16.00 mm, thick 1.50 mm" "$out"
+contains "verify a --code print: the verdict" "code.svg: OK: S:60,len=300 (piece 60), 64 section readings" "$out"
+out=$($PITWALL track verify code.svg --code stroke_pitch=16.5 2>&1); rc=$?
+check "verify --code over the file's: exit status" 1 "$rc"
+contains "verify --code over the file's: the spacing" "strokes 3.0 % closer together than designed" "$out"
+out=$($PITWALL track print S:60,len=300 --code thick=1.4 --out code.pdf 2>&1); rc=$?
+check "print a PDF with --code: exit status" 0 "$rc"
+contains "print a PDF with --code: stderr says which" "code: thick 1.40 mm" "$out"
+contains "print a PDF with --code: the page's label says which" "code: thick 1.40 mm" "$(pdftotext code.pdf - 2>/dev/null)"
+# an SVG written before the dimensions were recorded reads with the defaults
+sed 's/ code-[a-z-]*-mm="[^"]*"//g' piece.svg >old.svg
+check "an old SVG has no code dimensions" 0 "$(grep -c 'code-' old.svg)"
+$PITWALL track verify old.svg >/dev/null 2>&1
+check "verify an old SVG: the defaults" 0 "$?"
+bad "print --code with an unknown name" "--code thikc=1.4: unknown code dimension 'thikc' (did you mean thick?)" print S --code thikc=1.4 --out s.svg
+bad "print --code rows" "--code rows=8: rows decides the location ids the simulator reports, so it stays as it is" print S --code rows=8 --out s.svg
+bad "print --code nan" "--code thick=nan: 'nan' is not a number; give thick in mm" print S --code thick=nan --out s.svg
+bad "print --code too wide" "--code wide=2.6: a wide stroke reaches 4.04 mm from its line" print S --code wide=2.6 --out s.svg
+bad "verify --code 0" "--code gap=0: gap must be more than 0" verify piece.svg --code gap=0
+sed 's/code-thick-mm="[^"]*"/code-thick-mm="x"/' piece.svg >badcode.svg
+bad "verify an SVG with a bad code dimension" "badcode.svg is not a piece SVG written by \`pitwall track print\` (its pitwall piece metadata has no number code-thick-mm)" verify badcode.svg
+
 finish

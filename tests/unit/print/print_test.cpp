@@ -90,7 +90,7 @@ TEST_CASE("print: a piece token, start, a layout name or a layout file name thei
 }
 
 TEST_CASE("print: the metadata goes in after the svg tag and reads back; garbage is refused") {
-  print::PieceSvg p{"S:60,len=300", 60, {324, 208, 20, 104}};
+  print::PieceSvg p{"S:60,len=300", 60, {324, 208, 20, 104}, {}};
   const std::string svg = print::withMetadata(
       "<?xml version=\"1.0\"?>\n<svg width=\"324mm\" height=\"208mm\"><g/></svg>", p);
   CHECK(svg.find("<svg width=\"324mm\" height=\"208mm\">\n<metadata") != std::string::npos);
