@@ -380,15 +380,23 @@ Result<Track, std::string> parseLayout(std::string_view text, std::string name) 
   double gap = std::hypot(walk.at.x, walk.at.y);
   double turned = headingError(walk.at.heading);
   if (gap > kClosureToleranceMm || std::abs(turned) > kClosureToleranceDeg) {
-    std::string why = "the layout does not close: its end is " + formatMm(gap) +
-                      " mm from its start (x " + formatMm(walk.at.x) + " mm, y " +
-                      formatMm(walk.at.y) + " mm)";
+    std::string why =
+        "the layout does not close: its end (after its last piece, " + pieceToken(pieces.back()) +
+        " at position " + std::to_string(positions.back()) + ") is " + formatMm(gap) +
+        " mm from its start (x " + formatMm(walk.at.x) + " mm, y " + formatMm(walk.at.y) + " mm)";
     if (std::abs(turned) > kClosureToleranceDeg)
       why += " and heads " + formatNumber(std::round(std::abs(turned) * 100) / 100) + "° " +
              (std::abs(turned) > 179.99 ? "away from"
               : turned > 0              ? "left of"
                                         : "right of") +
              " the start direction";
+    // How far the curves turn in all: a closed loop turns 360°, so a curve of the wrong angle
+    // or direction shows here.
+    double curves = 0;
+    for (const Piece& p : pieces) curves += p.turn * p.angle();
+    if (std::abs(turned) > kClosureToleranceDeg)
+      why += "; its curves turn " + formatNumber(std::round(curves * 100) / 100) +
+             "° in all, and a closed loop turns 360° (or −360° turning right)";
     return fail(why + "; add or remove pieces until it does");
   }
   if (auto overlap = firstOverlap(pieces)) {

@@ -115,7 +115,9 @@ TEST_CASE("a layout needs exactly one start") {
 
 TEST_CASE("a layout that does not close says by how much") {
   auto e = errorOf("start S L L S L L");
-  CHECK(contains(e, "the layout does not close: its end is 560 mm from its start"));
+  CHECK(
+      contains(e, "the layout does not close: its end (after its last piece, L:23 at position 7)"));
+  CHECK(contains(e, ") is 560 mm from its start"));
   auto turned = errorOf("start S L");
   CHECK(contains(turned, "heads 90° left of the start direction"));
 }
@@ -219,6 +221,10 @@ TEST_CASE("invalid custom designs are refused with a sentence naming the piece")
   // does not close: an angle that leaves it turned
   CHECK(contains(errorOf("start S L L S S L L:61,r=280,deg=80"), "does not close"));
   CHECK(contains(errorOf("start S L L S S L L:61,r=280,deg=80"), "heads 10° right of"));
+  CHECK(contains(errorOf("start S L L S S L L:61,r=280,deg=80"),
+                 "its end (after its last piece, L:61,r=280,deg=80 at position 8) is 49 mm"));
+  CHECK(contains(errorOf("start S L L S S L L:61,r=280,deg=80"),
+                 "; its curves turn 350° in all, and a closed loop turns 360°"));
   // crosses itself: a full circle after the first straight comes back over it
   CHECK(contains(errorOf("start S L L L L S L L S S S L L"),
                  "pieces S:36 at position 2 and L:23 at position 6 overlap"));
