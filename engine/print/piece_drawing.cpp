@@ -150,7 +150,7 @@ void drawPiece(cairo_t* cr, const sim::Piece& piece, const Sheet& sheet, const s
     const sim::CodeRow& row = layout.rows[r];
     d.band(0, 1, row.offset_mm - g.line_width_mm / 2, row.offset_mm + g.line_width_mm / 2);
     for (int k = 0; k < row.sections; ++k) {
-      const auto strokes = optical::encodeSection(piece.id, row.first_location + k);
+      const auto strokes = optical::encodeSection(piece.id, row.locationOf(k));
       const auto centres = sim::strokeCentres(row, k, g);
       for (int j = 0; j < optical::kStrokes; ++j) {
         const double c = centres[static_cast<std::size_t>(j)];

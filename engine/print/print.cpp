@@ -165,16 +165,26 @@ Tiling tiling(double width_mm, double height_mm, const Paper& paper) {
   return t;
 }
 
+namespace {
+
+// What is printed: a right curve is its left curve's piece, laid the other way round.
+std::vector<sim::Piece> printed(std::vector<sim::Piece> pieces) {
+  for (sim::Piece& p : pieces) p = sim::printedPiece(p);
+  return pieces;
+}
+
+}  // namespace
+
 Result<std::vector<sim::Piece>, std::string> piecesOf(std::string_view arg) {
   std::error_code ec;
   if (std::filesystem::is_regular_file(std::filesystem::path(arg), ec)) {
     auto track = sim::loadLayout(arg);
     if (!track) return Unexpected<std::string>(track.error());
-    return track->pieces();
+    return printed(track->pieces());
   }
   auto piece = sim::parsePiece(arg);
-  if (piece) return *piece;
-  if (auto named = sim::namedLayout(arg)) return named->pieces();
+  if (piece) return printed(*piece);
+  if (auto named = sim::namedLayout(arg)) return printed(named->pieces());
   return Unexpected<std::string>(piece.error() + " (and no file is named '" + std::string(arg) +
                                  "')");
 }

@@ -360,7 +360,7 @@ RowPass readRow(const Raster& raster, const sim::Piece& piece, const sim::CodeLa
                             " sections where the design has " + std::to_string(row.sections));
   for (std::size_t k = 0; k < found.size() && k < static_cast<std::size_t>(row.sections); ++k) {
     const int designed = reversed ? row.sections - 1 - static_cast<int>(k) : static_cast<int>(k);
-    const int location = row.first_location + designed;
+    const int location = row.locationOf(designed);
     std::vector<optical::Stroke> marks;
     for (const auto& s : found[k]) marks.push_back(s.stroke);
     const std::string where = "section " + std::to_string(designed + 1) + " (piece " +

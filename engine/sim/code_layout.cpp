@@ -1,5 +1,6 @@
 #include "engine/sim/code_layout.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace pitwall::sim {
@@ -31,22 +32,41 @@ CodeRow rowOf(const Piece& piece, int i, int first_location, const CodeGeometry&
 
 }  // namespace
 
+Piece printedPiece(const Piece& piece) {
+  Piece out = piece;
+  if (out.turn < 0) out.turn = 1;
+  return out;
+}
+
 CodeLayout codeLayout(const Piece& piece, const CodeGeometry& g) {
   CodeLayout out;
+  const Piece printed = printedPiece(piece);
   out.rows.reserve(static_cast<std::size_t>(g.rows));
   for (int i = 0; i < g.rows; ++i) {
-    out.rows.push_back(rowOf(piece, i, out.locations, g));
+    out.rows.push_back(rowOf(printed, i, out.locations, g));
     out.locations += out.rows.back().sections;
+  }
+  if (piece.turn < 0) {  // the left curve's rows, seen driving it backwards
+    std::reverse(out.rows.begin(), out.rows.end());
+    for (CodeRow& row : out.rows) {
+      row.offset_mm = -row.offset_mm;
+      row.reversed = true;
+    }
   }
   return out;
 }
 
 std::optional<CodeSpot> locateCode(const Piece& piece, int location, const CodeGeometry& g) {
+  const Piece printed = printedPiece(piece);
   int first = 0;
   for (int i = 0; i < g.rows && location >= 0; ++i) {
-    CodeRow row = rowOf(piece, i, first, g);
+    CodeRow row = rowOf(printed, i, first, g);
     if (location < first + row.sections) {
-      const int k = location - first;
+      int k = location - first;
+      if (piece.turn < 0) {  // driven backwards: the row and the section from the other end
+        k = row.sections - 1 - k;
+        return CodeSpot{g.rows - 1 - i, k, row.sectionCentre(k) / row.length_mm};
+      }
       return CodeSpot{i, k, row.sectionCentre(k) / row.length_mm};
     }
     first += row.sections;

@@ -40,7 +40,12 @@ struct CodeRow {
   double offset_mm = 0;  // the lane line, right of the centre line (piece's forward direction)
   double length_mm = 0;  // along that line
   int sections = 0;
-  int first_location = 0;  // the location id of its first section
+  int first_location = 0;  // the lowest location id of the row
+  // The row's ids run against the layout's direction: a right curve is a left curve's piece
+  // driven backwards (see codeLayout).
+  bool reversed = false;
+  // The location id of section k, counted in the layout's driving direction.
+  int locationOf(int k) const { return first_location + (reversed ? sections - 1 - k : k); }
   // The centre of section k along the row (mm from its start) and of its strokes.
   double sectionCentre(int k) const { return (k + 0.5) * length_mm / sections; }
 };
@@ -50,7 +55,12 @@ struct CodeLayout {
   int locations = 0;          // location ids 0 … locations − 1
 };
 
+// A right curve is the same piece as the left curve of its id, laid the other way round: a car
+// turning right drives that piece backwards (as with Anki's curves, which are all one piece).
+// Its rows are the left curve's, mirrored, with their ids running backwards (CodeRow::reversed).
 CodeLayout codeLayout(const Piece& piece, const CodeGeometry& g = {});
+// The piece a print of `piece` shows: a right curve is printed as its left curve.
+Piece printedPiece(const Piece& piece);
 
 // Where location id `location` lies on `piece`: its row, its section, and the section's centre
 // as a fraction of the piece (forward); nothing when the piece has no such id. No allocation.

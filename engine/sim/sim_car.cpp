@@ -281,7 +281,7 @@ void Car::move(double lane_mm) {
         int idx = dir_ > 0 ? k : codes - 1 - k;
         double f = row.code_at[static_cast<std::size_t>(idx)];
         if (dir_ > 0 ? (f > u_ && f <= nu) : (f < u_ && f >= nu))
-          sendPosition(row.first_location + idx);
+          sendPosition(row.location[static_cast<std::size_t>(idx)]);
       }
     }
     // Wheels run on lanes of their own: in a curve the outer wheel travels further.

@@ -25,7 +25,7 @@ struct PieceInfo {
   // them, as fractions of the piece (forward), and the row's first location id.
   struct Row {
     std::vector<double> code_at;
-    int first_location = 0;
+    std::vector<int> location;  // the location id of each code, in the same order
   };
   std::vector<Row> rows;  // left to right in the piece's forward direction
   double row_pitch_mm = 12;

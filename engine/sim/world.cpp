@@ -30,9 +30,10 @@ PieceInfo describe(const Piece& piece) {
   info.row_pitch_mm = g.row_pitch_mm;
   for (const CodeRow& row : codeLayout(piece, g).rows) {
     PieceInfo::Row r;
-    r.first_location = row.first_location;
-    for (int k = 0; k < row.sections; ++k)
+    for (int k = 0; k < row.sections; ++k) {
       r.code_at.push_back(row.sectionCentre(k) / row.length_mm);
+      r.location.push_back(row.locationOf(k));
+    }
     info.rows.push_back(std::move(r));
   }
   return info;

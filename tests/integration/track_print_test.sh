@@ -78,6 +78,10 @@ contains "verify: every row forward" "piece.svg: row 16 forward:  OK, 2 sections
 contains "verify: every row backward" "piece.svg: row 1 backward: OK, 2 sections" "$out"
 contains "verify: the verdict" "piece.svg: OK: S:60,len=300 (piece 60), 64 section readings" "$out"
 # a curve, and the start pair (two files)
+# a right curve is its left curve's piece laid the other way round: the same sheet
+$PITWALL track print L:17 --out left.svg 2>/dev/null
+$PITWALL track print R:17 --out right.svg 2>/dev/null
+check "a right curve prints as its left curve" yes "$(cmp -s left.svg right.svg && echo yes)"
 $PITWALL track print L:61,r=400,deg=45 --out curve.svg 2>/dev/null
 out=$($PITWALL track verify curve.svg 2>&1); rc=$?
 check "verify a custom curve" 0 "$rc"

@@ -58,7 +58,7 @@ TEST_CASE("print: every piece type reads back on every row in both directions as
         for (int k = 0; k < row.sections; ++k) {
           const auto& r = pass.readings[static_cast<std::size_t>(k)];
           CHECK(r.piece_id == piece.id);
-          CHECK(r.location_id == row.first_location + (pass.reversed ? row.sections - 1 - k : k));
+          CHECK(r.location_id == row.locationOf(pass.reversed ? row.sections - 1 - k : k));
           CHECK(r.reversed == pass.reversed);
           ++readings;
         }
@@ -81,7 +81,7 @@ TEST_CASE("print: a stroke left white fails the read-back, naming its row and se
     const print::ReadBack result =
         print::readBack(print::renderPiece(piece, kPxPerMm, {}, options), piece);
     CHECK_FALSE(result.ok());
-    const int location = row.first_location + section;
+    const int location = row.locationOf(section);
     for (const print::RowPass& pass : result.passes) {
       CAPTURE(pass.row);
       CAPTURE(pass.reversed);

@@ -454,8 +454,7 @@ TEST_CASE(
           if (std::abs(r.offset_mm - pieceOffset) <= 6) row = &r;
         REQUIRE(row);
         for (int j = 0; j < row->sections; ++j)
-          expected.emplace_back(p.id,
-                                row->first_location + (backwards ? row->sections - 1 - j : j));
+          expected.emplace_back(p.id, row->locationOf(backwards ? row->sections - 1 - j : j));
       }
       std::vector<std::pair<int, int>> seen;
       for (auto& [t, m] : rig.all<anki::PositionUpdate>())

@@ -44,7 +44,7 @@ TEST_CASE("code layout: every location id lies in exactly one row and section, i
       CHECK(row.sections >= 1);
       CHECK(row.length_mm / row.sections >= 150 - 1e-9);
       for (int k = 0; k < row.sections; ++k) {
-        int id = row.first_location + k;
+        int id = row.locationOf(k);
         CHECK(seen.insert(id).second);
         auto spot = locateCode(p, id);
         REQUIRE(spot);
@@ -60,5 +60,34 @@ TEST_CASE("code layout: every location id lies in exactly one row and section, i
     CHECK(static_cast<int>(seen.size()) == layout.locations);
     CHECK_FALSE(locateCode(p, layout.locations));
     CHECK_FALSE(locateCode(p, -1));
+  }
+}
+
+TEST_CASE("code layout: a right curve is its left curve's piece driven backwards") {
+  // Anki's curves are one piece: laid the other way round it turns right, and a car reads its
+  // code backwards. The ids of a right curve are the left curve's, row for row mirrored and
+  // section for section reversed, at the same places.
+  for (const Piece& left : {stock(17, 1), Piece{61, anki::PieceType::Curve, 1, 0, 400, 45}}) {
+    Piece right = left;
+    right.turn = -1;
+    auto l = codeLayout(left);
+    auto r = codeLayout(right);
+    CHECK(r.locations == l.locations);
+    for (std::size_t i = 0; i < 16; ++i) {
+      const CodeRow& rr = r.rows[i];
+      const CodeRow& lr = l.rows[15 - i];
+      CHECK(rr.offset_mm == -lr.offset_mm);
+      CHECK(rr.length_mm == doctest::Approx(lr.length_mm));
+      REQUIRE(rr.sections == lr.sections);
+      for (int k = 0; k < rr.sections; ++k) {
+        CHECK(rr.locationOf(k) == lr.locationOf(lr.sections - 1 - k));
+        auto rs = locateCode(right, rr.locationOf(k));
+        auto ls = locateCode(left, rr.locationOf(k));
+        REQUIRE(rs);
+        REQUIRE(ls);
+        CHECK(rs->fraction == doctest::Approx(1 - ls->fraction));
+      }
+    }
+    CHECK(printedPiece(right).turn == 1);
   }
 }
