@@ -18,6 +18,15 @@ namespace {
 // A raster too large to hold (a sheet metres wide, or a huge --dpi) is refused, not attempted.
 constexpr double kMaxPixels = 300e6;
 constexpr int kBandRows = 512;  // rendered a band at a time: one byte per pixel is kept
+// cairo's image surfaces are at most this many pixels wide (or high).
+constexpr double kMaxSide = 32767;
+
+// A GError's message without the newline librsvg may end it with.
+std::string messageOf(const GError* e) {
+  std::string m = e ? e->message : "unknown error";
+  while (!m.empty() && (m.back() == '\n' || m.back() == ' ')) m.pop_back();
+  return m;
+}
 
 // Renders `paint` (user space: pixels) band by band on white, keeping darkness bytes.
 void rasterize(Raster& r, const std::function<void(cairo_t*)>& paint) {
@@ -25,6 +34,12 @@ void rasterize(Raster& r, const std::function<void(cairo_t*)>& paint) {
   for (int y0 = 0; y0 < r.height; y0 += kBandRows) {
     const int rows = std::min(kBandRows, r.height - y0);
     cairo_surface_t* band = cairo_image_surface_create(CAIRO_FORMAT_RGB24, r.width, rows);
+    if (cairo_surface_status(band) != CAIRO_STATUS_SUCCESS) {  // the callers keep within limits
+      cairo_surface_destroy(band);
+      r.dark.clear();
+      r.width = r.height = 0;
+      return;
+    }
     cairo_t* cr = cairo_create(band);
     cairo_set_source_rgb(cr, 1, 1, 1);
     cairo_paint(cr);
@@ -95,7 +110,7 @@ Result<std::pair<Raster, PieceSvg>, std::string> loadPieceSvg(const std::string&
   RsvgHandle* handle =
       rsvg_handle_new_from_data(reinterpret_cast<const guint8*>(svg.data()), svg.size(), &error);
   if (!handle) {
-    std::string why = error ? error->message : "unknown error";
+    std::string why = messageOf(error);
     if (error) g_error_free(error);
     return Error(path + " is not an SVG librsvg can read (" + why +
                  "): print the piece again with `pitwall track print`");
@@ -108,7 +123,8 @@ Result<std::pair<Raster, PieceSvg>, std::string> loadPieceSvg(const std::string&
                  " has no width and height in absolute units (mm): it cannot be printed "
                  "at actual size; print the piece again with `pitwall track print`");
   }
-  if (w * h > kMaxPixels) {
+  if (!std::isfinite(w) || !std::isfinite(h) || w > kMaxSide || h > kMaxSide ||
+      w * h > kMaxPixels) {
     g_object_unref(handle);
     char buf[160];
     std::snprintf(buf, sizeof buf, "%.0f × %.0f mm at %g dpi is %.0f million pixels",
@@ -127,7 +143,8 @@ Result<std::pair<Raster, PieceSvg>, std::string> loadPieceSvg(const std::string&
     GError* e = nullptr;
     if (!rsvg_handle_render_document(handle, cr, &viewport, &e)) {
       rendered = false;
-      if (e) why = e->message, g_error_free(e);
+      why = messageOf(e);
+      if (e) g_error_free(e);
     }
   });
   g_object_unref(handle);

@@ -1,5 +1,6 @@
 #include "engine/sim/track.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cctype>
 #include <charconv>
@@ -7,6 +8,7 @@
 #include <cstdio>
 #include <numbers>
 
+#include "engine/core/printable.hpp"
 #include "engine/sim/code_layout.hpp"
 #include "engine/sim/footprint.hpp"
 
@@ -31,6 +33,12 @@ constexpr double kClosureToleranceDeg = 0.01;
 constexpr double kMaxRadiusMm = 5000;
 constexpr double kMaxStraightMm = 5000;
 
+// Text of the layout in an error: at most 80 bytes, control characters and bytes that are not
+// UTF-8 escaped (a file may hold anything).
+std::string shown(std::string_view s) {
+  return printable(s, 80);
+}
+
 std::string lower(std::string_view s) {
   std::string out(s);
   for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
@@ -50,10 +58,11 @@ std::string formatMm(double mm) {
   return buf;
 }
 
+// The shortest text that reads back as exactly `v` (a layout written back must close as it did).
 std::string formatNumber(double v) {
   char buf[32];
-  std::snprintf(buf, sizeof buf, "%.10g", v);
-  return buf;
+  auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  return ec == std::errc() ? std::string(buf, end) : std::string("nan");
 }
 
 // Position and heading while walking the centre line.
@@ -177,6 +186,8 @@ Result<Parsed, std::string> parseTokens(std::string_view text) {
   auto& startAt = parsed.startAt;
   std::size_t straights = 0, curves = 0;
   int& position = parsed.tokens;
+  std::array<int, 256> firstWithId;  // the index of the first piece with each id, or −1
+  firstWithId.fill(-1);
   std::size_t i = 0;
   while (i < text.size()) {
     char c = text[i];
@@ -198,7 +209,9 @@ Result<Parsed, std::string> parseTokens(std::string_view text) {
     std::string at = " at position " + std::to_string(position);
 
     std::string_view head = token, keys;
-    if (auto comma = token.find(','); comma != std::string_view::npos) {
+    const auto comma = token.find(',');
+    const bool hasKeys = comma != std::string_view::npos;
+    if (hasKeys) {
       head = token.substr(0, comma);
       keys = token.substr(comma + 1);
     }
@@ -211,10 +224,10 @@ Result<Parsed, std::string> parseTokens(std::string_view text) {
       hasId = true;
     }
     std::string k = lower(kind);
-    const std::string named = "'" + std::string(token) + "'" + at;
+    const std::string named = "'" + shown(token) + "'" + at;
 
     if (k == "start") {
-      if (hasId || !keys.empty())
+      if (hasId || hasKeys)
         return fail(named + ": start is always pieces 34 and 33 and takes no piece id or keys");
       if (startAt != 0)
         return fail("a second start" + at + " (the first is at position " +
@@ -237,16 +250,22 @@ Result<Parsed, std::string> parseTokens(std::string_view text) {
       piece.type = anki::PieceType::Curve;
       piece.turn = -1;
     } else {
-      return fail("unknown piece '" + std::string(token) + "'" + at +
+      return fail("unknown piece '" + shown(token) + "'" + at +
                   "; use start, S (straight), L (left) or R (right), optionally with "
                   ":ID such as S:39");
     }
     const anki::PieceType type = piece.type;
 
     // Keys: a custom piece's geometry (len for a straight, r and deg for a curve).
-    while (!keys.empty()) {
-      std::string_view kv = keys.substr(0, keys.find(','));
-      keys = kv.size() < keys.size() ? keys.substr(kv.size() + 1) : std::string_view{};
+    std::vector<const double*> given;
+    for (bool more = hasKeys; more;) {
+      const auto next = keys.find(',');
+      std::string_view kv = keys.substr(0, next);
+      more = next != std::string_view::npos;
+      if (more) keys = keys.substr(next + 1);
+      if (kv.empty())
+        return fail(named + ": an empty key (two commas, or one at the end); write keys as " +
+                    (piece.turn ? "L:61,r=400,deg=45" : "S:60,len=300"));
       auto eq = kv.find('=');
       std::string key = lower(kv.substr(0, eq));
       const char* allowed = piece.turn ? "r (centre radius, mm) and deg (angle)" : "len (mm)";
@@ -255,7 +274,7 @@ Result<Parsed, std::string> parseTokens(std::string_view text) {
                      : piece.turn != 0 && key == "deg" ? &piece.angle_deg
                                                        : nullptr;
       if (!slot)
-        return fail(named + ": unknown key '" + std::string(kv.substr(0, eq)) + "'; a " +
+        return fail(named + ": unknown key '" + shown(kv.substr(0, eq)) + "'; a " +
                     (piece.turn ? "curve" : "straight") + " takes " + allowed + ", such as " +
                     (piece.turn ? "L:61,r=400,deg=45" : "S:60,len=300"));
       std::string_view valueText = eq == std::string_view::npos ? "" : kv.substr(eq + 1);
@@ -264,7 +283,7 @@ Result<Parsed, std::string> parseTokens(std::string_view text) {
           std::from_chars(valueText.data(), valueText.data() + valueText.size(), value);
       if (valueText.empty() || ec != std::errc() || ptr != valueText.data() + valueText.size() ||
           !std::isfinite(value) || value <= 0)
-        return fail(named + ": " + key + " '" + std::string(valueText) +
+        return fail(named + ": " + shown(key) + " '" + shown(valueText) +
                     "' is not a positive number" + (key == "deg" ? " of degrees" : " of mm"));
       if (key == "deg" && value > 180)
         return fail(named + ": deg=" + formatNumber(value) +
@@ -275,6 +294,9 @@ Result<Parsed, std::string> parseTokens(std::string_view text) {
       if (key == "len" && value > kMaxStraightMm)
         return fail(named + ": len=" + formatNumber(value) + " mm is more than " +
                     formatNumber(kMaxStraightMm) + " mm; split it into two straights");
+      if (std::find(given.begin(), given.end(), slot) != given.end())
+        return fail(named + ": " + key + " is given twice; give each key once");
+      given.push_back(slot);
       *slot = value;
     }
 
@@ -283,8 +305,7 @@ Result<Parsed, std::string> parseTokens(std::string_view text) {
       auto [ptr, ec] = std::from_chars(idText.data(), idText.data() + idText.size(), value);
       if (idText.empty() || ec != std::errc() || ptr != idText.data() + idText.size() ||
           value > 255)
-        return fail("piece id '" + std::string(idText) + "'" + at +
-                    " is not a number from 0 to 255");
+        return fail("piece id '" + shown(idText) + "'" + at + " is not a number from 0 to 255");
       piece.id = static_cast<std::uint8_t>(value);
       anki::PieceType actual = anki::pieceType(piece.id);
       if (actual == anki::PieceType::Unknown) {
@@ -311,7 +332,7 @@ Result<Parsed, std::string> parseTokens(std::string_view text) {
                   ": a custom piece needs an id of its own, one Anki does not use, "
                   "such as " +
                   std::string(piece.turn ? "L:61," : "S:60,") +
-                  std::string(token.substr(token.find(',') + 1)));
+                  shown(token.substr(token.find(',') + 1)));
     } else if (type == anki::PieceType::Straight) {
       piece.id = kStraightIds[straights++ % kStraightIds.size()];
     } else {
@@ -319,13 +340,12 @@ Result<Parsed, std::string> parseTokens(std::string_view text) {
     }
 
     // One custom id, one shape: the scan lap and pitwall.piece learn a piece's shape by its id.
-    for (std::size_t j = 0; j < pieces.size(); ++j) {
-      const Piece& o = pieces[j];
-      if (o.id != piece.id) continue;
+    if (const int j = firstWithId[piece.id]; j >= 0) {
+      const Piece& o = pieces[static_cast<std::size_t>(j)];
       if ((o.turn == 0) != (piece.turn == 0) || o.length(0) != piece.length(0) ||
           o.angle() != piece.angle())
         return fail(named + " has id " + std::to_string(piece.id) + ", which " + pieceToken(o) +
-                    " at position " + std::to_string(positions[j]) +
+                    " at position " + std::to_string(positions[static_cast<std::size_t>(j)]) +
                     " has with another shape; one id, one shape: give it an id of its own");
     }
 
@@ -345,6 +365,7 @@ Result<Parsed, std::string> parseTokens(std::string_view text) {
       return fail(named + " needs " + std::to_string(code.locations) +
                   " location ids and a 7-bit code carries 128; make it shorter or split it "
                   "into two pieces");
+    if (firstWithId[piece.id] < 0) firstWithId[piece.id] = static_cast<int>(pieces.size());
     pieces.push_back(piece);
     positions.push_back(position);
   }
@@ -357,7 +378,7 @@ Result<std::vector<Piece>, std::string> parsePiece(std::string_view token) {
   auto parsed = parseTokens(token);
   if (!parsed) return Unexpected<std::string>(parsed.error());
   if (parsed->tokens != 1)
-    return fail("'" + std::string(token) + "' is " + std::to_string(parsed->tokens) +
+    return fail("'" + shown(token) + "' is " + std::to_string(parsed->tokens) +
                 " pieces; give one, such as S, L:17, start or S:60,len=300");
   return std::move(parsed->pieces);
 }

@@ -63,6 +63,13 @@ end
 
 local letters = { straight = "S", curve = "?", intersection = "X" }
 
+-- A number as text that reads back as exactly that number (a layout must close as it did).
+local function exact(x)
+  local s = string.format("%.15g", x)
+  if tonumber(s) ~= x then s = string.format("%.17g", x) end
+  return s
+end
+
 --- The map as simulator layout text ("start S L L S S L L"); with `ids`, "S:36 L:17 …" and a
 --- custom piece's shape ("S:60,len=300").
 function Map:layout(ids)
@@ -77,9 +84,9 @@ function Map:layout(ids)
     -- a custom piece's shape, as a layout gives it (docs/tracks.md)
     if ids and p.custom then
       if p.radius then
-        word = string.format("%s,r=%g,deg=%g", word, p.radius, p.angle)
+        word = word .. ",r=" .. exact(p.radius) .. ",deg=" .. exact(p.angle)
       else
-        word = string.format("%s,len=%g", word, p.centre)
+        word = word .. ",len=" .. exact(p.centre)
       end
     end
     words[#words + 1] = word

@@ -134,6 +134,12 @@ sed 's/token="S:60,len=300"/token="Q:999"/' piece.svg >badtoken.svg
 bad "verify an SVG naming no piece" "badtoken.svg names the piece 'Q:999'" verify badtoken.svg
 sed 's/width="324mm" height="208mm"/width="90000mm" height="90000mm"/' piece.svg >huge.svg
 bad "verify a huge SVG" "use a lower --dpi" verify huge.svg
+# wider than cairo's 32767 px at an allowed --dpi: refused, not a crash (review of issue 21)
+$PITWALL track print S:60,len=736 --out long.svg 2>/dev/null
+bad "verify a sheet too wide at 1100 dpi" "use a lower --dpi" verify long.svg --dpi 1100
+sed 's/width="[0-9.]*mm" height="[0-9.]*mm"/width="1e30mm" height="1e-30mm"/' piece.svg >thin.svg
+out=$($PITWALL track verify thin.svg 2>&1); rc=$?
+check "verify an absurd sheet: exit status" 2 "$rc"
 bad "verify --dpi 0" "--dpi" verify piece.svg --dpi 0
 bad "verify --blur nan" "--blur nan is not a number" verify piece.svg --blur nan
 bad "print a bad token" "Q:9" print Q:9 --out q.pdf

@@ -251,6 +251,18 @@ TEST_CASE("invalid custom designs are refused with a sentence naming the piece")
                  "'S:60,len=400' at position 3 has id 60, which S:60,len=300 at position 2 has "
                  "with another shape"));
   CHECK(contains(errorOf("start,len=3 S L L S S L L"), "start is always pieces 34 and 33"));
+  CHECK(contains(errorOf("start, S L L S S L L"), "start is always pieces 34 and 33"));
+  CHECK(contains(errorOf("start S:60,len=560, L L S S L L"),
+                 "'S:60,len=560,' at position 2: an empty key (two commas, or one at the end)"));
+  CHECK(contains(errorOf("start S:60,,len=560 L L S S L L"), "an empty key"));
+  CHECK(contains(errorOf("start S L:61,deg=90,deg=90 L S S L L"),
+                 "'L:61,deg=90,deg=90' at position 3: deg is given twice; give each key once"));
+  // a hostile token is shown short and escaped: 80 bytes at most, bytes that are not UTF-8 as \xNN
+  const std::string huge = "start S:60,len=" + std::string(100000, '9') + "\xff L L S S L L";
+  const std::string e = errorOf(huge);
+  CHECK(e.size() < 400);
+  CHECK(contains(e, "…"));
+  CHECK(contains(errorOf("start Q\xff\x1b[2J L L S S L L"), "unknown piece 'Q\\xff\\x1b[2J'"));
   // hostile numbers and text never crash and always say what is wrong
   for (const char* bad : {"S:60,len=-1", "S:60,len=nan", "S:60,len=inf", "S:60,len=", "S:60,=3",
                           "S:60,,", "L:61,r=1e300", "L:61,deg=0.0000001", "S:9999999999999999999",
