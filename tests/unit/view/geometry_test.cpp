@@ -3,6 +3,8 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include "engine/sim/track.hpp"
 #include "engine/view/geometry.hpp"
@@ -17,9 +19,16 @@ double dist(const Pose& a, const Pose& b) {
 }  // namespace
 
 TEST_CASE("view geometry: every named layout's pieces meet, lane by lane, and the lap closes") {
-  for (const auto& name : sim::layoutNames()) {
+  std::vector<std::string> layouts = sim::layoutNames();
+  // and a track of custom pieces: 45° curves of 400 mm, 200 mm hairpins, straights of its own
+  layouts.push_back(
+      "start S:60,len=440 L:61,r=400,deg=45 L:61,r=400,deg=45 L:61,r=400,deg=45 "
+      "L:61,r=400,deg=45 S:60,len=440 S L:62,r=200,deg=90 S:64,len=400 L:62,r=200,deg=90");
+  for (const auto& name : layouts) {
     CAPTURE(name);
-    auto track = sim::namedLayout(name).value();
+    auto track =
+        (name.find(' ') == std::string::npos ? sim::namedLayout(name) : sim::parseLayout(name))
+            .value();
     for (double o : {-68.0, 0.0, 68.0}) {
       for (std::size_t i = 0; i < track.size(); ++i) {
         Pose end = pointOnTrack(track, i, 1.0, o);
