@@ -41,6 +41,8 @@ endif()
 # The installed tree (FHS): bin/pitwall finds share/pitwall beside it (engine/core/data_dir.hpp).
 include(GNUInstallDirs)
 install(TARGETS pitwall RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+# the print module (track print, track verify), found beside the binary: bin/../lib/pitwall
+install(TARGETS pitwall_print LIBRARY DESTINATION lib/pitwall)
 install(DIRECTORY ${CMAKE_SOURCE_DIR}/scripts/ DESTINATION ${CMAKE_INSTALL_DATADIR}/pitwall/scripts)
 install(DIRECTORY ${CMAKE_SOURCE_DIR}/examples/ DESTINATION ${CMAKE_INSTALL_DATADIR}/pitwall/examples)
 install(DIRECTORY ${CMAKE_SOURCE_DIR}/types/ DESTINATION ${CMAKE_INSTALL_DATADIR}/pitwall/types

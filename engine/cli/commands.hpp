@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "engine/print/commands.hpp"
+
 namespace pitwall::cli {
 
 // How to reach an MQTT broker (docs/mqtt.md): --mqtt URL and its companions.
@@ -139,28 +141,11 @@ struct TrackShowOptions {
 };
 int trackShow(const TrackShowOptions& options);
 
-// pitwall track print PIECE|FILE --out OUT.pdf|OUT.svg [--paper a4|a3] [--landscape]
-// [--code NAME=VALUE]…: printable pieces at 1:1 (docs/cli.md "track print").
-struct TrackPrintOptions {
-  std::string what;  // a piece token, a layout file or a layout name
-  std::string out;
-  std::string paper = "a4";
-  bool landscape = false;
-  bool custom = false;            // only the pieces with an id of their own (not Anki's stock ones)
-  std::vector<std::string> code;  // --code NAME=VALUE: stroke dimensions (print/code_options.hpp)
-};
+// pitwall track print / track verify (docs/cli.md): run by the print module, loaded for them
+// alone (engine/print/commands.hpp, engine/cli/print_module.hpp).
+using TrackPrintOptions = print::PrintRequest;
 int trackPrint(const TrackPrintOptions& options);
-
-// pitwall track verify FILE.svg [--dpi N] [--blur MM] [--misalign MM] [--code NAME=VALUE]…:
-// reads a printed piece back with the code dimensions its metadata gives (or --code's)
-// as a car's sensor would; 0 all as designed, 1 not, 2 bad input.
-struct TrackVerifyOptions {
-  std::string file;
-  double dpi = 300;
-  double blur_mm = 0.25;
-  double misalign_mm = 0.5;
-  std::vector<std::string> code;  // over the file's own dimensions
-};
+using TrackVerifyOptions = print::VerifyRequest;
 int trackVerify(const TrackVerifyOptions& options);
 
 int decode(const std::string& protocol, const std::vector<std::string>& hex);

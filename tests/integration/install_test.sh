@@ -36,6 +36,11 @@ runs_from() {
   contains "$name: the grand prix has a winner" "Winner: " "$out"
   out=$(hidden "$bin" run "$data/examples/hello.lua" --fast --cars 1 2>&1); rc=$?
   check "$name: hello.lua runs" 0 "$rc"
+  # the print module, loaded only by track print/verify, is found beside the binary too
+  out=$(hidden sh -c 'cd "$2" && "$1" track print S:60,len=300 --out p.svg && "$1" track verify p.svg' \
+    hide "$bin" "$TMP" 2>&1); rc=$?
+  check "$name: track print and verify run (exit status)" 0 "$rc"
+  contains "$name: track verify reads the print back" "all decode to the design" "$out"
   for f in scripts/pitwall/core.lua scripts/pitwall/race.lua examples/.luarc.json web/index.html \
       types/pitwall.lua; do
     [ -f "$data/$f" ] && echo "ok: $name: share/pitwall/$f" || fail "$name: share/pitwall/$f is missing"
@@ -49,7 +54,7 @@ runs_from() {
 # 1. cmake --install to a temporary prefix
 if cmake --install "$BUILD" --prefix "$TMP/prefix" >"$TMP/install.log" 2>&1; then
   echo "ok: cmake --install"
-  for f in bin/pitwall share/man/man1/pitwall.1.gz share/bash-completion/completions/pitwall \
+  for f in bin/pitwall lib/pitwall/pitwall_print.so share/man/man1/pitwall.1.gz share/bash-completion/completions/pitwall \
       share/zsh/vendor-completions/_pitwall share/doc/pitwall/README.md share/doc/pitwall/docs/install.md; do
     [ -f "$TMP/prefix/$f" ] && echo "ok: installs $f" || fail "cmake --install left out $f"
   done
@@ -76,6 +81,7 @@ if (cd "$BUILD" && cpack -G DEB -B "$TMP/pkg" >"$TMP/cpack.log" 2>&1); then
   listing=$(dpkg-deb -c "$deb")
   contains "the package has the man page" "./usr/share/man/man1/pitwall.1.gz" "$listing"
   contains "the package has bash completion" "./usr/share/bash-completion/completions/pitwall" "$listing"
+  contains "the package has the print module" "./usr/lib/pitwall/pitwall_print.so" "$listing"
 else
   fail "cpack: $(tail -20 "$TMP/cpack.log")"
 fi

@@ -1,0 +1,42 @@
+#pragma once
+// `pitwall track print` and `pitwall track verify` as the print module runs them (docs/cli.md):
+// what the command line asks, and the runs, which write to stdout/stderr and return the exit
+// status. The module (pitwall_print.so) holds cairo and librsvg, which cost about 10 MB of memory
+// once loaded; the command line loads it only for these two commands (engine/cli/print_module.cpp),
+// calling the C entry points below.
+#include <string>
+#include <vector>
+
+namespace pitwall::print {
+
+// pitwall track print PIECE|FILE --out OUT.pdf|OUT.svg [--paper a4|a3] [--landscape] [--custom]
+// [--code NAME=VALUE]…: printable pieces at 1:1.
+struct PrintRequest {
+  std::string what;  // a piece token, a layout file or a layout name
+  std::string out;
+  std::string paper = "a4";
+  bool landscape = false;
+  bool custom = false;            // only the pieces with an id of their own (not Anki's stock ones)
+  std::vector<std::string> code;  // --code NAME=VALUE: stroke dimensions (code_options.hpp)
+};
+int printPieces(const PrintRequest& request);
+
+// pitwall track verify FILE.svg [--dpi N] [--blur MM] [--misalign MM] [--code NAME=VALUE]…:
+// reads a printed piece back with the code dimensions its metadata gives (or --code's) as a
+// car's sensor would; 0 all as designed, 1 not, 2 bad input.
+struct VerifyRequest {
+  std::string file;
+  double dpi = 300;
+  double blur_mm = 0.25;
+  double misalign_mm = 0.5;
+  std::vector<std::string> code;  // over the file's own dimensions
+};
+int verifyPiece(const VerifyRequest& request);
+
+}  // namespace pitwall::print
+
+// The module's entry points, looked up by name (dlsym); the same compiler builds both sides.
+extern "C" {
+int pitwall_print_pieces(const pitwall::print::PrintRequest* request);
+int pitwall_verify_piece(const pitwall::print::VerifyRequest* request);
+}
