@@ -147,6 +147,14 @@ bad "print onto unknown paper" "unknown paper 'letter': use a4 or a3" print S --
 bad "print to neither PDF nor SVG" "--out 's.png' names neither a .pdf nor a .svg file" print S --out s.png
 bad "print into a missing folder" "cannot write no/such/s.svg" print S --out no/such/s.svg
 bad "print into a missing folder (PDF)" "cannot write no/such/s.pdf" print S --out no/such/s.pdf
+# the print module missing or broken: a sentence and status 2, never a crash
+out=$(PITWALL_PRINT_MODULE="$TMP/none.so" $PITWALL track print S --out m.pdf 2>&1); rc=$?
+check "print without its module: exit status" 2 "$rc"
+contains "print without its module: says so" "the print module cannot be loaded (looked for $TMP/none.so)" "$out"
+head -c 2000 /dev/urandom >bad.so
+out=$(PITWALL_PRINT_MODULE="$TMP/bad.so" $PITWALL track verify piece.svg 2>&1); rc=$?
+check "verify with a broken module: exit status" 2 "$rc"
+contains "verify with a broken module: says so" "pitwall track verify: the print module cannot be loaded (" "$out"
 bad "print --custom of stock pieces" "oval.txt has no custom pieces" print oval.txt --custom --out c.pdf
 
 # 6. --code: calibrated strokes, recorded in the SVG and read back with them; the PDF says so
