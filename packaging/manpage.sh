@@ -36,7 +36,14 @@ The race view's page, instead of the data folder's web/.
 .TP
 .B PITWALL_HISTORY
 The REPL's history file (default ~/.pitwall_history).
+.TP
+.B PITWALL_PRINT_MODULE
+The print module that track print and track verify load, instead of ../lib/pitwall/pitwall_print.so
+beside the binary.
 [FILES]
+.TP
+.I /usr/lib/pitwall/pitwall_print.so
+The print module (cairo, librsvg): loaded by track print and track verify only.
 .TP
 .I /usr/share/pitwall/examples
 Example race scripts, with a .luarc.json for the Lua language server.

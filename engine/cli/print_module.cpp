@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <string>
 #include <vector>
 
 #include "engine/core/data_dir.hpp"
@@ -18,7 +19,9 @@ constexpr const char* kModule = "pitwall_print.so";
 std::vector<std::filesystem::path> candidates() {
   std::vector<std::filesystem::path> out;
   if (const char* env = std::getenv("PITWALL_PRINT_MODULE"); env && *env) {
-    out.emplace_back(env);
+    std::error_code ec;  // dlopen reads a name without a slash as a library to search for
+    const auto path = std::filesystem::absolute(env, ec);
+    out.push_back(ec ? std::filesystem::path(env) : path);
     return out;
   }
   const std::filesystem::path exe = executableDir();
@@ -43,12 +46,24 @@ void* entry(const char* command, const char* symbol) {
       why = e ? e : "unknown error";
       continue;
     }
+    // The requests are C++ structs: the module must come from the same build as this binary.
+    auto abi = reinterpret_cast<unsigned long (*)()>(dlsym(handle, "pitwall_print_abi"));
+    if (!abi || abi() != print::kRequestAbi) {
+      why = path.string() + " is from another build of pitwall (requests " +
+            (abi ? std::to_string(abi()) : std::string("unknown")) + ", this one's " +
+            std::to_string(print::kRequestAbi) + ")";
+      continue;
+    }
     if (void* fn = dlsym(handle, symbol)) return fn;
     why = path.string() + " has no " + symbol;
   }
+  const bool fromEnv = std::getenv("PITWALL_PRINT_MODULE") && *std::getenv("PITWALL_PRINT_MODULE");
   std::cerr << "pitwall track " << command << ": the print module cannot be loaded ("
-            << (why.empty() ? "looked for " + tried : why)
-            << "); reinstall pitwall, or in a build tree build it: cmake --build build\n";
+            << (why.empty() ? "looked for " + tried : why) << "); "
+            << (fromEnv ? "set $PITWALL_PRINT_MODULE to the pitwall_print.so of this build, or "
+                          "unset it"
+                        : "reinstall pitwall, or in a build tree build it: cmake --build build")
+            << "\n";
   return nullptr;
 }
 

@@ -152,6 +152,9 @@ int verifyPiece(const VerifyRequest& options) {
 }  // namespace pitwall::print
 
 extern "C" {
+__attribute__((visibility("default"))) unsigned long pitwall_print_abi() {
+  return pitwall::print::kRequestAbi;
+}
 __attribute__((visibility("default"))) int pitwall_print_pieces(
     const pitwall::print::PrintRequest* request) {
   return pitwall::print::printPieces(*request);

@@ -33,10 +33,17 @@ struct VerifyRequest {
 };
 int verifyPiece(const VerifyRequest& request);
 
+// The requests' layout, checked before a loaded module is used: a module from another build of
+// pitwall, with other requests, is refused, never called. A version counted by hand (raise it
+// when a field changes) and the structs' sizes.
+inline constexpr unsigned long kRequestAbi =
+    1'000'000'000UL + sizeof(PrintRequest) * 10'000 + sizeof(VerifyRequest);
+
 }  // namespace pitwall::print
 
 // The module's entry points, looked up by name (dlsym); the same compiler builds both sides.
 extern "C" {
+unsigned long pitwall_print_abi();  // kRequestAbi of the build that made the module
 int pitwall_print_pieces(const pitwall::print::PrintRequest* request);
 int pitwall_verify_piece(const pitwall::print::VerifyRequest* request);
 }

@@ -5,7 +5,7 @@
 # allowed, by checking that no path of theirs is compiled into the binary.
 source "$(dirname "$0")/lib.sh"
 BUILD=$(cd "$(dirname "$PITWALL")" && pwd)
-unset PITWALL_DATA PITWALL_SCRIPTS PITWALL_VIEW_DIR
+unset PITWALL_DATA PITWALL_SCRIPTS PITWALL_VIEW_DIR PITWALL_PRINT_MODULE
 
 # hidden CMD…: CMD with $SRC and $BUILD hidden (when the mount namespace allows it), from $TMP.
 if unshare -m true 2>/dev/null; then

@@ -151,10 +151,15 @@ bad "print into a missing folder (PDF)" "cannot write no/such/s.pdf" print S --o
 out=$(PITWALL_PRINT_MODULE="$TMP/none.so" $PITWALL track print S --out m.pdf 2>&1); rc=$?
 check "print without its module: exit status" 2 "$rc"
 contains "print without its module: says so" "the print module cannot be loaded (looked for $TMP/none.so)" "$out"
+cp "$(dirname "$PITWALL")/lib/pitwall/pitwall_print.so" mod.so
+out=$(PITWALL_PRINT_MODULE=mod.so $PITWALL track print S --out rel.svg 2>&1); rc=$?
+check "print with \$PITWALL_PRINT_MODULE relative to the folder: exit status" 0 "$rc"
+contains "print with \$PITWALL_PRINT_MODULE relative to the folder: wrote it" "wrote rel.svg" "$out"
 head -c 2000 /dev/urandom >bad.so
 out=$(PITWALL_PRINT_MODULE="$TMP/bad.so" $PITWALL track verify piece.svg 2>&1); rc=$?
 check "verify with a broken module: exit status" 2 "$rc"
 contains "verify with a broken module: says so" "pitwall track verify: the print module cannot be loaded (" "$out"
+contains "verify with a broken module: names the variable" "set \$PITWALL_PRINT_MODULE to the pitwall_print.so of this build, or unset it" "$out"
 bad "print --custom of stock pieces" "oval.txt has no custom pieces" print oval.txt --custom --out c.pdf
 
 # 6. --code: calibrated strokes, recorded in the SVG and read back with them; the PDF says so
