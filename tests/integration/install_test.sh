@@ -69,7 +69,7 @@ if (cd "$BUILD" && cpack -G DEB -B "$TMP/pkg" >"$TMP/cpack.log" 2>&1); then
   version=$("$PITWALL" --version | head -1 | awk '{print $2}')
   check "the package's file name" "pitwall_${version}_$(dpkg --print-architecture).deb" "$(basename "${deb:-none}")"
   depends=$(dpkg-deb -f "$deb" Depends)
-  for lib in liblua5.4-0 libsdbus-c++1 libmosquitto1 libreadline8 libcairo2 librsvg2-2; do
+  for lib in liblua5.4-0 libsdbus-c++1 libmosquitto1 libreadline8 libevdev2 libcairo2 librsvg2-2; do
     contains "the package depends on $lib (dpkg-shlibdeps)" "$lib" "$depends"
   done
   # Its dependencies are met here as on any Debian 12 with them installed: dpkg would install it.

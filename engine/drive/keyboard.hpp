@@ -1,0 +1,30 @@
+#pragma once
+// The terminal's keyboard as one player's controller (docs/controllers.md), for testing without a
+// phone: ↑/↓ throttle up and down in steps, ←/→ lanes, space brakes to 0. It takes the first
+// free human seat. The terminal stays in cbreak mode (no echo, keys one by one, Ctrl-C still a
+// signal) while it drives and is restored when it is destroyed.
+#include <memory>
+#include <string>
+
+#include "engine/core/loop.hpp"
+#include "engine/core/result.hpp"
+#include "engine/drive/seats.hpp"
+
+namespace pitwall::drive {
+
+class Keyboard {
+ public:
+  Keyboard(Loop& loop, Seats& seats, int fd);  // fd: the terminal (stdin)
+  ~Keyboard();                                 // restores the terminal
+  Keyboard(const Keyboard&) = delete;
+  Keyboard& operator=(const Keyboard&) = delete;
+
+  // Takes a seat and starts reading; the error says why not (not a terminal; no free seat).
+  Result<bool, std::string> start();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace pitwall::drive

@@ -1,0 +1,217 @@
+// A gamepad's events → what its seat is asked (engine/drive/gamepad_mapping.hpp): the Linux
+// gamepad specification's trigger, stick and buttons, and input no driver should send.
+#include <doctest/doctest.h>
+#include <linux/input-event-codes.h>
+
+#include <climits>
+#include <random>
+
+#include "engine/drive/gamepad_mapping.hpp"
+
+using namespace pitwall::drive;
+
+namespace {
+
+// An Xbox-like pad as xpad reports it: triggers 0..1023 on ABS_Z/ABS_RZ, sticks ±32767.
+DeviceCaps xboxPad() {
+  DeviceCaps caps;
+  caps.keys = {BTN_SOUTH, BTN_EAST, BTN_NORTH, BTN_WEST, BTN_TL, BTN_TR, BTN_START, BTN_SELECT};
+  caps.axes[ABS_X] = {-32768, 32767, 128, 0};
+  caps.axes[ABS_Y] = {-32768, 32767, 128, 0};
+  caps.axes[ABS_Z] = {0, 1023, 0, 0};
+  caps.axes[ABS_RZ] = {0, 1023, 0, 0};
+  return caps;
+}
+
+// A pad with no analog trigger: a stick 0..255 (centre 127.5) and digital ZR.
+DeviceCaps stickPad() {
+  DeviceCaps caps;
+  caps.keys = {BTN_SOUTH, BTN_TL, BTN_TR, BTN_TL2, BTN_TR2};
+  caps.axes[ABS_X] = {0, 255, 15, 128};
+  caps.axes[ABS_Y] = {0, 255, 15, 128};
+  return caps;
+}
+
+}  // namespace
+
+TEST_CASE("gamepad: a device with gamepad or joystick buttons is a gamepad; a keyboard is not") {
+  CHECK(isGamepad(xboxPad()));
+  DeviceCaps joystick;
+  joystick.keys = {BTN_TRIGGER, BTN_THUMB};  // BTN_JOYSTICK == BTN_TRIGGER
+  CHECK(isGamepad(joystick));
+  DeviceCaps keyboard;
+  keyboard.keys = {KEY_A, KEY_UP, KEY_SPACE};
+  CHECK_FALSE(isGamepad(keyboard));
+  DeviceCaps mouse;
+  mouse.keys = {BTN_LEFT, BTN_RIGHT};
+  CHECK_FALSE(isGamepad(mouse));
+  CHECK_FALSE(isGamepad(DeviceCaps{}));
+}
+
+TEST_CASE("gamepad: the right trigger is the throttle, normalized over its range") {
+  GamepadMapping m(xboxPad());
+  CHECK(m.source() == ThrottleSource::Trigger);
+  CHECK(m.triggerAxis() == ABS_RZ);
+  auto half = m.event(EV_ABS, ABS_RZ, 512);
+  REQUIRE(half);
+  CHECK(half->throttle == doctest::Approx(0.50));
+  CHECK(half->laneStep == 0);
+  auto full = m.event(EV_ABS, ABS_RZ, 1023);
+  REQUIRE(full);
+  CHECK(full->throttle == 1.0);
+  auto off = m.event(EV_ABS, ABS_RZ, 0);
+  REQUIRE(off);
+  CHECK(off->throttle == 0.0);
+  // the left trigger and the sticks do nothing while a right trigger is there
+  CHECK_FALSE(m.event(EV_ABS, ABS_Z, 1023));
+  CHECK_FALSE(m.event(EV_ABS, ABS_Y, -32768));
+  CHECK_FALSE(m.event(EV_ABS, ABS_X, 32767));
+}
+
+TEST_CASE("gamepad: an input goes out only when the throttle changes by a hundredth or more") {
+  GamepadMapping m(xboxPad());
+  REQUIRE(m.event(EV_ABS, ABS_RZ, 512));
+  CHECK_FALSE(m.event(EV_ABS, ABS_RZ, 512));  // the same again
+  CHECK_FALSE(m.event(EV_ABS, ABS_RZ, 513));  // a jitter below 1 %
+  CHECK(m.event(EV_ABS, ABS_RZ, 530));
+  CHECK_FALSE(m.event(EV_SYN, SYN_REPORT, 0));
+  CHECK_FALSE(m.event(EV_MSC, MSC_SCAN, 90001));
+}
+
+TEST_CASE("gamepad: a trigger resting near its minimum reads 0 (its flat zone, or 2 %)") {
+  CHECK(GamepadMapping::triggerLevel({0, 1023, 0, 0}, 15) == 0.0);
+  CHECK(GamepadMapping::triggerLevel({0, 1023, 100, 0}, 90) == 0.0);
+  CHECK(GamepadMapping::triggerLevel({0, 1023, 100, 0}, 110) > 0.0);
+  // a trigger whose range is not from 0: −100..100 (a HAT2X-style axis)
+  CHECK(GamepadMapping::triggerLevel({-100, 100, 0, 0}, -100) == 0.0);
+  CHECK(GamepadMapping::triggerLevel({-100, 100, 0, 0}, 0) == doctest::Approx(0.5));
+  CHECK(GamepadMapping::triggerLevel({-100, 100, 0, 0}, 100) == 1.0);
+}
+
+TEST_CASE("gamepad: out-of-range axis values are clamped, never beyond 0..1") {
+  GamepadMapping m(xboxPad());
+  auto over = m.event(EV_ABS, ABS_RZ, INT_MAX);
+  REQUIRE(over);
+  CHECK(over->throttle == 1.0);
+  auto under = m.event(EV_ABS, ABS_RZ, INT_MIN);
+  REQUIRE(under);
+  CHECK(under->throttle == 0.0);
+  CHECK(GamepadMapping::stickUp({-32768, 32767, 0, 0}, INT_MIN) == 1.0);
+  CHECK(GamepadMapping::stickUp({-32768, 32767, 0, 0}, INT_MAX) == 0.0);
+  CHECK(GamepadMapping::triggerLevel({INT_MIN, INT_MAX, 0, 0}, INT_MAX) == 1.0);
+  CHECK(GamepadMapping::triggerLevel({INT_MIN, INT_MAX, INT_MAX, 0}, -1) ==
+        0.0);  // in its flat zone
+  CHECK(GamepadMapping::stickUp({INT_MIN, INT_MAX, INT_MIN, 0}, INT_MIN) == 1.0);
+}
+
+TEST_CASE("gamepad: absinfo with min == max (or min > max) gives no throttle from that axis") {
+  CHECK(GamepadMapping::triggerLevel({5, 5, 0, 5}, 5) == 0.0);
+  CHECK(GamepadMapping::triggerLevel({10, -10, 0, 0}, 7) == 0.0);
+  CHECK(GamepadMapping::stickUp({0, 0, 0, 0}, -1000) == 0.0);
+  CHECK(GamepadMapping::stickUp({0, 255, 200, 128}, 0) == 0.0);  // a flat wider than the travel
+  // A broken right trigger is passed over for the next axis the specification names.
+  DeviceCaps caps = xboxPad();
+  caps.axes[ABS_RZ] = {0, 0, 0, 0};
+  caps.axes[ABS_GAS] = {0, 255, 0, 0};
+  GamepadMapping m(caps);
+  CHECK(m.triggerAxis() == ABS_GAS);
+  CHECK_FALSE(m.event(EV_ABS, ABS_RZ, 100));
+  REQUIRE(m.event(EV_ABS, ABS_GAS, 255));
+  CHECK(m.throttle() == 1.0);
+  // …and with none at all, a stick with no range gives nothing either.
+  DeviceCaps dead;
+  dead.keys = {BTN_SOUTH};
+  dead.axes[ABS_Y] = {3, 3, 0, 3};
+  GamepadMapping d(dead);
+  CHECK(d.source() == ThrottleSource::StickAndButton);
+  CHECK_FALSE(d.event(EV_ABS, ABS_Y, -100000));
+}
+
+TEST_CASE("gamepad: ABS_HAT2X, the specification's analog ZR, is a trigger too") {
+  DeviceCaps caps;
+  caps.keys = {BTN_SOUTH};
+  caps.axes[ABS_HAT2X] = {0, 255, 0, 0};
+  GamepadMapping m(caps);
+  CHECK(m.triggerAxis() == ABS_HAT2X);
+  REQUIRE(m.event(EV_ABS, ABS_HAT2X, 255));
+  CHECK(m.throttle() == 1.0);
+}
+
+TEST_CASE("gamepad: without an analog trigger, the left stick up or the digital ZR drive") {
+  GamepadMapping m(stickPad());
+  CHECK(m.source() == ThrottleSource::StickAndButton);
+  CHECK(m.triggerAxis() == -1);
+  CHECK_FALSE(m.event(EV_ABS, ABS_Y, 120));  // near the centre: the deadzone
+  CHECK_FALSE(m.event(EV_ABS, ABS_Y, 255));  // down is not reverse: 0
+  auto up = m.event(EV_ABS, ABS_Y, 0);
+  REQUIRE(up);
+  CHECK(up->throttle == 1.0);
+  auto partway = m.event(EV_ABS, ABS_Y, 64);
+  REQUIRE(partway);
+  CHECK(partway->throttle > 0.3);
+  CHECK(partway->throttle < 0.7);
+  REQUIRE(m.event(EV_ABS, ABS_Y, 128));
+  CHECK(m.throttle() == 0.0);
+  auto zr = m.event(EV_KEY, BTN_TR2, 1);
+  REQUIRE(zr);
+  CHECK(zr->throttle == 1.0);
+  auto zrOff = m.event(EV_KEY, BTN_TR2, 0);
+  REQUIRE(zrOff);
+  CHECK(zrOff->throttle == 0.0);
+}
+
+TEST_CASE("gamepad: the shoulder buttons step a lane on the press, not on repeat or release") {
+  GamepadMapping m(xboxPad());
+  auto left = m.event(EV_KEY, BTN_TL, 1);
+  REQUIRE(left);
+  CHECK(left->laneStep == -1);
+  CHECK_FALSE(m.event(EV_KEY, BTN_TL, 2));  // auto-repeat
+  CHECK_FALSE(m.event(EV_KEY, BTN_TL, 0));  // release
+  auto right = m.event(EV_KEY, BTN_TR, 1);
+  REQUIRE(right);
+  CHECK(right->laneStep == +1);
+  CHECK(right->throttle == 0.0);
+  // a press replayed by a resync after SYN_DROPPED steps no lane
+  CHECK_FALSE(m.event(EV_KEY, BTN_TR, 1, /*replay=*/true));
+}
+
+TEST_CASE("gamepad: BTN_SOUTH held brakes to 0 whatever the trigger; let go, the trigger counts") {
+  GamepadMapping m(xboxPad());
+  REQUIRE(m.event(EV_ABS, ABS_RZ, 1023));
+  auto brake = m.event(EV_KEY, BTN_SOUTH, 1);
+  REQUIRE(brake);
+  CHECK(brake->throttle == 0.0);
+  CHECK_FALSE(m.event(EV_ABS, ABS_RZ, 800));  // still braking
+  auto back = m.event(EV_KEY, BTN_SOUTH, 0);
+  REQUIRE(back);
+  CHECK(back->throttle == doctest::Approx(0.78));
+}
+
+TEST_CASE("gamepad: replayed axis events after SYN_DROPPED bring the throttle up to date") {
+  GamepadMapping m(xboxPad());
+  auto caught = m.event(EV_ABS, ABS_RZ, 1023, /*replay=*/true);
+  REQUIRE(caught);
+  CHECK(caught->throttle == 1.0);
+}
+
+TEST_CASE("gamepad: random events never give a throttle outside 0..1 or a lane step beyond 1") {
+  std::mt19937 rng(22);
+  std::uniform_int_distribution<int> type(0, EV_MAX);
+  std::uniform_int_distribution<int> code(0, KEY_MAX);
+  std::uniform_int_distribution<int> value(INT_MIN, INT_MAX);
+  std::uniform_int_distribution<int> small(-2, 3);
+  for (auto caps : {xboxPad(), stickPad(), DeviceCaps{}}) {
+    GamepadMapping m(caps);
+    for (int i = 0; i < 20000; ++i) {
+      const int t = i % 3 == 0 ? EV_KEY : i % 3 == 1 ? EV_ABS : type(rng);
+      const int c = i % 5 == 0 ? (t == EV_ABS ? ABS_RZ : BTN_TL) : code(rng) % (ABS_MAX + 1);
+      const int v = i % 2 ? small(rng) : value(rng);
+      auto out = m.event(t, c, v, i % 7 == 0);
+      if (!out) continue;
+      CHECK(out->throttle >= 0.0);
+      CHECK(out->throttle <= 1.0);
+      CHECK(out->laneStep >= -1);
+      CHECK(out->laneStep <= 1);
+    }
+  }
+}

@@ -1,0 +1,144 @@
+// The terminal's keyboard as a controller (engine/drive/keyboard.hpp), on a real pseudo-terminal:
+// cbreak while it drives, the keys into the seat, the terminal's modes back when it is gone.
+#include "engine/drive/keyboard.hpp"
+
+#include <doctest/doctest.h>
+#include <fcntl.h>
+#include <pty.h>
+#include <termios.h>
+#include <unistd.h>
+
+#include <string>
+
+#include "engine/drive/seats.hpp"
+#include "engine/fleet/fleet.hpp"
+
+using namespace pitwall;
+
+namespace {
+
+struct Pty {
+  int master = -1, slave = -1;
+  Pty() {
+    REQUIRE(::openpty(&master, &slave, nullptr, nullptr, nullptr) == 0);
+    ::fcntl(master, F_SETFL, O_NONBLOCK);
+  }
+  ~Pty() {
+    ::close(master);
+    ::close(slave);
+  }
+  void type(const std::string& bytes) const {
+    REQUIRE(::write(master, bytes.data(), bytes.size()) == static_cast<ssize_t>(bytes.size()));
+  }
+  tcflag_t lflag() const {
+    termios t{};
+    REQUIRE(::tcgetattr(slave, &t) == 0);
+    return t.c_lflag;
+  }
+};
+
+struct Rig {
+  Loop loop{ClockKind::Real};
+  Fleet fleet{loop};
+  drive::Seats seats{loop, fleet, 2};
+  void run(double seconds) {
+    loop.after(fromSeconds(seconds), [this] { loop.stop(); });
+    loop.run();
+  }
+};
+
+}  // namespace
+
+TEST_CASE("keyboard: not a terminal, start() says --keyboard needs one and takes no seat") {
+  Rig r;
+  int fds[2];
+  REQUIRE(::pipe(fds) == 0);
+  drive::Keyboard k(r.loop, r.seats, fds[0]);
+  auto started = k.start();
+  REQUIRE_FALSE(started);
+  CHECK(started.error().find("--keyboard needs a terminal: ") == 0);
+  CHECK_FALSE(r.seats.seat(1)->held());
+  ::close(fds[0]);
+  ::close(fds[1]);
+}
+
+TEST_CASE("keyboard: cbreak while it drives (no ICANON, no ECHO, ISIG kept), restored after") {
+  Rig r;
+  Pty pty;
+  const tcflag_t before = pty.lflag();
+  REQUIRE((before & ICANON));
+  REQUIRE((before & ECHO));
+  {
+    drive::Keyboard k(r.loop, r.seats, pty.slave);
+    REQUIRE(k.start());
+    const tcflag_t during = pty.lflag();
+    CHECK_FALSE((during & ICANON));
+    CHECK_FALSE((during & ECHO));
+    CHECK((during & ISIG));
+    CHECK(r.seats.seat(1)->held());
+    CHECK(r.seats.seat(1)->kind == drive::Holder::Keyboard);
+  }
+  CHECK(pty.lflag() == before);
+  CHECK_FALSE(r.seats.seat(1)->held());  // let go with the keyboard
+}
+
+TEST_CASE("keyboard: ↑ adds a tenth of throttle, ↓ takes one, space stops, ←/→ step lanes") {
+  Rig r;
+  Pty pty;
+  drive::Keyboard k(r.loop, r.seats, pty.slave);
+  REQUIRE(k.start());
+  pty.type("\x1b[A\x1b[A\x1b");  // the third arrow split across two writes
+  r.run(0.05);
+  CHECK(r.seats.seat(1)->throttle == doctest::Approx(0.2));
+  pty.type("[A\x1bOA");
+  r.run(0.05);
+  CHECK(r.seats.seat(1)->throttle == doctest::Approx(0.4));
+  pty.type("\x1b[B");
+  r.run(0.05);
+  CHECK(r.seats.seat(1)->throttle == doctest::Approx(0.3));
+  pty.type("\x1b[D\x1b[D\x1b[C");
+  r.run(0.05);
+  CHECK(r.seats.takeLanes(1) == -1);
+  pty.type(" ");
+  r.run(0.05);
+  CHECK(r.seats.seat(1)->throttle == 0.0);
+  // the throttle stays within 0..1 however often a key is pressed
+  std::string ups;
+  for (int i = 0; i < 15; ++i) ups += "\x1b[A";
+  pty.type(ups);
+  r.run(0.05);
+  CHECK(r.seats.seat(1)->throttle == 1.0);
+  std::string downs;
+  for (int i = 0; i < 15; ++i) downs += "\x1b[B";
+  pty.type(downs);
+  r.run(0.05);
+  CHECK(r.seats.seat(1)->throttle == 0.0);
+  CHECK(r.seats.seat(1)->live);  // a keyboard is never silent: its throttle holds
+}
+
+TEST_CASE("keyboard: no free seat, start() says so and leaves the terminal as it was") {
+  Rig r;
+  Pty pty;
+  REQUIRE(r.seats.claim("a", drive::Holder::Phone, 1));
+  REQUIRE(r.seats.claim("b", drive::Holder::Phone, 2));
+  const tcflag_t before = pty.lflag();
+  drive::Keyboard k(r.loop, r.seats, pty.slave);
+  auto started = k.start();
+  REQUIRE_FALSE(started);
+  CHECK(started.error().find("every seat is taken") != std::string::npos);
+  CHECK(pty.lflag() == before);
+}
+
+TEST_CASE("keyboard: the terminal hung up, the seat is let go (the car slows to a stop)") {
+  Rig r;
+  Pty pty;
+  drive::Keyboard k(r.loop, r.seats, pty.slave);
+  REQUIRE(k.start());
+  pty.type("\x1b[A");
+  r.run(0.05);
+  CHECK(r.seats.seat(1)->throttle == doctest::Approx(0.1));
+  ::close(pty.master);
+  pty.master = ::open("/dev/null", O_RDONLY);  // for the destructor's close
+  r.run(0.05);
+  CHECK_FALSE(r.seats.seat(1)->held());
+}
