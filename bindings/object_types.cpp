@@ -6,7 +6,8 @@ namespace pitwall::lua {
 
 namespace {
 constexpr const char* kTimerMetatable = "pitwall.timer";  // bindings/pitwall_module.cpp
-}
+constexpr const char* kSeatMetatable = "pitwall.seat";    // bindings/seat_binding.cpp
+}  // namespace
 
 void pushObjectTypes(lua_State* L) {
   lua_newtable(L);
@@ -17,7 +18,9 @@ void pushObjectTypes(lua_State* L) {
     if (lua_type(L, -2) == LUA_TSTRING && lua_istable(L, -1)) {
       const bool object = lua_getfield(L, -1, "__objecttype") != LUA_TNIL;
       lua_pop(L, 1);
-      if (object || std::strcmp(lua_tostring(L, -2), kTimerMetatable) == 0) {
+      const char* key = lua_tostring(L, -2);
+      if (object || std::strcmp(key, kTimerMetatable) == 0 ||
+          std::strcmp(key, kSeatMetatable) == 0) {
         lua_pushvalue(L, -2);
         lua_pushvalue(L, -2);
         lua_rawset(L, out);

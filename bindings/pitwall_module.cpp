@@ -417,6 +417,7 @@ void openPitwallModule(ScriptHost& host) {
   openMindroadModule(host);
   openAlphabotModule(host);
   openViewModule(host);
+  openSeatModule(host);
 
   // Cars already known get their Lua objects now; later ones when they join
   // (ScriptHost::carJoined).

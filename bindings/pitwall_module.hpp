@@ -16,4 +16,6 @@ void openMindroadModule(ScriptHost& host);
 void openAlphabotModule(ScriptHost& host);
 // pitwall.view (view_binding.cpp): what a script tells the race view.
 void openViewModule(ScriptHost& host);
+// pitwall.seats, pitwall.seat and sim.openSeats (seat_binding.cpp): human drivers' seats.
+void openSeatModule(ScriptHost& host);
 }  // namespace pitwall

@@ -12,6 +12,7 @@
 #include "engine/core/console.hpp"
 #include "engine/core/data_dir.hpp"
 #include "engine/core/log.hpp"
+#include "engine/drive/seats.hpp"
 
 namespace pitwall {
 
@@ -249,6 +250,10 @@ ScriptHost::~ScriptHost() {
   // (the tasks' and timers' wake-ups are cancelled by their destructors)
   cars_.reset();  // unhooks the cars before their Lua objects go
   lua_close(L_);
+}
+
+void ScriptHost::openSeats(int count) {
+  ownSeats_ = std::make_unique<drive::Seats>(loop_, fleet_, count);
 }
 
 ScriptHost& ScriptHost::from(lua_State* L) {

@@ -28,6 +28,9 @@
 namespace pitwall {
 
 class CarBinding;
+namespace drive {
+class Seats;
+}
 namespace view {
 class Feed;
 }
@@ -52,6 +55,8 @@ struct HostOptions {
   // --ble --track FILE: the layout of the pieces the real cars are on; pitwall.piece knows its
   // custom pieces' shapes (docs/tracks.md). With the simulator, its own track serves.
   const sim::Track* design = nullptr;
+  // --humans: the seats of human drivers (pitwall.seats); none: no seats.
+  drive::Seats* seats = nullptr;
 };
 
 class ScriptHost {
@@ -70,6 +75,10 @@ class ScriptHost {
   const Tasks& tasks() const { return tasks_; }
   Timers& timers() { return timers_; }
   const HostOptions& options() const { return options_; }
+  // The seats of human drivers: the run's (--humans), or the script's own in the simulator
+  // (sim.openSeats); nullptr: none.
+  drive::Seats* seats() { return options_.seats ? options_.seats : ownSeats_.get(); }
+  void openSeats(int count);
 
   // Loads SCRIPT and starts its main chunk as a task (so it may pitwall.sleep). A script that
   // does not load gives "FILE:LINE: message". Its folder joins the require path.
@@ -204,6 +213,7 @@ class ScriptHost {
   std::optional<std::string> trialError_;
   std::vector<std::string> loadedFiles_;
   std::vector<std::function<void()>> atShutDown_;
+  std::unique_ptr<drive::Seats> ownSeats_;  // sim.openSeats: after L_, which reads them
 };
 
 }  // namespace pitwall

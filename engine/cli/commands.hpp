@@ -41,6 +41,12 @@ struct CarSource {
   double mqttTimeout = 5;
   // --view [[HOST:]PORT]: serve the race view (docs/view.md); "" the default port; none: off
   std::optional<std::string> view;
+  // Human drivers (docs/racing.md "Human drivers"): --humans N opens cars 1..N to people, who
+  // hold them from a phone (--view's /drive page), a gamepad (--gamepads) or this terminal's
+  // keyboard (--keyboard).
+  int humans = 0;
+  bool gamepads = false;
+  bool keyboard = false;
 };
 
 struct RunOptions : CarSource {

@@ -89,6 +89,19 @@ CLI::Option* addView(CLI::App* cmd, std::optional<std::string>& target) {
   return v.option;
 }
 
+void addHumans(CLI::App* cmd, CarSource& source) {
+  auto* humans = cmd->add_option("--humans", source.humans,
+                                 "Open cars 1..N to human drivers: phones on --view's /drive page, "
+                                 "--gamepads, --keyboard (docs/racing.md)")
+                     ->check(CLI::Range(0, 64));
+  cmd->add_flag("--gamepads", source.gamepads,
+                "With --humans: every gamepad plugged in takes a free seat (docs/controllers.md)")
+      ->needs(humans);
+  cmd->add_flag("--keyboard", source.keyboard,
+                "With --humans: this terminal's arrow keys drive the first free seat")
+      ->needs(humans);
+}
+
 void takeViews() {
   for (auto& v : g_views)
     if (v.option->count() > 0) *v.target = v.value;

@@ -67,11 +67,13 @@ int run(const RunOptions& options) {
       return status;
   }
   if (int status = session.connectCars("run"); status != 0) return status;
+  if (int status = session.startSeats(options, "run"); status != 0) return status;
 
   HostOptions host;
   host.seed = options.seed;
   host.results = options.results;
   host.view = session.viewFeed();
+  host.seats = session.seats();
   try {
     session.startHost(host);
   } catch (const std::exception& e) {
@@ -163,6 +165,7 @@ Command addRunCommand(CLI::App& app) {
   // a broker lives in real time
   addRemoteCars(cmd, *run)->excludes(fastFlag);
   addView(cmd, run->view);
+  addHumans(cmd, *run);
   auto* replFlag = cmd->add_flag("--repl", run->repl,
                                  "Open a Lua prompt beside the script, in the same Lua world");
   cmd->add_flag("--watch", run->watch,
@@ -170,6 +173,9 @@ Command addRunCommand(CLI::App& app) {
   cmd->add_option("--history", run->history, "With --repl: the history file")->needs(replFlag);
   // A prompt needs the real clock: virtual time would race ahead while the operator types.
   replFlag->excludes(fastFlag);
+  // Hands on a gamepad or the keys drive in real time; the keys are the prompt's with --repl.
+  cmd->get_option("--gamepads")->excludes(fastFlag);
+  cmd->get_option("--keyboard")->excludes(fastFlag)->excludes(replFlag);
   return {cmd, [run] { return cli::run(*run); }};
 }
 

@@ -46,6 +46,9 @@ Session::~Session() {
   scripts_.reset();
   server_.reset();
   feed_.reset();
+  keyboard_.reset();
+  gamepads_.reset();
+  seats_.reset();
   bridge_.reset();
   remote_.reset();
   mqtt_.reset();
@@ -468,6 +471,28 @@ int Session::startView(const std::string& endpoint, const std::string& source,
   return 0;
 }
 
+int Session::startSeats(const CarSource& source, const char* command) {
+  if (source.humans <= 0) return 0;
+  seats_ = std::make_unique<drive::Seats>(loop_, fleet_, source.humans);
+  if (source.gamepads) {
+    drive::GamepadsOptions options;
+    if (const char* dir = std::getenv("PITWALL_INPUT_DIR"); dir && *dir) options.folder = dir;
+    gamepads_ = std::make_unique<drive::Gamepads>(loop_, *seats_, options);
+    if (auto started = gamepads_->start(); !started) {
+      std::cerr << "pitwall " << command << ": " << started.error() << "\n";
+      return 2;
+    }
+  }
+  if (source.keyboard) {
+    keyboard_ = std::make_unique<drive::Keyboard>(loop_, *seats_, 0);
+    if (auto started = keyboard_->start(); !started) {
+      std::cerr << "pitwall " << command << ": " << started.error() << "\n";
+      return 2;
+    }
+  }
+  return 0;
+}
+
 view::Feed& Session::startFeed(const std::string& source) {
   if (!feed_) {
     feed_ = std::make_unique<view::Feed>(loop_, fleet_, source);
@@ -487,6 +512,9 @@ void Session::finish() {
   // Then every car's stop, the last command it takes (AnkiCar::halt); a spectator's cars are
   // other hosts' and get nothing from it.
   if (!spectator_) fleet_.haltAll();
+  // The terminal back to itself, the gamepads closed: nothing holds a seat any more.
+  keyboard_.reset();
+  gamepads_.reset();
   // A race cut short says where it stood: the final table, the results (nothing can drive now).
   if (scripts_) scripts_->lastWords();
   if (recorder_) recorder_->flush();

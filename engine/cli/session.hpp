@@ -9,6 +9,9 @@
 #include "engine/cli/commands.hpp"
 #include "engine/core/loop.hpp"
 #include "engine/core/stop_signals.hpp"
+#include "engine/drive/gamepads.hpp"
+#include "engine/drive/keyboard.hpp"
+#include "engine/drive/seats.hpp"
 #include "engine/fleet/ble_central.hpp"
 #include "engine/fleet/fleet.hpp"
 #include "engine/mqtt/bridge.hpp"
@@ -71,6 +74,11 @@ class Session {
   // it when there is none.
   view::Feed& startFeed(const std::string& source);
   view::Feed* viewFeed() { return feed_.get(); }
+  // --humans N and what holds the seats (--gamepads, --keyboard; phones through --view): after
+  // the cars and the view are up, before the script. Non-zero (an error printed) when a holder
+  // cannot start (no terminal for --keyboard, an unreadable input folder).
+  int startSeats(const CarSource& source, const char* command);
+  drive::Seats* seats() { return seats_.get(); }
   // A spectator (pitwall view): remote cars are read-only, and the end of the run sends them
   // nothing (they are their bridges' cars, not ours).
   void spectate() { spectator_ = true; }
@@ -96,6 +104,10 @@ class Session {
   std::unique_ptr<MqttClient> mqtt_;
   std::unique_ptr<RemoteCars> remote_;
   std::unique_ptr<MqttBridge> bridge_;
+  // human seats (--humans): before the feed, which shows them, and the devices that hold them
+  std::unique_ptr<drive::Seats> seats_;
+  std::unique_ptr<drive::Gamepads> gamepads_;
+  std::unique_ptr<drive::Keyboard> keyboard_;
   // the race view: the feed follows the fleet (restores its hooks when destroyed, before it)
   std::unique_ptr<view::Feed> feed_;
   std::unique_ptr<view::Server> server_;

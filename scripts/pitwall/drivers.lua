@@ -9,7 +9,9 @@
 --                            the car itself (car:setSpeed(speed, accel), car:changeLane(offset))
 --                            and sends no command that changes nothing (one frame per
 --                            connection interval on a real car's link);
---   driver:finish(car, ctx)  when the car's race is over (the director stops the car anyway).
+--   driver:finish(car, ctx)  when the car's race is over (the director stops the car anyway);
+--   driver:waiting(car, ctx) every period while the start lights are on, for drivers that may
+--                            move then (a human's throttle): a car that moves jumps the start.
 -- ctx (drivers.context; a race director builds the same):
 --   ctx.car, ctx.map (pitwall.track map), ctx.loc (this car's pitwall.localize tracker),
 --   ctx.period (s), ctx.limit (speed cap, mm/s, nil = none: every driver respects it),

@@ -2,6 +2,7 @@
 -- the cars to the grid, each in a lane of its own, then the start lights with false starts.
 -- These are methods of a session; race.lua takes them in.
 local localize = require "pitwall.localize"
+local drivers = require "pitwall.drivers"
 
 local Start = {}
 
@@ -117,7 +118,19 @@ function Start:_lights()
     subs[#subs + 1] = pitwall.listen(e.car, "onTransition", function() e.moved = true end)
     subs[#subs + 1] = pitwall.listen(e.car, "onPosition", function() e.moved = true end)
   end
+  -- Drivers that drive during the lights (driver:waiting: a human's throttle goes through) are
+  -- asked every period; what they do is judged like everything else.
+  local period, nextWait = self.period or 0.1, -math.huge
   local function check()
+    local now = pitwall.now()
+    if now >= nextWait then
+      nextWait = now + period
+      for _, e in ipairs(self.order) do
+        if not e.falseStart and e.driver and e.driver.waiting and e.car.connected then
+          drivers.call(e.driver, "waiting", e.car, e.ctx)
+        end
+      end
+    end
     for _, e in ipairs(self.order) do
       if not e.falseStart and (e.moved or (e.car.targetSpeed or 0) > 0) then
         e.falseStart = true

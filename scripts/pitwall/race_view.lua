@@ -44,6 +44,12 @@ function View:_viewState()
         local e = self.order[k]
         local car = e.car
         row.driver = driverName(e.driver)
+        -- a human's seat: who drives (a phone's player name, the gamepad's)
+        local seat = type(e.driver) == "table" and rawget(e.driver, "seat")
+        if type(seat) == "userdata" then
+          local ok, player = pcall(function() return seat.player or seat.holder end)
+          if ok then row.player = player end
+        end
         row.speed = car.speed
         row.lane = car.offset
         row.connected = car.connected

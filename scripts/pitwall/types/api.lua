@@ -123,6 +123,11 @@ function Stdout:flush() end
 @param event string an event name: "onPosition", …
 @param fn fun(object: any, ev: any, ...: any)
 @return pitwall.Listener]],
+      seats = [[The seats of human drivers, in number order (empty: the run has none; docs/racing.md "Human drivers").
+@return pitwall.Seat[] ]],
+      seat = [[Seat n, or nil.
+@param n integer
+@return pitwall.Seat?]],
       piece = [[What a road piece is, or nil for an unknown id.
 @param id integer road piece id
 @return pitwall.PieceInfo?]],
@@ -139,6 +144,29 @@ function Stdout:flush() end
       alphabot = [[An Alphabot over WLAN (TCP) or Bluetooth LE (docs/robots.md); in a task it waits until connected.
 @param options pitwall.AlphabotOptions
 @return pitwall.Alphabot]],
+    },
+  },
+  {
+    metatable = "pitwall.seat",
+    class = "pitwall.Seat",
+    localName = "Seat",
+    doc = [[A human driver's seat (docs/racing.md "Human drivers"): --humans N opens cars 1..N; a phone (/drive), a gamepad, the keyboard or a script holds it.]],
+    fields = {
+      number = { "integer", "the seat's number: it drives the car of that number" },
+      car = { "pitwall.Car?", "the car it drives (nil until the car is there)" },
+      held = { "boolean", "someone holds the seat" },
+      live = { "boolean", "held, and its input is fresh (a phone or script silent for 1 s is not)" },
+      holder = { "\"phone\"|\"gamepad\"|\"keyboard\"|\"script\"|nil", "what holds it" },
+      player = { "string?", "the name its holder gave" },
+      throttle = { "number", "0..1 as asked; 0 while not live" },
+    },
+    methods = {
+      lanes = [[The lane steps asked since the last call: − left, + right (at most 3 either way).
+@return integer]],
+      feed = [[The script holds the seat and asks for this (scripted input; feed at least every second, or the seat loses its input and the car is stopped).
+@param throttle number 0..1
+@param lane? integer -1 (left), 0, 1 (right)]],
+      release = [[The script lets go of the seat: its car slows to a stop.]],
     },
   },
   {

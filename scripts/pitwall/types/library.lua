@@ -223,6 +223,11 @@ function Driver:start(car, ctx) end
 ---@param ctx pitwall.drivers.Context
 function Driver:update(car, ctx) end
 
+---Optional: every ctx.period s while the start lights are on (a human's throttle); a car that moves then jumps the start.
+---@param car pitwall.Car
+---@param ctx pitwall.drivers.Context
+function Driver:waiting(car, ctx) end
+
 ---When the car's race is over.
 ---@param car pitwall.Car
 ---@param ctx pitwall.drivers.Context
@@ -305,7 +310,7 @@ function Handle:stop() end]],
       optionList = [=[A list of the names in all the lists given, in order, each once.
 @param ... string[]
 @return string[]]=],
-      load = [[The driver class named `x` (pitwall.drivers.<x>: "cruiser", "follower", "lanekeeper", "overtaker"), or `x` itself when it is a table.
+      load = [[The driver class named `x` (pitwall.drivers.<x>: "cruiser", "follower", "human", "lanekeeper", "overtaker"), or `x` itself when it is a table.
 @param x string|pitwall.drivers.Class
 @return pitwall.drivers.Class]],
       context = [[The context a driver drives `car` with; `field` lists every racing car ({car =, loc =} or a bare car).
@@ -385,6 +390,51 @@ function Cruiser:target(car, ctx) end]],
       new = [[A cruiser.
 @param options? pitwall.drivers.CruiserOptions
 @return pitwall.drivers.Cruiser]],
+    },
+  },
+  {
+    file = "pitwall/drivers/human.lua",
+    text = [[
+---Options of human.new.
+---@class pitwall.drivers.HumanOptions
+---@field seat integer|pitwall.Seat the seat the person drives from
+---@field max? number mm/s at full throttle (default 1200)
+---@field min? number mm/s at the least throttle that moves (default 300)
+---@field accel? number mm/s² (default 2500)
+---@field decel? number mm/s² (default 4000)
+---@field assist? boolean cap curve speeds at the cruiser's (default false)
+
+---A human driver: the seat's throttle and lane steps, under ctx.limit.
+---@class pitwall.drivers.Human: pitwall.drivers.Driver
+---@field seat pitwall.Seat
+local Human = {}
+
+---The speed the seat asks for now, without sending it.
+---@param car pitwall.Car
+---@param ctx pitwall.drivers.Context
+---@return number
+function Human:target(car, ctx) end
+
+---While the start lights are on: the throttle goes through (a jump start is caught).
+---@param car pitwall.Car
+---@param ctx pitwall.drivers.Context
+function Human:waiting(car, ctx) end]],
+  },
+  {
+    file = "pitwall/drivers/human.lua",
+    class = "pitwall.drivers.human",
+    declare = "local human",
+    module = "pitwall.drivers.human",
+    returns = "human",
+    doc = [[A person drives, from a seat (require "pitwall.drivers.human", drivers.load "human"; docs/racing.md "Human drivers").]],
+    fields = {
+      name = { "string", "\"human\"" },
+      options = { "string[]", "the option names new takes" },
+    },
+    functions = {
+      new = [[A human driver.
+@param options pitwall.drivers.HumanOptions
+@return pitwall.drivers.Human]],
     },
   },
   {

@@ -83,6 +83,9 @@ See docs/testing.md and docs/simulator.md.]],
 @param track string]],
       layouts = [[The names of the built-in layouts.
 @return string[] ]],
+      openSeats = [[Opens seats 1..n for human drivers, as --humans N does (scenario tests feed them with seat:feed). Not there when the run has seats from --humans.
+@param n integer 1..64
+@return pitwall.Seat[] ]],
       truth = [[Ground truth of a car.
 @param car pitwall.Car
 @return pitwall.sim.Truth]],

@@ -1,0 +1,156 @@
+// Human seats against the simulator (engine/drive/seats.hpp): who may hold which seat, what a
+// holder may ask for, and that a car whose holder lets go or falls silent is slowed to a stop by
+// the engine itself — with no driver, no script, nothing else commanding it.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "engine/drive/seats.hpp"
+#include "engine/fleet/fleet.hpp"
+#include "engine/sim/grid.hpp"
+#include "engine/sim/world.hpp"
+#include "tests/support/sim_cars.hpp"
+
+using namespace pitwall;
+
+namespace {
+
+struct Run {
+  Loop loop{ClockKind::Virtual};
+  sim::World world{loop, sim::namedLayout("oval").value(), 1};
+  Fleet fleet{loop};
+  drive::Seats seats{loop, fleet, 2};
+  AnkiCar* cars[2] = {};
+  Run() {
+    for (int i = 0; i < 2; ++i)
+      cars[i] = &testing::addSimulatedCar(loop, fleet, world, sim::gridSpec(world.track(), i));
+    run(0.5);
+    for (auto* c : cars) REQUIRE(c->sdkMode(true));
+  }
+  void run(double seconds) {
+    loop.at(loop.now() + fromSeconds(seconds), [this] { loop.stop(); });
+    loop.run();
+  }
+  // Drives car `i` at `speed` as a driver would when its seat says so.
+  void drive(int i, int speed) { REQUIRE(cars[i]->setSpeed(speed, 2000)); }
+  // The simulator's truth: how fast car i really goes (mm/s).
+  double speed(int i) { return world.cars()[static_cast<std::size_t>(i)]->truth().speed_mm_s; }
+};
+
+}  // namespace
+
+TEST_CASE("seats: one holder a seat; a held seat cannot be taken; 0 takes the first free") {
+  Run r;
+  auto a = r.seats.claim("phone#1", drive::Holder::Phone, 1, "Anna");
+  REQUIRE(a);
+  CHECK(*a == 1);
+  auto b = r.seats.claim("phone#2", drive::Holder::Phone, 1, "Ben");
+  REQUIRE_FALSE(b);
+  CHECK(b.error().find("seat 1 is held by another phone (Anna)") != std::string::npos);
+  auto any = r.seats.claim("phone#2", drive::Holder::Phone, 0, "Ben");
+  REQUIRE(any);
+  CHECK(*any == 2);
+  auto none = r.seats.claim("pad", drive::Holder::Gamepad, 0);
+  REQUIRE_FALSE(none);
+  CHECK(none.error().find("every seat is taken (2)") != std::string::npos);
+  auto bad = r.seats.claim("pad", drive::Holder::Gamepad, 3);
+  REQUIRE_FALSE(bad);
+  CHECK(bad.error().find("there is no seat 3: this run has seats 1..2") != std::string::npos);
+  CHECK(r.seats.claim("pad", drive::Holder::Gamepad, -1).error().find("no seat -1") !=
+        std::string::npos);
+  // asking again for one's own seat keeps it; a holder that moves frees the one it had
+  CHECK(*r.seats.claim("phone#1", drive::Holder::Phone, 1) == 1);
+  r.seats.release("phone#2", "left");
+  CHECK(*r.seats.claim("phone#1", drive::Holder::Phone, 2) == 2);
+  CHECK_FALSE(r.seats.seat(1)->held());
+  CHECK(r.seats.heldBy("phone#1")->number == 2);
+}
+
+TEST_CASE("seats: no seats: driving is off, and the error says how to turn it on") {
+  Loop loop{ClockKind::Virtual};
+  Fleet fleet{loop};
+  drive::Seats seats{loop, fleet, 0};
+  auto c = seats.claim("phone#1", drive::Holder::Phone);
+  REQUIRE_FALSE(c);
+  CHECK(c.error().find("--humans N") != std::string::npos);
+}
+
+TEST_CASE("seats: hostile input is refused with the value, and changes nothing") {
+  Run r;
+  REQUIRE(r.seats.claim("phone#1", drive::Holder::Phone, 1));
+  REQUIRE(r.seats.input("phone#1", 0.5, 1));
+  const double bad[] = {-0.01,
+                        1.0001,
+                        1e308,
+                        -1e308,
+                        std::numeric_limits<double>::infinity(),
+                        -std::numeric_limits<double>::infinity(),
+                        std::numeric_limits<double>::quiet_NaN()};
+  for (double v : bad) {
+    auto in = r.seats.input("phone#1", v, 0);
+    REQUIRE_FALSE(in);
+    CHECK(in.error().find("out of range: give 0 (stop) to 1 (full)") != std::string::npos);
+  }
+  CHECK(r.seats.input("phone#1", 0.5, 2).error().find("lane step 2") != std::string::npos);
+  CHECK(r.seats.input("phone#1", 0.5, -7).error().find("lane step -7") != std::string::npos);
+  CHECK(r.seats.input("nobody", 0.5, 0).error().find("take one first") != std::string::npos);
+  CHECK(r.seats.seat(1)->throttle == 0.5);
+  // lane steps add up, at most three either way, and are taken once
+  for (int i = 0; i < 10; ++i) REQUIRE(r.seats.input("phone#1", 0.5, -1));
+  CHECK(r.seats.takeLanes(1) == -3);
+  CHECK(r.seats.takeLanes(1) == 0);
+}
+
+TEST_CASE("seats: a phone silent for 1 s loses its input and its car is slowed to a stop") {
+  Run r;
+  REQUIRE(r.seats.claim("phone#1", drive::Holder::Phone, 1));
+  REQUIRE(r.seats.claim("phone#2", drive::Holder::Phone, 2));
+  r.drive(0, 800);
+  r.drive(1, 800);
+  // phone 2 keeps talking every 0.1 s; phone 1 says one thing and then nothing
+  REQUIRE(r.seats.input("phone#1", 0.8, 0));
+  for (int k = 0; k < 30; ++k) {
+    REQUIRE(r.seats.input("phone#2", 0.8, 0));
+    r.run(0.1);
+  }
+  CHECK_FALSE(r.seats.seat(1)->live);
+  CHECK(r.seats.seat(1)->held());  // still its phone's: input again makes it live
+  CHECK(r.seats.seat(1)->throttle == 0);
+  CHECK(r.cars[0]->state().target_speed_mm_s == 0);
+  CHECK(r.speed(0) == 0);
+  CHECK(r.seats.seat(2)->live);
+  CHECK(r.speed(1) > 700);  // the other car drives on
+  REQUIRE(r.seats.input("phone#1", 0.3, 0));
+  CHECK(r.seats.seat(1)->live);
+}
+
+TEST_CASE("seats: a holder that lets go stops its car, however it was driven") {
+  Run r;
+  REQUIRE(r.seats.claim("pad", drive::Holder::Gamepad, 1));
+  r.drive(0, 900);
+  r.run(3);  // a gamepad holds its throttle without sending: no silence for it
+  CHECK(r.seats.seat(1)->live);
+  CHECK(r.speed(0) > 800);
+  r.seats.release("pad", "the gamepad was unplugged");
+  CHECK_FALSE(r.seats.seat(1)->held());
+  r.run(1.5);
+  CHECK(r.speed(0) == 0);
+}
+
+TEST_CASE("seats: no live phone, no timer: a virtual run is not kept going by the seats") {
+  Loop loop{ClockKind::Virtual};
+  Fleet fleet{loop};  // no cars: the only timers are the seats'
+  drive::Seats seats{loop, fleet, 2};
+  REQUIRE(seats.claim("phone#1", drive::Holder::Phone, 1));
+  CHECK(loop.pendingTimers() == 1);  // the silence timer
+  REQUIRE(seats.claim("pad", drive::Holder::Gamepad, 2));
+  CHECK(loop.pendingTimers() == 1);  // still one: a gamepad has none
+  seats.release("phone#1", "left");
+  CHECK(loop.pendingTimers() == 0);
+  REQUIRE(seats.claim("phone#1", drive::Holder::Phone, 1));
+  loop.run();  // ends: the phone falls silent after 1 s and nothing is left to wait for
+  CHECK(loop.seconds() == doctest::Approx(1.0));
+  CHECK_FALSE(seats.seat(1)->live);
+  CHECK(loop.pendingTimers() == 0);
+}
