@@ -474,6 +474,7 @@ int Session::startView(const std::string& endpoint, const std::string& source,
 int Session::startSeats(const CarSource& source, const char* command) {
   if (source.humans <= 0) return 0;
   seats_ = std::make_unique<drive::Seats>(loop_, fleet_, source.humans);
+  if (feed_) feed_->setSeats(seats_.get());  // phones take seats on the view's /drive page
   if (source.gamepads) {
     drive::GamepadsOptions options;
     if (const char* dir = std::getenv("PITWALL_INPUT_DIR"); dir && *dir) options.folder = dir;
@@ -489,6 +490,16 @@ int Session::startSeats(const CarSource& source, const char* command) {
       std::cerr << "pitwall " << command << ": " << started.error() << "\n";
       return 2;
     }
+  }
+  const std::string cars =
+      source.humans == 1 ? "car 1" : "cars 1.." + std::to_string(source.humans);
+  if (server_) {
+    console::noteOutput();
+    std::cerr << "drive: " << server_->url() << "drive (" << cars << ": one phone a car)\n";
+  } else if (!source.gamepads && !source.keyboard) {
+    log::warn("seats", "--humans " + std::to_string(source.humans) +
+                           " and nothing to hold the seats but a script: add --view (phones on "
+                           "its /drive page), --gamepads or --keyboard");
   }
   return 0;
 }
