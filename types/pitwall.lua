@@ -130,6 +130,15 @@ function pitwall.now() end
 ---@return pitwall.PieceInfo?
 function pitwall.piece(id) end
 
+---Seat n, or nil.
+---@param n integer
+---@return pitwall.Seat?
+function pitwall.seat(n) end
+
+---The seats of human drivers, in number order (empty: the run has none; docs/racing.md "Human drivers").
+---@return pitwall.Seat[]
+function pitwall.seats() end
+
 ---Inside a task: resumes after `seconds` ≥ 0 of engine time. Outside a task it raises an error.
 ---@param seconds number
 function pitwall.sleep(seconds) end
@@ -159,6 +168,29 @@ function pitwall.waitUntil(cond, timeout, step) end
 ---@param path? string
 ---@return string path
 function pitwall.writeResults(rows, columns, path) end
+
+---A human driver's seat (docs/racing.md "Human drivers"): --humans N opens cars 1..N; a phone (/drive), a gamepad, the keyboard or a script holds it.
+---@class pitwall.Seat
+---@field car pitwall.Car? the car it drives (nil until the car is there)
+---@field held boolean someone holds the seat
+---@field holder "phone"|"gamepad"|"keyboard"|"script"|nil what holds it
+---@field live boolean held, and its input is fresh (a phone or script silent for 1 s is not)
+---@field number integer the seat's number: it drives the car of that number
+---@field player string? the name its holder gave
+---@field throttle number 0..1 as asked; 0 while not live
+local Seat = {}
+
+---The script holds the seat and asks for this (scripted input; feed at least every second, or the seat loses its input and the car is stopped).
+---@param throttle number 0..1
+---@param lane? integer -1 (left), 0, 1 (right)
+function Seat:feed(throttle, lane) end
+
+---The lane steps asked since the last call: − left, + right (at most 3 either way).
+---@return integer
+function Seat:lanes() end
+
+---The script lets go of the seat: its car slows to a stop.
+function Seat:release() end
 
 ---What the race view shows (docs/view.md); without --view the calls do nothing visible.
 ---@class pitwall.view
@@ -703,6 +735,11 @@ function pitwall.sim.lift(car) end
 ---@param noise? pitwall.sim.Noise
 ---@return pitwall.sim.Noise
 function pitwall.sim.noise(noise) end
+
+---Opens seats 1..n for human drivers, as --humans N does (scenario tests feed them with seat:feed). Not there when the run has seats from --humans.
+---@param n integer 1..64
+---@return pitwall.Seat[]
+function pitwall.sim.openSeats(n) end
 
 ---Puts the car back on piece `piece` (1-based index) at `offset` mm.
 ---@param car pitwall.Car

@@ -9,7 +9,7 @@ local drivers = require "pitwall.drivers"
 local map = track.fromSim()
 
 expect.fails(function() drivers.load("no-such-driver") end,
-  "no driver no-such-driver; the drivers are cruiser, follower, lanekeeper, overtaker")
+  "no driver no-such-driver; the drivers are cruiser, follower, human, lanekeeper, overtaker")
 expect.fails(function() drivers.load(42) end, "driver name")
 for _, name in ipairs { "cruiser", "lanekeeper", "follower", "overtaker" } do
   local cls = drivers.load(name)

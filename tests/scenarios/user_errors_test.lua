@@ -95,7 +95,7 @@ blames(function() drivers.load("lanekeeper").new { driver = "crusier" } end, "dr
 
 -- A misspelled driver lists the drivers instead of package.path.
 err = blames(function() drivers.load("crusier") end,
-  "drivers.load: no driver crusier; did you mean cruiser? The drivers are cruiser, follower, lanekeeper, overtaker (")
+  "drivers.load: no driver crusier; did you mean cruiser? The drivers are cruiser, follower, human, lanekeeper, overtaker (")
 expect.falsy(err:find("no file", 1, true), "no package.path search list: " .. err)
 
 -- Numbers: a computed speed is rounded half away from zero, then range-checked.

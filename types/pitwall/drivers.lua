@@ -17,6 +17,11 @@ function Driver:start(car, ctx) end
 ---@param ctx pitwall.drivers.Context
 function Driver:update(car, ctx) end
 
+---Optional: every ctx.period s while the start lights are on (a human's throttle); a car that moves then jumps the start.
+---@param car pitwall.Car
+---@param ctx pitwall.drivers.Context
+function Driver:waiting(car, ctx) end
+
 ---When the car's race is over.
 ---@param car pitwall.Car
 ---@param ctx pitwall.drivers.Context
@@ -122,7 +127,7 @@ function drivers.checkOptions(name, options, known) end
 ---@return pitwall.drivers.Context
 function drivers.context(car, map, field, options) end
 
----The driver class named `x` (pitwall.drivers.<x>: "cruiser", "follower", "lanekeeper", "overtaker"), or `x` itself when it is a table.
+---The driver class named `x` (pitwall.drivers.<x>: "cruiser", "follower", "human", "lanekeeper", "overtaker"), or `x` itself when it is a table.
 ---@param x string|pitwall.drivers.Class
 ---@return pitwall.drivers.Class
 function drivers.load(x) end

@@ -151,6 +151,6 @@ TEST_CASE_FIXTURE(TypesFixture, "types: every definition file is Lua that compil
   REQUIRE(luaL_loadstring(L, code) == LUA_OK);
   lua::pushObjectTypes(L);
   REQUIRE_MESSAGE(lua_pcall(L, 1, 1, 0) == LUA_OK, lua_tostring(L, -1));
-  CHECK(lua_tointeger(L, -1) == 13);  // pitwall.lua and one file per module under pitwall/
+  CHECK(lua_tointeger(L, -1) == 14);  // pitwall.lua and one file per module under pitwall/
   lua_pop(L, 1);
 }
