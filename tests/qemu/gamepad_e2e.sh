@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# Gamepads end to end with REAL kernel input devices, in a QEMU guest (tests/qemu/README.md).
+#
+#   tests/qemu/gamepad_e2e.sh PITWALL_BINARY SOURCE_DIR UINPUT_PAD_BINARY
+#
+# The host kernel here has no /dev/uinput, so the guest of boot_lib.sh (Debian's 6.1 kernel, the
+# host's `/` read-only over 9p) loads uinput and evdev; inside (tests/qemu/gamepad_guest.sh),
+# uinput_pad makes virtual gamepads that evdev shows in /dev/input like any USB pad, and
+# `pitwall run --humans 1 --gamepads` drives car 1 of the simulator with them: the trigger
+# drives, BTN_SOUTH brakes, unplugging stops the car, a pad plugged in later takes the seat.
+# No Bluetooth, no D-Bus: the lightest guest. Exit 77 (ctest: skipped) when it cannot run here,
+# always saying why.
+set -uo pipefail
+PACKAGES=(qemu-system-x86 busybox-static cpio kmod)
+skip() {
+  echo "SKIP: $*"
+  exit 77
+}
+fail() {
+  echo "FAIL: $*"
+  exit 1
+}
+
+[ $# -eq 3 ] || { echo "usage: $0 PITWALL_BINARY SOURCE_DIR UINPUT_PAD_BINARY" >&2; exit 2; }
+PITWALL=$(realpath "$1")
+SRC=$(realpath "$2")
+PAD=$(realpath "$3")
+[ -x "$PITWALL" ] || fail "no pitwall binary at $1"
+[ -x "$PAD" ] || fail "no uinput_pad binary at $3"
+
+source "$SRC/tests/qemu/boot_lib.sh"
+qemu_check_host "${PACKAGES[@]}"
+qemu_kernel gamepad
+qemu_initrd gamepad "/tmp /run /root" \
+  /bin/bash "$SRC/tests/qemu/gamepad_guest.sh" "$PITWALL" "$SRC" "$PAD"
+status=$(qemu_boot "gamepads")
+[ -n "$status" ] ||
+  fail "the guest gave no exit status (QEMU status 124 = killed after ${QEMU_TIMEOUT}s)"
+[ "$status" = 77 ] && exit 77
+[ "$status" = 0 ] && { echo "PASS: uinput gamepads drive car 1; unplugged, it stops"; exit 0; }
+fail "the guest's checks failed (status $status)"

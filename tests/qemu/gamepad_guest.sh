@@ -1,0 +1,110 @@
+#!/usr/bin/env bash
+# Runs inside the QEMU guest of tests/qemu/gamepad_e2e.sh, chrooted into the host's tree
+# (read-only; /tmp is tmpfs), as root, with uinput and evdev loaded: real kernel input devices
+# made by uinput_pad drive car 1 of the simulator through `pitwall run --humans 1 --gamepads`.
+# Exit status: 0 passed, 1 failed (with the last lines of each log).
+#
+#   gamepad_guest.sh PITWALL SOURCE_DIR UINPUT_PAD
+set -uo pipefail
+PITWALL=$1
+SRC=$2
+PAD=$3
+LOGS=/tmp/logs
+mkdir -p "$LOGS"
+T0=$(date +%s%N)
+
+say() {
+  local ms=$((($(date +%s%N) - T0) / 1000000))
+  printf '[guest %3d.%03d] %s\n' $((ms / 1000)) $((ms % 1000)) "$*"
+}
+fail() {
+  say "FAIL: $*"
+  for log in "$LOGS"/*; do
+    [ -s "$log" ] || continue
+    echo "---- last lines of $(basename "$log")"
+    tail -n 25 "$log"
+  done
+  exit 1
+}
+# wait_line FILE PATTERN SECONDS: until a line of FILE matches PATTERN (grep -E); false if never.
+wait_line() {
+  local deadline=$(($(date +%s%N) + $3 * 1000000000))
+  until grep -qE "$2" "$1" 2>/dev/null; do
+    [ "$(date +%s%N)" -lt "$deadline" ] || return 1
+    sleep 0.1
+  done
+}
+# after FILE: the lines written to FILE from now on are the ones `wait_new` looks at
+mark() { wc -l <"$1"; }
+wait_new() {  # wait_new FILE MARK PATTERN SECONDS
+  local deadline=$(($(date +%s%N) + $4 * 1000000000))
+  until tail -n +"$(($2 + 1))" "$1" | grep -qE "$3"; do
+    [ "$(date +%s%N)" -lt "$deadline" ] || return 1
+    sleep 0.1
+  done
+}
+
+[ -c /dev/uinput ] || fail "no /dev/uinput in the guest (the uinput module did not load)"
+mkdir -p /dev/input
+
+# pad NAME: a virtual gamepad fed through a FIFO on fd 3 (A) or 4 (B), its output in a log
+plug() {  # plug FD NAME
+  mkfifo "/tmp/pad$1.in"
+  "$PAD" "$2" <"/tmp/pad$1.in" >"$LOGS/pad$1.out" 2>&1 &
+  eval "exec $1>/tmp/pad$1.in"
+  wait_line "$LOGS/pad$1.out" '^device /dev/input/event' 10 || fail "uinput_pad '$2' made no device"
+  say "plugged in: $2 at $(sed -n 's/^device //p' "$LOGS/pad$1.out")"
+}
+
+# ---- pad A, there before pitwall starts (found by the scan of /dev/input) ----
+plug 3 "Pad A"
+
+RUN=$LOGS/run.out
+# --budget 2: the emulated CPU (TCG) loads the race library slower than 100 ms
+"$PITWALL" run "$SRC/tests/integration/human_seat1.lua" --humans 1 --gamepads --duration 60 \
+  --budget 2 >"$RUN" 2>&1 &
+PID=$!
+wait_line "$RUN" 'seat 1: holder=gamepad' 20 || fail "pad A took no seat"
+grep -q 'gamepad "Pad A" at /dev/input/event[0-9]*: throttle on ABS_RZ' "$RUN" ||
+  fail "pitwall did not name pad A and its trigger"
+say "pad A holds seat 1"
+
+m=$(mark "$RUN")
+echo "axis 5 255" >&3  # the right trigger all the way
+wait_new "$RUN" "$m" 'throttle=1.00 speed=[0-9]+ moving=yes' 20 || fail "the trigger did not drive car 1"
+say "trigger pulled: car 1 drives"
+
+m=$(mark "$RUN")
+echo "key 304 1" >&3  # BTN_SOUTH: brake
+wait_new "$RUN" "$m" 'throttle=0.00 .* moving=no' 20 || fail "BTN_SOUTH did not stop car 1"
+echo "key 304 0" >&3  # let go of the brake: the trigger, still pulled, counts again
+wait_new "$RUN" "$m" 'throttle=1.00 .* moving=yes' 20 || fail "car 1 did not drive after the brake"
+say "BTN_SOUTH braked car 1 to a stop, and it drove on when let go"
+
+m=$(mark "$RUN")
+echo "unplug" >&3  # the trigger still pulled: the car must stop all the same
+exec 3>&-
+wait_new "$RUN" "$m" 'the gamepad was unplugged' 10 || fail "pitwall did not see pad A unplugged"
+wait_new "$RUN" "$m" 'holder=nil throttle=0.00 .* moving=no' 20 ||
+  fail "car 1 did not slow to a stop after pad A was unplugged"
+say "pad A unplugged with its trigger held: seat 1 free, car 1 stopped"
+
+# ---- pad B, plugged in while pitwall runs (inotify: hot-plug) ----
+m=$(mark "$RUN")
+plug 4 "Pad B"
+wait_new "$RUN" "$m" 'seat 1: holder=gamepad' 20 || fail "pad B, plugged in later, took no seat"
+echo "axis 5 128" >&4
+wait_new "$RUN" "$m" 'throttle=0.50 .* moving=yes' 20 || fail "pad B's trigger did not drive car 1"
+say "pad B plugged in while running: holds seat 1, half trigger drives car 1"
+
+kill -TERM "$PID"
+wait "$PID"
+status=$?
+[ "$status" -eq 130 ] || fail "pitwall run exited with status $status after SIGTERM, not 130 (docs/cli.md)"
+grep -q 'seat 1: the gamepad was unplugged; its car slows to a stop' "$RUN" ||
+  fail "the seat's log did not say why car 1 was stopped"
+echo "unplug" >&4
+exec 4>&-
+wait
+say "passed: a uinput gamepad drives car 1, unplugging it stops the car, a new one is picked up"
+exit 0
