@@ -27,8 +27,8 @@
 #include <set>
 #include <string>
 
+#include "engine/core/token_bucket.hpp"
 #include "engine/fleet/fleet.hpp"
-#include "engine/mqtt/throttle.hpp"
 #include "engine/mqtt/topics.hpp"
 #include "engine/transport/mqtt_client.hpp"
 

@@ -44,6 +44,7 @@ Feed::Feed(Loop& loop, Fleet& fleet, std::string source)
 
 Feed::~Feed() {
   followLog(false);
+  seatsSub_.disconnect();
   framesSub_.disconnect();
   connectionSub_.disconnect();
 }
@@ -133,6 +134,13 @@ void Feed::setRace(nlohmann::json race) {
   }
 }
 
+void Feed::setSeats(drive::Seats* seats) {
+  seatsSub_.disconnect();
+  seats_ = seats;
+  if (seats_) seatsSub_ = seats_->changed.connect([this](const drive::Seat&) { ++changes_; });
+  ++changes_;
+}
+
 void Feed::event(const std::string& level, const std::string& text) {
   events_.push_back({nextEvent_++, now(), level, text});
   ++changes_;
@@ -215,6 +223,25 @@ nlohmann::json Feed::carsJson(bool history) const {
   return cars;
 }
 
+// The seats as every page sees them: who holds which car, not who the holder is (a phone's
+// connection id stays the server's).
+nlohmann::json Feed::seatsJson() const {
+  nlohmann::json seats = nlohmann::json::array();
+  if (!seats_) return seats;
+  for (const drive::Seat& s : seats_->all()) {
+    const AnkiCar* car = fleet_.find(s.number);
+    seats.push_back(
+        {{"number", s.number},
+         {"car", car ? nlohmann::json(car->identity().name) : nlohmann::json(nullptr)},
+         {"held", s.held()},
+         {"live", s.live},
+         {"holder", s.held() ? nlohmann::json(drive::holderName(s.kind)) : nlohmann::json(nullptr)},
+         {"player", s.held() ? nlohmann::json(s.player) : nlohmann::json(nullptr)},
+         {"throttle", round3(s.throttle)}});
+  }
+  return seats;
+}
+
 nlohmann::json Feed::eventsJson(std::uint64_t from) const {
   nlohmann::json events = nlohmann::json::array();
   for (const Event& e : events_)
@@ -233,6 +260,7 @@ nlohmann::json Feed::state() const {
           {"race", race_.is_null() ? nlohmann::json(nullptr) : race_},
           {"replay", replay_.is_null() ? nlohmann::json(nullptr) : replay_},
           {"cars", carsJson(true)},
+          {"seats", seatsJson()},
           {"events", std::move(events)}};
 }
 
@@ -245,7 +273,8 @@ std::string Feed::updateText(std::uint64_t& cursor, std::uint64_t& trackSeen) co
   if (sharedAt_ != changes_) {
     nlohmann::json shared = {{"cars", carsJson(false)},
                              {"race", race_.is_null() ? nlohmann::json(nullptr) : race_},
-                             {"replay", replay_.is_null() ? nlohmann::json(nullptr) : replay_}};
+                             {"replay", replay_.is_null() ? nlohmann::json(nullptr) : replay_},
+                             {"seats", seatsJson()}};
     shared_ = shared.dump(-1, ' ', false, kReplace);
     shared_ = shared_.substr(1, shared_.size() - 2);  // its members, without the braces
     sharedAt_ = changes_;

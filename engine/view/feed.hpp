@@ -13,6 +13,7 @@
 #include <string>
 
 #include "engine/core/loop.hpp"
+#include "engine/drive/seats.hpp"
 #include "engine/fleet/fleet.hpp"
 #include "engine/sim/track.hpp"
 #include "engine/view/tracker.hpp"
@@ -39,6 +40,14 @@ class Feed {
     replay_ = std::move(replay);
     ++changes_;
   }
+  // The seats of human drivers (--humans N), shown to every page and taken by the controller
+  // page (/drive); nullptr: none (driving is off). The seats must outlive the feed or be set
+  // to nullptr before they go.
+  void setSeats(drive::Seats* seats);
+  drive::Seats* seats() const { return seats_; }
+  // A seat's input changed what the seats show (a throttle): the next update carries it.
+  // Seats::changed says only when a seat changes hands or liveness.
+  void seatsTouched() { ++changes_; }
   // One line of the event log: level "info", "warn" or "error".
   void event(const std::string& level, const std::string& text);
   // The engine's warnings and errors, and its reload lines, join the event log while `on`.
@@ -79,6 +88,7 @@ class Feed {
   void frame(AnkiCar& car, AnkiCar::Direction d, const anki::Message& m);
   nlohmann::json carJson(const AnkiCar& car, std::size_t laps) const;
   nlohmann::json carsJson(bool history) const;
+  nlohmann::json seatsJson() const;
 
   double now() const { return clock_ ? clock_() : loop_.seconds(); }
 
@@ -100,6 +110,8 @@ class Feed {
   std::uint64_t nextEvent_ = 0;
   std::map<int, std::unique_ptr<Car>> cars_;
   Subscription framesSub_, connectionSub_;  // the fleet's events, while the feed lives
+  drive::Seats* seats_ = nullptr;
+  Subscription seatsSub_;
   std::uint64_t logTap_ = 0;
   std::uint64_t changes_ = 0;
   mutable std::string shared_;  // updateText's shared part, as of change sharedAt_

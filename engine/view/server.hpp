@@ -1,8 +1,11 @@
 #pragma once
 // The race view's HTTP + WebSocket server (docs/view.md), on the engine's one loop (Boost.Beast):
 //   GET /            the page, and its assets, from the installed data folder
+//   GET /drive       the controller page (drive.html): a phone takes a seat and drives it
 //   GET /api/state   the feed's whole state as JSON
-//   GET /ws          a WebSocket: the state, then updates at most `maxRate` a second
+//   GET /ws          a WebSocket: the state, then updates at most `maxRate` a second; a page
+//                    may send replay controls and, with the feed's seats, seat/drive/leave
+//                    (each WebSocket is one holder; closing it frees its seat)
 // A browser that reads slowly gets fewer updates, never a queue: each connection has at most one
 // write in flight and the next update is built when it is done. A closed or stalled browser
 // costs the loop nothing (writes are asynchronous; a write that stalls past a limit closes it).

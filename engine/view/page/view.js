@@ -17,6 +17,8 @@
 //   #events li                      the event log, newest first
 //   #lap-chart, #speed-chart        the uPlot charts
 //   #replay                         replay controls, shown only when `replay` is non-null
+//   #drive-link                     the link to the controller page (/drive), shown only when
+//                                   the state has seats (a run with --humans N)
 "use strict";
 
 const SVG_NS = "http://www.w3.org/2000/svg";
@@ -493,6 +495,7 @@ function onState(s) {
   view.cars = new Map((s.cars || []).map((c) => [c.number, c]));
   view.race = s.race || null;
   view.replay = s.replay || null;
+  showDriveLink(s.seats);
   view.source = s.source || "";
   view.time = s.time || 0;
   view.receivedAt = performance.now();
@@ -521,12 +524,17 @@ function onUpdate(u) {
   }
   if (u.race !== undefined) view.race = u.race;
   if (u.replay !== undefined) view.replay = u.replay;
+  if (u.seats !== undefined) showDriveLink(u.seats);
   syncMarkers();
   renderRace();
   if (u.events && u.events.length) addEvents(u.events, false);
   renderBoard();
   view.chartsDirty = true;
   if (changed) renderCharts();
+}
+
+function showDriveLink(seats) {
+  $("#drive-link").hidden = !(Array.isArray(seats) && seats.length > 0);
 }
 
 let socket = null;

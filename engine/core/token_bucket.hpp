@@ -1,8 +1,9 @@
 #pragma once
-// Rate limits for what arrives over MQTT (docs/mqtt.md "Hostile input"): a token bucket on the
-// engine clock. Anyone who can publish on the broker can send a flood of messages, while a car's
-// BLE link takes about 20–50 commands a second; and an answer to every message of a flood would
-// be a flood of its own.
+// Rate limits for what arrives from outside — over MQTT (docs/mqtt.md "Hostile input"), from a
+// page on the race view's WebSocket (docs/view.md) — a token bucket on the engine clock. Anyone
+// who can publish on the broker or open the page can send a flood of messages, while a car's BLE
+// link takes about 20–50 commands a second; and an answer to every message of a flood would be a
+// flood of its own.
 #include <algorithm>
 
 #include "engine/core/loop.hpp"

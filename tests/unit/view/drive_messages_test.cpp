@@ -1,0 +1,383 @@
+// The controller page's messages on the race view's WebSocket (docs/view.md "The controller page"):
+// a page takes a seat, drives it, leaves it; a second page cannot take a held seat; a page that
+// closes or goes silent has its car slowed to a stop; hostile messages are answered or dropped,
+// never thrown out of the loop. Real loopback sockets and a real clock, as server_test.cpp; the
+// cars are simulated ones behind the real codec, so "speed 0" is the command the car was sent.
+#include <doctest/doctest.h>
+
+#include <atomic>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/websocket.hpp>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include "engine/drive/seats.hpp"
+#include "engine/fleet/fleet.hpp"
+#include "engine/sim/track.hpp"
+#include "engine/sim/world.hpp"
+#include "engine/view/server.hpp"
+#include "tests/support/run_until.hpp"
+#include "tests/support/sim_cars.hpp"
+
+using namespace pitwall;
+namespace asio = boost::asio;
+namespace beast = boost::beast;
+namespace websocket = beast::websocket;
+using tcp = asio::ip::tcp;
+using testing::runUntil;
+
+namespace {
+
+struct Rig {
+  std::filesystem::path assets;
+  Loop loop{ClockKind::Real};
+  sim::World world{loop, sim::namedLayout("oval").value(), 1};
+  Fleet fleet{loop};
+  std::unique_ptr<drive::Seats> seats;
+  view::Feed feed{loop, fleet, "simulator"};
+  std::unique_ptr<view::Server> server;
+  std::string failure;
+
+  explicit Rig(int humans, int cars = 2, drive::SeatsOptions seatOptions = {}) {
+    assets = std::filesystem::temp_directory_path() /
+             ("pitwall-drive-test-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(assets);
+    std::ofstream(assets / "index.html") << "<!doctype html><title>race view</title>";
+    std::ofstream(assets / "drive.html") << "<!doctype html><title>drive</title>";
+    for (int i = 0; i < cars; ++i)
+      testing::addSimulatedCar(loop, fleet, world,
+                               sim::CarSpec{.name = "car" + std::to_string(i + 1),
+                                            .piece_index = 0,
+                                            .offset_mm = i % 2 ? 68.0 : -68.0});
+    REQUIRE(runUntil(loop, [&] {
+      for (AnkiCar* c : fleet.cars())
+        if (!c->state().connected) return false;
+      return true;
+    }));
+    for (AnkiCar* c : fleet.cars()) REQUIRE(c->sdkMode(true));
+    if (humans > 0) {
+      seats = std::make_unique<drive::Seats>(loop, fleet, humans, seatOptions);
+      feed.setSeats(seats.get());
+    }
+    view::ServerOptions o;
+    o.port = 0;
+    o.assets = assets;
+    server = std::make_unique<view::Server>(loop, feed, o);
+    REQUIRE(server->start());
+  }
+  ~Rig() {
+    server.reset();
+    feed.setSeats(nullptr);
+    std::filesystem::remove_all(assets);
+  }
+  // Runs `client` in a thread while the loop runs, as server_test.cpp does.
+  void with(const std::function<void(std::uint16_t port)>& client,
+            Duration limit = std::chrono::seconds(20)) {
+    std::atomic<bool> done{false};
+    std::thread t([&] {
+      try {
+        client(server->port());
+      } catch (const std::exception& e) {
+        failure = e.what();
+      }
+      done = true;
+    });
+    runUntil(
+        loop, [&] { return done.load(); }, limit);
+    t.join();
+    CHECK_MESSAGE(failure.empty(), "the client failed: " << failure);
+    failure.clear();
+  }
+  // Runs the loop for `seconds` (the seats' timers, the cars' frames).
+  void pass(double seconds) {
+    runUntil(
+        loop, [] { return false; }, fromSeconds(seconds));
+  }
+  AnkiCar& car(int number) { return *fleet.find(number); }
+};
+
+// A phone: sends messages, reads until an answer (a "seat" or an "error"), skipping updates.
+struct Phone {
+  asio::io_context io;
+  websocket::stream<tcp::socket> ws{io};
+  explicit Phone(std::uint16_t port) {
+    ws.next_layer().connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
+    ws.handshake("127.0.0.1", "/ws");
+  }
+  void send(const char* text) { send(std::string(text)); }
+  void send(const std::string& text) {
+    ws.text(true);
+    ws.write(asio::buffer(text));
+  }
+  void send(const nlohmann::json& j) { send(j.dump()); }
+  nlohmann::json read() {
+    beast::flat_buffer b;
+    ws.read(b);
+    return nlohmann::json::parse(beast::buffers_to_string(b.data()));
+  }
+  nlohmann::json answer() {
+    for (;;) {
+      auto m = read();
+      if (m["type"] == "seat" || m["type"] == "error") return m;
+    }
+  }
+  // The next update (or state) whose seats satisfy `ok`.
+  nlohmann::json seatsWhere(const std::function<bool(const nlohmann::json&)>& ok) {
+    for (;;) {
+      auto m = read();
+      if ((m["type"] == "update" || m["type"] == "state") && m.contains("seats") && ok(m["seats"]))
+        return m["seats"];
+    }
+  }
+  void close() {
+    beast::error_code ignored;
+    ws.close(websocket::close_code::normal, ignored);
+  }
+};
+
+nlohmann::json seatMessage(int seat, const std::string& player) {
+  return {{"type", "seat"}, {"seat", seat}, {"player", player}};
+}
+nlohmann::json driveMessage(double throttle, int lane = 0) {
+  return {{"type", "drive"}, {"throttle", throttle}, {"lane", lane}};
+}
+
+}  // namespace
+
+TEST_CASE("view drive: a page takes a free seat; a second page cannot take it, takes another") {
+  Rig rig(2);
+  std::unique_ptr<Phone> a, b;
+  rig.with([&](std::uint16_t port) {
+    a = std::make_unique<Phone>(port);
+    b = std::make_unique<Phone>(port);
+    auto state = a->read();
+    REQUIRE(state["type"] == "state");
+    REQUIRE(state["seats"].size() == 2);
+    CHECK(state["seats"][0]["number"] == 1);
+    CHECK(state["seats"][0]["car"] == "car1");
+    CHECK(state["seats"][0]["held"] == false);
+    CHECK(state["seats"][0]["holder"].is_null());
+
+    a->send(seatMessage(1, "Anna"));
+    CHECK(a->answer() == nlohmann::json{{"type", "seat"}, {"seat", 1}});
+    b->send(seatMessage(1, "Ben"));
+    auto refused = b->answer();
+    CHECK(refused["type"] == "error");
+    CHECK(refused["message"].get<std::string>().find("seat 1 is held") != std::string::npos);
+    CHECK(refused["message"].get<std::string>().find("Anna") != std::string::npos);
+    b->send(seatMessage(0, "Ben"));  // any free one
+    CHECK(b->answer() == nlohmann::json{{"type", "seat"}, {"seat", 2}});
+
+    // every page sees who holds what (not the holder's connection id)
+    auto seats = b->seatsWhere([](const nlohmann::json& s) { return s[1]["held"] == true; });
+    CHECK(seats[0]["player"] == "Anna");
+    CHECK(seats[0]["holder"] == "phone");
+    CHECK(seats[0]["live"] == true);
+    CHECK(seats[1]["player"] == "Ben");
+  });
+  REQUIRE(rig.seats->seat(1)->held());
+  CHECK(rig.seats->seat(1)->holder != rig.seats->seat(2)->holder);
+  CHECK(rig.seats->seat(1)->kind == drive::Holder::Phone);
+  auto state = rig.feed.state();
+  CHECK(state["seats"][0]["held"] == true);
+}
+
+TEST_CASE("view drive: a page drives its own seat only, and leaving stops the car") {
+  Rig rig(2, 2, {.silence = 10});  // no silence in this test: it is another
+  std::unique_ptr<Phone> a, b;
+  rig.with([&](std::uint16_t port) {
+    a = std::make_unique<Phone>(port);
+    b = std::make_unique<Phone>(port);
+    a->send(seatMessage(1, "Anna"));
+    CHECK(a->answer()["seat"] == 1);
+    a->send(driveMessage(0.5, 1));
+    b->send(driveMessage(1.0));  // b holds no seat
+    auto refused = b->answer();
+    CHECK(refused["type"] == "error");
+    CHECK(refused["message"].get<std::string>().find("take one first") != std::string::npos);
+    // the throttle reaches every page with the next update
+    a->seatsWhere([](const nlohmann::json& s) { return s[0]["throttle"] == 0.5; });
+  });
+  CHECK(rig.seats->seat(1)->throttle == 0.5);
+  CHECK(rig.seats->takeLanes(1) == 1);
+  CHECK(rig.seats->seat(2)->throttle == 0);
+  // the human driver (the race library) would command the car from the seat; here the test does
+  REQUIRE(rig.car(1).setSpeed(600, 2000));
+  rig.with([&](std::uint16_t) {
+    a->send(R"({"type":"leave"})");
+    a->seatsWhere([](const nlohmann::json& s) { return s[0]["held"] == false; });
+  });
+  CHECK_FALSE(rig.seats->seat(1)->held());
+  CHECK(rig.car(1).state().target_speed_mm_s == 0);
+}
+
+TEST_CASE("view drive: a page that closes frees its seat and its car is commanded to stop") {
+  Rig rig(2, 2, {.silence = 10});
+  std::unique_ptr<Phone> a, b;
+  rig.with([&](std::uint16_t port) {
+    a = std::make_unique<Phone>(port);
+    b = std::make_unique<Phone>(port);
+    a->send(seatMessage(1, "Anna"));
+    CHECK(a->answer()["seat"] == 1);
+    b->send(seatMessage(2, "Ben"));
+    CHECK(b->answer()["seat"] == 2);
+  });
+  REQUIRE(rig.car(1).setSpeed(700, 2000));
+  REQUIRE(rig.car(2).setSpeed(700, 2000));
+  SUBCASE("closed by the page") {
+    rig.with([&](std::uint16_t) { a->close(); });
+  }
+  SUBCASE("the connection dropped without a close") {
+    rig.with([&](std::uint16_t) {
+      beast::error_code ignored;
+      a->ws.next_layer().close(ignored);
+    });
+  }
+  REQUIRE(runUntil(rig.loop, [&] { return !rig.seats->seat(1)->held(); }));
+  CHECK(rig.car(1).state().target_speed_mm_s == 0);
+  CHECK(rig.car(2).state().target_speed_mm_s == 700);  // the other seat is untouched
+  CHECK(rig.seats->seat(2)->held());
+  // seat 1 is free again for another phone
+  rig.with([&](std::uint16_t port) {
+    Phone c(port);
+    c.send(seatMessage(1, "Cleo"));
+    CHECK(c.answer()["seat"] == 1);
+    b->close();
+  });
+}
+
+TEST_CASE("view drive: a page silent for 1 s loses its input: the car is commanded to stop") {
+  Rig rig(1);
+  std::unique_ptr<Phone> a;
+  rig.with([&](std::uint16_t port) {
+    a = std::make_unique<Phone>(port);
+    a->send(seatMessage(1, "Anna"));
+    CHECK(a->answer()["seat"] == 1);
+    a->send(driveMessage(0.8));
+  });
+  REQUIRE(runUntil(rig.loop, [&] { return rig.seats->seat(1)->throttle == 0.8; }));
+  REQUIRE(rig.car(1).setSpeed(800, 2000));
+  const double from = rig.loop.seconds();
+  REQUIRE(runUntil(
+      rig.loop, [&] { return !rig.seats->seat(1)->live; }, std::chrono::seconds(3)));
+  CHECK(rig.loop.seconds() - from <= 1.2);
+  CHECK(rig.seats->seat(1)->held());  // still held: the next input makes it live again
+  CHECK(rig.seats->seat(1)->throttle == 0);
+  CHECK(rig.car(1).state().target_speed_mm_s == 0);
+  rig.with([&](std::uint16_t) {
+    a->send(driveMessage(0.3));
+    a->seatsWhere([](const nlohmann::json& s) { return s[0]["live"] == true; });
+  });
+  CHECK(rig.seats->seat(1)->throttle == 0.3);
+}
+
+TEST_CASE("view drive: hostile messages are refused or dropped, never thrown") {
+  Rig rig(2);
+  std::unique_ptr<Phone> kept;
+  rig.with([&](std::uint16_t port) {
+    // (each page has its own allowance of messages: the groups below are within one)
+    kept = std::make_unique<Phone>(port);
+    Phone& a = *kept;
+    for (const char* bad :
+         {R"({"type":"seat","seat":3})", R"({"type":"seat","seat":-1})",
+          R"({"type":"seat","seat":1.5})", R"({"type":"seat","seat":"1"})",
+          R"({"type":"seat","seat":1e300})", R"({"type":"seat","seat":null})",
+          R"({"type":"seat","seat":18446744073709551617})", R"({"type":"seat","seat":[1]})",
+          R"({"type":"seat","seat":1,"player":42})", R"({"type":"seat","seat":1,"player":{}})"}) {
+      a.send(std::string(bad));
+      auto m = a.answer();
+      CHECK_MESSAGE(m["type"] == "error", bad);
+      CHECK_MESSAGE(!m["message"].get<std::string>().empty(), bad);
+    }
+    // a name with control characters and a long one: taken, kept short and printable (below)
+    a.send(R"({"type":"seat","seat":1,"player":"\u0000\u001b[31mAnna)" + std::string(300, 'x') +
+           "\"}");
+    CHECK(a.answer()["seat"] == 1);
+    // not JSON, not an object, no type, unknown types, a type that is not text: ignored
+    for (const char* ignored : {"", "{", "[]", "42", R"({"seat":1})", R"({"type":"hello"})",
+                                R"({"type":7})", R"({"type":null})", "\"drive\""})
+      a.send(std::string(ignored));
+
+    Phone b(port);
+    b.send(seatMessage(2, "Ben"));
+    CHECK(b.answer()["seat"] == 2);
+    // drive messages that are no drive: each refusal said (the same one once a second)
+    for (const char* bad :
+         {R"({"type":"drive","throttle":"NaN"})", R"({"type":"drive","throttle":1e308,"lane":0})",
+          R"({"type":"drive","throttle":-0.5})", R"({"type":"drive","throttle":0.5,"lane":2})"}) {
+      b.send(std::string(bad));
+      auto m = b.answer();
+      CHECK_MESSAGE(m["type"] == "error", bad);
+    }
+    // the same refusals again at once: not said again (no reply flood), and nothing taken
+    for (const char* again : {R"({"type":"drive","throttle":"1"})", R"({"type":"drive"})",
+                              R"({"type":"drive","throttle":0.5,"lane":0.5})",
+                              R"({"type":"drive","throttle":0.5,"lane":"left"})"})
+      b.send(std::string(again));
+    // a flood: dropped, said once, and the seat is not lost over it
+    for (int i = 0; i < 500; ++i) b.send(driveMessage(0.25));
+    auto flood = b.answer();
+    CHECK(flood["type"] == "error");
+    CHECK_MESSAGE(
+        flood["message"].get<std::string>().find("too many messages") != std::string::npos,
+        flood.dump());
+    b.send(R"({"type":"leave"})");  // taken even in a flood
+    b.seatsWhere([](const nlohmann::json& s) { return s[1]["held"] == false; });
+  });
+  CHECK_FALSE(rig.seats->seat(2)->held());
+  REQUIRE(rig.seats->seat(1)->held());
+  const std::string& player = rig.seats->seat(1)->player;
+  CHECK(player.find('\0') == std::string::npos);
+  CHECK(player.find('\x1b') == std::string::npos);
+  CHECK(player.size() <= 24 + 3);  // 24 bytes, then "…"
+}
+
+TEST_CASE("view drive: a player's name is kept printable") {
+  Rig rig(1);
+  std::unique_ptr<Phone> a;
+  rig.with([&](std::uint16_t port) {
+    a = std::make_unique<Phone>(port);
+    a->send(R"({"type":"seat","seat":0,"player":"\u0007Zo\u00e9)" + std::string(100, 'y') + "\"}");
+    CHECK(a->answer()["seat"] == 1);
+  });
+  const std::string& player = rig.seats->seat(1)->player;
+  CHECK(player.find('\x07') == std::string::npos);
+  CHECK(player.size() <= 24 + 3);  // 24 bytes, then "…"
+  CHECK_MESSAGE(player.find("Zo\xc3\xa9") != std::string::npos, player);
+}
+
+TEST_CASE("view drive: without seats, driving is off and says how to start it") {
+  Rig rig(0);
+  rig.with([&](std::uint16_t port) {
+    Phone a(port);
+    CHECK(a.read()["seats"] == nlohmann::json::array());
+    for (auto m : {seatMessage(1, "Anna"), driveMessage(0.5)}) {
+      a.send(m);
+      auto r = a.answer();
+      CHECK(r["type"] == "error");
+      CHECK(r["message"].get<std::string>().find("--humans N") != std::string::npos);
+    }
+    a.send(R"({"type":"leave"})");  // nothing to let go of: no answer, no harm
+    a.send(R"({"type":"control","pause":true})");
+    CHECK(a.answer()["message"].get<std::string>().find("replays") != std::string::npos);
+  });
+}
+
+TEST_CASE("view drive: GET /drive serves the controller page") {
+  Rig rig(1);
+  rig.with([&](std::uint16_t port) {
+    asio::io_context io;
+    beast::tcp_stream stream(io);
+    stream.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
+    std::string req = "GET /drive HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n";
+    asio::write(stream.socket(), asio::buffer(req));
+    beast::flat_buffer buffer;
+    beast::http::response<beast::http::string_body> res;
+    beast::http::read(stream, buffer, res);
+    CHECK(res.result() == beast::http::status::ok);
+    CHECK(res.body().find("<title>drive</title>") != std::string::npos);
+    CHECK(std::string(res[beast::http::field::content_type]).starts_with("text/html"));
+  });
+}

@@ -1,0 +1,223 @@
+// Two phones on the controller page (/drive) in headless Chromium against a run with --humans 2
+// (tests/integration/drive_browser_test.sh; the DOM hooks are listed at the top of
+// engine/view/page/drive.js; the messages in docs/view.md "The controller page").
+//
+//   node drive_check.mjs URL [--timeout SECONDS] [--chromium PATH] [--artifacts DIR]
+//
+// Checks: the race view links to /drive; page 1 takes seat 1; page 2 asks for seat 1 and is told
+// it is taken, then takes seat 2; page 1 holds its throttle up → car 1 is commanded a speed and
+// runs, while car 2 stays commanded 0 and stands; page 1 lets go → car 1 is commanded 0 (the
+// dead man's handle); page 1 holds the throttle again, then closes while holding → the engine
+// frees seat 1 and car 1 is commanded 0 and stops. Cars are read from URL/api/state (their
+// commanded `targetSpeed` and reported `speed`).
+// Prints one PASS/FAIL line per check; exit status 1 when a check failed, 2 on bad arguments.
+// Every wait polls with a deadline (--timeout, default 30 s); no fixed sleeps.
+import puppeteer from "puppeteer-core";
+
+function usage(message) {
+  if (message) console.error(`drive_check: ${message}`);
+  console.error("usage: node drive_check.mjs URL [--timeout SECONDS] [--chromium PATH] [--artifacts DIR]");
+  process.exit(2);
+}
+
+const args = process.argv.slice(2);
+const opts = { timeout: 30, chromium: process.env.CHROMIUM || "/usr/bin/chromium", artifacts: null };
+const positional = [];
+for (let i = 0; i < args.length; i++) {
+  const a = args[i];
+  const value = () => (i + 1 < args.length ? args[++i] : usage(`${a} needs a value`));
+  if (a === "--timeout") opts.timeout = Number(value());
+  else if (a === "--chromium") opts.chromium = value();
+  else if (a === "--artifacts") opts.artifacts = value();
+  else if (a.startsWith("--")) usage(`unknown option ${a}`);
+  else positional.push(a);
+}
+if (positional.length !== 1) usage("give the view's URL");
+if (!(opts.timeout > 0)) usage("--timeout takes seconds > 0");
+const url = positional[0].endsWith("/") ? positional[0] : `${positional[0]}/`;
+const timeoutMs = opts.timeout * 1000;
+
+let failures = 0;
+function pass(name, detail) { console.log(`PASS: ${name}${detail ? ` (${detail})` : ""}`); }
+function fail(name, detail) { failures++; console.log(`FAIL: ${name}${detail ? `: ${detail}` : ""}`); }
+function check(name, ok, detail) { (ok ? pass : fail)(name, detail); return ok; }
+
+// Waits for fn in the page; a timeout is a FAIL with `name` said, not an exception.
+async function waitFor(page, name, fn, arg) {
+  try {
+    await page.waitForFunction(fn, { timeout: timeoutMs, polling: 50 }, arg);
+    pass(name);
+    return true;
+  } catch (e) {
+    fail(name, `not within ${opts.timeout} s (${String(e.message).split("\n")[0]})`);
+    return false;
+  }
+}
+
+async function state() {
+  const r = await fetch(`${url}api/state`);
+  return r.json();
+}
+const carOf = (s, n) => (s.cars || []).find((c) => c.number === n) || {};
+const seatOf = (s, n) => (s.seats || []).find((x) => x.number === n) || {};
+const show = (c) => `target ${c.targetSpeed}, speed ${c.speed}`;
+
+// Polls /api/state until ok(state) (true) or the deadline (a FAIL naming the last state seen).
+// `always(state)`, when given, must hold at every poll (a FAIL at the first that breaks it).
+async function until(name, ok, describe, always) {
+  const deadline = Date.now() + timeoutMs;
+  let last = null, broken = false;
+  for (;;) {
+    try { last = await state(); } catch (e) { last = null; }
+    if (last && always && !broken) {
+      const why = always(last);
+      if (why) { fail(name, why); broken = true; }
+    }
+    if (last && ok(last)) {
+      if (!broken) pass(name, describe(last));
+      return last;
+    }
+    if (Date.now() > deadline) {
+      fail(name, `not within ${opts.timeout} s; last: ${last ? describe(last) : "no state"}`);
+      return null;
+    }
+    await new Promise((r) => setTimeout(r, 100));  // a poll's pace, not a wait for an event
+  }
+}
+
+let browser;
+try {
+  browser = await puppeteer.launch({
+    executablePath: opts.chromium,
+    headless: true,
+    args: [
+      "--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
+      "--no-first-run", "--no-default-browser-check", "--disable-background-networking",
+      "--disable-component-update", "--disable-sync", "--disable-extensions",
+      // two phones in one browser: neither page's timers may be slowed as a background tab's
+      "--disable-background-timer-throttling", "--disable-renderer-backgrounding",
+      "--disable-backgrounding-occluded-windows",
+      "--host-resolver-rules=MAP * ~NOTFOUND, EXCLUDE localhost, EXCLUDE 127.0.0.1",
+    ],
+    timeout: timeoutMs,
+  });
+} catch (e) {
+  fail("chromium starts", `${opts.chromium}: ${e.message.split("\n")[0]}`);
+  process.exit(1);
+}
+
+const pageErrors = [];
+async function phone(name) {
+  // each phone a browser of its own (its own storage), phone-sized
+  const context = await browser.createBrowserContext();
+  const page = await context.newPage();
+  await page.setViewport({ width: 390, height: 780, deviceScaleFactor: 1 });
+  page.on("pageerror", (e) => pageErrors.push(`${name}: ${String(e.message || e).split("\n")[0]}`));
+  page.on("console", (m) => {
+    if (m.type() === "error" && !/WebSocket|ERR_CONNECTION_REFUSED/.test(m.text()))
+      pageErrors.push(`${name} console: ${m.text()}`);
+  });
+  page.on("response", (r) => { if (r.status() >= 400) pageErrors.push(`${name}: ${r.url()} HTTP ${r.status()}`); });
+  const response = await page.goto(`${url}drive`, { waitUntil: "load", timeout: timeoutMs });
+  check(`${name}: /drive loads`, response && response.ok(), `HTTP ${response && response.status()}`);
+  return page;
+}
+
+// Holds the throttle bar at `fraction` of its height (a finger down and moved up, kept down).
+async function holdThrottle(page, fraction) {
+  await page.bringToFront();
+  const box = await (await page.$("#throttle")).boundingBox();
+  const x = box.x + box.width / 2;
+  await page.mouse.move(x, box.y + box.height - 4);
+  await page.mouse.down();
+  await page.mouse.move(x, box.y + box.height * (1 - fraction), { steps: 8 });
+  return page.$eval("#throttle", (el) => Number(el.dataset.value));
+}
+
+try {
+  // The race view links to the controller page (the run has seats).
+  const viewPage = await (await browser.createBrowserContext()).newPage();
+  await viewPage.goto(url, { waitUntil: "load", timeout: timeoutMs });
+  await waitFor(viewPage, "the race view shows a link to /drive",
+    () => { const a = document.querySelector("#drive-link"); return a && !a.hidden && a.getAttribute("href") === "/drive"; });
+  await viewPage.close();
+
+  const one = await phone("page 1");
+  const two = await phone("page 2");
+  for (const [name, page] of [["page 1", one], ["page 2", two]])
+    await waitFor(page, `${name}: live, two seats to pick`,
+      () => document.querySelector("#connection")?.textContent === "live" &&
+        document.querySelectorAll("#seats button[data-number]").length === 2 && !document.querySelector("#pick").hidden);
+
+  // page 1 takes seat 1
+  await one.type("#player", "Anna");
+  await one.click('#seats button[data-number="1"]');
+  await waitFor(one, "page 1 holds seat 1: the controls are shown",
+    () => !document.querySelector("#drive").hidden && document.querySelector("#drive").dataset.seat === "1");
+
+  // page 2 sees it taken, asks for it anyway, is refused, takes seat 2
+  await waitFor(two, "page 2 sees seat 1 held",
+    () => document.querySelector('#seats button[data-number="1"]')?.classList.contains("held"));
+  await two.type("#player", "Ben");
+  await two.click('#seats button[data-number="1"]');
+  if (await waitFor(two, "page 2 is told seat 1 is taken",
+      () => { const n = document.querySelector("#notice"); return !n.hidden && n.dataset.kind === "taken"; })) {
+    const text = await two.$eval("#notice", (n) => n.textContent);
+    check("the refusal names the holder", /seat 1 is held by another phone \(Anna\)/.test(text), text);
+  }
+  check("page 2 holds no seat after the refusal", await two.$eval("#drive", (d) => d.hidden));
+  if (opts.artifacts) await two.screenshot({ path: `${opts.artifacts}/drive-page-taken.png` });
+  await two.click('#seats button[data-number="2"]');
+  await waitFor(two, "page 2 holds seat 2",
+    () => !document.querySelector("#drive").hidden && document.querySelector("#drive").dataset.seat === "2");
+
+  await until("the state shows seat 1 held by Anna and seat 2 by Ben",
+    (s) => seatOf(s, 1).player === "Anna" && seatOf(s, 2).player === "Ben" && seatOf(s, 1).live && seatOf(s, 2).live,
+    (s) => JSON.stringify(s.seats));
+
+  // page 1 drives: car 1 is commanded a speed and runs; car 2 stays put
+  const car2Still = (s) => {
+    const c = carOf(s, 2);
+    return (c.targetSpeed || 0) === 0 && (c.speed || 0) === 0 ? null : `car 2 moved: ${show(c)}`;
+  };
+  let value = await holdThrottle(one, 0.9);
+  check("page 1's throttle is up", value >= 0.8, `data-value ${value}`);
+  await until("car 1 is commanded a speed and runs", (s) => carOf(s, 1).targetSpeed >= 300 && carOf(s, 1).speed >= 300,
+    (s) => `car 1 ${show(carOf(s, 1))}; car 2 ${show(carOf(s, 2))}`, car2Still);
+  await until("seat 1's throttle is in the state", (s) => seatOf(s, 1).throttle >= 0.8,
+    (s) => `throttle ${seatOf(s, 1).throttle}`);
+  if (opts.artifacts) await one.screenshot({ path: `${opts.artifacts}/drive-page.png` });
+
+  // letting go is 0 (the dead man's handle)
+  await one.mouse.up();
+  value = await one.$eval("#throttle", (el) => Number(el.dataset.value));
+  check("page 1's throttle falls to 0 when the finger lets go", value === 0, `data-value ${value}`);
+  await until("car 1 is commanded 0 after the finger let go", (s) => carOf(s, 1).targetSpeed === 0,
+    (s) => `car 1 ${show(carOf(s, 1))}`, car2Still);
+
+  // drive again, then the phone goes away while the finger is down
+  value = await holdThrottle(one, 0.9);
+  await until("car 1 runs again", (s) => carOf(s, 1).targetSpeed >= 300 && carOf(s, 1).speed >= 300,
+    (s) => `car 1 ${show(carOf(s, 1))}`, car2Still);
+  await one.close();
+  await until("closing page 1 frees seat 1", (s) => !seatOf(s, 1).held, (s) => JSON.stringify(seatOf(s, 1)));
+  // the car is commanded 0; stopped: its reported speed 0, or no position for a second (a car
+  // that stands reports nothing; its last reported speed stays)
+  let since = null, pos = null;
+  await until("car 1 is commanded 0 and stops", (s) => {
+    const c = carOf(s, 1);
+    if (c.positionTime !== pos) { pos = c.positionTime; since = Date.now(); }
+    return c.targetSpeed === 0 && (c.speed === 0 || Date.now() - since > 1000);
+  }, (s) => `car 1 ${show(carOf(s, 1))}`, car2Still);
+  await until("seat 2 is still held by page 2", (s) => seatOf(s, 2).held && seatOf(s, 2).player === "Ben",
+    (s) => JSON.stringify(seatOf(s, 2)));
+  if (opts.artifacts) await two.screenshot({ path: `${opts.artifacts}/drive-page-2.png` });
+
+  check("no script errors or failed requests", pageErrors.length === 0, pageErrors.join("; "));
+} catch (e) {
+  fail("drive check", String(e.stack || e));
+} finally {
+  await browser.close().catch(() => {});
+}
+console.log(failures === 0 ? "drive check: all passed" : `drive check: ${failures} failed`);
+process.exit(failures === 0 ? 0 : 1);
