@@ -19,10 +19,11 @@ FLOORS = {
     "engine/fleet": 5,
     "engine/record": 6,
     "engine/mqtt": 6,
-    "engine/view": 6,
+    "engine/drive": 6,  # human seats and the devices that hold them: above the fleet
+    "engine/view": 7,  # the view shows the seats and its /drive page holds them
     "engine/print": 6,  # printing pieces and reading them back: the sim's geometry, drawn
-    "bindings": 7,
-    "engine/cli": 8,
+    "bindings": 8,
+    "engine/cli": 9,
 }
 LUA_FROM = FLOORS["bindings"]  # the lowest floor that may know Lua
 INCLUDE = re.compile(r'^\s*#\s*include\s*[<"]([^>"]+)[>"]')

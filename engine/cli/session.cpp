@@ -496,6 +496,10 @@ int Session::startSeats(const CarSource& source, const char* command) {
   if (server_) {
     console::noteOutput();
     std::cerr << "drive: " << server_->url() << "drive (" << cars << ": one phone a car)\n";
+    const std::string host = server_->url().substr(7, server_->url().rfind(':') - 7);
+    if (host != "127.0.0.1" && host != "[::1]")
+      log::warn("seats", "anyone who can reach this machine can take a free seat and drive " +
+                             cars + ": serve the view on a network you trust");
   } else if (!source.gamepads && !source.keyboard) {
     log::warn("seats", "--humans " + std::to_string(source.humans) +
                            " and nothing to hold the seats but a script: add --view (phones on "

@@ -150,11 +150,14 @@ void Seats::lose(Seat& s, const std::string& why) {
   s.throttle = 0;
   s.lanes = 0;
   s.live = false;
-  log::info(kLog, "seat " + std::to_string(s.number) + ": " + why + "; its car slows to a stop");
-  if (AnkiCar* car = fleet_.find(s.number); car && car->state().connected && !car->halted()) {
-    auto sent = car->setSpeed(0, options_.stopDecel);
-    if (!sent) log::warn(kLog, "seat " + std::to_string(s.number) + ": " + sent.error());
+  AnkiCar* car = fleet_.find(s.number);
+  if (!car || !car->state().connected || car->halted()) {  // (the end of the run stopped it)
+    log::debug(kLog, "seat " + std::to_string(s.number) + ": " + why);
+    return;
   }
+  log::info(kLog, "seat " + std::to_string(s.number) + ": " + why + "; its car slows to a stop");
+  if (auto sent = car->setSpeed(0, options_.stopDecel); !sent)
+    log::warn(kLog, "seat " + std::to_string(s.number) + ": " + sent.error());
 }
 
 // One timer for every seat: due when the first live phone or script would fall silent; none

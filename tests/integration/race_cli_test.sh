@@ -83,11 +83,27 @@ check "custom track over --ble: exit status" 0 "$rc"
 contains "custom track over --ble: the winner" "Winner: " "$out"
 if grep -q "error " "$TMP/ble-hairpin.err"; then fail "custom track over --ble reported an error: $(cat "$TMP/ble-hairpin.err")"; fi
 check "custom track over --ble: every car finished its lap" 2 "$(grep -c ',1,[0-9.]*,[0-9.]*,[0-9.]*,true,false$' "$TMP/ble-hairpin.csv")"
+# People: two seats the script holds (as phones would) race two cruisers; then input loss.
+human_race() {  # $1: what runs the cars; the rest: options
+  local what=$1; shift
+  out=$(LAPS=1 $PITWALL run "$SRC/tests/integration/human_race.lua" --humans 2 "$@" 2>"$TMP/human.err"); rc=$?
+  check "humans $what: exit status" 0 "$rc"
+  if grep -q "error " "$TMP/human.err"; then fail "humans $what reported an error: $(cat "$TMP/human.err")"; fi
+  check "humans $what: both humans finished, no false start" 2 \
+    "$(echo "$out" | grep -c ' human laps=1 finished=true falseStart=false')"
+  check "humans $what: both AI drivers finished" 2 \
+    "$(echo "$out" | grep -c ' cruiser laps=[01] finished=true falseStart=false')"
+  contains "humans $what: a silent seat's car stopped" "input loss: moving=true stopped=true" "$out"
+}
+human_race "on the simulator" --fast --cars 4
 echo 'local p = pitwall.piece(61) print(p and string.format("%s r=%g deg=%g", p.type, p.radius, p.angle)) pitwall.stop()' >"$TMP/piece.lua"
 out=$($PITWALL run "$TMP/piece.lua" --ble --scan-timeout 1 --track "$SRC/examples/tracks/hairpin.layout" 2>/dev/null)
 check "--ble --track: pitwall.piece knows a custom piece" "curve r=400 deg=45" "$out"
 out=$($PITWALL run "$TMP/piece.lua" --ble --scan-timeout 1 2>/dev/null)
 check "--ble without --track: a custom id is unknown" "nil" "$out"
+stop_fake
+start_fake --adapters 1 --cars 4
+human_race "over --ble" --ble --scan-timeout 1
 stop_fake
 out=$($PITWALL run "$SRC/examples/grand_prix.lua" --ble --track "$TMP/none.layout" 2>&1); rc=$?
 check "--ble with a missing --track file: exit status" 2 "$rc"
