@@ -8,6 +8,8 @@
 //   seat:lanes()             → the lane steps asked since the last call (− left, + right)
 //   seat:feed(throttle [, lane])  the script holds the seat and asks for this (scripted input)
 //   seat:release()           the script lets go of the seat (its car slows to a stop)
+//   seat:driving()           a driver drives the car from the seat now (at every update): only
+//                            then does a lost holder stop the car (engine/drive/seats.hpp)
 #include <string>
 
 #include "bindings/car_binding.hpp"
@@ -110,6 +112,12 @@ int seatFeed(lua_State* L) {
   return 0;
 }
 
+int seatDriving(lua_State* L) {
+  const drive::Seat& s = checkSeat(L, 1);
+  seatsOf(L)->driving(s.number);
+  return 0;
+}
+
 int seatRelease(lua_State* L) {
   const drive::Seat& s = checkSeat(L, 1);
   seatsOf(L)->release(scriptHolder(s.number), "the script let go");
@@ -175,6 +183,7 @@ void openSeatModule(ScriptHost& host) {
   static const luaL_Reg methods[] = {{"lanes", lua::guarded<seatLanes>},
                                      {"feed", lua::guarded<seatFeed>},
                                      {"release", lua::guarded<seatRelease>},
+                                     {"driving", lua::guarded<seatDriving>},
                                      {nullptr, nullptr}};
   luaL_newlib(L, methods);
   lua_setfield(L, -2, "__methods");

@@ -180,6 +180,9 @@ function pitwall.writeResults(rows, columns, path) end
 ---@field throttle number 0..1 as asked; 0 while not live
 local Seat = {}
 
+---A driver drives the car from the seat now (call it at every update): for the next second a lost holder stops the car.
+function Seat:driving() end
+
 ---The script holds the seat and asks for this (scripted input; feed at least every second, or the seat loses its input and the car is stopped).
 ---@param throttle number 0..1
 ---@param lane? integer -1 (left), 0, 1 (right)

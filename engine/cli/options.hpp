@@ -44,7 +44,7 @@ CLI::Option* addRemoteCars(CLI::App* cmd, CarSource& source);
 // only after parsing, so takeViews() copies each one to its target then.
 CLI::Option* addView(CLI::App* cmd, std::optional<std::string>& target);
 void takeViews();
-// --humans N, --gamepads, --keyboard (run, repl): the seats of human drivers and what holds them.
+// --humans N, --gamepads, --keyboard (run): the seats of human drivers and what holds them.
 void addHumans(CLI::App* cmd, CarSource& source);
 
 }  // namespace pitwall::cli

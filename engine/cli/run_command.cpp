@@ -49,6 +49,11 @@ int run(const RunOptions& options) {
       return 2;
     }
   }
+  if (options.humans > 0 && options.fast && options.view) {  // phones live in real time
+    std::cerr << "pitwall run: phones drive in real time: --humans with --view needs no --fast "
+                 "(a phone's second of silence would pass in an instant)\n";
+    return 2;
+  }
   auto made = Session::open(options, options.fast, "run");
   if (!made) return 2;
   Session& session = *made;

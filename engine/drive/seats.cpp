@@ -43,6 +43,10 @@ Seats::Seats(Loop& loop, Fleet& fleet, int count, SeatsOptions options)
 
 Seats::~Seats() {
   if (silenceTimer_) loop_.cancel(*silenceTimer_);
+  // Seats that go while held (a script's own, sim.openSeats, with its version on a reload) stop
+  // the cars driven from them, as a holder that lets go would.
+  for (auto& s : seats_)
+    if (s.held() && s.live) lose(s, "its seats are gone");
 }
 
 Seat* Seats::find(const std::string& holder) {
@@ -92,7 +96,11 @@ Result<int, std::string> Seats::claim(const std::string& holder, Holder kind, in
           "seat " + std::to_string(number) + " is held by another " + holderName(target->kind) +
           (target->player.empty() ? "" : " (" + target->player + ")") + "; pick a free seat");
   }
-  if (mine) release(holder, "took seat " + std::to_string(target->number));
+  std::string before;
+  if (mine) {  // (its old seat is let go once the new one is taken: no one can slip in between)
+    before = holder + "#moving";
+    mine->holder = before;
+  }
   target->holder = holder;
   target->kind = kind;
   target->player = printable(player, 24);
@@ -105,6 +113,7 @@ Result<int, std::string> Seats::claim(const std::string& holder, Holder kind, in
                       (target->player.empty() ? "" : " (" + target->player + ")"));
   armSilence();
   changed.emit(*target);
+  if (mine) release(before, "took seat " + std::to_string(target->number));
   return target->number;
 }
 
@@ -129,6 +138,7 @@ Result<int, std::string> Seats::input(const std::string& holder, double throttle
     return Unexpected("lane step " + std::to_string(laneStep) +
                       " is out of range: -1 left, 0, +1 right");
   const bool wasLive = s->live;
+  const bool news = throttle != s->throttle || laneStep != 0;
   s->throttle = throttle;
   s->lanes = std::clamp(s->lanes + laneStep, -kMaxLanes, kMaxLanes);
   s->lastInput = loop_.seconds();
@@ -138,7 +148,13 @@ Result<int, std::string> Seats::input(const std::string& holder, double throttle
     armSilence();
     changed.emit(*s);
   }
+  if (news) asked.emit(*s);
   return s->number;
+}
+
+void Seats::driving(int number) {
+  if (number < 1 || number > static_cast<int>(seats_.size())) return;
+  seats_[static_cast<std::size_t>(number - 1)].drivenAt = loop_.seconds();
 }
 
 int Seats::takeLanes(int number) {
@@ -153,6 +169,11 @@ void Seats::lose(Seat& s, const std::string& why) {
   AnkiCar* car = fleet_.find(s.number);
   if (!car || !car->state().connected || car->halted()) {  // (the end of the run stopped it)
     log::debug(kLog, "seat " + std::to_string(s.number) + ": " + why);
+    return;
+  }
+  if (loop_.seconds() - s.drivenAt > kDrivenFor) {  // someone else drives the car now
+    log::info(kLog, "seat " + std::to_string(s.number) + ": " + why +
+                        " (no driver drives its car from it: the car is left to its driver)");
     return;
   }
   log::info(kLog, "seat " + std::to_string(s.number) + ": " + why + "; its car slows to a stop");

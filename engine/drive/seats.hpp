@@ -7,8 +7,9 @@
 // The engine keeps a held car safe, whatever the script does:
 // - a holder that lets go (a phone disconnects, a gamepad is unplugged) frees the seat, and
 // - a phone or script that says nothing for `silence` s (1 s) loses its input;
-// either way the throttle reads 0 and the car is slowed to a stop here, at once — not left at
-// speed until a driver notices. Gamepads and keyboards hold a throttle without sending (a trigger
+// either way the throttle reads 0 and, while a driver drives the car from the seat (the human
+// driver), the car is slowed to a stop here, at once — not left at speed until the driver
+// notices. Gamepads and keyboards hold a throttle without sending (a trigger
 // held still sends nothing), so silence is no loss for them: their loss is the device's.
 #include <cstdint>
 #include <optional>
@@ -34,11 +35,12 @@ struct Seat {
   int number = 0;      // 1, 2, …: the car number it drives (seat 2 drives car 2)
   std::string holder;  // who holds it (a phone's connection, a device path); empty: free
   Holder kind = Holder::Phone;
-  std::string player;    // the name the holder gave ("Anna"; a gamepad's device name)
-  double throttle = 0;   // 0..1 as last asked; 0 while not live
-  int lanes = 0;         // lane steps asked and not taken yet: − left, + right (at most ±3)
-  double lastInput = 0;  // engine seconds of the last input
-  bool live = false;     // held, and its input is fresh
+  std::string player;        // the name the holder gave ("Anna"; a gamepad's device name)
+  double throttle = 0;       // 0..1 as last asked; 0 while not live
+  int lanes = 0;             // lane steps asked and not taken yet: − left, + right (at most ±3)
+  double lastInput = 0;      // engine seconds of the last input
+  double drivenAt = -1e300;  // engine seconds a driver last said it drives from this seat
+  bool live = false;         // held, and its input is fresh
   bool held() const { return !holder.empty(); }
 };
 
@@ -67,10 +69,18 @@ class Seats {
   const Seat* heldBy(const std::string& holder) const;
   // The lane steps asked since the last take (− left, + right); they are forgotten.
   int takeLanes(int number);
+  // A driver drives seat `number`'s car from the seat now (the human driver says so at every
+  // update and while the lights are on). Only while one does — said within kDrivenFor s — does
+  // a lost holder stop the car: a car that the race director drives (a scan lap, to the grid) or
+  // an AI driver drives is not the seat's to stop.
+  void driving(int number);
+  static constexpr double kDrivenFor = 1.0;
   std::size_t count() const { return seats_.size(); }
 
-  // A seat changed hands or liveness (not every throttle change): the view redraws its list.
+  // A seat changed hands or liveness: the view redraws its list; gamepads look for a free seat.
   Signal<const Seat&> changed;
+  // A holder asked for another throttle or a lane step (the view shows the throttle).
+  Signal<const Seat&> asked;
 
  private:
   Seat* find(const std::string& holder);

@@ -45,6 +45,7 @@ Feed::Feed(Loop& loop, Fleet& fleet, std::string source)
 Feed::~Feed() {
   followLog(false);
   seatsSub_.disconnect();
+  askedSub_.disconnect();
   framesSub_.disconnect();
   connectionSub_.disconnect();
 }
@@ -136,8 +137,12 @@ void Feed::setRace(nlohmann::json race) {
 
 void Feed::setSeats(drive::Seats* seats) {
   seatsSub_.disconnect();
+  askedSub_.disconnect();
   seats_ = seats;
-  if (seats_) seatsSub_ = seats_->changed.connect([this](const drive::Seat&) { ++changes_; });
+  if (seats_) {
+    seatsSub_ = seats_->changed.connect([this](const drive::Seat&) { ++changes_; });
+    askedSub_ = seats_->asked.connect([this](const drive::Seat&) { ++changes_; });
+  }
   ++changes_;
 }
 

@@ -45,9 +45,6 @@ class Feed {
   // to nullptr before they go.
   void setSeats(drive::Seats* seats);
   drive::Seats* seats() const { return seats_; }
-  // A seat's input changed what the seats show (a throttle): the next update carries it.
-  // Seats::changed says only when a seat changes hands or liveness.
-  void seatsTouched() { ++changes_; }
   // One line of the event log: level "info", "warn" or "error".
   void event(const std::string& level, const std::string& text);
   // The engine's warnings and errors, and its reload lines, join the event log while `on`.
@@ -111,7 +108,7 @@ class Feed {
   std::map<int, std::unique_ptr<Car>> cars_;
   Subscription framesSub_, connectionSub_;  // the fleet's events, while the feed lives
   drive::Seats* seats_ = nullptr;
-  Subscription seatsSub_;
+  Subscription seatsSub_, askedSub_;  // the seats' changes, and their holders' asks
   std::uint64_t logTap_ = 0;
   std::uint64_t changes_ = 0;
   mutable std::string shared_;  // updateText's shared part, as of change sharedAt_

@@ -220,13 +220,12 @@ struct Server::Impl::Socket : std::enable_shared_from_this<Socket> {
     const int count = static_cast<int>(seats->count());
     const nlohmann::json* n = field(m, "seat");
     auto number = n ? whole(n, 0, count) : std::optional<int>(0);
-    if (!number)
-      return answer(
-          error("seat " +
-                (n ? n->dump(-1, ' ', false, nlohmann::json::error_handler_t::replace).substr(0, 40)
-                   : "") +
-                " is not a seat of this run: give 1.." + std::to_string(count) +
-                ", or 0 for the first free one"));
+    if (!number)  // (a number is shown; anything else by its type: a deep array is not dumped)
+      return answer(error(
+          "seat " +
+          (n->is_number() ? n->dump().substr(0, 40) : std::string("(") + n->type_name() + ")") +
+          " is not a seat of this run: give 1.." + std::to_string(count) +
+          ", or 0 for the first free one"));
     std::string player;
     if (const nlohmann::json* p = field(m, "player"); p && !p->is_null()) {
       if (!p->is_string()) return answer(error("the player's name must be text"));
@@ -248,12 +247,9 @@ struct Server::Impl::Socket : std::enable_shared_from_this<Socket> {
     const nlohmann::json* l = field(m, "lane");
     auto lane = l && !l->is_null() ? whole(l, -1, 1) : std::optional<int>(0);
     if (!lane) return refuseDrive("lane must be -1 (left), 0 or 1 (right)");
-    const drive::Seat* before = seats->heldBy(holder);
-    const double was = before ? before->throttle : -1;
-    auto done = seats->input(holder, t->get<double>(), *lane);
-    if (!done) return refuseDrive(done.error());
-    const drive::Seat* now = seats->heldBy(holder);
-    if (now && (now->throttle != was || *lane != 0)) server->feed.seatsTouched();
+    // (what changed reaches the feed through Seats::asked)
+    if (auto done = seats->input(holder, t->get<double>(), *lane); !done)
+      return refuseDrive(done.error());
   }
   void refuseDrive(const std::string& why) {
     const double t = server->loop.seconds();

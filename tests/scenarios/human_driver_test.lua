@@ -99,7 +99,7 @@ pitwall.sleep(2)
 expect.eq(sim.truth(cars[1]).speed, 0, "and stays stopped while its driver runs")
 handle:stop()
 
--- A held seat is the holder's: the script cannot feed a seat a phone holds (and vice versa).
+-- What a script feeds is checked like a phone's input.
 feeding[2] = false
 seats[2]:release()
 expect.falsy(seats[2].held, "released")

@@ -8,8 +8,10 @@
 -- (ctx.limit: a safety car, a penalty). Lane steps move the car one lane left or right of the one
 -- it is in (a car that stands cannot change lanes: a step asked then is dropped). A seat without
 -- input (its phone silent for 1 s, gone, or unplugged) reads throttle 0: the engine has slowed the
--- car already, and the driver asks for 0 as well. `assist` caps the speed in curves at what the
--- cruiser would drive there (a car too fast in a curve comes off the track, as on the real one).
+-- car already (while a driver drives from the seat: seat:driving(), said at every update), and the
+-- driver asks for 0 as well. Seat k drives car k: a human driver given another car's seat raises.
+-- `assist` caps the speed in curves at what the cruiser would drive there (a car too fast in a
+-- curve comes off the track, as on the real one).
 --
 -- During the start lights the director calls driver:waiting: a human who gives throttle before
 -- green jumps the start, and is caught like anyone else.
@@ -51,6 +53,13 @@ function human.new(options)
   end
   checkSpeed("max", options.max, 100, 1500)
   checkSpeed("min", options.min, 0, 1500)
+  for _, k in ipairs { "accel", "decel" } do
+    local v = options[k]
+    if v ~= nil and (type(v) ~= "number" or v ~= v or v < 100 or v > 25000) then
+      pitwall._raise(string.format("human.new: %s must be a number from 100 to 25000 mm/s², got %s",
+        k, tostring(v)))
+    end
+  end
   local self = setmetatable({
     name = "human",
     seat = seat,
@@ -76,6 +85,16 @@ function Human:target(car, ctx)
   return drivers.cap(ctx, v)
 end
 
+-- The seat drives `car`: seat k drives car k (its loss stops car k).
+function Human:_check(car)
+  local mine = self.seat.car
+  if mine ~= car then
+    pitwall._raise(string.format("human driver: seat %d drives %s, not %s: give this car's seat "
+      .. "(seat = %s)", self.seat.number, tostring(mine), tostring(car), tostring(car.number)))
+  end
+  self.seat:driving() -- the engine stops the car if the seat's holder goes (seats.hpp)
+end
+
 function Human:_drive(car, ctx)
   local v = self:target(car, ctx)
   local accel = v < (car.targetSpeed or 0) and self.decel or self.accel
@@ -94,12 +113,14 @@ function Human:_lanes(car)
 end
 
 function Human:update(car, ctx)
+  self:_check(car)
   self:_drive(car, ctx)
   self:_lanes(car)
 end
 
 -- The lights are on: the throttle goes through, so a person who does not wait jumps the start.
 function Human:waiting(car, ctx)
+  self:_check(car)
   if self.seat.throttle >= 0.02 then self:_drive(car, ctx) end
   self.seat:lanes() -- (a step asked on the grid is not kept for the green light)
 end

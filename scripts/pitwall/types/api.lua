@@ -167,6 +167,7 @@ function Stdout:flush() end
 @param throttle number 0..1
 @param lane? integer -1 (left), 0, 1 (right)]],
       release = [[The script lets go of the seat: its car slows to a stop.]],
+      driving = [[A driver drives the car from the seat now (call it at every update): for the next second a lost holder stops the car.]],
     },
   },
   {

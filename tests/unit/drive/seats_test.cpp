@@ -4,6 +4,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <functional>
 #include <limits>
 
 #include "engine/drive/seats.hpp"
@@ -34,6 +35,16 @@ struct Run {
   }
   // Drives car `i` at `speed` as a driver would when its seat says so.
   void drive(int i, int speed) { REQUIRE(cars[i]->setSpeed(speed, 2000)); }
+  // Runs `seconds`, with a driver saying every 0.1 s that it drives from seats `from`..`to`
+  // (what the human driver does at every update).
+  void runDriving(double seconds, int from = 1, int to = 2,
+                  const std::function<void()>& each = {}) {
+    for (int k = 0; k < static_cast<int>(seconds * 10 + 0.5); ++k) {
+      for (int n = from; n <= to; ++n) seats.driving(n);
+      if (each) each();
+      run(0.1);
+    }
+  }
   // The simulator's truth: how fast car i really goes (mm/s).
   double speed(int i) { return world.cars()[static_cast<std::size_t>(i)]->truth().speed_mm_s; }
 };
@@ -110,10 +121,7 @@ TEST_CASE("seats: a phone silent for 1 s loses its input and its car is slowed t
   r.drive(1, 800);
   // phone 2 keeps talking every 0.1 s; phone 1 says one thing and then nothing
   REQUIRE(r.seats.input("phone#1", 0.8, 0));
-  for (int k = 0; k < 30; ++k) {
-    REQUIRE(r.seats.input("phone#2", 0.8, 0));
-    r.run(0.1);
-  }
+  r.runDriving(3, 1, 2, [&] { REQUIRE(r.seats.input("phone#2", 0.8, 0)); });
   CHECK_FALSE(r.seats.seat(1)->live);
   CHECK(r.seats.seat(1)->held());  // still its phone's: input again makes it live
   CHECK(r.seats.seat(1)->throttle == 0);
@@ -129,7 +137,7 @@ TEST_CASE("seats: a holder that lets go stops its car, however it was driven") {
   Run r;
   REQUIRE(r.seats.claim("pad", drive::Holder::Gamepad, 1));
   r.drive(0, 900);
-  r.run(3);  // a gamepad holds its throttle without sending: no silence for it
+  r.runDriving(3);  // a gamepad holds its throttle without sending: no silence for it
   CHECK(r.seats.seat(1)->live);
   CHECK(r.speed(0) > 800);
   r.seats.release("pad", "the gamepad was unplugged");
@@ -153,4 +161,70 @@ TEST_CASE("seats: no live phone, no timer: a virtual run is not kept going by th
   CHECK(loop.seconds() == doctest::Approx(1.0));
   CHECK_FALSE(seats.seat(1)->live);
   CHECK(loop.pendingTimers() == 0);
+}
+
+TEST_CASE("seats: `asked` tells each new throttle and lane step, not a repeat") {
+  Run r;
+  int asked = 0, changed = 0;
+  auto a = r.seats.asked.connect([&](const drive::Seat&) { ++asked; });
+  auto c = r.seats.changed.connect([&](const drive::Seat&) { ++changed; });
+  REQUIRE(r.seats.claim("pad", drive::Holder::Gamepad, 1));
+  CHECK(changed == 1);
+  REQUIRE(r.seats.input("pad", 0.5, 0));
+  REQUIRE(r.seats.input("pad", 0.5, 0));  // the heartbeat of a phone: nothing new
+  CHECK(asked == 1);
+  REQUIRE(r.seats.input("pad", 0.5, 1));
+  REQUIRE(r.seats.input("pad", 0.25, 0));
+  CHECK(asked == 3);
+  CHECK(changed == 1);
+}
+
+TEST_CASE("seats: a loss leaves alone a car that no driver drives from the seat") {
+  // The race director drives the scan lap and the grid itself, an AI may drive a seat no one
+  // took: a phone that goes then must not stop a car that is not its to drive.
+  Run r;
+  REQUIRE(r.seats.claim("phone#1", drive::Holder::Phone, 1));
+  REQUIRE(r.seats.claim("phone#2", drive::Holder::Phone, 2));
+  r.drive(0, 700);
+  r.drive(1, 700);
+  r.runDriving(1.5, 2, 2, [&] {  // only seat 2's car is driven from its seat
+    REQUIRE(r.seats.input("phone#1", 0.5, 0));
+    REQUIRE(r.seats.input("phone#2", 0.5, 0));
+  });
+  r.seats.release("phone#1", "the phone disconnected");
+  r.seats.release("phone#2", "the phone disconnected");
+  r.run(1.5);
+  CHECK(r.cars[0]->state().target_speed_mm_s == 700);
+  CHECK(r.speed(0) > 600);
+  CHECK(r.cars[1]->state().target_speed_mm_s == 0);
+  CHECK(r.speed(1) == 0);
+}
+
+TEST_CASE("seats: seats that go while held stop the cars driven from them") {
+  Run r;
+  auto own = std::make_unique<drive::Seats>(r.loop, r.fleet, 1);  // a script's own, say
+  REQUIRE(own->claim("script#1", drive::Holder::Script, 1));
+  REQUIRE(own->input("script#1", 1, 0));
+  r.drive(0, 900);
+  own->driving(1);
+  r.run(0.5);
+  own.reset();  // its version reloaded away
+  r.run(1.5);
+  CHECK(r.cars[0]->state().target_speed_mm_s == 0);
+  CHECK(r.speed(0) == 0);
+}
+
+TEST_CASE("seats: a holder moving to another seat lets go of its old one after it took the new") {
+  Run r;
+  REQUIRE(r.seats.claim("phone#1", drive::Holder::Phone, 1));
+  std::vector<std::string> seen;
+  auto sub = r.seats.changed.connect([&](const drive::Seat& s) {
+    seen.push_back(std::to_string(s.number) + (s.held() ? " held" : " free"));
+    // someone waiting for a free seat takes it the moment it frees
+    if (!s.held()) CHECK(r.seats.claim("pad", drive::Holder::Gamepad, 0));
+  });
+  REQUIRE(*r.seats.claim("phone#1", drive::Holder::Phone, 2) == 2);
+  CHECK(seen == std::vector<std::string>{"2 held", "1 free", "1 held"});
+  CHECK(r.seats.heldBy("phone#1")->number == 2);
+  CHECK(r.seats.heldBy("pad")->number == 1);
 }

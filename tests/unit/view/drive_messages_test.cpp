@@ -5,6 +5,8 @@
 // cars are simulated ones behind the real codec, so "speed 0" is the command the car was sent.
 #include <doctest/doctest.h>
 
+#include <functional>
+
 #include <atomic>
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/beast/core.hpp>
@@ -205,6 +207,7 @@ TEST_CASE("view drive: a page drives its own seat only, and leaving stops the ca
   CHECK(rig.seats->seat(2)->throttle == 0);
   // the human driver (the race library) would command the car from the seat; here the test does
   REQUIRE(rig.car(1).setSpeed(600, 2000));
+  rig.seats->driving(1);
   rig.with([&](std::uint16_t) {
     a->send(R"({"type":"leave"})");
     a->seatsWhere([](const nlohmann::json& s) { return s[0]["held"] == false; });
@@ -226,6 +229,8 @@ TEST_CASE("view drive: a page that closes frees its seat and its car is commande
   });
   REQUIRE(rig.car(1).setSpeed(700, 2000));
   REQUIRE(rig.car(2).setSpeed(700, 2000));
+  rig.seats->driving(1);  // (as the human driver says at every update)
+  rig.seats->driving(2);
   SUBCASE("closed by the page") {
     rig.with([&](std::uint16_t) { a->close(); });
   }
@@ -259,6 +264,14 @@ TEST_CASE("view drive: a page silent for 1 s loses its input: the car is command
   });
   REQUIRE(runUntil(rig.loop, [&] { return rig.seats->seat(1)->throttle == 0.8; }));
   REQUIRE(rig.car(1).setSpeed(800, 2000));
+  // a driver drives from the seat, saying so every 0.1 s (as the human driver does)
+  bool driven = true;
+  std::function<void()> drive = [&] {
+    if (!driven) return;
+    rig.seats->driving(1);
+    rig.loop.after(fromSeconds(0.1), drive);
+  };
+  drive();
   const double from = rig.loop.seconds();
   REQUIRE(runUntil(
       rig.loop, [&] { return !rig.seats->seat(1)->live; }, std::chrono::seconds(3)));
@@ -271,6 +284,7 @@ TEST_CASE("view drive: a page silent for 1 s loses its input: the car is command
     a->seatsWhere([](const nlohmann::json& s) { return s[0]["live"] == true; });
   });
   CHECK(rig.seats->seat(1)->throttle == 0.3);
+  driven = false;
 }
 
 TEST_CASE("view drive: hostile messages are refused or dropped, never thrown") {
@@ -290,6 +304,15 @@ TEST_CASE("view drive: hostile messages are refused or dropped, never thrown") {
       auto m = a.answer();
       CHECK_MESSAGE(m["type"] == "error", bad);
       CHECK_MESSAGE(!m["message"].get<std::string>().empty(), bad);
+    }
+    // a seat nested 30 000 arrays deep, in the 64 KB a message may have: named by its type (a
+    // recursive dump of it would overflow the stack)
+    a.send(R"({"type":"seat","seat":)" + std::string(30000, '[') + std::string(30000, ']') + "}");
+    {
+      auto m = a.answer();
+      CHECK(m["type"] == "error");
+      CHECK(m["message"].get<std::string>().find("seat (array) is not a seat") !=
+            std::string::npos);
     }
     // a name with control characters and a long one: taken, kept short and printable (below)
     a.send(R"({"type":"seat","seat":1,"player":"\u0000\u001b[31mAnna)" + std::string(300, 'x') +
