@@ -9,7 +9,8 @@
 --   build/pitwall run examples/party.lua --ble --humans 2 --view       -- the same, real cars
 --
 -- Seats still free after WAIT seconds (default 60) get an AI driver; without --humans every car
--- is an AI (then it is a plain grand prix with items). LAPS laps (default 5).
+-- is an AI (then it is a plain grand prix with items). LAPS laps (default 5). With --view the
+-- results stay up for SHOW seconds (default 60) before the run ends.
 local race = require "pitwall.race"
 local drivers = require "pitwall.drivers"
 
@@ -104,4 +105,9 @@ local party = race.laps {
 local winner = party:results()[1]
 print(string.format("Winner: %s, %d laps in %s", winner.car, winner.laps,
   race.time(winner.totalTime)))
+if pitwall.view.active then -- the results stay up on the view and the phones for a while
+  local show = tonumber(os.getenv("SHOW")) or 60
+  print(string.format("The results stay on the view for %d s (Ctrl-C ends sooner)", show))
+  pitwall.sleep(show)
+end
 pitwall.stop()

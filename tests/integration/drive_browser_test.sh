@@ -79,4 +79,33 @@ if [ "$FAILURES" -ne 0 ]; then
   echo "pitwall's stderr:"
   sed 's/^/  | /' "$TMP/err" | tail -40
 fi
+
+# Done when: two people with phones and two AI drivers run a race (examples/party.lua, one lap)
+# to its end, with the race view showing it.
+LAPS=1 WAIT=120 SHOW=10 "$PITWALL" run "$SRC/examples/party.lua" --view 127.0.0.1:0 --humans 2 --cars 4 \
+  --duration 300 > "$TMP/party.out" 2> "$TMP/party.err" &
+pid=$!
+if wait_for "$TMP/party.err" '^view: http://127\.0\.0\.1:[0-9]+/' 20; then
+  url=$(grep -oE '^view: http://127\.0\.0\.1:[0-9]+/' "$TMP/party.err" | head -1 | sed 's/^view: //')
+  timeout -k 5 280 node "$CHECK/drive_check.mjs" "$url" --party --timeout 120 --chromium "$CHROMIUM" \
+    --artifacts "$ART"
+  check "party check exit status" 0 "$?"
+  deadline=$((SECONDS + 40))  # the script ends the run itself once the results were shown (SHOW)
+  while kill -0 "$pid" 2>/dev/null && [ $SECONDS -lt $deadline ]; do sleep 0.1; done
+  if kill -0 "$pid" 2>/dev/null; then
+    fail "the party did not end 40 s after the check"
+  else
+    wait "$pid"
+    check "party exit status" 0 "$?"
+    pid=""
+  fi
+  contains "the party names a winner" "Winner: " "$(cat "$TMP/party.out")"
+  contains "the party waited for both players" "seat 2: Ben" "$(cat "$TMP/party.out")"
+else
+  fail "the party printed no 'view: http://127.0.0.1:PORT/' line within 20 s"
+fi
+if [ "$FAILURES" -ne 0 ]; then
+  echo "the party's stderr:"
+  sed 's/^/  | /' "$TMP/party.err" | tail -40
+fi
 finish

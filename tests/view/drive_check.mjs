@@ -2,7 +2,13 @@
 // (tests/integration/drive_browser_test.sh; the DOM hooks are listed at the top of
 // engine/view/page/drive.js; the messages in docs/view.md "The controller page").
 //
-//   node drive_check.mjs URL [--timeout SECONDS] [--chromium PATH] [--artifacts DIR]
+//   node drive_check.mjs URL [--timeout SECONDS] [--chromium PATH] [--artifacts DIR] [--party]
+//
+// --party: against examples/party.lua (--humans 2, four cars): Anna and Ben take seats 1 and 2,
+// wait for the green light with their fingers off the throttle, then drive (Anna flat out, Ben at
+// four fifths) until the race is done; the race's rows must show both players as human drivers
+// that finished without a false start, the two AI drivers finished, and the race view's
+// leaderboard names the players.
 //
 // Checks: the race view links to /drive; page 1 takes seat 1; page 2 asks for seat 1 and is told
 // it is taken, then takes seat 2; page 1 holds its throttle up → car 1 is commanded a speed and
@@ -16,12 +22,12 @@ import puppeteer from "puppeteer-core";
 
 function usage(message) {
   if (message) console.error(`drive_check: ${message}`);
-  console.error("usage: node drive_check.mjs URL [--timeout SECONDS] [--chromium PATH] [--artifacts DIR]");
+  console.error("usage: node drive_check.mjs URL [--timeout SECONDS] [--chromium PATH] [--artifacts DIR] [--party]");
   process.exit(2);
 }
 
 const args = process.argv.slice(2);
-const opts = { timeout: 30, chromium: process.env.CHROMIUM || "/usr/bin/chromium", artifacts: null };
+const opts = { timeout: 30, chromium: process.env.CHROMIUM || "/usr/bin/chromium", artifacts: null, party: false };
 const positional = [];
 for (let i = 0; i < args.length; i++) {
   const a = args[i];
@@ -29,6 +35,7 @@ for (let i = 0; i < args.length; i++) {
   if (a === "--timeout") opts.timeout = Number(value());
   else if (a === "--chromium") opts.chromium = value();
   else if (a === "--artifacts") opts.artifacts = value();
+  else if (a === "--party") opts.party = true;
   else if (a.startsWith("--")) usage(`unknown option ${a}`);
   else positional.push(a);
 }
@@ -134,7 +141,59 @@ async function holdThrottle(page, fraction) {
   return page.$eval("#throttle", (el) => Number(el.dataset.value));
 }
 
-try {
+// Takes seat `n` on `page` as `player`.
+async function takeSeat(page, name, n, player) {
+  await waitFor(page, `${name}: live, seats to pick`,
+    () => document.querySelector("#connection")?.textContent === "live" &&
+      document.querySelectorAll("#seats button[data-number]").length >= 2 && !document.querySelector("#pick").hidden);
+  await page.type("#player", player);
+  await page.click(`#seats button[data-number="${n}"]`);
+  return waitFor(page, `${name} holds seat ${n}`,
+    (k) => !document.querySelector("#drive").hidden && document.querySelector("#drive").dataset.seat === String(k), n);
+}
+
+// The party race (examples/party.lua): two phones and two AI drivers, to the finish.
+async function party() {
+  const one = await phone("Anna's phone");
+  const two = await phone("Ben's phone");
+  await takeSeat(one, "Anna's phone", 1, "Anna");
+  await takeSeat(two, "Ben's phone", 2, "Ben");
+  // the race starts once both seats are held: a scan lap, the grid, the lights; no finger on
+  // the throttle until green (a jump start would be caught)
+  const racing = await until("the race goes green", (s) => s.race && s.race.phase === "racing",
+    (s) => `phase ${s.race && s.race.phase}`);
+  if (!racing) return;
+  await holdThrottle(one, 1.0);
+  await holdThrottle(two, 0.8);
+  await until("car 1 and car 2 are driven by their phones",
+    (s) => carOf(s, 1).targetSpeed >= 300 && carOf(s, 2).targetSpeed >= 300,
+    (s) => `car 1 ${show(carOf(s, 1))}; car 2 ${show(carOf(s, 2))}`);
+  const view = await (await browser.createBrowserContext()).newPage();
+  await view.goto(url, { waitUntil: "load", timeout: timeoutMs });
+  const done = await until("the race is done", (s) => s.race && s.race.phase === "done",
+    (s) => `phase ${s.race && s.race.phase}, laps ${(s.race && s.race.rows || []).map((r) => r.lap).join("/")}`);
+  if (!done) return;
+  const rows = done.race.rows || [];
+  check("four cars in the results", rows.length === 4, JSON.stringify(rows.map((r) => r.car)));
+  for (const [n, player] of [[1, "Anna"], [2, "Ben"]]) {
+    const r = rows.find((x) => x.number === n) || {};
+    check(`${player} raced car ${n} as a human driver and finished, no false start`,
+      r.player === player && r.driver === "human" && r.finished === true && r.falseStart !== true,
+      JSON.stringify(r));
+  }
+  const ai = rows.filter((r) => r.number > 2);
+  check("the two AI drivers finished", ai.length === 2 && ai.every((r) => r.finished === true && r.driver !== "human"),
+    JSON.stringify(ai));
+  await waitFor(view, "the race view's leaderboard names both players",
+    () => { const t = document.body.innerText; return t.includes("Anna (human)") && t.includes("Ben (human)"); });
+  if (opts.artifacts) await view.screenshot({ path: `${opts.artifacts}/drive-party.png` });
+  await one.mouse.up();
+  await two.mouse.up();
+  check("no script errors or failed requests", pageErrors.length === 0, pageErrors.join("; "));
+}
+
+// The two-phone checks against tests/view/drive_race.lua (the header says which).
+async function twoPhones() {
   // The race view links to the controller page (the run has seats).
   const viewPage = await (await browser.createBrowserContext()).newPage();
   await viewPage.goto(url, { waitUntil: "load", timeout: timeoutMs });
@@ -214,6 +273,10 @@ try {
   if (opts.artifacts) await two.screenshot({ path: `${opts.artifacts}/drive-page-2.png` });
 
   check("no script errors or failed requests", pageErrors.length === 0, pageErrors.join("; "));
+}
+
+try {
+  await (opts.party ? party() : twoPhones());
 } catch (e) {
   fail("drive check", String(e.stack || e));
 } finally {

@@ -314,7 +314,7 @@ function renderBoard() {
     const cells = [
       r.position ?? i + 1,
       `<span class="swatch"></span>${escapeHtml(r.car ?? car.name ?? `car ${r.number}`)}`,
-      escapeHtml(r.driver ?? "–"),
+      escapeHtml(r.player ? `${r.player} (${r.driver ?? "human"})` : (r.driver ?? "–")),
       r.lap ?? "–", fmtTime(r.lastLap), fmtTime(r.bestLap), gap,
       r.speed == null ? "–" : Math.round(r.speed), fmtMm(r.lane),
     ];
