@@ -94,8 +94,7 @@ end
 
 print(string.format("Party race: %d cars, %d laps", #cars, LAPS))
 local party = race.laps {
-  laps = LAPS,
-  scan = true,
+  laps = LAPS, -- (the map: the simulator's own, or a scan lap on real cars)
   drivers = driverFor,
   title = string.format("Party race, %d laps", LAPS),
   onLap = function(car, lap, session)
