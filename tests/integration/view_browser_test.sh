@@ -4,40 +4,11 @@
 # tests/view/package-lock.json): track, 4 moving cars, leaderboard, charts; then Ctrl-C to the
 # engine and the open page says "engine gone". Screenshots in ./view_test_artifacts/.
 source "$(dirname "$0")/lib.sh"
+source "$(dirname "$0")/browser_lib.sh"
+need_firefox
 
-pid=""
-cleanup() {
-  [ -n "$pid" ] && kill -KILL "$pid" 2>/dev/null
-  rm -rf "$TMP"
-}
-trap cleanup EXIT
-
-# Real parts: no browser or no node is a failure, not a skip (./dev test installs them).
-CHROMIUM=${CHROMIUM:-/usr/bin/chromium}
-FIREFOX=${FIREFOX:-/usr/bin/firefox-esr}
-command -v node >/dev/null || { echo "FAIL: node is missing; install nodejs (./dev test does)"; exit 1; }
-command -v npm >/dev/null || { echo "FAIL: npm is missing; install npm (./dev test does)"; exit 1; }
-[ -x "$CHROMIUM" ] || { echo "FAIL: no Chromium at $CHROMIUM; install chromium (./dev test does) or set CHROMIUM"; exit 1; }
-[ -x "$FIREFOX" ] || { echo "FAIL: no Firefox at $FIREFOX; install firefox-esr (./dev test does) or set FIREFOX"; exit 1; }
-
-# puppeteer-core, installed once in the build tree (again when the lockfile changes).
-CHECK="$PWD/view_browser_check"
-mkdir -p "$CHECK"
-if ! cmp -s "$SRC/tests/view/package-lock.json" "$CHECK/installed.lock" ||
-   [ ! -d "$CHECK/node_modules/puppeteer-core" ]; then
-  cp "$SRC/tests/view/package.json" "$SRC/tests/view/package-lock.json" "$CHECK/"
-  if ! (cd "$CHECK" && timeout 300 npm ci --no-audit --no-fund --loglevel=error); then
-    echo "FAIL: npm ci of tests/view (puppeteer-core) in $CHECK"
-    exit 1
-  fi
-  cp "$SRC/tests/view/package-lock.json" "$CHECK/installed.lock"
-fi
-# Beside its node_modules, so that `import "puppeteer-core"` resolves.
-cp "$SRC/tests/view/browser_check.mjs" "$CHECK/"
-
-ART="$PWD/view_test_artifacts"
-mkdir -p "$ART"
-rm -f "$ART"/view-*.png
+install_checks view_browser_check browser_check.mjs
+artifacts 'view-*.png'
 
 # in_browser NAME BROWSER-OPTION PATH: a long race (it must not end by itself before the check is
 # done), real time, any free port; the page checked in that browser, then SIGINT to pitwall and
@@ -46,19 +17,13 @@ rm -f "$ART"/view-*.png
 in_browser() {
   local name=$1 option=$2 path=$3
   # Emptied here, not by the redirection below: that happens in the background child, after
-  # wait_for may already have read the previous run's address from the old file.
+  # await_view may already have read the previous run's address from the old file.
   : > "$TMP/out"
   : > "$TMP/err"
   LAPS=50 "$PITWALL" run "$SRC/examples/grand_prix.lua" --view 127.0.0.1:0 \
     > "$TMP/out" 2> "$TMP/err" &
   pid=$!
-  if ! wait_for "$TMP/err" '^view: http://127\.0\.0\.1:[0-9]+/' 20; then
-    fail "pitwall printed no 'view: http://127.0.0.1:PORT/' line within 20 s; its stderr:"
-    sed 's/^/  | /' "$TMP/err"
-    finish
-  fi
-  url=$(grep -oE '^view: http://127\.0\.0\.1:[0-9]+/' "$TMP/err" | head -1 | sed 's/^view: //')
-  echo "ok: view at $url ($name)"
+  await_view "$TMP/err" "$name" || finish
   local addr=${url#http://}
   addr=${addr%/}
 
@@ -75,21 +40,10 @@ in_browser() {
   check "$name: browser check exit status" 0 "$?"
 
   # pitwall ends on Ctrl-C, as without a browser (exit status 130), within 10 s.
-  local deadline=$((SECONDS + 10))
-  while kill -0 "$pid" 2>/dev/null && [ $SECONDS -lt $deadline ]; do sleep 0.05; done
-  if kill -0 "$pid" 2>/dev/null; then
-    fail "pitwall still runs 10 s after SIGINT"
-  else
-    wait "$pid"
-    check "pitwall exit status after Ctrl-C" 130 "$?"
-    pid=""
-  fi
+  await_end "pitwall after Ctrl-C" 10 130
   [ -s "$ART/view-$name.png" ] && echo "ok: screenshot $ART/view-$name.png" ||
     fail "no screenshot at $ART/view-$name.png"
-  if [ "$FAILURES" -ne 0 ]; then
-    echo "pitwall's stderr:"
-    sed 's/^/  | /' "$TMP/err" | tail -40
-  fi
+  show_if_failed "pitwall's stderr" "$TMP/err"
 }
 
 in_browser chromium --chromium "$CHROMIUM"

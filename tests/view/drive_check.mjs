@@ -18,48 +18,13 @@
 // commanded `targetSpeed` and reported `speed`).
 // Prints one PASS/FAIL line per check; exit status 1 when a check failed, 2 on bad arguments.
 // Every wait polls with a deadline (--timeout, default 30 s); no fixed sleeps.
-import puppeteer from "puppeteer-core";
+import { check, fail, finish, launch, parseArgs, pass, passWhen, settings, watchPage } from "./check_lib.mjs";
 
-function usage(message) {
-  if (message) console.error(`drive_check: ${message}`);
-  console.error("usage: node drive_check.mjs URL [--timeout SECONDS] [--chromium PATH] [--artifacts DIR] [--party]");
-  process.exit(2);
-}
-
-const args = process.argv.slice(2);
-const opts = { timeout: 30, chromium: process.env.CHROMIUM || "/usr/bin/chromium", artifacts: null, party: false };
-const positional = [];
-for (let i = 0; i < args.length; i++) {
-  const a = args[i];
-  const value = () => (i + 1 < args.length ? args[++i] : usage(`${a} needs a value`));
-  if (a === "--timeout") opts.timeout = Number(value());
-  else if (a === "--chromium") opts.chromium = value();
-  else if (a === "--artifacts") opts.artifacts = value();
-  else if (a === "--party") opts.party = true;
-  else if (a.startsWith("--")) usage(`unknown option ${a}`);
-  else positional.push(a);
-}
-if (positional.length !== 1) usage("give the view's URL");
-if (!(opts.timeout > 0)) usage("--timeout takes seconds > 0");
+const { opts, positional } = parseArgs("drive_check",
+  "URL [--timeout SECONDS] [--chromium PATH] [--artifacts DIR] [--party]",
+  { "--artifacts": ["artifacts", String], "--party": ["party"] }, [1, "give the view's URL"]);
 const url = positional[0].endsWith("/") ? positional[0] : `${positional[0]}/`;
-const timeoutMs = opts.timeout * 1000;
-
-let failures = 0;
-function pass(name, detail) { console.log(`PASS: ${name}${detail ? ` (${detail})` : ""}`); }
-function fail(name, detail) { failures++; console.log(`FAIL: ${name}${detail ? `: ${detail}` : ""}`); }
-function check(name, ok, detail) { (ok ? pass : fail)(name, detail); return ok; }
-
-// Waits for fn in the page; a timeout is a FAIL with `name` said, not an exception.
-async function waitFor(page, name, fn, arg) {
-  try {
-    await page.waitForFunction(fn, { timeout: timeoutMs, polling: 50 }, arg);
-    pass(name);
-    return true;
-  } catch (e) {
-    fail(name, `not within ${opts.timeout} s (${String(e.message).split("\n")[0]})`);
-    return false;
-  }
-}
+const timeoutMs = settings.timeoutMs;
 
 async function state() {
   const r = await fetch(`${url}api/state`);
@@ -92,39 +57,15 @@ async function until(name, ok, describe, always) {
   }
 }
 
-let browser;
-try {
-  browser = await puppeteer.launch({
-    executablePath: opts.chromium,
-    headless: true,
-    args: [
-      "--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
-      "--no-first-run", "--no-default-browser-check", "--disable-background-networking",
-      "--disable-component-update", "--disable-sync", "--disable-extensions",
-      // two phones in one browser: neither page's timers may be slowed as a background tab's
-      "--disable-background-timer-throttling", "--disable-renderer-backgrounding",
-      "--disable-backgrounding-occluded-windows",
-      "--host-resolver-rules=MAP * ~NOTFOUND, EXCLUDE localhost, EXCLUDE 127.0.0.1",
-    ],
-    timeout: timeoutMs,
-  });
-} catch (e) {
-  fail("chromium starts", `${opts.chromium}: ${e.message.split("\n")[0]}`);
-  process.exit(1);
-}
+const browser = await launch({ chromium: opts.chromium });
 
-const pageErrors = [];
+const log = { errors: [], requests: [] };  // of every phone
 async function phone(name) {
   // each phone a browser of its own (its own storage), phone-sized
   const context = await browser.createBrowserContext();
   const page = await context.newPage();
   await page.setViewport({ width: 390, height: 780, deviceScaleFactor: 1 });
-  page.on("pageerror", (e) => pageErrors.push(`${name}: ${String(e.message || e).split("\n")[0]}`));
-  page.on("console", (m) => {
-    if (m.type() === "error" && !/WebSocket|ERR_CONNECTION_REFUSED/.test(m.text()))
-      pageErrors.push(`${name} console: ${m.text()}`);
-  });
-  page.on("response", (r) => { if (r.status() >= 400) pageErrors.push(`${name}: ${r.url()} HTTP ${r.status()}`); });
+  watchPage(page, log, name);
   const response = await page.goto(`${url}drive`, { waitUntil: "load", timeout: timeoutMs });
   check(`${name}: /drive loads`, response && response.ok(), `HTTP ${response && response.status()}`);
   return page;
@@ -143,12 +84,12 @@ async function holdThrottle(page, fraction) {
 
 // Takes seat `n` on `page` as `player`.
 async function takeSeat(page, name, n, player) {
-  await waitFor(page, `${name}: live, seats to pick`,
+  await passWhen(page, `${name}: live, seats to pick`,
     () => document.querySelector("#connection")?.textContent === "live" &&
       document.querySelectorAll("#seats button[data-number]").length >= 2 && !document.querySelector("#pick").hidden);
   await page.type("#player", player);
   await page.click(`#seats button[data-number="${n}"]`);
-  return waitFor(page, `${name} holds seat ${n}`,
+  return passWhen(page, `${name} holds seat ${n}`,
     (k) => !document.querySelector("#drive").hidden && document.querySelector("#drive").dataset.seat === String(k), n);
 }
 
@@ -184,12 +125,13 @@ async function party() {
   const ai = rows.filter((r) => r.number > 2);
   check("the two AI drivers finished", ai.length === 2 && ai.every((r) => r.finished === true && r.driver !== "human"),
     JSON.stringify(ai));
-  await waitFor(view, "the race view's leaderboard names both players",
+  await passWhen(view, "the race view's leaderboard names both players",
     () => { const t = document.body.innerText; return t.includes("Anna (human)") && t.includes("Ben (human)"); });
   if (opts.artifacts) await view.screenshot({ path: `${opts.artifacts}/drive-party.png` });
   await one.mouse.up();
   await two.mouse.up();
-  check("no script errors or failed requests", pageErrors.length === 0, pageErrors.join("; "));
+  check("no script errors or failed requests", log.errors.length + log.requests.length === 0,
+    [...log.errors, ...log.requests].join("; "));
 }
 
 // The two-phone checks against tests/view/drive_race.lua (the header says which).
@@ -197,29 +139,29 @@ async function twoPhones() {
   // The race view links to the controller page (the run has seats).
   const viewPage = await (await browser.createBrowserContext()).newPage();
   await viewPage.goto(url, { waitUntil: "load", timeout: timeoutMs });
-  await waitFor(viewPage, "the race view shows a link to /drive",
+  await passWhen(viewPage, "the race view shows a link to /drive",
     () => { const a = document.querySelector("#drive-link"); return a && !a.hidden && a.getAttribute("href") === "/drive"; });
   await viewPage.close();
 
   const one = await phone("page 1");
   const two = await phone("page 2");
   for (const [name, page] of [["page 1", one], ["page 2", two]])
-    await waitFor(page, `${name}: live, two seats to pick`,
+    await passWhen(page, `${name}: live, two seats to pick`,
       () => document.querySelector("#connection")?.textContent === "live" &&
         document.querySelectorAll("#seats button[data-number]").length === 2 && !document.querySelector("#pick").hidden);
 
   // page 1 takes seat 1
   await one.type("#player", "Anna");
   await one.click('#seats button[data-number="1"]');
-  await waitFor(one, "page 1 holds seat 1: the controls are shown",
+  await passWhen(one, "page 1 holds seat 1: the controls are shown",
     () => !document.querySelector("#drive").hidden && document.querySelector("#drive").dataset.seat === "1");
 
   // page 2 sees it taken, asks for it anyway, is refused, takes seat 2
-  await waitFor(two, "page 2 sees seat 1 held",
+  await passWhen(two, "page 2 sees seat 1 held",
     () => document.querySelector('#seats button[data-number="1"]')?.classList.contains("held"));
   await two.type("#player", "Ben");
   await two.click('#seats button[data-number="1"]');
-  if (await waitFor(two, "page 2 is told seat 1 is taken",
+  if (await passWhen(two, "page 2 is told seat 1 is taken",
       () => { const n = document.querySelector("#notice"); return !n.hidden && n.dataset.kind === "taken"; })) {
     const text = await two.$eval("#notice", (n) => n.textContent);
     check("the refusal names the holder", /seat 1 is held by another phone \(Anna\)/.test(text), text);
@@ -227,7 +169,7 @@ async function twoPhones() {
   check("page 2 holds no seat after the refusal", await two.$eval("#drive", (d) => d.hidden));
   if (opts.artifacts) await two.screenshot({ path: `${opts.artifacts}/drive-page-taken.png` });
   await two.click('#seats button[data-number="2"]');
-  await waitFor(two, "page 2 holds seat 2",
+  await passWhen(two, "page 2 holds seat 2",
     () => !document.querySelector("#drive").hidden && document.querySelector("#drive").dataset.seat === "2");
 
   await until("the state shows seat 1 held by Anna and seat 2 by Ben",
@@ -272,7 +214,8 @@ async function twoPhones() {
     (s) => JSON.stringify(seatOf(s, 2)));
   if (opts.artifacts) await two.screenshot({ path: `${opts.artifacts}/drive-page-2.png` });
 
-  check("no script errors or failed requests", pageErrors.length === 0, pageErrors.join("; "));
+  check("no script errors or failed requests", log.errors.length + log.requests.length === 0,
+    [...log.errors, ...log.requests].join("; "));
 }
 
 try {
@@ -282,5 +225,4 @@ try {
 } finally {
   await browser.close().catch(() => {});
 }
-console.log(failures === 0 ? "drive check: all passed" : `drive check: ${failures} failed`);
-process.exit(failures === 0 ? 0 : 1);
+finish("drive check");
