@@ -37,6 +37,9 @@ The race view's page, instead of the data folder's web/.
 .B PITWALL_HISTORY
 The REPL's history file (default ~/.pitwall_history).
 .TP
+.B PITWALL_INPUT_DIR
+The folder run --gamepads watches for gamepads (evdev event nodes), instead of /dev/input.
+.TP
 .B PITWALL_PRINT_MODULE
 The print module that track print and track verify load, instead of ../lib/pitwall/pitwall_print.so
 beside the binary.
