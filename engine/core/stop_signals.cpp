@@ -59,6 +59,13 @@ StopSignals::StopSignals(Loop& loop) : loop_(loop), pipe_(loop.io()) {
   sa.sa_flags = 0;
   ::sigaction(SIGINT, &sa, &oldInt_);
   ::sigaction(SIGTERM, &sa, &oldTerm_);
+  // SIGHUP: the terminal closed (a window shut, an SSH connection dropped). Its default action
+  // ends the process on the spot — no stop for any car, the terminal's modes not put back — so
+  // it ends the run as SIGTERM does. (nohup's SIG_IGN is kept: the run was meant to outlive
+  // its terminal.)
+  ::sigaction(SIGHUP, nullptr, &oldHup_);
+  hupCaught_ = oldHup_.sa_handler != SIG_IGN;
+  if (hupCaught_) ::sigaction(SIGHUP, &sa, nullptr);
   if (loop.clockKind() == ClockKind::Virtual)
     loop.setPassCheck([this] { drain(); });
   else
@@ -69,6 +76,7 @@ StopSignals::~StopSignals() {
   if (loop_.clockKind() == ClockKind::Virtual) loop_.setPassCheck({});
   if (!sigintReleased_) ::sigaction(SIGINT, &oldInt_, nullptr);
   ::sigaction(SIGTERM, &oldTerm_, nullptr);
+  if (hupCaught_) ::sigaction(SIGHUP, &oldHup_, nullptr);
   g_writeFd.store(-1, std::memory_order_relaxed);
   boost::system::error_code ignored;
   pipe_.close(ignored);

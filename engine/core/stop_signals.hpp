@@ -1,6 +1,6 @@
 #pragma once
-// SIGINT and SIGTERM for a run (docs/safety.md). The handler does only async-signal-safe work:
-// it counts the signal, calls an async-signal-safe hook (the bindings interrupt the Lua code
+// SIGINT, SIGTERM and SIGHUP for a run (docs/safety.md). The handler does only async-signal-safe
+// work: it counts the signal, calls an async-signal-safe hook (the bindings interrupt the Lua code
 // running now, so a busy callback cannot hold Ctrl-C up), and wakes the loop through a pipe; the
 // loop then calls onSignal. A virtual loop, which never sleeps, reads the pipe when the handler's
 // count says there is something in it (Loop::setPassCheck) instead of keeping a read pending. A
@@ -22,7 +22,7 @@ class StopSignals {
   StopSignals(const StopSignals&) = delete;
   StopSignals& operator=(const StopSignals&) = delete;
 
-  // On the loop: `count` is how many SIGINT/SIGTERM arrived so far (1 for the first).
+  // On the loop: `count` is how many SIGINT/SIGTERM/SIGHUP arrived so far (1 for the first).
   std::function<void(int sig, int count)> onSignal;
   // Called inside the handler, on every signal; must be async-signal-safe.
   static void setAsyncHook(AsyncHook hook);
@@ -37,7 +37,8 @@ class StopSignals {
   boost::asio::posix::stream_descriptor pipe_;
   int writeFd_ = -1;
   struct sigaction oldInt_ {
-  }, oldTerm_{};
+  }, oldTerm_{}, oldHup_{};
+  bool hupCaught_ = false;  // not when SIGHUP was ignored (nohup)
   bool sigintReleased_ = false;
   char byte_ = 0;
   int drained_ = 0;  // signals a virtual loop has read

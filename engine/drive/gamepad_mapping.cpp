@@ -31,6 +31,7 @@ GamepadMapping::GamepadMapping(const DeviceCaps& caps) {
     trigger_ = code;
     triggerInfo_ = it->second;
     triggerValue_ = it->second.value;
+    armed_ = atRest(triggerInfo_, triggerValue_);
     source_ = ThrottleSource::Trigger;
     break;
   }
@@ -50,6 +51,10 @@ double GamepadMapping::triggerLevel(const AxisInfo& info, int value) {
   return std::clamp(from / span, 0.0, 1.0);
 }
 
+bool GamepadMapping::atRest(const AxisInfo& info, int value) {
+  return info.maximum > info.minimum && value >= info.minimum && triggerLevel(info, value) == 0;
+}
+
 double GamepadMapping::stickUp(const AxisInfo& info, int value) {
   if (info.maximum <= info.minimum) return 0;
   const double centre = (static_cast<double>(info.minimum) + info.maximum) / 2;
@@ -62,8 +67,7 @@ double GamepadMapping::stickUp(const AxisInfo& info, int value) {
 
 double GamepadMapping::wanted() const {
   if (brake_) return 0;
-  if (source_ == ThrottleSource::Trigger)
-    return quantized(triggerLevel(triggerInfo_, triggerValue_));
+  if (armed_) return quantized(triggerLevel(triggerInfo_, triggerValue_));
   double level = digitalTrigger_ ? 1.0 : 0.0;
   if (hasStick_) level = std::max(level, stickUp(stickInfo_, stickValue_));
   return quantized(level);
@@ -72,9 +76,10 @@ double GamepadMapping::wanted() const {
 std::optional<GamepadInput> GamepadMapping::event(int type, int code, int value, bool replay) {
   int lane = 0;
   if (type == EV_ABS) {
-    if (code == trigger_)
+    if (code == trigger_) {
       triggerValue_ = value;
-    else if (code == ABS_Y && hasStick_)
+      if (!armed_) armed_ = atRest(triggerInfo_, value);
+    } else if (code == ABS_Y && hasStick_)
       stickValue_ = value;
     else
       return std::nullopt;

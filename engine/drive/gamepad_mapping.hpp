@@ -9,6 +9,12 @@
 //   (gamepad.rst: "Lower trigger buttons are reported as BTN_TR2 or ABS_HAT2X (right/ZR)") —
 //   normalized with its absinfo; a pad without one: the digital right trigger BTN_TR2 (full
 //   while held), and the left stick pushed up (−ABS_Y, outside a deadzone) whichever is more;
+// - a trigger axis counts only once it has been seen at rest, within its rest zone at its
+//   minimum (when the device is opened, or later): on many hid-generic pads (Logitech F310 in
+//   D mode, DragonRise) ABS_Z/ABS_RZ is the right stick, resting mid-range, and some wheels'
+//   pedals rest at their maximum — read as a trigger, that is half or full throttle with no hand
+//   on it. Until then the axis reads 0 and BTN_TR2 and the left stick drive as on a pad without
+//   one;
 // - lanes: BTN_TL (left shoulder) one lane left, BTN_TR (right shoulder) one lane right, on the
 //   press (not on the kernel's auto-repeat, not on the release);
 // - brake: BTN_SOUTH (A on Xbox pads, cross on PlayStation ones) held: throttle 0, whatever the
@@ -52,6 +58,9 @@ class GamepadMapping {
 
   ThrottleSource source() const { return source_; }
   int triggerAxis() const { return trigger_; }  // the ABS code, or −1
+  // The trigger axis has been seen at rest at its minimum and is the throttle; false before
+  // (BTN_TR2 and the left stick drive meanwhile) and on a pad without one.
+  bool triggerArmed() const { return armed_; }
 
   // One event (type, code, value as struct input_event has them). The input to send when the
   // throttle changed or a lane button was pressed; nothing otherwise. `replay`: an event of a
@@ -66,6 +75,8 @@ class GamepadMapping {
   static double triggerLevel(const AxisInfo& info, int value);
   // How far a stick is pushed up (towards min): 0 at or below the centre plus deadzone, 1 at min.
   static double stickUp(const AxisInfo& info, int value);
+  // A trigger at rest: within its rest zone at the minimum (triggerLevel 0, not below the range).
+  static bool atRest(const AxisInfo& info, int value);
 
  private:
   double wanted() const;
@@ -73,6 +84,7 @@ class GamepadMapping {
   ThrottleSource source_ = ThrottleSource::StickAndButton;
   int trigger_ = -1;
   AxisInfo triggerInfo_;
+  bool armed_ = false;
   bool hasStick_ = false;
   AxisInfo stickInfo_;
   int triggerValue_ = 0;

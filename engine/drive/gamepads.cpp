@@ -2,7 +2,9 @@
 
 #include <fcntl.h>
 #include <libevdev/libevdev.h>
+#include <poll.h>
 #include <sys/inotify.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <boost/asio/posix/stream_descriptor.hpp>
@@ -12,6 +14,7 @@
 #include <map>
 #include <set>
 #include <system_error>
+#include <vector>
 
 #include "engine/core/log.hpp"
 #include "engine/core/printable.hpp"
@@ -52,13 +55,27 @@ DeviceCaps capsOf(const libevdev* dev) {
   return caps;
 }
 
+std::string axisName(int code) {
+  const char* name = libevdev_event_code_get_name(EV_ABS, static_cast<unsigned>(code));
+  return name ? name : "ABS_" + std::to_string(code);
+}
+
 std::string throttleText(const GamepadMapping& m) {
-  if (m.source() == ThrottleSource::Trigger)
-    return std::string("throttle on ") +
-           libevdev_event_code_get_name(EV_ABS, static_cast<unsigned>(m.triggerAxis()));
+  if (m.triggerArmed()) return "throttle on " + axisName(m.triggerAxis());
   return "throttle on the left stick (up) or BTN_TR2";
 }
+
 }  // namespace
+
+bool sameNode(int fd, const std::string& path) {
+  pollfd p{fd, POLLIN, 0};
+  if (::poll(&p, 1, 0) < 0 || (p.revents & (POLLHUP | POLLERR | POLLNVAL))) return false;
+  struct stat held {
+  }, there{};
+  if (::fstat(fd, &held) < 0 || ::stat(path.c_str(), &there) < 0) return false;
+  return held.st_dev == there.st_dev && held.st_ino == there.st_ino &&
+         held.st_rdev == there.st_rdev;
+}
 
 struct Gamepads::Impl {
   struct Device {
@@ -88,6 +105,7 @@ struct Gamepads::Impl {
 
   Result<bool, std::string> start();
   void scan();
+  void overflowed();
   void waitFolder();
   void readFolder();
   void open(const std::string& path);
@@ -143,12 +161,33 @@ Result<bool, std::string> Gamepads::Impl::start() {
 }
 
 void Gamepads::Impl::scan() {
+  // The error_code overloads only: a folder that goes away or fails half way through is a
+  // warning, never an exception out of the loop.
   std::error_code ec;
   std::set<std::string> names;
-  for (const auto& entry : fs::directory_iterator(options.folder, ec))
-    if (isEventNode(entry.path().filename().string())) names.insert(entry.path().string());
+  for (fs::directory_iterator it(options.folder, ec), end; !ec && it != end; it.increment(ec))
+    if (isEventNode(it->path().filename().string())) names.insert(it->path().string());
   if (ec) log::warn(kLog, "cannot list " + options.folder.string() + ": " + ec.message());
   for (const auto& path : names) open(path);  // sorted: event2 before event3, a stable order
+}
+
+// inotify's queue overflowed (IN_Q_OVERFLOW): unplugs and plug-ins may have been lost. A gamepad
+// whose node is gone or is another device now is dropped — else a pad plugged in again under the
+// same name would be passed over as already open — and nodes passed over are looked at again (a
+// keyboard's node may be a gamepad's now); then the folder is read afresh.
+void Gamepads::Impl::overflowed() {
+  log::debug(kLog, "inotify's queue overflowed: looking at " + options.folder.string() + " again");
+  std::weak_ptr<bool> weak = alive;
+  std::vector<std::string> gone;
+  for (const auto& [path, device] : devices)
+    if (!sameNode(device->stream.native_handle(), path)) gone.push_back(path);
+  for (const auto& path : gone) {
+    drop(path, "the gamepad was unplugged");
+    if (weak.expired()) return;
+  }
+  notGamepads.clear();
+  refused.clear();
+  scan();
 }
 
 void Gamepads::Impl::waitFolder() {
@@ -171,7 +210,8 @@ void Gamepads::Impl::readFolder() {
       auto* e = reinterpret_cast<inotify_event*>(p);
       p += sizeof(inotify_event) + e->len;
       if (e->mask & IN_Q_OVERFLOW) {  // events lost: look at the folder again
-        scan();
+        overflowed();
+        if (weak.expired()) return;
         continue;
       }
       if (e->mask & IN_IGNORED) {
@@ -226,6 +266,15 @@ void Gamepads::Impl::open(const std::string& path) {
   devices[path] = device;
   log::info(kLog, "gamepad \"" + device->name + "\" at " + path + ": " +
                       throttleText(*device->mapping) + ", BTN_TL/BTN_TR lanes, BTN_SOUTH brakes");
+  if (const auto& m = *device->mapping;
+      m.source() == ThrottleSource::Trigger && !m.triggerArmed()) {
+    const AxisInfo& a = caps.axes.at(m.triggerAxis());
+    log::warn(kLog, "gamepad \"" + device->name + "\": " + axisName(m.triggerAxis()) +
+                        " does not rest at its minimum (" + std::to_string(a.value) + " in " +
+                        std::to_string(a.minimum) + ".." + std::to_string(a.maximum) +
+                        "; a stick or a pedal, not a trigger?): it is not the throttle until it "
+                        "does (docs/controllers.md)");
+  }
   seat(*device);
   waitDevice(device);
 }
@@ -286,8 +335,13 @@ void Gamepads::Impl::readDevice(const std::shared_ptr<Device>& device) {
       flags = LIBEVDEV_READ_FLAG_SYNC;
       continue;  // this event is the SYN_DROPPED itself
     }
+    const bool armed = device->mapping->triggerArmed();
     auto input =
         device->mapping->event(ev.type, ev.code, ev.value, flags == LIBEVDEV_READ_FLAG_SYNC);
+    if (!armed && device->mapping->triggerArmed())
+      log::info(kLog, "gamepad \"" + device->name +
+                          "\": " + axisName(device->mapping->triggerAxis()) +
+                          " rests at its minimum: it is the throttle from now on");
     if (input && device->seated) {
       auto sent = seats.input(device->path, input->throttle, input->laneStep);
       if (!sent) log::debug(kLog, device->path + ": " + sent.error());
@@ -321,6 +375,10 @@ Result<bool, std::string> Gamepads::start() {
 
 std::size_t Gamepads::count() const {
   return impl_->devices.size();
+}
+
+std::size_t Gamepads::passedOver() const {
+  return impl_->notGamepads.size();
 }
 
 const fs::path& Gamepads::folder() const {

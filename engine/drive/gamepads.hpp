@@ -30,12 +30,19 @@ class Gamepads {
   // Watches the folder and opens the gamepads in it now. The error names the folder and what to
   // do (no such folder; not readable: the user is not in group `input`).
   Result<bool, std::string> start();
-  std::size_t count() const;                    // gamepads open now
+  std::size_t count() const;       // gamepads open now
+  std::size_t passedOver() const;  // event nodes looked at and found no gamepad (there now)
   const std::filesystem::path& folder() const;  // the folder watched (after start())
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// The node at `path` is still the device `fd` has open: the kernel has not said it is gone (evdev
+// polls POLLHUP | POLLERR for a device unplugged), and the node is the same inode — a pad plugged
+// in again gets the same name and device number, but a new node. Checked for every open gamepad
+// when inotify lost events (IN_Q_OVERFLOW); exposed for the tests.
+bool sameNode(int fd, const std::string& path);
 
 }  // namespace pitwall::drive

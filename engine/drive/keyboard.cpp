@@ -54,7 +54,9 @@ struct Keyboard::Impl {
   Result<bool, std::string> start();
   void wait();
   void read();
+  void waited(const boost::system::error_code& ec);
   void key(Key k);
+  void lost(const std::string& what, const std::string& why);  // logged; the seat's reason
   bool ready();
 
   Loop& loop;
@@ -84,12 +86,15 @@ Result<bool, std::string> Keyboard::Impl::start() {
   if (!got) return Unexpected("--keyboard: " + got.error());
   seated = true;
   // cbreak: keys one at a time (no ICANON), not echoed (no ECHO); ISIG stays, so Ctrl-C is still
-  // SIGINT and stops the run (and the cars) as always.
+  // SIGINT and stops the run (and the cars) as always. But not Ctrl-Z: SIGTSTP would freeze the
+  // whole loop with the cars at speed and nothing left to stop them (VSUSP off; POSIX
+  // _POSIX_VDISABLE), until the modes are put back.
   termios cbreak = modes;
   cbreak.c_lflag &= ~static_cast<tcflag_t>(ICANON | ECHO);
   cbreak.c_lflag |= ISIG;
   cbreak.c_cc[VMIN] = 1;
   cbreak.c_cc[VTIME] = 0;
+  cbreak.c_cc[VSUSP] = _POSIX_VDISABLE;
   saved = SavedTerminal{true, fd, modes};
   static bool registered = false;
   if (!registered) registered = std::atexit(restoreSaved) == 0;
@@ -118,14 +123,19 @@ Result<bool, std::string> Keyboard::Impl::start() {
 void Keyboard::Impl::wait() {
   std::weak_ptr<bool> weak = alive;
   input.async_wait(stream_descriptor::wait_read, [this, weak](const boost::system::error_code& ec) {
-    if (weak.expired() || ec == boost::asio::error::operation_aborted) return;
-    if (ec) {
-      log::warn(kLog, "cannot read the terminal: " + ec.message());
-      return;
-    }
-    read();
-    if (!weak.expired() && seated) wait();
+    if (!weak.expired()) waited(ec);
   });
+}
+
+void Keyboard::Impl::waited(const boost::system::error_code& ec) {
+  if (ec == boost::asio::error::operation_aborted) return;
+  if (ec) {  // the terminal cannot be waited for: as good as hung up
+    lost("cannot wait for the terminal: " + ec.message(), "the terminal cannot be read");
+    return;
+  }
+  std::weak_ptr<bool> weak = alive;
+  read();
+  if (!weak.expired() && seated) wait();
 }
 
 bool Keyboard::Impl::ready() {
@@ -141,10 +151,9 @@ void Keyboard::Impl::read() {
     ssize_t n = ::read(input.native_handle(), buf, sizeof buf);
     if (n < 0 && (errno == EINTR || errno == EAGAIN)) return;
     if (n <= 0) {  // the terminal hung up
-      log::warn(kLog, n == 0 ? std::string("the terminal closed")
-                             : "cannot read the terminal: " + std::string(std::strerror(errno)));
-      if (seated) seats.release(kHolder, "the terminal closed");
-      seated = false;
+      lost(n == 0 ? std::string("the terminal closed")
+                  : "cannot read the terminal: " + std::string(std::strerror(errno)),
+           "the terminal closed");
       return;
     }
     for (Key k : parser.feed(std::string_view(buf, static_cast<std::size_t>(n)))) {
@@ -152,6 +161,14 @@ void Keyboard::Impl::read() {
       if (weak.expired() || !seated) return;
     }
   }
+}
+
+// The terminal cannot be read any more: the keyboard lets go of its seat, so its car slows to a
+// stop instead of keeping the last throttle asked for. No more waits.
+void Keyboard::Impl::lost(const std::string& what, const std::string& why) {
+  log::warn(kLog, what);
+  if (seated) seats.release(kHolder, why);
+  seated = false;
 }
 
 void Keyboard::Impl::key(Key k) {
@@ -191,6 +208,10 @@ Keyboard::~Keyboard() = default;
 
 Result<bool, std::string> Keyboard::start() {
   return impl_->start();
+}
+
+void Keyboard::waited(const boost::system::error_code& ec) {
+  impl_->waited(ec);
 }
 
 }  // namespace pitwall::drive

@@ -2,14 +2,21 @@
 # `pitwall run --humans 1 --keyboard` as a player uses it (docs/controllers.md "Keyboard"): on a
 # real pseudo-terminal (pexpect), the arrow keys drive car 1 of the simulator through the race
 # library's human driver; space stops it; the terminal is in cbreak mode while it drives and as it
-# was once pitwall has exited — after the run's end and after Ctrl-C. Every wait is an expect
-# with a timeout.
+# was once pitwall has exited — after the run's end and after Ctrl-C; a terminal that closes under
+# it (SIGHUP) ends the run through its stop path. Every wait has a timeout.
 #
 # usage: keyboard_pty_test.py PITWALL SOURCE_DIR  (exit 0 passed, 1 failed, 77 no python3-pexpect)
+import json
 import os
+import pty
 import re
+import select
+import shutil
+import signal
 import sys
+import tempfile
 import termios
+import time
 
 try:
     import pexpect
@@ -123,9 +130,68 @@ def run_to_duration():
     child.close()
 
 
+def run_hung_up():
+    """The terminal closes under a driving keyboard (a window shut, SSH dropped): the kernel sends
+    SIGHUP, which must end the run like SIGTERM — every car stopped, status 130 — not kill it."""
+    tmp = tempfile.mkdtemp(prefix="pitwall-hup-")
+    record, log = os.path.join(tmp, "run.jsonl"), os.path.join(tmp, "stderr")
+    pid, master = pty.fork()  # pitwall leads a new session, the pty its controlling terminal
+    if pid == 0:
+        err = os.open(log, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+        os.dup2(err, 2)  # the log outlives the terminal
+        os.execve(PITWALL, [PITWALL, "run", SCRIPT, "--humans", "1", "--keyboard", "--duration",
+                            "30", "--record", record], dict(os.environ, TERM="xterm"))
+    seen = ""
+
+    def expect(pattern):
+        nonlocal seen
+        deadline = time.monotonic() + TIMEOUT
+        while not re.search(pattern, seen):
+            left = deadline - time.monotonic()
+            if left <= 0 or not select.select([master], [], [], left)[0]:
+                raise pexpect.TIMEOUT(f"no {pattern!r} on the terminal")
+            seen += os.read(master, 4096).decode("utf-8", "replace")
+        seen = seen[re.search(pattern, seen).end():]
+
+    try:
+        expect(r"holder=keyboard")
+        os.write(master, (UP * 5).encode())
+        expect(r"holder=keyboard throttle=0\.50 speed=\d+ moving=yes")
+        check("hang-up: the keyboard drives car 1", True)
+    except pexpect.TIMEOUT:
+        os.kill(pid, signal.SIGKILL)
+        os.waitpid(pid, 0)
+        raise
+    os.close(master)  # the terminal is gone: SIGHUP to pitwall, EIO on its reads
+    deadline = time.monotonic() + TIMEOUT
+    while (done := os.waitpid(pid, os.WNOHANG))[0] == 0 and time.monotonic() < deadline:
+        time.sleep(0.05)
+    if done[0] == 0:
+        os.kill(pid, signal.SIGKILL)
+        done = os.waitpid(pid, 0)
+    status = done[1]
+    check("hang-up: pitwall exits with status 130, not killed by SIGHUP",
+          os.WIFEXITED(status) and os.WEXITSTATUS(status) == 130,
+          f"exit {os.WEXITSTATUS(status)}" if os.WIFEXITED(status)
+          else f"signal {os.WTERMSIG(status)}")
+    text = open(log, encoding="utf-8", errors="replace").read()
+    check("hang-up: the log says the cars are stopped", "stopping the cars" in text,
+          text[-400:])
+    last = {}
+    for line in open(record, encoding="utf-8"):
+        r = json.loads(line)
+        if r["dir"] == "tx":
+            last[r["car"]] = r["msg"]
+    stops = {car: m["name"] == "set-speed" and m.get("speed_mm_s") == 0 for car, m in last.items()}
+    check("hang-up: the last frame to every car is its stop", bool(stops) and all(stops.values()),
+          str(last))
+    shutil.rmtree(tmp, ignore_errors=True)
+
+
 try:
     run_until_end()
     run_to_duration()
+    run_hung_up()
 except (pexpect.TIMEOUT, pexpect.EOF) as e:
     failures.append(f"pitwall did not show what was expected: {type(e).__name__}")
     print(f"\nFAIL: {type(e).__name__} waiting for the expected output")

@@ -6,13 +6,17 @@
 //   unplug            destroys the device (as pulling its cable does), then exits
 // and prints `device /dev/input/eventN` once the device is there.
 //
-//   uinput_pad [NAME]    (exit 0; 1 when uinput refuses, saying why)
+//   uinput_pad [NAME [RZ]]    (exit 0; 1 when uinput refuses, saying why)
+//
+// RZ: where ABS_RZ is when the device appears (default 0, a trigger at rest); 128 makes it a
+// hid-generic pad whose ABS_RZ is a right stick resting mid-range.
 #include <fcntl.h>
 #include <libevdev/libevdev-uinput.h>
 #include <libevdev/libevdev.h>
 #include <linux/input-event-codes.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <iostream>
 #include <sstream>
@@ -20,20 +24,24 @@
 
 int main(int argc, char** argv) {
   const char* name = argc > 1 ? argv[1] : "pitwall test pad";
+  const int rz = argc > 2 ? std::atoi(argv[2]) : 0;
   libevdev* dev = libevdev_new();
   libevdev_set_name(dev, name);
   libevdev_set_id_bustype(dev, BUS_USB);
   libevdev_set_id_vendor(dev, 0x045e);  // shaped like an Xbox 360 pad (xpad's ranges)
   libevdev_set_id_product(dev, 0x028e);
-  for (unsigned code : {BTN_SOUTH, BTN_EAST, BTN_NORTH, BTN_WEST, BTN_TL, BTN_TR, BTN_SELECT,
-                        BTN_START, BTN_MODE, BTN_THUMBL, BTN_THUMBR})
+  for (unsigned code : {BTN_SOUTH, BTN_EAST, BTN_NORTH, BTN_WEST, BTN_TL, BTN_TR, BTN_TR2,
+                        BTN_SELECT, BTN_START, BTN_MODE, BTN_THUMBL, BTN_THUMBR})
     libevdev_enable_event_code(dev, EV_KEY, code, nullptr);
   input_absinfo stick{0, -32768, 32767, 16, 128, 0};
   input_absinfo trigger{0, 0, 255, 0, 0, 0};
   input_absinfo hat{0, -1, 1, 0, 0, 0};
   for (unsigned code : {ABS_X, ABS_Y, ABS_RX, ABS_RY})
     libevdev_enable_event_code(dev, EV_ABS, code, &stick);
-  for (unsigned code : {ABS_Z, ABS_RZ}) libevdev_enable_event_code(dev, EV_ABS, code, &trigger);
+  libevdev_enable_event_code(dev, EV_ABS, ABS_Z, &trigger);
+  input_absinfo rightTrigger = trigger;
+  rightTrigger.value = rz;
+  libevdev_enable_event_code(dev, EV_ABS, ABS_RZ, &rightTrigger);
   for (unsigned code : {ABS_HAT0X, ABS_HAT0Y}) libevdev_enable_event_code(dev, EV_ABS, code, &hat);
 
   libevdev_uinput* pad = nullptr;

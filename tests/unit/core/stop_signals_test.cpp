@@ -46,3 +46,38 @@ TEST_CASE("stop signals reach a real run through the pipe") {
   loop.cancel(guard);
   CHECK(got == SIGTERM * 100 + 1);
 }
+
+// A terminal that closes (a window shut, SSH dropped) sends SIGHUP, whose default action ends the
+// process with no stop for any car: it ends the run as SIGTERM does. Ignored before (nohup), it
+// stays ignored. Afterwards the handler that was there comes back.
+TEST_CASE("SIGHUP ends a run as SIGTERM does, unless it was ignored (nohup)") {
+  struct sigaction before {};
+  ::sigaction(SIGHUP, nullptr, &before);
+  {
+    Loop loop(ClockKind::Real);
+    StopSignals signals(loop);
+    int got = 0;
+    signals.onSignal = [&](int sig, int count) {
+      got = sig * 100 + count;
+      loop.stop();
+    };
+    loop.after(10ms, [] { std::raise(SIGHUP); });
+    auto guard = loop.after(20s, [&] { loop.stop(); });
+    loop.run();
+    loop.cancel(guard);
+    CHECK(got == SIGHUP * 100 + 1);
+  }
+  struct sigaction after {};
+  ::sigaction(SIGHUP, nullptr, &after);
+  CHECK((after.sa_handler == before.sa_handler));
+
+  std::signal(SIGHUP, SIG_IGN);
+  {
+    Loop loop(ClockKind::Real);
+    StopSignals signals(loop);
+    struct sigaction during {};
+    ::sigaction(SIGHUP, nullptr, &during);
+    CHECK((during.sa_handler == SIG_IGN));
+  }
+  ::sigaction(SIGHUP, &before, nullptr);
+}

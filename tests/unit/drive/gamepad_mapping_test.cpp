@@ -137,6 +137,69 @@ TEST_CASE("gamepad: ABS_HAT2X, the specification's analog ZR, is a trigger too")
   CHECK(m.throttle() == 1.0);
 }
 
+// A hid-generic pad (Logitech F310 in D mode, DragonRise): ABS_Z/ABS_RZ is the right stick,
+// resting mid-range; BTN_TR2 is the digital right trigger.
+DeviceCaps stickOnRz() {
+  DeviceCaps caps = stickPad();
+  caps.axes[ABS_Z] = {0, 255, 15, 128};
+  caps.axes[ABS_RZ] = {0, 255, 15, 128};
+  return caps;
+}
+
+TEST_CASE(
+    "gamepad: an ABS_RZ resting mid-range is no throttle; pressing and letting go of A sends "
+    "none") {
+  GamepadMapping m(stickOnRz());
+  CHECK(m.triggerAxis() == ABS_RZ);
+  CHECK_FALSE(m.triggerArmed());
+  // A pressed and let go: the brake lets go to 0, not to the stick's half way
+  auto brake = m.event(EV_KEY, BTN_SOUTH, 1);
+  CHECK((!brake || brake->throttle == 0.0));
+  auto letGo = m.event(EV_KEY, BTN_SOUTH, 0);
+  CHECK((!letGo || letGo->throttle == 0.0));
+  CHECK(m.throttle() == 0.0);
+  // the right stick moved about, never to its minimum: still nothing
+  CHECK_FALSE(m.event(EV_ABS, ABS_RZ, 200));
+  CHECK_FALSE(m.event(EV_ABS, ABS_RZ, 255));
+  CHECK_FALSE(m.event(EV_ABS, ABS_RZ, 60));
+  CHECK_FALSE(m.triggerArmed());
+  // meanwhile BTN_TR2 and the left stick up drive, as on a pad without an analog trigger
+  auto zr = m.event(EV_KEY, BTN_TR2, 1);
+  REQUIRE(zr);
+  CHECK(zr->throttle == 1.0);
+  auto zrOff = m.event(EV_KEY, BTN_TR2, 0);
+  REQUIRE(zrOff);
+  CHECK(zrOff->throttle == 0.0);
+  auto up = m.event(EV_ABS, ABS_Y, 0);
+  REQUIRE(up);
+  CHECK(up->throttle == 1.0);
+  REQUIRE(m.event(EV_ABS, ABS_Y, 128));
+  CHECK(m.throttle() == 0.0);
+}
+
+TEST_CASE("gamepad: a trigger not at rest when opened is the throttle once seen at its minimum") {
+  DeviceCaps caps = stickPad();
+  caps.axes[ABS_RZ] = {0, 255, 15, 255};  // a pedal pressed (or resting at max) when opened
+  GamepadMapping m(caps);
+  CHECK_FALSE(m.triggerArmed());
+  CHECK_FALSE(m.event(EV_ABS, ABS_RZ, 250));
+  CHECK_FALSE(m.event(EV_ABS, ABS_RZ, INT_MIN));  // below the range is no rest either
+  CHECK_FALSE(m.triggerArmed());
+  CHECK_FALSE(m.event(EV_ABS, ABS_RZ, 10));  // within its flat zone at the minimum: at rest
+  CHECK(m.triggerArmed());
+  auto half = m.event(EV_ABS, ABS_RZ, 128);
+  REQUIRE(half);
+  CHECK(half->throttle == doctest::Approx(0.50));
+  // armed, the trigger alone is the throttle: the stick and BTN_TR2 no longer add to it
+  CHECK_FALSE(m.event(EV_ABS, ABS_Y, 0));
+  CHECK_FALSE(m.event(EV_KEY, BTN_TR2, 1));
+  // an xpad trigger opened at 0 is armed from the start
+  CHECK(GamepadMapping(xboxPad()).triggerArmed());
+  CHECK(GamepadMapping::atRest({0, 1023, 0, 0}, 20));
+  CHECK_FALSE(GamepadMapping::atRest({0, 1023, 0, 0}, 512));
+  CHECK_FALSE(GamepadMapping::atRest({0, 0, 0, 0}, 0));
+}
+
 TEST_CASE("gamepad: without an analog trigger, the left stick up or the digital ZR drive") {
   GamepadMapping m(stickPad());
   CHECK(m.source() == ThrottleSource::StickAndButton);

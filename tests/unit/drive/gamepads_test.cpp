@@ -1,9 +1,11 @@
 // Gamepads on the host (engine/drive/gamepads.hpp), as far as a machine without input devices
-// can tell: the folder's errors, and nodes that are no gamepads left alone. A real kernel gamepad
-// (uinput) plugged in and out drives a car in tests/qemu/gamepad_e2e.sh.
+// can tell: the folder's errors, nodes that are no gamepads looked at as they come and go
+// (hot-plug), the folder read again when inotify loses events, a stale node told from a new one. A
+// real kernel gamepad (uinput) plugged in and out drives a car in tests/qemu/gamepad_e2e.sh.
 #include "engine/drive/gamepads.hpp"
 
 #include <doctest/doctest.h>
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <cstdlib>
@@ -60,10 +62,58 @@ TEST_CASE("gamepads: event nodes that are no evdev devices, there or plugged in,
   drive::Gamepads pads(r.loop, r.seats, {r.folder});
   REQUIRE(pads.start());
   CHECK(pads.count() == 0);
+  CHECK(pads.passedOver() == 1);  // event0 looked at; mouse0 is no event node
+  // Hot-plug: a node created while running is looked at (inotify, IN_CREATE) …
   std::ofstream(r.folder / "event1") << "plugged in";
   fs::permissions(r.folder / "event1", fs::perms::owner_read);  // IN_ATTRIB
-  fs::remove(r.folder / "event0");                              // IN_DELETE
   r.run(0.1);
+  CHECK(pads.passedOver() == 2);
+  // … and one deleted is forgotten (IN_DELETE).
+  fs::remove(r.folder / "event0");
+  r.run(0.1);
+  CHECK(pads.passedOver() == 1);
   CHECK(pads.count() == 0);
   CHECK_FALSE(r.seats.seat(1)->held());
+}
+
+TEST_CASE("gamepads: when inotify's queue overflows, the folder is read again") {
+  std::ifstream limitFile("/proc/sys/fs/inotify/max_queued_events");
+  long limit = 0;
+  limitFile >> limit;
+  if (limit <= 0 || limit > 200000) {
+    MESSAGE("skipped: max_queued_events is " << limit);
+    return;
+  }
+  Rig r;
+  drive::Gamepads pads(r.loop, r.seats, {r.folder});
+  REQUIRE(pads.start());
+  CHECK(pads.passedOver() == 0);
+  // The loop does not run: more events than the queue holds (two files in turn, so the kernel
+  // cannot merge them), then a node whose IN_CREATE is lost with the rest.
+  std::ofstream(r.folder / "a") << "";
+  std::ofstream(r.folder / "b") << "";
+  for (long i = 0; i <= limit; ++i)
+    fs::permissions(r.folder / (i % 2 ? "a" : "b"),
+                    i % 4 < 2 ? fs::perms::owner_read : fs::perms::owner_all);
+  std::ofstream(r.folder / "event7") << "plugged in while the queue was full";
+  r.run(0.2);
+  CHECK(pads.passedOver() == 1);  // event7, found by reading the folder again
+}
+
+TEST_CASE("gamepads: sameNode tells an open node from one gone or made again under its name") {
+  Rig r;
+  const fs::path node = r.folder / "event3";
+  std::ofstream(node) << "pad";
+  int fd = ::open(node.c_str(), O_RDONLY | O_CLOEXEC);
+  REQUIRE(fd >= 0);
+  CHECK(drive::sameNode(fd, node.string()));
+  fs::remove(node);
+  CHECK_FALSE(drive::sameNode(fd, node.string()));  // unplugged
+  std::ofstream(node) << "another pad";             // plugged in again: the same name
+  CHECK_FALSE(drive::sameNode(fd, node.string()));
+  ::close(fd);
+  fd = ::open(node.c_str(), O_RDONLY | O_CLOEXEC);
+  CHECK(drive::sameNode(fd, node.string()));
+  ::close(fd);
+  CHECK_FALSE(drive::sameNode(fd, node.string()));  // closed: POLLNVAL
 }

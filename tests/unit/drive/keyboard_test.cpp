@@ -8,6 +8,7 @@
 #include <termios.h>
 #include <unistd.h>
 
+#include <boost/asio/error.hpp>
 #include <string>
 
 #include "engine/drive/seats.hpp"
@@ -30,10 +31,11 @@ struct Pty {
   void type(const std::string& bytes) const {
     REQUIRE(::write(master, bytes.data(), bytes.size()) == static_cast<ssize_t>(bytes.size()));
   }
-  tcflag_t lflag() const {
+  tcflag_t lflag() const { return modes().c_lflag; }
+  termios modes() const {
     termios t{};
     REQUIRE(::tcgetattr(slave, &t) == 0);
-    return t.c_lflag;
+    return t;
   }
 };
 
@@ -141,4 +143,32 @@ TEST_CASE("keyboard: the terminal hung up, the seat is let go (the car slows to 
   pty.master = ::open("/dev/null", O_RDONLY);  // for the destructor's close
   r.run(0.05);
   CHECK_FALSE(r.seats.seat(1)->held());
+}
+
+TEST_CASE("keyboard: Ctrl-Z is off while it drives (no SIGTSTP to freeze the cars), back after") {
+  Rig r;
+  Pty pty;
+  const cc_t before = pty.modes().c_cc[VSUSP];
+  REQUIRE(before != _POSIX_VDISABLE);  // a fresh pty: ^Z
+  {
+    drive::Keyboard k(r.loop, r.seats, pty.slave);
+    REQUIRE(k.start());
+    CHECK(pty.modes().c_cc[VSUSP] == _POSIX_VDISABLE);
+    CHECK(pty.modes().c_cc[VINTR] != _POSIX_VDISABLE);  // Ctrl-C still ends the run
+  }
+  CHECK(pty.modes().c_cc[VSUSP] == before);
+}
+
+TEST_CASE("keyboard: a wait for the terminal that fails lets go of the seat; a cancel does not") {
+  Rig r;
+  Pty pty;
+  drive::Keyboard k(r.loop, r.seats, pty.slave);
+  REQUIRE(k.start());
+  pty.type("\x1b[A\x1b[A");
+  r.run(0.05);
+  CHECK(r.seats.seat(1)->throttle == doctest::Approx(0.2));
+  k.waited(boost::asio::error::operation_aborted);
+  CHECK(r.seats.seat(1)->held());
+  k.waited(boost::asio::error::bad_descriptor);
+  CHECK_FALSE(r.seats.seat(1)->held());  // the car slows to a stop, not on at 0.2
 }
