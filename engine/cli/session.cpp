@@ -147,8 +147,10 @@ void Session::catchSignals() {
       return;
     }
     interrupted_ = true;
-    log::warn("pitwall",
-              std::string(sig == SIGINT ? "interrupted" : "terminated") + ": stopping the cars");
+    log::warn("pitwall", std::string(sig == SIGINT   ? "interrupted"
+                                     : sig == SIGHUP ? "hung up"
+                                                     : "terminated") +
+                             ": stopping the cars");
     finish();
   };
 }

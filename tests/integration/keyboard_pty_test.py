@@ -175,7 +175,7 @@ def run_hung_up():
           f"exit {os.WEXITSTATUS(status)}" if os.WIFEXITED(status)
           else f"signal {os.WTERMSIG(status)}")
     text = open(log, encoding="utf-8", errors="replace").read()
-    check("hang-up: the log says the cars are stopped", "stopping the cars" in text,
+    check("hang-up: the log says the cars are stopped", "hung up: stopping the cars" in text,
           text[-400:])
     last = {}
     for line in open(record, encoding="utf-8"):
