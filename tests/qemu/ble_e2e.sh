@@ -9,6 +9,8 @@
 # an Anki car on hci0 and a central on hci1 (tests/qemu/guest.sh). The guest's exit status is the
 # script's. Exit 77 (ctest: skipped) when it cannot run here, always saying why.
 set -uo pipefail
+# skip, fail, the arguments, the kernel, the initramfs and the boot (shared with gamepad_e2e.sh)
+source "$(dirname "${BASH_SOURCE[0]}")/boot_lib.sh"
 
 # Who plays the central on hci1 (PITWALL_QEMU_CENTRAL): one or more of these, separated by
 # commas, one after the other against the same car in one boot (default bleak,pitwall):
@@ -27,19 +29,8 @@ CENTRAL=${PITWALL_QEMU_CENTRAL:-bleak,pitwall}
 # Debian packages the harness needs (installed by the project's ./dev, never by this script).
 PACKAGES=(qemu-system-x86 busybox-static cpio kmod bluez bluez-test-tools dbus-daemon dbus-bin)
 [[ ",$CENTRAL," == *,bleak,* ]] && PACKAGES+=(python3-bleak)
-skip() {
-  echo "SKIP: $*"
-  exit 77
-}
-fail() {
-  echo "FAIL: $*"
-  exit 1
-}
 
-[ $# -eq 2 ] || { echo "usage: $0 PITWALL_BINARY SOURCE_DIR" >&2; exit 2; }
-PITWALL=$(realpath "$1")
-SRC=$(realpath "$2")
-[ -x "$PITWALL" ] || fail "no pitwall binary at $1"
+qemu_args "PITWALL_BINARY SOURCE_DIR" "$@"
 IFS=, read -r -a centrals <<<"$CENTRAL"
 [ ${#centrals[@]} -gt 0 ] || fail "PITWALL_QEMU_CENTRAL is empty"
 for c in "${centrals[@]}"; do
@@ -49,8 +40,6 @@ for c in "${centrals[@]}"; do
   esac
 done
 
-# the kernel, the initramfs and the boot (shared with gamepad_e2e.sh)
-source "$SRC/tests/qemu/boot_lib.sh"
 qemu_check_host "${PACKAGES[@]}"
 BLUETOOTHD=
 for b in /usr/libexec/bluetooth/bluetoothd /usr/lib/bluetooth/bluetoothd /usr/sbin/bluetoothd; do
@@ -73,9 +62,5 @@ if [ -n "$status" ] && [ "$status" != 0 ] && [ "$status" != 77 ]; then
   echo "qemu: the guest's checks failed (status $status); booting once more (btvirt, see above)"
   status=$(qemu_boot "central: $CENTRAL")
 fi
-if [ -z "$status" ]; then
-  fail "the guest gave no exit status (QEMU status 124 = killed after ${QEMU_TIMEOUT}s)"
-fi
-[ "$status" = 77 ] && exit 77
-[ "$status" = 0 ] && { echo "PASS: central '$CENTRAL' against the real bluetoothd"; exit 0; }
-fail "the guest's checks failed twice (status $status)"
+qemu_result "$status" "central '$CENTRAL' against the real bluetoothd" \
+  "the guest's checks failed twice"

@@ -5,14 +5,19 @@
 # runs the test's guest script chrooted into it, and one TCG boot whose exit status the guest
 # prints on the console.
 #
-# The sourcing script defines skip (exit 77 with a reason) and fail (exit 1), sets PITWALL and
-# SRC (absolute), and calls:
+# The sourcing script (source "$(dirname "${BASH_SOURCE[0]}")/boot_lib.sh", first thing) calls:
+#   skip REASON / fail REASON        exit 77 (ctest: skipped) / exit 1, saying why
+#   qemu_args USAGE "$@"             its arguments: as many as USAGE has words, the first two
+#                                    PITWALL_BINARY SOURCE_DIR (PITWALL and SRC, absolute, set
+#                                    here), else USAGE and exit 2
+#   qemu_check_host PACKAGE...       skips without x86_64 or without one of the Debian packages
 #   qemu_kernel SET                  the kernel and SET's modules (QEMU_MODULE_SETS below)
 #   qemu_initrd SET TMPFS GUEST...   the initramfs: SET's modules loaded, the folders in TMPFS
 #                                    (space-separated) writable tmpfs, then GUEST... (a command
 #                                    and its arguments, run as root in the chroot with a clean
 #                                    environment plus QEMU_GUEST_ENV, "NAME=value" words)
 #   status=$(qemu_boot LABEL)        one boot; the guest's exit status (empty: it gave none)
+#   qemu_result STATUS PASS FAILED   the script's end: exit 0 saying PASS, 77, or fail saying FAILED
 # PITWALL_QEMU_TIMEOUT: seconds before QEMU is killed, boot included (default 180).
 
 # Modules each test's guest loads (their dependencies come from the kernel's own modules.dep).
@@ -28,6 +33,25 @@ QEMU_TIMEOUT=${PITWALL_QEMU_TIMEOUT:-180}
 declare -p QEMU_GUEST_ENV >/dev/null 2>&1 || QEMU_GUEST_ENV=()
 QEMU_RUN='' QEMU_FETCH=''  # scratch folders in the cache, removed however the script ends
 trap 'rm -rf "$QEMU_RUN" "$QEMU_FETCH"' EXIT
+
+skip() {
+  echo "SKIP: $*"
+  exit 77
+}
+fail() {
+  echo "FAIL: $*"
+  exit 1
+}
+
+qemu_args() {  # qemu_args USAGE "$@"
+  local usage=$1 words
+  shift
+  read -r -a words <<<"$usage"
+  [ $# -eq ${#words[@]} ] || { echo "usage: $0 $usage" >&2; exit 2; }
+  PITWALL=$(realpath "$1")
+  SRC=$(realpath "$2")
+  [ -x "$PITWALL" ] || fail "no pitwall binary at $1"
+}
 
 qemu_check_host() {  # qemu_check_host PACKAGE...: skips without x86_64 or without a package
   [ "$(uname -m)" = x86_64 ] ||
@@ -165,4 +189,14 @@ qemu_boot() {  # qemu_boot LABEL
     tail -n1)
   echo "qemu: guest finished in ${elapsed}s (QEMU status $qemu_rc)" >&2
   echo "$status"
+}
+
+# The guest's status (from qemu_boot) made the script's: 0 printing "PASS: " and PASS, 77 (the
+# guest skipped), or fail with FAILED and the status.
+qemu_result() {  # qemu_result STATUS PASS FAILED
+  [ -n "$1" ] ||
+    fail "the guest gave no exit status (QEMU status 124 = killed after ${QEMU_TIMEOUT}s)"
+  [ "$1" = 77 ] && exit 77
+  [ "$1" = 0 ] && { echo "PASS: $2"; exit 0; }
+  fail "$3 (status $1)"
 }

@@ -11,31 +11,19 @@
 # No Bluetooth, no D-Bus: the lightest guest. Exit 77 (ctest: skipped) when it cannot run here,
 # always saying why.
 set -uo pipefail
+# skip, fail, the arguments, the kernel, the initramfs and the boot (shared with ble_e2e.sh)
+source "$(dirname "${BASH_SOURCE[0]}")/boot_lib.sh"
 PACKAGES=(qemu-system-x86 busybox-static cpio kmod)
-skip() {
-  echo "SKIP: $*"
-  exit 77
-}
-fail() {
-  echo "FAIL: $*"
-  exit 1
-}
 
-[ $# -eq 3 ] || { echo "usage: $0 PITWALL_BINARY SOURCE_DIR UINPUT_PAD_BINARY" >&2; exit 2; }
-PITWALL=$(realpath "$1")
-SRC=$(realpath "$2")
+qemu_args "PITWALL_BINARY SOURCE_DIR UINPUT_PAD_BINARY" "$@"
 PAD=$(realpath "$3")
-[ -x "$PITWALL" ] || fail "no pitwall binary at $1"
 [ -x "$PAD" ] || fail "no uinput_pad binary at $3"
 
-source "$SRC/tests/qemu/boot_lib.sh"
 qemu_check_host "${PACKAGES[@]}"
 qemu_kernel gamepad
 qemu_initrd gamepad "/tmp /run /root" \
   /bin/bash "$SRC/tests/qemu/gamepad_guest.sh" "$PITWALL" "$SRC" "$PAD"
 status=$(qemu_boot "gamepads")
-[ -n "$status" ] ||
-  fail "the guest gave no exit status (QEMU status 124 = killed after ${QEMU_TIMEOUT}s)"
-[ "$status" = 77 ] && exit 77
-[ "$status" = 0 ] && { echo "PASS: uinput gamepads drive car 1; unplugged, it stops; a resting mid-range ABS_RZ does not drive"; exit 0; }
-fail "the guest's checks failed (status $status)"
+qemu_result "$status" \
+  "uinput gamepads drive car 1; unplugged, it stops; a resting mid-range ABS_RZ does not drive" \
+  "the guest's checks failed"

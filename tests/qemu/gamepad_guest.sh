@@ -10,40 +10,14 @@ set -uo pipefail
 PITWALL=$1
 SRC=$2
 PAD=$3
-LOGS=/tmp/logs
-mkdir -p "$LOGS"
-T0=$(date +%s%N)
+source "$SRC/tests/qemu/guest_lib.sh"  # LOGS, say, fail, until_ok
 
-say() {
-  local ms=$((($(date +%s%N) - T0) / 1000000))
-  printf '[guest %3d.%03d] %s\n' $((ms / 1000)) $((ms % 1000)) "$*"
-}
-fail() {
-  say "FAIL: $*"
-  for log in "$LOGS"/*; do
-    [ -s "$log" ] || continue
-    echo "---- last lines of $(basename "$log")"
-    tail -n 25 "$log"
-  done
-  exit 1
-}
 # wait_line FILE PATTERN SECONDS: until a line of FILE matches PATTERN (grep -E); false if never.
-wait_line() {
-  local deadline=$(($(date +%s%N) + $3 * 1000000000))
-  until grep -qE "$2" "$1" 2>/dev/null; do
-    [ "$(date +%s%N)" -lt "$deadline" ] || return 1
-    sleep 0.1
-  done
-}
+wait_line() { until_ok "$3" grep -qE "$2" "$1"; }
 # after FILE: the lines written to FILE from now on are the ones `wait_new` looks at
 mark() { wc -l <"$1"; }
-wait_new() {  # wait_new FILE MARK PATTERN SECONDS
-  local deadline=$(($(date +%s%N) + $4 * 1000000000))
-  until tail -n +"$(($2 + 1))" "$1" | grep -qE "$3"; do
-    [ "$(date +%s%N)" -lt "$deadline" ] || return 1
-    sleep 0.1
-  done
-}
+new_match() { tail -n +"$(($2 + 1))" "$1" | grep -qE "$3"; }  # new_match FILE MARK PATTERN
+wait_new() { until_ok "$4" new_match "$1" "$2" "$3"; }  # wait_new FILE MARK PATTERN SECONDS
 
 [ -c /dev/uinput ] || fail "no /dev/uinput in the guest (the uinput module did not load)"
 mkdir -p /dev/input
@@ -51,16 +25,16 @@ mkdir -p /dev/input
 # pad NAME: a virtual gamepad fed through a FIFO on fd 3 (A), 4 (B) or 5 (C), its output in a log
 plug() {  # plug FD NAME [RZ]
   mkfifo "/tmp/pad$1.in"
-  "$PAD" "$2" ${3:-} <"/tmp/pad$1.in" >"$LOGS/pad$1.out" 2>&1 &
+  "$PAD" "$2" ${3:-} <"/tmp/pad$1.in" >"$LOGS/pad$1.log" 2>&1 &
   eval "exec $1>/tmp/pad$1.in"
-  wait_line "$LOGS/pad$1.out" '^device /dev/input/event' 10 || fail "uinput_pad '$2' made no device"
-  say "plugged in: $2 at $(sed -n 's/^device //p' "$LOGS/pad$1.out")"
+  wait_line "$LOGS/pad$1.log" '^device /dev/input/event' 10 || fail "uinput_pad '$2' made no device"
+  say "plugged in: $2 at $(sed -n 's/^device //p' "$LOGS/pad$1.log")"
 }
 
 # ---- pad A, there before pitwall starts (found by the scan of /dev/input) ----
 plug 3 "Pad A"
 
-RUN=$LOGS/run.out
+RUN=$LOGS/run.log
 # --budget 2: the emulated CPU (TCG) loads the race library slower than 100 ms
 "$PITWALL" run "$SRC/tests/integration/human_seat1.lua" --humans 1 --gamepads --duration 60 \
   --budget 2 >"$RUN" 2>&1 &

@@ -13,32 +13,7 @@ PITWALL=$1
 SRC=$2
 CENTRALS=$3
 BLUETOOTHD=$4
-LOGS=/tmp/logs
-mkdir -p "$LOGS"
-T0=$(date +%s%N)
-
-say() {
-  local ms=$((($(date +%s%N) - T0) / 1000000))
-  printf '[guest %3d.%03d] %s\n' $((ms / 1000)) $((ms % 1000)) "$*"
-}
-fail() {
-  say "FAIL: $*"
-  for log in "$LOGS"/*.log; do
-    [ -s "$log" ] || continue
-    echo "---- last lines of $(basename "$log")"
-    tail -n 25 "$log"
-  done
-  exit 1
-}
-# until SECONDS_MAX COMMAND...: retries every 50 ms; false when it never succeeded.
-until_ok() {
-  local deadline=$(($(date +%s%N) + $1 * 1000000000))
-  shift
-  while ! "$@" >/dev/null 2>&1; do
-    [ "$(date +%s%N)" -lt "$deadline" ] || return 1
-    sleep 0.05
-  done
-}
+source "$SRC/tests/qemu/guest_lib.sh"  # LOGS, say, fail, until_ok
 bluez_get() {  # bluez_get PATH INTERFACE PROPERTY → the value as dbus-send prints it
   dbus-send --system --print-reply --dest=org.bluez "$1" org.freedesktop.DBus.Properties.Get \
     "string:$2" "string:$3" | sed -n '2,$p'

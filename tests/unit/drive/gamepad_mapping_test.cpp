@@ -32,6 +32,13 @@ DeviceCaps stickPad() {
   return caps;
 }
 
+// The throttle that `m.event(...)` asks for; the event must ask for one.
+double throttleOf(GamepadMapping& m, int type, int code, int value, bool replay = false) {
+  auto in = m.event(type, code, value, replay);
+  REQUIRE(in);
+  return in->throttle;
+}
+
 }  // namespace
 
 TEST_CASE("gamepad: a device with gamepad or joystick buttons is a gamepad; a keyboard is not") {
@@ -56,12 +63,8 @@ TEST_CASE("gamepad: the right trigger is the throttle, normalized over its range
   REQUIRE(half);
   CHECK(half->throttle == doctest::Approx(0.50));
   CHECK(half->laneStep == 0);
-  auto full = m.event(EV_ABS, ABS_RZ, 1023);
-  REQUIRE(full);
-  CHECK(full->throttle == 1.0);
-  auto off = m.event(EV_ABS, ABS_RZ, 0);
-  REQUIRE(off);
-  CHECK(off->throttle == 0.0);
+  CHECK(throttleOf(m, EV_ABS, ABS_RZ, 1023) == 1.0);
+  CHECK(throttleOf(m, EV_ABS, ABS_RZ, 0) == 0.0);
   // the left trigger and the sticks do nothing while a right trigger is there
   CHECK_FALSE(m.event(EV_ABS, ABS_Z, 1023));
   CHECK_FALSE(m.event(EV_ABS, ABS_Y, -32768));
@@ -90,12 +93,8 @@ TEST_CASE("gamepad: a trigger resting near its minimum reads 0 (its flat zone, o
 
 TEST_CASE("gamepad: out-of-range axis values are clamped, never beyond 0..1") {
   GamepadMapping m(xboxPad());
-  auto over = m.event(EV_ABS, ABS_RZ, INT_MAX);
-  REQUIRE(over);
-  CHECK(over->throttle == 1.0);
-  auto under = m.event(EV_ABS, ABS_RZ, INT_MIN);
-  REQUIRE(under);
-  CHECK(under->throttle == 0.0);
+  CHECK(throttleOf(m, EV_ABS, ABS_RZ, INT_MAX) == 1.0);
+  CHECK(throttleOf(m, EV_ABS, ABS_RZ, INT_MIN) == 0.0);
   CHECK(GamepadMapping::stickUp({-32768, 32767, 0, 0}, INT_MIN) == 1.0);
   CHECK(GamepadMapping::stickUp({-32768, 32767, 0, 0}, INT_MAX) == 0.0);
   CHECK(GamepadMapping::triggerLevel({INT_MIN, INT_MAX, 0, 0}, INT_MAX) == 1.0);
@@ -164,15 +163,9 @@ TEST_CASE(
   CHECK_FALSE(m.event(EV_ABS, ABS_RZ, 60));
   CHECK_FALSE(m.triggerArmed());
   // meanwhile BTN_TR2 and the left stick up drive, as on a pad without an analog trigger
-  auto zr = m.event(EV_KEY, BTN_TR2, 1);
-  REQUIRE(zr);
-  CHECK(zr->throttle == 1.0);
-  auto zrOff = m.event(EV_KEY, BTN_TR2, 0);
-  REQUIRE(zrOff);
-  CHECK(zrOff->throttle == 0.0);
-  auto up = m.event(EV_ABS, ABS_Y, 0);
-  REQUIRE(up);
-  CHECK(up->throttle == 1.0);
+  CHECK(throttleOf(m, EV_KEY, BTN_TR2, 1) == 1.0);
+  CHECK(throttleOf(m, EV_KEY, BTN_TR2, 0) == 0.0);
+  CHECK(throttleOf(m, EV_ABS, ABS_Y, 0) == 1.0);
   REQUIRE(m.event(EV_ABS, ABS_Y, 128));
   CHECK(m.throttle() == 0.0);
 }
@@ -187,9 +180,7 @@ TEST_CASE("gamepad: a trigger not at rest when opened is the throttle once seen 
   CHECK_FALSE(m.triggerArmed());
   CHECK_FALSE(m.event(EV_ABS, ABS_RZ, 10));  // within its flat zone at the minimum: at rest
   CHECK(m.triggerArmed());
-  auto half = m.event(EV_ABS, ABS_RZ, 128);
-  REQUIRE(half);
-  CHECK(half->throttle == doctest::Approx(0.50));
+  CHECK(throttleOf(m, EV_ABS, ABS_RZ, 128) == doctest::Approx(0.50));
   // armed, the trigger alone is the throttle: the stick and BTN_TR2 no longer add to it
   CHECK_FALSE(m.event(EV_ABS, ABS_Y, 0));
   CHECK_FALSE(m.event(EV_KEY, BTN_TR2, 1));
@@ -206,21 +197,14 @@ TEST_CASE("gamepad: without an analog trigger, the left stick up or the digital 
   CHECK(m.triggerAxis() == -1);
   CHECK_FALSE(m.event(EV_ABS, ABS_Y, 120));  // near the centre: the deadzone
   CHECK_FALSE(m.event(EV_ABS, ABS_Y, 255));  // down is not reverse: 0
-  auto up = m.event(EV_ABS, ABS_Y, 0);
-  REQUIRE(up);
-  CHECK(up->throttle == 1.0);
-  auto partway = m.event(EV_ABS, ABS_Y, 64);
-  REQUIRE(partway);
-  CHECK(partway->throttle > 0.3);
-  CHECK(partway->throttle < 0.7);
+  CHECK(throttleOf(m, EV_ABS, ABS_Y, 0) == 1.0);
+  const double partway = throttleOf(m, EV_ABS, ABS_Y, 64);
+  CHECK(partway > 0.3);
+  CHECK(partway < 0.7);
   REQUIRE(m.event(EV_ABS, ABS_Y, 128));
   CHECK(m.throttle() == 0.0);
-  auto zr = m.event(EV_KEY, BTN_TR2, 1);
-  REQUIRE(zr);
-  CHECK(zr->throttle == 1.0);
-  auto zrOff = m.event(EV_KEY, BTN_TR2, 0);
-  REQUIRE(zrOff);
-  CHECK(zrOff->throttle == 0.0);
+  CHECK(throttleOf(m, EV_KEY, BTN_TR2, 1) == 1.0);
+  CHECK(throttleOf(m, EV_KEY, BTN_TR2, 0) == 0.0);
 }
 
 TEST_CASE("gamepad: the shoulder buttons step a lane on the press, not on repeat or release") {
@@ -241,20 +225,14 @@ TEST_CASE("gamepad: the shoulder buttons step a lane on the press, not on repeat
 TEST_CASE("gamepad: BTN_SOUTH held brakes to 0 whatever the trigger; let go, the trigger counts") {
   GamepadMapping m(xboxPad());
   REQUIRE(m.event(EV_ABS, ABS_RZ, 1023));
-  auto brake = m.event(EV_KEY, BTN_SOUTH, 1);
-  REQUIRE(brake);
-  CHECK(brake->throttle == 0.0);
+  CHECK(throttleOf(m, EV_KEY, BTN_SOUTH, 1) == 0.0);
   CHECK_FALSE(m.event(EV_ABS, ABS_RZ, 800));  // still braking
-  auto back = m.event(EV_KEY, BTN_SOUTH, 0);
-  REQUIRE(back);
-  CHECK(back->throttle == doctest::Approx(0.78));
+  CHECK(throttleOf(m, EV_KEY, BTN_SOUTH, 0) == doctest::Approx(0.78));
 }
 
 TEST_CASE("gamepad: replayed axis events after SYN_DROPPED bring the throttle up to date") {
   GamepadMapping m(xboxPad());
-  auto caught = m.event(EV_ABS, ABS_RZ, 1023, /*replay=*/true);
-  REQUIRE(caught);
-  CHECK(caught->throttle == 1.0);
+  CHECK(throttleOf(m, EV_ABS, ABS_RZ, 1023, /*replay=*/true) == 1.0);
 }
 
 TEST_CASE("gamepad: random events never give a throttle outside 0..1 or a lane step beyond 1") {

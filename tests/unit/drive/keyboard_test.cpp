@@ -49,6 +49,20 @@ struct Rig {
   }
 };
 
+// A keyboard started on a pty: it holds seat 1.
+struct Driving {
+  Rig r;
+  Pty pty;
+  drive::Keyboard k{r.loop, r.seats, pty.slave};
+  Driving() { REQUIRE(k.start()); }
+  // Types `bytes` and lets the loop read them; seat 1's throttle then.
+  double type(const std::string& bytes) {
+    pty.type(bytes);
+    r.run(0.05);
+    return r.seats.seat(1)->throttle;
+  }
+};
+
 }  // namespace
 
 TEST_CASE("keyboard: not a terminal, start() says --keyboard needs one and takes no seat") {
@@ -85,37 +99,22 @@ TEST_CASE("keyboard: cbreak while it drives (no ICANON, no ECHO, ISIG kept), res
 }
 
 TEST_CASE("keyboard: ↑ adds a tenth of throttle, ↓ takes one, space stops, ←/→ step lanes") {
-  Rig r;
-  Pty pty;
-  drive::Keyboard k(r.loop, r.seats, pty.slave);
-  REQUIRE(k.start());
-  pty.type("\x1b[A\x1b[A\x1b");  // the third arrow split across two writes
-  r.run(0.05);
-  CHECK(r.seats.seat(1)->throttle == doctest::Approx(0.2));
-  pty.type("[A\x1bOA");
-  r.run(0.05);
-  CHECK(r.seats.seat(1)->throttle == doctest::Approx(0.4));
-  pty.type("\x1b[B");
-  r.run(0.05);
-  CHECK(r.seats.seat(1)->throttle == doctest::Approx(0.3));
-  pty.type("\x1b[D\x1b[D\x1b[C");
-  r.run(0.05);
-  CHECK(r.seats.takeLanes(1) == -1);
-  pty.type(" ");
-  r.run(0.05);
-  CHECK(r.seats.seat(1)->throttle == 0.0);
+  Driving d;
+  // the third arrow split across two writes
+  CHECK(d.type("\x1b[A\x1b[A\x1b") == doctest::Approx(0.2));
+  CHECK(d.type("[A\x1bOA") == doctest::Approx(0.4));
+  CHECK(d.type("\x1b[B") == doctest::Approx(0.3));
+  d.type("\x1b[D\x1b[D\x1b[C");
+  CHECK(d.r.seats.takeLanes(1) == -1);
+  CHECK(d.type(" ") == 0.0);
   // the throttle stays within 0..1 however often a key is pressed
   std::string ups;
   for (int i = 0; i < 15; ++i) ups += "\x1b[A";
-  pty.type(ups);
-  r.run(0.05);
-  CHECK(r.seats.seat(1)->throttle == 1.0);
+  CHECK(d.type(ups) == 1.0);
   std::string downs;
   for (int i = 0; i < 15; ++i) downs += "\x1b[B";
-  pty.type(downs);
-  r.run(0.05);
-  CHECK(r.seats.seat(1)->throttle == 0.0);
-  CHECK(r.seats.seat(1)->live);  // a keyboard is never silent: its throttle holds
+  CHECK(d.type(downs) == 0.0);
+  CHECK(d.r.seats.seat(1)->live);  // a keyboard is never silent: its throttle holds
 }
 
 TEST_CASE("keyboard: no free seat, start() says so and leaves the terminal as it was") {
@@ -132,17 +131,12 @@ TEST_CASE("keyboard: no free seat, start() says so and leaves the terminal as it
 }
 
 TEST_CASE("keyboard: the terminal hung up, the seat is let go (the car slows to a stop)") {
-  Rig r;
-  Pty pty;
-  drive::Keyboard k(r.loop, r.seats, pty.slave);
-  REQUIRE(k.start());
-  pty.type("\x1b[A");
-  r.run(0.05);
-  CHECK(r.seats.seat(1)->throttle == doctest::Approx(0.1));
-  ::close(pty.master);
-  pty.master = ::open("/dev/null", O_RDONLY);  // for the destructor's close
-  r.run(0.05);
-  CHECK_FALSE(r.seats.seat(1)->held());
+  Driving d;
+  CHECK(d.type("\x1b[A") == doctest::Approx(0.1));
+  ::close(d.pty.master);
+  d.pty.master = ::open("/dev/null", O_RDONLY);  // for the destructor's close
+  d.r.run(0.05);
+  CHECK_FALSE(d.r.seats.seat(1)->held());
 }
 
 TEST_CASE("keyboard: Ctrl-Z is off while it drives (no SIGTSTP to freeze the cars), back after") {
@@ -160,15 +154,10 @@ TEST_CASE("keyboard: Ctrl-Z is off while it drives (no SIGTSTP to freeze the car
 }
 
 TEST_CASE("keyboard: a wait for the terminal that fails lets go of the seat; a cancel does not") {
-  Rig r;
-  Pty pty;
-  drive::Keyboard k(r.loop, r.seats, pty.slave);
-  REQUIRE(k.start());
-  pty.type("\x1b[A\x1b[A");
-  r.run(0.05);
-  CHECK(r.seats.seat(1)->throttle == doctest::Approx(0.2));
-  k.waited(boost::asio::error::operation_aborted);
-  CHECK(r.seats.seat(1)->held());
-  k.waited(boost::asio::error::bad_descriptor);
-  CHECK_FALSE(r.seats.seat(1)->held());  // the car slows to a stop, not on at 0.2
+  Driving d;
+  CHECK(d.type("\x1b[A\x1b[A") == doctest::Approx(0.2));
+  d.k.waited(boost::asio::error::operation_aborted);
+  CHECK(d.r.seats.seat(1)->held());
+  d.k.waited(boost::asio::error::bad_descriptor);
+  CHECK_FALSE(d.r.seats.seat(1)->held());  // the car slows to a stop, not on at 0.2
 }

@@ -35,6 +35,13 @@ struct Run {
   }
   // Drives car `i` at `speed` as a driver would when its seat says so.
   void drive(int i, int speed) { REQUIRE(cars[i]->setSpeed(speed, 2000)); }
+  // phone#1 holds seat 1 and phone#2 seat 2; both cars driven at `speed`.
+  void twoPhonesDriving(int speed) {
+    REQUIRE(seats.claim("phone#1", drive::Holder::Phone, 1));
+    REQUIRE(seats.claim("phone#2", drive::Holder::Phone, 2));
+    drive(0, speed);
+    drive(1, speed);
+  }
   // Runs `seconds`, with a driver saying every 0.1 s that it drives from seats `from`..`to`
   // (what the human driver does at every update).
   void runDriving(double seconds, int from = 1, int to = 2,
@@ -115,10 +122,7 @@ TEST_CASE("seats: hostile input is refused with the value, and changes nothing")
 
 TEST_CASE("seats: a phone silent for 1 s loses its input and its car is slowed to a stop") {
   Run r;
-  REQUIRE(r.seats.claim("phone#1", drive::Holder::Phone, 1));
-  REQUIRE(r.seats.claim("phone#2", drive::Holder::Phone, 2));
-  r.drive(0, 800);
-  r.drive(1, 800);
+  r.twoPhonesDriving(800);
   // phone 2 keeps talking every 0.1 s; phone 1 says one thing and then nothing
   REQUIRE(r.seats.input("phone#1", 0.8, 0));
   r.runDriving(3, 1, 2, [&] { REQUIRE(r.seats.input("phone#2", 0.8, 0)); });
@@ -183,10 +187,7 @@ TEST_CASE("seats: a loss leaves alone a car that no driver drives from the seat"
   // The race director drives the scan lap and the grid itself, an AI may drive a seat no one
   // took: a phone that goes then must not stop a car that is not its to drive.
   Run r;
-  REQUIRE(r.seats.claim("phone#1", drive::Holder::Phone, 1));
-  REQUIRE(r.seats.claim("phone#2", drive::Holder::Phone, 2));
-  r.drive(0, 700);
-  r.drive(1, 700);
+  r.twoPhonesDriving(700);
   r.runDriving(1.5, 2, 2, [&] {  // only seat 2's car is driven from its seat
     REQUIRE(r.seats.input("phone#1", 0.5, 0));
     REQUIRE(r.seats.input("phone#2", 0.5, 0));

@@ -7,13 +7,10 @@
 
 #include <functional>
 
-#include <atomic>
-#include <boost/asio/ip/tcp.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/websocket.hpp>
 #include <filesystem>
 #include <fstream>
-#include <thread>
 
 #include "engine/drive/seats.hpp"
 #include "engine/fleet/fleet.hpp"
@@ -22,13 +19,15 @@
 #include "engine/view/server.hpp"
 #include "tests/support/run_until.hpp"
 #include "tests/support/sim_cars.hpp"
+#include "tests/unit/view/server_client.hpp"
 
 using namespace pitwall;
-namespace asio = boost::asio;
 namespace beast = boost::beast;
 namespace websocket = beast::websocket;
-using tcp = asio::ip::tcp;
+using testing::httpGet;
+using testing::runClient;
 using testing::runUntil;
+using testing::WsClient;
 
 namespace {
 
@@ -40,7 +39,6 @@ struct Rig {
   std::unique_ptr<drive::Seats> seats;
   view::Feed feed{loop, fleet, "simulator"};
   std::unique_ptr<view::Server> server;
-  std::string failure;
 
   explicit Rig(int humans, int cars = 2, drive::SeatsOptions seatOptions = {}) {
     assets = std::filesystem::temp_directory_path() /
@@ -77,20 +75,7 @@ struct Rig {
   // Runs `client` in a thread while the loop runs, as server_test.cpp does.
   void with(const std::function<void(std::uint16_t port)>& client,
             Duration limit = std::chrono::seconds(20)) {
-    std::atomic<bool> done{false};
-    std::thread t([&] {
-      try {
-        client(server->port());
-      } catch (const std::exception& e) {
-        failure = e.what();
-      }
-      done = true;
-    });
-    runUntil(
-        loop, [&] { return done.load(); }, limit);
-    t.join();
-    CHECK_MESSAGE(failure.empty(), "the client failed: " << failure);
-    failure.clear();
+    runClient(loop, server->port(), client, limit);
   }
   // Runs the loop for `seconds` (the seats' timers, the cars' frames).
   void pass(double seconds) {
@@ -101,24 +86,8 @@ struct Rig {
 };
 
 // A phone: sends messages, reads until an answer (a "seat" or an "error"), skipping updates.
-struct Phone {
-  asio::io_context io;
-  websocket::stream<tcp::socket> ws{io};
-  explicit Phone(std::uint16_t port) {
-    ws.next_layer().connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
-    ws.handshake("127.0.0.1", "/ws");
-  }
-  void send(const char* text) { send(std::string(text)); }
-  void send(const std::string& text) {
-    ws.text(true);
-    ws.write(asio::buffer(text));
-  }
-  void send(const nlohmann::json& j) { send(j.dump()); }
-  nlohmann::json read() {
-    beast::flat_buffer b;
-    ws.read(b);
-    return nlohmann::json::parse(beast::buffers_to_string(b.data()));
-  }
+struct Phone : WsClient {
+  using WsClient::WsClient;
   nlohmann::json answer() {
     for (;;) {
       auto m = read();
@@ -144,6 +113,13 @@ nlohmann::json seatMessage(int seat, const std::string& player) {
 }
 nlohmann::json driveMessage(double throttle, int lane = 0) {
   return {{"type", "drive"}, {"throttle", throttle}, {"lane", lane}};
+}
+// A phone on `port` that has taken seat `seat` as `player`.
+std::unique_ptr<Phone> seatedPhone(std::uint16_t port, int seat, const std::string& player) {
+  auto phone = std::make_unique<Phone>(port);
+  phone->send(seatMessage(seat, player));
+  CHECK(phone->answer()["seat"] == seat);
+  return phone;
 }
 
 }  // namespace
@@ -190,10 +166,8 @@ TEST_CASE("view drive: a page drives its own seat only, and leaving stops the ca
   Rig rig(2, 2, {.silence = 10});  // no silence in this test: it is another
   std::unique_ptr<Phone> a, b;
   rig.with([&](std::uint16_t port) {
-    a = std::make_unique<Phone>(port);
+    a = seatedPhone(port, 1, "Anna");
     b = std::make_unique<Phone>(port);
-    a->send(seatMessage(1, "Anna"));
-    CHECK(a->answer()["seat"] == 1);
     a->send(driveMessage(0.5, 1));
     b->send(driveMessage(1.0));  // b holds no seat
     auto refused = b->answer();
@@ -220,12 +194,8 @@ TEST_CASE("view drive: a page that closes frees its seat and its car is commande
   Rig rig(2, 2, {.silence = 10});
   std::unique_ptr<Phone> a, b;
   rig.with([&](std::uint16_t port) {
-    a = std::make_unique<Phone>(port);
-    b = std::make_unique<Phone>(port);
-    a->send(seatMessage(1, "Anna"));
-    CHECK(a->answer()["seat"] == 1);
-    b->send(seatMessage(2, "Ben"));
-    CHECK(b->answer()["seat"] == 2);
+    a = seatedPhone(port, 1, "Anna");
+    b = seatedPhone(port, 2, "Ben");
   });
   REQUIRE(rig.car(1).setSpeed(700, 2000));
   REQUIRE(rig.car(2).setSpeed(700, 2000));
@@ -246,9 +216,7 @@ TEST_CASE("view drive: a page that closes frees its seat and its car is commande
   CHECK(rig.seats->seat(2)->held());
   // seat 1 is free again for another phone
   rig.with([&](std::uint16_t port) {
-    Phone c(port);
-    c.send(seatMessage(1, "Cleo"));
-    CHECK(c.answer()["seat"] == 1);
+    auto c = seatedPhone(port, 1, "Cleo");
     b->close();
   });
 }
@@ -257,9 +225,7 @@ TEST_CASE("view drive: a page silent for 1 s loses its input: the car is command
   Rig rig(1);
   std::unique_ptr<Phone> a;
   rig.with([&](std::uint16_t port) {
-    a = std::make_unique<Phone>(port);
-    a->send(seatMessage(1, "Anna"));
-    CHECK(a->answer()["seat"] == 1);
+    a = seatedPhone(port, 1, "Anna");
     a->send(driveMessage(0.8));
   });
   REQUIRE(runUntil(rig.loop, [&] { return rig.seats->seat(1)->throttle == 0.8; }));
@@ -391,14 +357,7 @@ TEST_CASE("view drive: without seats, driving is off and says how to start it") 
 TEST_CASE("view drive: GET /drive serves the controller page") {
   Rig rig(1);
   rig.with([&](std::uint16_t port) {
-    asio::io_context io;
-    beast::tcp_stream stream(io);
-    stream.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
-    std::string req = "GET /drive HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n";
-    asio::write(stream.socket(), asio::buffer(req));
-    beast::flat_buffer buffer;
-    beast::http::response<beast::http::string_body> res;
-    beast::http::read(stream, buffer, res);
+    auto res = httpGet(port, "/drive");
     CHECK(res.result() == beast::http::status::ok);
     CHECK(res.body().find("<title>drive</title>") != std::string::npos);
     CHECK(std::string(res[beast::http::field::content_type]).starts_with("text/html"));

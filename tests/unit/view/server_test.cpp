@@ -17,6 +17,7 @@
 #include "engine/fleet/fleet.hpp"
 #include "engine/view/server.hpp"
 #include "tests/support/run_until.hpp"
+#include "tests/unit/view/server_client.hpp"
 
 using namespace pitwall;
 namespace asio = boost::asio;
@@ -24,7 +25,10 @@ namespace beast = boost::beast;
 namespace http = beast::http;
 namespace websocket = beast::websocket;
 using tcp = asio::ip::tcp;
+using testing::httpGet;
+using testing::runClient;
 using testing::runUntil;
+using testing::WsClient;
 
 namespace {
 
@@ -61,54 +65,7 @@ struct Rig {
   // Runs `client` in a thread while the loop runs; returns when it is done (or after `limit`).
   void with(const std::function<void(std::uint16_t port)>& client,
             Duration limit = std::chrono::seconds(20)) {
-    std::atomic<bool> done{false};
-    std::thread t([&] {
-      try {
-        client(server->port());
-      } catch (const std::exception& e) {
-        failure = e.what();  // reported below, on the test's thread
-      }
-      done = true;
-    });
-    runUntil(
-        loop, [&] { return done.load(); }, limit);
-    t.join();
-    CHECK_MESSAGE(failure.empty(), "the client failed: " << failure);
-  }
-  std::string failure;
-};
-
-http::response<http::string_body> get(std::uint16_t port, const std::string& target,
-                                      http::verb verb = http::verb::get,
-                                      const std::string& extraHeader = "") {
-  asio::io_context io;
-  beast::tcp_stream stream(io);
-  stream.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
-  std::string req =
-      std::string(http::to_string(verb)) + " " + target + " HTTP/1.1\r\nHost: 127.0.0.1\r\n";
-  if (!extraHeader.empty()) req += "X-Big: " + extraHeader + "\r\n";
-  req += "Connection: close\r\n\r\n";
-  beast::error_code wec;
-  asio::write(stream.socket(), asio::buffer(req), wec);
-  beast::flat_buffer buffer;
-  http::response<http::string_body> res;
-  beast::error_code ec;
-  http::read(stream, buffer, res, ec);
-  if (ec) res.result(http::status::unknown);
-  return res;
-}
-
-struct WsClient {
-  asio::io_context io;
-  websocket::stream<tcp::socket> ws{io};
-  explicit WsClient(std::uint16_t port) {
-    ws.next_layer().connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
-    ws.handshake("127.0.0.1", "/ws");
-  }
-  nlohmann::json read() {
-    beast::flat_buffer b;
-    ws.read(b);
-    return nlohmann::json::parse(beast::buffers_to_string(b.data()));
+    runClient(loop, server->port(), client, limit);
   }
 };
 
@@ -117,12 +74,12 @@ struct WsClient {
 TEST_CASE("view server: the page, its assets and /api/state; nothing outside the folder") {
   Rig rig;
   rig.with([](std::uint16_t port) {
-    auto page = get(port, "/");
+    auto page = httpGet(port, "/");
     CHECK(page.result() == http::status::ok);
     CHECK(page.body().find("race view") != std::string::npos);
     CHECK(std::string(page[http::field::content_type]).starts_with("text/html"));
-    CHECK(get(port, "/vendor/lib.js").result() == http::status::ok);
-    auto state = get(port, "/api/state");
+    CHECK(httpGet(port, "/vendor/lib.js").result() == http::status::ok);
+    auto state = httpGet(port, "/api/state");
     REQUIRE(state.result() == http::status::ok);
     auto j = nlohmann::json::parse(state.body());
     CHECK(j["type"] == "state");
@@ -131,12 +88,13 @@ TEST_CASE("view server: the page, its assets and /api/state; nothing outside the
     for (const char* bad :
          {"/../pitwall-view-secret.txt", "/vendor/../../pitwall-view-secret.txt",
           "/%2e%2e/pitwall-view-secret.txt", "//etc/passwd", "/vendor", "/nothing.js", "/a\\b"})
-      CHECK_MESSAGE(get(port, bad).result() == http::status::not_found, std::string(bad));
-    CHECK(get(port, "/api/state", http::verb::post).result() == http::status::method_not_allowed);
+      CHECK_MESSAGE(httpGet(port, bad).result() == http::status::not_found, std::string(bad));
+    CHECK(httpGet(port, "/api/state", http::verb::post).result() ==
+          http::status::method_not_allowed);
     // a header beyond the limit: refused, and the server goes on
-    CHECK(get(port, "/", http::verb::get, std::string(64 * 1024, 'x')).result() !=
+    CHECK(httpGet(port, "/", http::verb::get, std::string(64 * 1024, 'x')).result() !=
           http::status::ok);
-    CHECK(get(port, "/api/state").result() == http::status::ok);
+    CHECK(httpGet(port, "/api/state").result() == http::status::ok);
   });
 }
 
@@ -363,7 +321,7 @@ TEST_CASE("view server: another site's page may not connect; HEAD has no body; l
       CHECK(all.find("Content-Length: ") != std::string::npos);
       CHECK(all.ends_with("\r\n\r\n"));
     }
-    auto big = get(port, "/", http::verb::get, std::string(20 * 1024, 'x'));
+    auto big = httpGet(port, "/", http::verb::get, std::string(20 * 1024, 'x'));
     CHECK(big.result() == http::status::request_header_fields_too_large);
   });
 }
