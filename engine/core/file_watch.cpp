@@ -1,10 +1,7 @@
 #include "engine/core/file_watch.hpp"
 
 #include <sys/inotify.h>
-#include <unistd.h>
 
-#include <cerrno>
-#include <cstring>
 #include <filesystem>
 #include <stdexcept>
 
@@ -23,18 +20,19 @@ constexpr std::uint32_t kSaved = IN_CLOSE_WRITE | IN_MOVED_TO;
 }  // namespace
 
 FileWatch::FileWatch(Loop& loop, Duration debounce)
-    : loop_(loop), debounce_(debounce), fd_(loop.io()), alive_(std::make_shared<bool>(true)) {
-  int fd = ::inotify_init1(IN_NONBLOCK | IN_CLOEXEC);
-  if (fd < 0) throw std::runtime_error(std::string("cannot watch files: ") + std::strerror(errno));
-  fd_.assign(fd);
-  waitForEvents();
+    : loop_(loop), debounce_(debounce), alive_(std::make_shared<bool>(true)) {
+  auto made = Inotify::open(loop);
+  if (!made) throw std::runtime_error("cannot watch files: " + made.error());
+  inotify_ = std::move(made).value();
+  inotify_->onEvent = [this](int wd, std::uint32_t mask, const std::string& name) {
+    event(wd, mask, name);
+  };
+  inotify_->onOverflow = [this] { overflowed(); };
 }
 
 FileWatch::~FileWatch() {
   *alive_ = false;
   loop_.cancel(quiet_);
-  boost::system::error_code ec;
-  fd_.close(ec);
 }
 
 Result<bool, std::string> FileWatch::add(const std::string& file) {
@@ -43,11 +41,10 @@ Result<bool, std::string> FileWatch::add(const std::string& file) {
   if (ec) return Unexpected{"cannot watch " + file + ": " + ec.message()};
   std::string folder = path.parent_path().string();
   if (!names_.count(folder)) {
-    int wd = ::inotify_add_watch(fd_.native_handle(), folder.c_str(), kMask);
-    if (wd < 0)
-      return Unexpected{"cannot watch " + file + ": its folder " + folder + ": " +
-                        std::strerror(errno)};
-    folders_[wd] = folder;
+    auto wd = inotify_->add(folder, kMask);
+    if (!wd)
+      return Unexpected{"cannot watch " + file + ": its folder " + folder + ": " + wd.error()};
+    folders_[*wd] = folder;
   }
   names_[folder].insert(path.filename().string());
   return true;
@@ -60,43 +57,21 @@ std::vector<std::string> FileWatch::files() const {
   return out;
 }
 
-void FileWatch::waitForEvents() {
-  std::weak_ptr<bool> alive = alive_;
-  fd_.async_wait(boost::asio::posix::stream_descriptor::wait_read,
-                 [this, alive](const boost::system::error_code& ec) {
-                   if (alive.expired() || ec) return;
-                   readEvents();
-                   waitForEvents();
-                 });
+// The kernel's queue overflowed (a flood of changes in a watched folder): events were lost, a save
+// among them perhaps. Every watched file is taken as changed, after quiet.
+void FileWatch::overflowed() {
+  for (const auto& [folder, names] : names_)
+    for (const auto& name : names) changed((fs::path(folder) / name).string(), IN_MODIFY);
 }
 
-void FileWatch::readEvents() {
-  alignas(inotify_event) char buf[4096];
-  bool saved = false;
-  for (;;) {
-    ssize_t n = ::read(fd_.native_handle(), buf, sizeof buf);
-    if (n <= 0) break;  // EAGAIN: all read
-    for (char* p = buf; p < buf + n;) {
-      auto* e = reinterpret_cast<inotify_event*>(p);
-      p += sizeof(inotify_event) + e->len;
-      if (e->mask & IN_Q_OVERFLOW) {
-        // The kernel's queue overflowed (a flood of changes in a watched folder): events were
-        // lost, a save among them perhaps. Every watched file is taken as changed, after quiet.
-        for (const auto& [folder, names] : names_)
-          for (const auto& name : names) changed((fs::path(folder) / name).string(), IN_MODIFY);
-        continue;
-      }
-      if (e->len == 0) continue;
-      auto folder = folders_.find(e->wd);
-      if (folder == folders_.end()) continue;
-      std::string name = e->name;
-      if (names_[folder->second].count(name))
-        saved |= changed((fs::path(folder->second) / name).string(), e->mask);
-    }
-  }
-  // The leading edge of a burst: reported on the next turn of the loop, with everything this
-  // read brought. Within a burst, saves wait for the end of the window.
-  if (saved && !inBurst_ && !reportPosted_) {
+void FileWatch::event(int wd, std::uint32_t mask, const std::string& name) {
+  if (name.empty()) return;
+  auto folder = folders_.find(wd);
+  if (folder == folders_.end() || !names_[folder->second].count(name)) return;
+  // A complete save is the leading edge of a burst: reported on the next turn of the loop, with
+  // everything this read of the queue brought (the read goes on until the queue is empty before
+  // the loop turns). Within a burst, saves wait for the end of the window.
+  if (changed((fs::path(folder->second) / name).string(), mask) && !inBurst_ && !reportPosted_) {
     reportPosted_ = true;
     std::weak_ptr<bool> alive = alive_;
     loop_.post([this, alive] {

@@ -12,7 +12,6 @@
 // Changes that are not a complete save (written but not closed yet, created, deleted, moved
 // away, attributes changed) are reported only once the files have been quiet for the window, so
 // a half-written file is not loaded.
-#include <boost/asio/posix/stream_descriptor.hpp>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -21,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/core/inotify.hpp"
 #include "engine/core/loop.hpp"
 #include "engine/core/result.hpp"
 
@@ -45,8 +45,8 @@ class FileWatch {
   Changed onChange;
 
  private:
-  void waitForEvents();
-  void readEvents();
+  void event(int wd, std::uint32_t mask, const std::string& name);
+  void overflowed();
   // One inotify event on a watched file; true when it is a complete save.
   bool changed(const std::string& path, std::uint32_t mask);
   void armQuiet();
@@ -57,7 +57,7 @@ class FileWatch {
 
   Loop& loop_;
   Duration debounce_;
-  boost::asio::posix::stream_descriptor fd_;
+  std::unique_ptr<Inotify> inotify_;
   std::map<int, std::string> folders_;                  // watch descriptor → folder
   std::map<std::string, std::set<std::string>> names_;  // folder → names watched in it
   std::set<std::string> pending_;

@@ -16,6 +16,7 @@
 #include <system_error>
 #include <vector>
 
+#include "engine/core/inotify.hpp"
 #include "engine/core/log.hpp"
 #include "engine/core/printable.hpp"
 #include "engine/drive/gamepad_mapping.hpp"
@@ -89,7 +90,7 @@ struct Gamepads::Impl {
   };
 
   Impl(Loop& loop, Seats& seats, GamepadsOptions options)
-      : loop(loop), seats(seats), options(std::move(options)), inotify(loop.io()) {}
+      : loop(loop), seats(seats), options(std::move(options)) {}
 
   ~Impl() {
     *alive = false;
@@ -99,15 +100,12 @@ struct Gamepads::Impl {
     for (auto& [path, device] : devices)
       if (device->seated) seats.release(path, "the gamepads stop");
     devices.clear();
-    boost::system::error_code ec;
-    inotify.close(ec);
   }
 
   Result<bool, std::string> start();
   void scan();
   void overflowed();
-  void waitFolder();
-  void readFolder();
+  void folderEvent(std::uint32_t mask, const std::string& name);
   void open(const std::string& path);
   void seat(Device& device);
   void seatWaiting();
@@ -118,7 +116,7 @@ struct Gamepads::Impl {
   Loop& loop;
   Seats& seats;
   GamepadsOptions options;
-  stream_descriptor inotify;
+  std::unique_ptr<Inotify> inotify;
   std::map<std::string, std::shared_ptr<Device>> devices;
   std::set<std::string> notGamepads;  // nodes opened once and found no gamepad: not again
   std::set<std::string> refused;      // nodes we may not open (permissions) — for the hint
@@ -139,17 +137,22 @@ Result<bool, std::string> Gamepads::Impl::start() {
         "no gamepads: " + folder + " is not a folder" +
         (ec ? " (" + ec.message() + ")" : std::string()) +
         "; is this a Linux host with evdev? ($PITWALL_INPUT_DIR names another folder)");
-  int fd = ::inotify_init1(IN_NONBLOCK | IN_CLOEXEC);
-  if (fd < 0) return Unexpected("no gamepads: cannot watch " + folder + ": " + errnoText(errno));
-  inotify.assign(fd);
-  if (::inotify_add_watch(fd, folder.c_str(), kMask) < 0)
-    return Unexpected(
-        "no gamepads: cannot watch " + folder + ": " + errnoText(errno) +
-        (errno == EACCES ? " (add the user to group `input`, docs/controllers.md)" : ""));
+  auto made = Inotify::open(loop);
+  if (!made) return Unexpected("no gamepads: cannot watch " + folder + ": " + made.error());
+  inotify = std::move(made).value();
+  if (auto wd = inotify->add(folder, kMask); !wd)
+    return Unexpected("no gamepads: cannot watch " + folder + ": " + wd.error() +
+                      (wd.error() == errnoText(EACCES)
+                           ? " (add the user to group `input`, docs/controllers.md)"
+                           : ""));
+  // One folder is watched: every event is about it.
+  inotify->onEvent = [this](int, std::uint32_t mask, const std::string& name) {
+    folderEvent(mask, name);
+  };
+  inotify->onOverflow = [this] { overflowed(); };  // events lost: look at the folder again
   watchSeats = seats.changed.connect([this](const Seat& s) {
     if (!s.held()) seatWaiting();
   });
-  waitFolder();
   scan();
   if (devices.empty() && !refused.empty())
     log::warn(kLog, "no gamepad in " + folder + " can be read: " + std::to_string(refused.size()) +
@@ -190,45 +193,19 @@ void Gamepads::Impl::overflowed() {
   scan();
 }
 
-void Gamepads::Impl::waitFolder() {
-  std::weak_ptr<bool> weak = alive;
-  inotify.async_wait(stream_descriptor::wait_read,
-                     [this, weak](const boost::system::error_code& ec) {
-                       if (weak.expired() || ec) return;
-                       readFolder();
-                       if (!weak.expired()) waitFolder();
-                     });
-}
-
-void Gamepads::Impl::readFolder() {
-  alignas(inotify_event) char buf[4096];
-  std::weak_ptr<bool> weak = alive;
-  for (;;) {
-    ssize_t n = ::read(inotify.native_handle(), buf, sizeof buf);
-    if (n <= 0) break;  // EAGAIN: all read
-    for (char* p = buf; p < buf + n;) {
-      auto* e = reinterpret_cast<inotify_event*>(p);
-      p += sizeof(inotify_event) + e->len;
-      if (e->mask & IN_Q_OVERFLOW) {  // events lost: look at the folder again
-        overflowed();
-        if (weak.expired()) return;
-        continue;
-      }
-      if (e->mask & IN_IGNORED) {
-        log::warn(kLog, options.folder.string() + " is gone: no new gamepad will be seen");
-        continue;
-      }
-      if (e->len == 0 || !isEventNode(e->name)) continue;
-      const std::string path = (options.folder / e->name).string();
-      if (e->mask & (IN_DELETE | IN_MOVED_FROM)) {
-        notGamepads.erase(path);
-        refused.erase(path);
-        drop(path, "the gamepad was unplugged");
-      } else if (!devices.count(path) && !notGamepads.count(path)) {
-        open(path);  // IN_CREATE, or IN_ATTRIB once udev let us read it
-      }
-      if (weak.expired()) return;
-    }
+void Gamepads::Impl::folderEvent(std::uint32_t mask, const std::string& name) {
+  if (mask & IN_IGNORED) {
+    log::warn(kLog, options.folder.string() + " is gone: no new gamepad will be seen");
+    return;
+  }
+  if (name.empty() || !isEventNode(name)) return;
+  const std::string path = (options.folder / name).string();
+  if (mask & (IN_DELETE | IN_MOVED_FROM)) {
+    notGamepads.erase(path);
+    refused.erase(path);
+    drop(path, "the gamepad was unplugged");
+  } else if (!devices.count(path) && !notGamepads.count(path)) {
+    open(path);  // IN_CREATE, or IN_ATTRIB once udev let us read it
   }
 }
 
