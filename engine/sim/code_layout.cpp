@@ -74,6 +74,15 @@ std::optional<CodeSpot> locateCode(const Piece& piece, int location, const CodeG
   return std::nullopt;
 }
 
+std::vector<double> codeFractions(const Piece& piece, const CodeGeometry& g) {
+  std::vector<double> out;
+  for (int location = 0;; ++location) {  // (the rows, walked once per id: a piece entered)
+    auto spot = locateCode(piece, location, g);
+    if (!spot) return out;
+    out.push_back(spot->fraction);
+  }
+}
+
 std::array<double, anki::optical::kStrokes> strokeCentres(const CodeRow& row, int section,
                                                           const CodeGeometry& g) {
   std::array<double, anki::optical::kStrokes> out;

@@ -70,6 +70,9 @@ struct CodeSpot {
   double fraction = 0;
 };
 std::optional<CodeSpot> locateCode(const Piece& piece, int location, const CodeGeometry& g = {});
+// locateCode's fraction for every location id of the piece at once, by id (the view keeps the
+// current piece's: a position update then costs a lookup, not a walk over the rows).
+std::vector<double> codeFractions(const Piece& piece, const CodeGeometry& g = {});
 // The centres of section k's 9 strokes along its row, in forward order.
 std::array<double, anki::optical::kStrokes> strokeCentres(const CodeRow& row, int section,
                                                           const CodeGeometry& g = {});

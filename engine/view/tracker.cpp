@@ -6,21 +6,25 @@
 
 namespace pitwall::view {
 
-namespace {
-
 // Where along a piece a location code lies (docs/tracks.md "The code"): the centre of its
 // section, as a fraction of the piece in its own forward direction; location ids name the same
-// spot whichever way the car drives. Unknown ids: the middle.
-double codeFraction(const sim::Piece& piece, int location) {
-  auto spot = sim::locateCode(piece, location);
-  return spot ? spot->fraction : 0.5;
+// spot whichever way the car drives. Unknown ids: the middle. The fractions of the piece the car
+// is on are kept (`key`: the track's piece index, or the stock piece's id and direction), so a
+// position update looks one up instead of walking the piece's code rows.
+double CarTracker::codeFraction(const sim::Piece& piece, long key, int location) {
+  if (key != fractionsKey_) {
+    fractions_ = sim::codeFractions(piece);
+    fractionsKey_ = key;
+  }
+  return location >= 0 && static_cast<std::size_t>(location) < fractions_.size()
+             ? fractions_[static_cast<std::size_t>(location)]
+             : 0.5;
 }
-
-}  // namespace
 
 void CarTracker::setTrack(const sim::Track* track) {
   track_ = track && track->size() ? track : nullptr;
   index_.reset();
+  fractionsKey_ = -1;
 }
 
 std::optional<std::size_t> CarTracker::locate(int pieceId, bool reverse) const {
@@ -63,8 +67,12 @@ void CarTracker::update(const anki::Message& message, const CarState& state, dou
     // The piece as the track has it (a custom one's shape), else Anki's stock piece of that id.
     sim::Piece piece{p->piece_id, anki::pieceType(p->piece_id),
                      anki::pieceType(p->piece_id) == anki::PieceType::Curve ? 1 : 0};
-    if (track_ && index_) piece = track_->pieces()[*index_];
-    fraction_ = codeFraction(piece, p->location_id);
+    long key = 1000000 + 2L * p->piece_id + (piece.turn < 0 ? 1 : 0);
+    if (track_ && index_) {
+      piece = track_->pieces()[*index_];
+      key = static_cast<long>(*index_);
+    }
+    fraction_ = codeFraction(piece, key, p->location_id);
     positionTime_ = now;
   } else if (std::holds_alternative<anki::TransitionUpdate>(message)) {
     // The car left the piece it last reported: 34 → 33 driving forward is the finish line.

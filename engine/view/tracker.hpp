@@ -32,9 +32,12 @@ class CarTracker {
  private:
   void crossFinish(double now);
   std::optional<std::size_t> locate(int pieceId, bool reverse) const;
+  double codeFraction(const sim::Piece& piece, long key, int location);
 
   const sim::Track* track_ = nullptr;
   std::optional<std::size_t> index_;
+  long fractionsKey_ = -1;  // whose code fractions fractions_ holds (codeFraction)
+  std::vector<double> fractions_;
   double fraction_ = 0;
   double positionTime_ = -1;
   int lastPieceId_ = -1;

@@ -91,3 +91,17 @@ TEST_CASE("code layout: a right curve is its left curve's piece driven backwards
     CHECK(printedPiece(right).turn == 1);
   }
 }
+
+TEST_CASE("code layout: codeFractions is locateCode's fraction for every id, and no more") {
+  for (const Piece& p : {stock(36, 0), stock(17, 1), stock(17, -1), stock(34, 0), stock(33, 0),
+                         Piece{60, anki::PieceType::Straight, 0, 300},
+                         Piece{61, anki::PieceType::Curve, -1, 0, 400, 45}}) {
+    CAPTURE(p.id);
+    CAPTURE(p.turn);
+    const auto fractions = codeFractions(p);
+    REQUIRE(fractions.size() == static_cast<std::size_t>(codeLayout(p).locations));
+    for (std::size_t k = 0; k < fractions.size(); ++k)
+      CHECK(fractions[k] == locateCode(p, static_cast<int>(k))->fraction);
+    CHECK_FALSE(locateCode(p, static_cast<int>(fractions.size())));
+  }
+}
