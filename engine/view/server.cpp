@@ -8,16 +8,13 @@
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
 #include <charconv>
-#include <cmath>
-#include <deque>
 #include <fstream>
 #include <list>
-#include <map>
 #include <sstream>
 
 #include "engine/core/data_dir.hpp"
 #include "engine/core/log.hpp"
-#include "engine/core/token_bucket.hpp"
+#include "engine/view/page_messages.hpp"
 
 namespace pitwall::view {
 
@@ -36,12 +33,6 @@ constexpr auto kRequestTimeout = std::chrono::seconds(10);  // for a request to 
 constexpr std::size_t kMaxBrowsers = 64;                    // WebSockets at once
 constexpr std::size_t kMaxConnections = 128;  // HTTP connections at once (not upgraded)
 constexpr auto kAcceptRetry = std::chrono::milliseconds(250);  // after a failed accept()
-// A page's messages: the controller page sends 10 drive messages a second and one on each
-// change of its controls (at most 30 a second); more is a flood, dropped without an answer each.
-constexpr RateLimit kPageMessages{.perSecond = 40, .burst = 20};
-constexpr std::size_t kMaxReplies = 8;  // answers waiting for a slow page; the oldest go first
-constexpr double kErrorEvery = 1.0;     // s: the same refusal of a drive message, said again
-constexpr const char* kDrivingOff = "driving is off in this run: start it with --humans N";
 
 std::string_view contentType(const std::filesystem::path& path) {
   const std::string ext = path.extension().string();
@@ -105,7 +96,7 @@ struct Server::Impl::Socket : std::enable_shared_from_this<Socket> {
         ws(std::move(sock)),
         pace(server->loop.io()),
         stall(server->loop.io()),
-        holder("phone#" + std::to_string(++server->phones)) {}
+        page(server->loop, server->feed, "phone#" + std::to_string(++server->phones)) {}
 
   std::shared_ptr<Impl> server;
   websocket::stream<beast::tcp_stream> ws;
@@ -113,11 +104,7 @@ struct Server::Impl::Socket : std::enable_shared_from_this<Socket> {
   beast::flat_buffer in;
   std::string out;                                // the message being written
   std::uint64_t lastChanges = ~std::uint64_t{0};  // the feed's changes() at the last update
-  std::deque<std::string> replies;     // answers to a page's messages, sent before the next update
-  std::string holder;                  // this connection as the holder of a seat ("phone#3")
-  TokenBucket bucket;                  // the page's messages (kPageMessages)
-  bool flooding = false;               // said once a flood: more messages than kPageMessages
-  std::map<std::string, double> said;  // refusals of drive messages, and when each was said
+  PageMessages page;  // what the page sends (a seat's holder), its answers before the next update
   std::uint64_t cursor = 0, trackSeen = 0;
   bool writing = false, closed = false;
   std::chrono::steady_clock::time_point lastWrite{};  // the last message written
@@ -147,120 +134,9 @@ struct Server::Impl::Socket : std::enable_shared_from_this<Socket> {
       if (ec) return self->close();
       std::string text = beast::buffers_to_string(self->in.data());
       self->in.consume(self->in.size());
-      self->message(text);
+      self->page.receive(text);
       self->read();
     });
-  }
-
-  // A page's message. Nothing in it may throw out of the loop (that would end the run with
-  // the cars at speed): every field's type is checked before it is read, the control's handler is
-  // guarded, and a flood is dropped (a seat's holder that floods loses nothing but the extra).
-  void message(const std::string& text) noexcept {
-    try {
-      nlohmann::json m = nlohmann::json::parse(text, nullptr, false);
-      const nlohmann::json* type = m.is_object() ? field(m, "type") : nullptr;
-      if (!type || !type->is_string()) return;
-      const std::string& kind = type->get_ref<const std::string&>();
-      // letting go is always taken: a page that flooded may still leave its seat
-      if (kind == "leave") return leave();
-      if (kind != "control" && kind != "seat" && kind != "drive") return;  // not for the view
-      if (!bucket.take(kPageMessages, server->loop.now())) {
-        if (!flooding)
-          answer(error("too many messages: a page may send " +
-                       std::to_string(static_cast<int>(kPageMessages.perSecond)) +
-                       " a second; the others are dropped"));
-        flooding = true;
-        return;
-      }
-      flooding = false;
-      if (kind == "control") return control(m);
-      if (kind == "seat") return seat(m);
-      if (kind == "drive") return drive(m);
-    } catch (const std::exception& e) {  // none expected: the last guard of the loop
-      log::warn("view", std::string("a page's message was dropped: ") + e.what());
-    }
-  }
-
-  static const nlohmann::json* field(const nlohmann::json& m, const char* name) {
-    auto it = m.find(name);
-    return it == m.end() ? nullptr : &*it;
-  }
-  static std::string error(const std::string& why) {
-    return nlohmann::json{{"type", "error"}, {"message", why}}.dump(
-        -1, ' ', false, nlohmann::json::error_handler_t::replace);
-  }
-  void answer(std::string text) {
-    replies.push_back(std::move(text));
-    while (replies.size() > kMaxReplies) replies.pop_front();
-  }
-  // A whole number from a message, within [lo, hi]; none for anything else (text, 1.5, 1e300).
-  static std::optional<int> whole(const nlohmann::json* v, int lo, int hi) {
-    if (!v || !v->is_number()) return std::nullopt;
-    const double d = v->get<double>();
-    if (!std::isfinite(d) || d != std::floor(d) || d < lo || d > hi) return std::nullopt;
-    return static_cast<int>(d);
-  }
-
-  void control(const nlohmann::json& m) {
-    if (!server->feed.onControl)
-      return answer(
-          error("controls are for replays (pitwall replay FILE --view); this is a live run"));
-    try {
-      server->feed.onControl(m);
-    } catch (const std::exception& e) {
-      log::warn("view", std::string("a page's control was refused: ") + e.what());
-      answer(error(std::string("control refused: ") + e.what()));
-    }
-  }
-
-  // {"type":"seat","seat":N,"player":"name"}: this page takes seat N (0: the first free one).
-  void seat(const nlohmann::json& m) {
-    drive::Seats* seats = server->feed.seats();
-    if (!seats || seats->count() == 0) return answer(error(kDrivingOff));
-    const int count = static_cast<int>(seats->count());
-    const nlohmann::json* n = field(m, "seat");
-    auto number = n ? whole(n, 0, count) : std::optional<int>(0);
-    if (!number)  // (a number is shown; anything else by its type: a deep array is not dumped)
-      return answer(error(
-          "seat " +
-          (n->is_number() ? n->dump().substr(0, 40) : std::string("(") + n->type_name() + ")") +
-          " is not a seat of this run: give 1.." + std::to_string(count) +
-          ", or 0 for the first free one"));
-    std::string player;
-    if (const nlohmann::json* p = field(m, "player"); p && !p->is_null()) {
-      if (!p->is_string()) return answer(error("the player's name must be text"));
-      player = p->get_ref<const std::string&>().substr(0, 256);  // the seats keep 24 bytes
-    }
-    auto taken = seats->claim(holder, drive::Holder::Phone, *number, player);
-    if (!taken) return answer(error(taken.error()));
-    answer(nlohmann::json{{"type", "seat"}, {"seat", *taken}}.dump());
-  }
-
-  // {"type":"drive","throttle":x,"lane":-1|0|1}: what the driver asks for, and the sign of life
-  // that keeps the seat live. Refusals are said, the same one at most once a second.
-  void drive(const nlohmann::json& m) {
-    drive::Seats* seats = server->feed.seats();
-    if (!seats || seats->count() == 0) return refuseDrive(kDrivingOff);
-    const nlohmann::json* t = field(m, "throttle");
-    if (!t || !t->is_number())
-      return refuseDrive("throttle must be a number from 0 (stop) to 1 (full)");
-    const nlohmann::json* l = field(m, "lane");
-    auto lane = l && !l->is_null() ? whole(l, -1, 1) : std::optional<int>(0);
-    if (!lane) return refuseDrive("lane must be -1 (left), 0 or 1 (right)");
-    // (what changed reaches the feed through Seats::asked)
-    if (auto done = seats->input(holder, t->get<double>(), *lane); !done)
-      return refuseDrive(done.error());
-  }
-  void refuseDrive(const std::string& why) {
-    const double t = server->loop.seconds();
-    std::erase_if(said, [t](const auto& e) { return t - e.second >= kErrorEvery; });
-    if (said.contains(why) || said.size() >= kMaxReplies) return;
-    said.emplace(why, t);
-    answer(error(why));
-  }
-
-  void leave() {
-    if (drive::Seats* seats = server->feed.seats()) seats->release(holder, "the player left");
   }
 
   void write(std::string text) {
@@ -297,11 +173,7 @@ struct Server::Impl::Socket : std::enable_shared_from_this<Socket> {
   }
 
   void send() {
-    if (!replies.empty()) {
-      std::string text = std::move(replies.front());
-      replies.pop_front();
-      return write(std::move(text));
-    }
+    if (auto answer = page.nextAnswer()) return write(std::move(*answer));
     const Feed& feed = server->feed;
     bool unchanged = feed.changes() == lastChanges && feed.eventCursor() == cursor &&
                      feed.trackVersion() == trackSeen;
@@ -319,8 +191,7 @@ struct Server::Impl::Socket : std::enable_shared_from_this<Socket> {
     closed = true;
     server->open--;
     // a phone that goes (closed, lost, stalled) lets go of its seat: its car slows to a stop
-    if (drive::Seats* seats = server->feed.seats())
-      seats->release(holder, "the phone disconnected");
+    page.closed();
     pace.cancel();
     stall.cancel();
     beast::error_code ignored;

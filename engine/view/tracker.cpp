@@ -67,7 +67,7 @@ void CarTracker::update(const anki::Message& message, const CarState& state, dou
     // The piece as the track has it (a custom one's shape), else Anki's stock piece of that id.
     sim::Piece piece{p->piece_id, anki::pieceType(p->piece_id),
                      anki::pieceType(p->piece_id) == anki::PieceType::Curve ? 1 : 0};
-    long key = 1000000 + 2L * p->piece_id + (piece.turn < 0 ? 1 : 0);
+    long key = 1000000L + p->piece_id;  // (a stock piece: its id; a curve is a left one here)
     if (track_ && index_) {
       piece = track_->pieces()[*index_];
       key = static_cast<long>(*index_);
