@@ -23,6 +23,12 @@ static_assert(std::atomic<int>::is_always_lock_free);
 
 void onStopSignal(int sig) {
   int saved = errno;
+  // A hang-up comes twice or more (the shell passes its own on, the kernel sends one to the
+  // foreground group): only a first one counts — a repeat must not make the stop "leave now".
+  if (sig == SIGHUP && g_count.load(std::memory_order_relaxed) > 0) {
+    errno = saved;
+    return;
+  }
   int count = g_count.fetch_add(1, std::memory_order_relaxed) + 1;
   if (auto hook = g_hook.load(std::memory_order_relaxed)) hook();
   if (count >= 3 && g_acted.load(std::memory_order_relaxed) < 2) {

@@ -25,13 +25,24 @@ bool isGamepad(const DeviceCaps& caps) {
 }
 
 GamepadMapping::GamepadMapping(const DeviceCaps& caps) {
-  for (int code : {ABS_RZ, ABS_GAS, ABS_HAT2X}) {
+  auto has = [&caps](int code) {
     auto it = caps.axes.find(code);
-    if (it == caps.axes.end() || it->second.maximum <= it->second.minimum) continue;
+    return it != caps.axes.end() && it->second.maximum > it->second.minimum;
+  };
+  // A pad with its right stick on ABS_RX/ABS_RY, as the gamepad spec has it, has its triggers
+  // on the Z axes: one resting at its minimum when opened is the throttle at once. Without them
+  // ABS_RZ may well be the right stick (hid-generic pads), and the value read at open proves
+  // nothing — the kernel holds 0 until the pad's first report — so it is the throttle only once
+  // an event has brought it to rest at its minimum. (ABS_GAS and ABS_HAT2X come from drivers
+  // that follow the spec: at rest when opened is enough.)
+  const bool rightStick = has(ABS_RX) && has(ABS_RY);
+  for (int code : {ABS_RZ, ABS_GAS, ABS_HAT2X}) {
+    if (!has(code)) continue;
+    auto it = caps.axes.find(code);
     trigger_ = code;
     triggerInfo_ = it->second;
     triggerValue_ = it->second.value;
-    armed_ = atRest(triggerInfo_, triggerValue_);
+    armed_ = (code != ABS_RZ || rightStick) && atRest(triggerInfo_, triggerValue_);
     source_ = ThrottleSource::Trigger;
     break;
   }

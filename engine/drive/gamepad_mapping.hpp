@@ -59,7 +59,9 @@ class GamepadMapping {
   ThrottleSource source() const { return source_; }
   int triggerAxis() const { return trigger_; }  // the ABS code, or −1
   // The trigger axis has been seen at rest at its minimum and is the throttle; false before
-  // (BTN_TR2 and the left stick drive meanwhile) and on a pad without one.
+  // (BTN_TR2 and the left stick drive meanwhile) and on a pad without one. ABS_RZ seen there at
+  // open counts only on a pad with a right stick on ABS_RX/ABS_RY (the gamepad spec's layout);
+  // on others an event must bring it there.
   bool triggerArmed() const { return armed_; }
 
   // One event (type, code, value as struct input_event has them). The input to send when the

@@ -88,13 +88,15 @@ Result<bool, std::string> Keyboard::Impl::start() {
   // cbreak: keys one at a time (no ICANON), not echoed (no ECHO); ISIG stays, so Ctrl-C is still
   // SIGINT and stops the run (and the cars) as always. But not Ctrl-Z: SIGTSTP would freeze the
   // whole loop with the cars at speed and nothing left to stop them (VSUSP off; POSIX
-  // _POSIX_VDISABLE), until the modes are put back.
+  // _POSIX_VDISABLE), until the modes are put back; nor Ctrl-\: SIGQUIT's default action ends
+  // the process at once, dumping core, with no stop for any car (VQUIT off).
   termios cbreak = modes;
   cbreak.c_lflag &= ~static_cast<tcflag_t>(ICANON | ECHO);
   cbreak.c_lflag |= ISIG;
   cbreak.c_cc[VMIN] = 1;
   cbreak.c_cc[VTIME] = 0;
   cbreak.c_cc[VSUSP] = _POSIX_VDISABLE;
+  cbreak.c_cc[VQUIT] = _POSIX_VDISABLE;
   saved = SavedTerminal{true, fd, modes};
   static bool registered = false;
   if (!registered) registered = std::atexit(restoreSaved) == 0;

@@ -154,7 +154,10 @@ Result<int, std::string> Seats::input(const std::string& holder, double throttle
 
 void Seats::driving(int number) {
   if (number < 1 || number > static_cast<int>(seats_.size())) return;
-  seats_[static_cast<std::size_t>(number - 1)].drivenAt = loop_.seconds();
+  Seat& s = seats_[static_cast<std::size_t>(number - 1)];
+  s.drivenAt = loop_.seconds();
+  const AnkiCar* car = fleet_.find(number);
+  s.drivenSpeed = car ? car->state().target_speed_mm_s : 0;
 }
 
 int Seats::takeLanes(int number) {
@@ -171,7 +174,10 @@ void Seats::lose(Seat& s, const std::string& why) {
     log::debug(kLog, "seat " + std::to_string(s.number) + ": " + why);
     return;
   }
-  if (loop_.seconds() - s.drivenAt > kDrivenFor) {  // someone else drives the car now
+  const bool driven = loop_.seconds() - s.drivenAt <= kDrivenFor;
+  const bool stillAsSeatAsked =
+      s.drivenSpeed > 0 && car->state().target_speed_mm_s == s.drivenSpeed;
+  if (!driven && !stillAsSeatAsked) {  // someone else drives the car now
     log::info(kLog, "seat " + std::to_string(s.number) + ": " + why +
                         " (no driver drives its car from it: the car is left to its driver)");
     return;

@@ -40,6 +40,7 @@ struct Seat {
   int lanes = 0;             // lane steps asked and not taken yet: − left, + right (at most ±3)
   double lastInput = 0;      // engine seconds of the last input
   double drivenAt = -1e300;  // engine seconds a driver last said it drives from this seat
+  int drivenSpeed = 0;       // the car's commanded speed then (mm/s)
   bool live = false;         // held, and its input is fresh
   bool held() const { return !holder.empty(); }
 };
@@ -69,10 +70,12 @@ class Seats {
   const Seat* heldBy(const std::string& holder) const;
   // The lane steps asked since the last take (− left, + right); they are forgotten.
   int takeLanes(int number);
-  // A driver drives seat `number`'s car from the seat now (the human driver says so at every
-  // update and while the lights are on). Only while one does — said within kDrivenFor s — does
-  // a lost holder stop the car: a car that the race director drives (a scan lap, to the grid) or
-  // an AI driver drives is not the seat's to stop.
+  // A driver drives seat `number`'s car from the seat now, and has just commanded it (the human
+  // driver says so after each update and while the lights are on). A lost holder stops the car
+  // while one does — said within kDrivenFor s — and also later, as long as the car still goes
+  // at the speed it last had from the seat's driver (nothing else commanded it since: a driver
+  // that stopped being called, a reload's pause, a long period). A car that the race director
+  // drives (a scan lap, to the grid) or an AI driver drives is not the seat's to stop.
   void driving(int number);
   static constexpr double kDrivenFor = 1.0;
   std::size_t count() const { return seats_.size(); }

@@ -79,8 +79,9 @@ expect.eq(entry.driver.name, "human", "a human driver in the race")
 expect.near(sim.truth(cars[1]).offset - offsetBefore, 45, 12, "one lane to the right")
 
 -- Input loss. Human 1 drives again outside a race; then its input stops (a phone that went
--- silent) while its driver keeps running: the engine slows the car to a stop within the 1 s
--- silence and the braking from its speed, and the driver does not drive it off again.
+-- silent) while its driver keeps running: the car is stopped within the 1 s silence and the
+-- braking from its speed, and the driver does not drive it off again. (The driver and the engine
+-- both ask for the stop here; the engine's own, with no driver, is tests/unit/drive/seats_test.)
 local handle = drivers.run(cars[1], human.new { seat = 1, max = 1000 },
   drivers.context(cars[1], track.fromSim(), cars))
 want[1].throttle = 0.8

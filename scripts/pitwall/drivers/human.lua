@@ -92,7 +92,6 @@ function Human:_check(car)
     pitwall._raise(string.format("human driver: seat %d drives %s, not %s: give this car's seat "
       .. "(seat = %s)", self.seat.number, tostring(mine), tostring(car), tostring(car.number)))
   end
-  self.seat:driving() -- the engine stops the car if the seat's holder goes (seats.hpp)
 end
 
 function Human:_drive(car, ctx)
@@ -116,6 +115,7 @@ function Human:update(car, ctx)
   self:_check(car)
   self:_drive(car, ctx)
   self:_lanes(car)
+  self.seat:driving() -- the engine stops the car if the seat's holder goes (seats.hpp)
 end
 
 -- The lights are on: the throttle goes through, so a person who does not wait jumps the start.
@@ -123,6 +123,7 @@ function Human:waiting(car, ctx)
   self:_check(car)
   if self.seat.throttle >= 0.02 then self:_drive(car, ctx) end
   self.seat:lanes() -- (a step asked on the grid is not kept for the green light)
+  self.seat:driving()
 end
 
 return human

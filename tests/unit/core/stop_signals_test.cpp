@@ -67,6 +67,24 @@ TEST_CASE("SIGHUP ends a run as SIGTERM does, unless it was ignored (nohup)") {
     loop.cancel(guard);
     CHECK(got == SIGHUP * 100 + 1);
   }
+  {  // a hang-up comes twice (the shell's and the kernel's): the repeat is no second signal
+    Loop loop(ClockKind::Real);
+    StopSignals signals(loop);
+    std::vector<int> got;
+    signals.onSignal = [&](int sig, int count) {
+      got.push_back(sig * 100 + count);
+      if (sig == SIGTERM) loop.stop();
+    };
+    loop.after(10ms, [] {
+      std::raise(SIGHUP);
+      std::raise(SIGHUP);
+    });
+    loop.after(200ms, [] { std::raise(SIGTERM); });  // a real second signal still counts
+    auto guard = loop.after(20s, [&] { loop.stop(); });
+    loop.run();
+    loop.cancel(guard);
+    CHECK(got == std::vector<int>{SIGHUP * 100 + 1, SIGTERM * 100 + 2});
+  }
   struct sigaction after {};
   ::sigaction(SIGHUP, nullptr, &after);
   CHECK((after.sa_handler == before.sa_handler));

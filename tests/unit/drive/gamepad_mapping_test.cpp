@@ -18,6 +18,8 @@ DeviceCaps xboxPad() {
   caps.keys = {BTN_SOUTH, BTN_EAST, BTN_NORTH, BTN_WEST, BTN_TL, BTN_TR, BTN_START, BTN_SELECT};
   caps.axes[ABS_X] = {-32768, 32767, 128, 0};
   caps.axes[ABS_Y] = {-32768, 32767, 128, 0};
+  caps.axes[ABS_RX] = {-32768, 32767, 128, 0};
+  caps.axes[ABS_RY] = {-32768, 32767, 128, 0};
   caps.axes[ABS_Z] = {0, 1023, 0, 0};
   caps.axes[ABS_RZ] = {0, 1023, 0, 0};
   return caps;
@@ -255,4 +257,27 @@ TEST_CASE("gamepad: random events never give a throttle outside 0..1 or a lane s
       CHECK(out->laneStep <= 1);
     }
   }
+}
+
+TEST_CASE(
+    "gamepad: without a right stick on RX/RY, ABS_RZ at 0 when opened is not yet the throttle") {
+  // a hid-generic pad (DragonRise, F310 in D mode): X/Y the left stick, Z/RZ the right one; the
+  // kernel holds 0 for every axis until the pad's first report, so 0 at open proves nothing
+  DeviceCaps caps;
+  caps.keys = {BTN_SOUTH, BTN_TL, BTN_TR, BTN_TR2, BTN_JOYSTICK};
+  caps.axes[ABS_X] = {0, 255, 15, 0};
+  caps.axes[ABS_Y] = {0, 255, 15, 0};
+  caps.axes[ABS_Z] = {0, 255, 15, 0};
+  caps.axes[ABS_RZ] = {0, 255, 15, 0};
+  GamepadMapping m(caps);
+  CHECK_FALSE(m.triggerArmed());
+  // the first report: the right stick at rest, mid-range; the left stick at rest too
+  m.event(EV_ABS, ABS_Y, 128);
+  auto in = m.event(EV_ABS, ABS_RZ, 128);
+  CHECK((!in || in->throttle == 0));
+  CHECK(m.throttle() == 0);
+  CHECK_FALSE(m.triggerArmed());
+  // pressed to its minimum by an event: from then on it is taken as the throttle (documented)
+  m.event(EV_ABS, ABS_RZ, 0);
+  CHECK(m.triggerArmed());
 }

@@ -139,18 +139,24 @@ TEST_CASE("keyboard: the terminal hung up, the seat is let go (the car slows to 
   CHECK_FALSE(d.r.seats.seat(1)->held());
 }
 
-TEST_CASE("keyboard: Ctrl-Z is off while it drives (no SIGTSTP to freeze the cars), back after") {
+TEST_CASE(
+    "keyboard: Ctrl-Z and Ctrl-backslash are off while it drives (no SIGTSTP, no SIGQUIT), back "
+    "after") {
   Rig r;
   Pty pty;
   const cc_t before = pty.modes().c_cc[VSUSP];
+  const cc_t quit = pty.modes().c_cc[VQUIT];
   REQUIRE(before != _POSIX_VDISABLE);  // a fresh pty: ^Z
+  REQUIRE(quit != _POSIX_VDISABLE);    // and ^\ (backslash)
   {
     drive::Keyboard k(r.loop, r.seats, pty.slave);
     REQUIRE(k.start());
     CHECK(pty.modes().c_cc[VSUSP] == _POSIX_VDISABLE);
+    CHECK(pty.modes().c_cc[VQUIT] == _POSIX_VDISABLE);
     CHECK(pty.modes().c_cc[VINTR] != _POSIX_VDISABLE);  // Ctrl-C still ends the run
   }
   CHECK(pty.modes().c_cc[VSUSP] == before);
+  CHECK(pty.modes().c_cc[VQUIT] == quit);
 }
 
 TEST_CASE("keyboard: a wait for the terminal that fails lets go of the seat; a cancel does not") {

@@ -1,6 +1,7 @@
 // Human seats against the simulator (engine/drive/seats.hpp): who may hold which seat, what a
 // holder may ask for, and that a car whose holder lets go or falls silent is slowed to a stop by
-// the engine itself — with no driver, no script, nothing else commanding it.
+// the engine itself — no driver commands it here, the tests only say `driving()` as the human
+// driver does — when the car is the seat's, and left alone when someone else drives it.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -228,4 +229,27 @@ TEST_CASE("seats: a holder moving to another seat lets go of its old one after i
   CHECK(seen == std::vector<std::string>{"2 held", "1 free", "1 held"});
   CHECK(r.seats.heldBy("phone#1")->number == 2);
   CHECK(r.seats.heldBy("pad")->number == 1);
+}
+
+TEST_CASE("seats: a car still at the speed its seat's driver gave is stopped, however long ago") {
+  // the driver stopped saying so (a reload's pause, a director that fails, a long period), but
+  // nothing else has commanded the car since: the speed it runs at is the seat's
+  Run r;
+  REQUIRE(r.seats.claim("phone#1", drive::Holder::Phone, 1));
+  REQUIRE(r.seats.claim("phone#2", drive::Holder::Phone, 2));
+  r.drive(0, 800);
+  r.drive(1, 800);
+  r.seats.driving(1);
+  r.seats.driving(2);
+  r.drive(1, 500);  // car 2: someone else (the director's cool-down, say) commands it after
+  r.runDriving(3, 1, 0, [&] {  // no driver says anything for 3 s; the phones still talk
+    REQUIRE(r.seats.input("phone#1", 0.8, 0));
+    REQUIRE(r.seats.input("phone#2", 0.8, 0));
+  });
+  r.seats.release("phone#1", "the phone disconnected");
+  r.seats.release("phone#2", "the phone disconnected");
+  r.run(1.5);
+  CHECK(r.cars[0]->state().target_speed_mm_s == 0);
+  CHECK(r.speed(0) == 0);
+  CHECK(r.cars[1]->state().target_speed_mm_s == 500);  // left to whoever commanded it last
 }
