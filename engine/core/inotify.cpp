@@ -5,6 +5,9 @@
 
 #include <cerrno>
 #include <cstring>
+#include <string>
+
+#include "engine/core/log.hpp"
 
 namespace pitwall {
 
@@ -35,18 +38,23 @@ void Inotify::wait() {
   fd_.async_wait(boost::asio::posix::stream_descriptor::wait_read,
                  [this, alive](const boost::system::error_code& ec) {
                    if (alive.expired() || ec) return;
-                   read();
-                   if (!alive.expired()) wait();
+                   const bool readable = read();
+                   if (readable && !alive.expired()) wait();
                  });
 }
 
-void Inotify::read() {
+bool Inotify::read() {
   alignas(inotify_event) char buf[4096];
   std::weak_ptr<bool> alive = alive_;
   for (;;) {
     ssize_t n = ::read(fd_.native_handle(), buf, sizeof buf);
     if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) break;  // EAGAIN: all read
+    if (n < 0 && errno != EAGAIN && errno != EWOULDBLOCK) {
+      log::warn("inotify", std::string("reading the file watch failed: ") + std::strerror(errno) +
+                               "; no more changes are seen");
+      return false;
+    }
+    if (n <= 0) return true;  // EAGAIN: all read
     for (char* p = buf; p < buf + n;) {
       auto* e = reinterpret_cast<inotify_event*>(p);
       p += sizeof(inotify_event) + e->len;
@@ -57,7 +65,7 @@ void Inotify::read() {
         // The name is padded with NULs to its length; none when the event is the folder's own.
         call(e->wd, e->mask, e->len ? std::string(e->name) : std::string());
       }
-      if (alive.expired()) return;  // a callback destroyed this watch: buf is ours, nothing else
+      if (alive.expired()) return false;  // a callback destroyed this watch: buf is ours only
     }
   }
 }

@@ -43,7 +43,9 @@ class Inotify {
  private:
   Inotify(Loop& loop, int fd);
   void wait();
-  void read();
+  // Reads until the queue is empty; false when reading failed for good (said in the log): the
+  // watch then stops rather than spin on an fd that stays readable.
+  bool read();
 
   boost::asio::posix::stream_descriptor fd_;
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);

@@ -32,19 +32,28 @@ TEST_CASE("stop signals reach a virtual run on its next pass, before later timer
   CHECK_FALSE(later);
 }
 
-TEST_CASE("stop signals reach a real run through the pipe") {
+namespace {
+// Signals raised at the given times (ms) into a real run with StopSignals: what onSignal got, as
+// sig * 100 + count each, until `last` arrives (or the test's own bound of 20 s, not expected).
+std::vector<int> signalsSeen(const std::vector<std::pair<int, int>>& raised, int last) {
   Loop loop(ClockKind::Real);
   StopSignals signals(loop);
-  int got = 0;
+  std::vector<int> got;
   signals.onSignal = [&](int sig, int count) {
-    got = sig * 100 + count;
-    loop.stop();
+    got.push_back(sig * 100 + count);
+    if (sig == last) loop.stop();
   };
-  loop.after(10ms, [] { std::raise(SIGTERM); });
-  auto guard = loop.after(20s, [&] { loop.stop(); });  // the test's own bound, not expected
+  for (auto [ms, sig] : raised)
+    loop.after(std::chrono::milliseconds(ms), [sig = sig] { std::raise(sig); });
+  auto guard = loop.after(20s, [&] { loop.stop(); });
   loop.run();
   loop.cancel(guard);
-  CHECK(got == SIGTERM * 100 + 1);
+  return got;
+}
+}  // namespace
+
+TEST_CASE("stop signals reach a real run through the pipe") {
+  CHECK(signalsSeen({{10, SIGTERM}}, SIGTERM) == std::vector<int>{SIGTERM * 100 + 1});
 }
 
 // A terminal that closes (a window shut, SSH dropped) sends SIGHUP, whose default action ends the
@@ -53,38 +62,11 @@ TEST_CASE("stop signals reach a real run through the pipe") {
 TEST_CASE("SIGHUP ends a run as SIGTERM does, unless it was ignored (nohup)") {
   struct sigaction before {};
   ::sigaction(SIGHUP, nullptr, &before);
-  {
-    Loop loop(ClockKind::Real);
-    StopSignals signals(loop);
-    int got = 0;
-    signals.onSignal = [&](int sig, int count) {
-      got = sig * 100 + count;
-      loop.stop();
-    };
-    loop.after(10ms, [] { std::raise(SIGHUP); });
-    auto guard = loop.after(20s, [&] { loop.stop(); });
-    loop.run();
-    loop.cancel(guard);
-    CHECK(got == SIGHUP * 100 + 1);
-  }
-  {  // a hang-up comes twice (the shell's and the kernel's): the repeat is no second signal
-    Loop loop(ClockKind::Real);
-    StopSignals signals(loop);
-    std::vector<int> got;
-    signals.onSignal = [&](int sig, int count) {
-      got.push_back(sig * 100 + count);
-      if (sig == SIGTERM) loop.stop();
-    };
-    loop.after(10ms, [] {
-      std::raise(SIGHUP);
-      std::raise(SIGHUP);
-    });
-    loop.after(200ms, [] { std::raise(SIGTERM); });  // a real second signal still counts
-    auto guard = loop.after(20s, [&] { loop.stop(); });
-    loop.run();
-    loop.cancel(guard);
-    CHECK(got == std::vector<int>{SIGHUP * 100 + 1, SIGTERM * 100 + 2});
-  }
+  CHECK(signalsSeen({{10, SIGHUP}}, SIGHUP) == std::vector<int>{SIGHUP * 100 + 1});
+  // a hang-up comes twice (the shell's and the kernel's): the repeat is no second signal; a real
+  // second signal still counts
+  CHECK(signalsSeen({{10, SIGHUP}, {10, SIGHUP}, {200, SIGTERM}}, SIGTERM) ==
+        std::vector<int>{SIGHUP * 100 + 1, SIGTERM * 100 + 2});
   struct sigaction after {};
   ::sigaction(SIGHUP, nullptr, &after);
   CHECK((after.sa_handler == before.sa_handler));

@@ -43,6 +43,16 @@ struct Run {
     drive(0, speed);
     drive(1, speed);
   }
+  // Both phones talk (throttle `throttle`) for `seconds` while a driver says it drives from
+  // seats `from`..`to`; then both phones go.
+  void phonesTalkThenGo(double seconds, int from, int to, double throttle = 0.5) {
+    runDriving(seconds, from, to, [&] {
+      REQUIRE(seats.input("phone#1", throttle, 0));
+      REQUIRE(seats.input("phone#2", throttle, 0));
+    });
+    seats.release("phone#1", "the phone disconnected");
+    seats.release("phone#2", "the phone disconnected");
+  }
   // Runs `seconds`, with a driver saying every 0.1 s that it drives from seats `from`..`to`
   // (what the human driver does at every update).
   void runDriving(double seconds, int from = 1, int to = 2,
@@ -189,12 +199,7 @@ TEST_CASE("seats: a loss leaves alone a car that no driver drives from the seat"
   // took: a phone that goes then must not stop a car that is not its to drive.
   Run r;
   r.twoPhonesDriving(700);
-  r.runDriving(1.5, 2, 2, [&] {  // only seat 2's car is driven from its seat
-    REQUIRE(r.seats.input("phone#1", 0.5, 0));
-    REQUIRE(r.seats.input("phone#2", 0.5, 0));
-  });
-  r.seats.release("phone#1", "the phone disconnected");
-  r.seats.release("phone#2", "the phone disconnected");
+  r.phonesTalkThenGo(1.5, 2, 2);  // only seat 2's car is driven from its seat
   r.run(1.5);
   CHECK(r.cars[0]->state().target_speed_mm_s == 700);
   CHECK(r.speed(0) > 600);
@@ -235,19 +240,11 @@ TEST_CASE("seats: a car still at the speed its seat's driver gave is stopped, ho
   // the driver stopped saying so (a reload's pause, a director that fails, a long period), but
   // nothing else has commanded the car since: the speed it runs at is the seat's
   Run r;
-  REQUIRE(r.seats.claim("phone#1", drive::Holder::Phone, 1));
-  REQUIRE(r.seats.claim("phone#2", drive::Holder::Phone, 2));
-  r.drive(0, 800);
-  r.drive(1, 800);
+  r.twoPhonesDriving(800);
   r.seats.driving(1);
   r.seats.driving(2);
   r.drive(1, 500);  // car 2: someone else (the director's cool-down, say) commands it after
-  r.runDriving(3, 1, 0, [&] {  // no driver says anything for 3 s; the phones still talk
-    REQUIRE(r.seats.input("phone#1", 0.8, 0));
-    REQUIRE(r.seats.input("phone#2", 0.8, 0));
-  });
-  r.seats.release("phone#1", "the phone disconnected");
-  r.seats.release("phone#2", "the phone disconnected");
+  r.phonesTalkThenGo(3, 1, 0, 0.8);  // no driver says anything for 3 s; the phones still talk
   r.run(1.5);
   CHECK(r.cars[0]->state().target_speed_mm_s == 0);
   CHECK(r.speed(0) == 0);
