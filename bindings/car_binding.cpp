@@ -63,7 +63,7 @@ void raiseIfRefused(const AnkiCar::Sent& sent) {
 
 // ---- methods ----
 int setSpeed(lua_State* L) {
-  AnkiCar& car = CarBinding::check(L, 1);
+  AnkiCar& car = CarBinding::command(L, 1);
   auto speed = lua::checkRounded(L, 2, "speed (mm/s)");
   auto accel = lua::optRounded(L, 3, "acceleration (mm/s²)", kDefaultAccel);
   bool limit = lua_toboolean(L, 4);
@@ -75,7 +75,7 @@ int stop(lua_State* L) {
   return 0;
 }
 int changeLane(lua_State* L) {
-  AnkiCar& car = CarBinding::check(L, 1);
+  AnkiCar& car = CarBinding::command(L, 1);
   double offset = lua::checkNumber(L, 2, "offset (mm)");
   auto speed = lua::optRounded(L, 3, "lane-change speed (mm/s)", kDefaultLaneSpeed);
   auto accel = lua::optRounded(L, 4, "lane-change acceleration (mm/s²)", kDefaultLaneAccel);
@@ -83,20 +83,20 @@ int changeLane(lua_State* L) {
   return 0;
 }
 int setOffset(lua_State* L) {
-  AnkiCar& car = CarBinding::check(L, 1);
+  AnkiCar& car = CarBinding::command(L, 1);
   raiseIfRefused(car.setOffset(lua::checkNumber(L, 2, "offset (mm)")));
   return 0;
 }
 int cancelLaneChange(lua_State* L) {
-  raiseIfRefused(CarBinding::check(L, 1).cancelLaneChange());
+  raiseIfRefused(CarBinding::command(L, 1).cancelLaneChange());
   return 0;
 }
 int uturn(lua_State* L) {
-  raiseIfRefused(CarBinding::check(L, 1).turn(TurnType::UTurn));
+  raiseIfRefused(CarBinding::command(L, 1).turn(TurnType::UTurn));
   return 0;
 }
 int turn(lua_State* L) {
-  AnkiCar& car = CarBinding::check(L, 1);
+  AnkiCar& car = CarBinding::command(L, 1);
   std::string type = lua::checkString(L, 2, "turn type");
   std::string trigger = lua_isnoneornil(L, 3) ? "immediate" : lua::checkString(L, 3, "trigger");
   TurnType t;
@@ -400,6 +400,58 @@ void CarBinding::registerType(lua_State* L) {
 
 AnkiCar& CarBinding::check(lua_State* L, int idx) {
   return *proxyAt(L, idx).car;
+}
+
+AnkiCar& CarBinding::command(lua_State* L, int idx) {
+  Proxy& p = proxyAt(L, idx);
+  if (!p.stopped.empty())
+    throw LuaError(p.stopped +
+                   "; it takes no command from this script until the script is reloaded (save "
+                   "it fixed) or the run restarts");
+  return *p.car;
+}
+
+namespace {
+HandlerErrorLimit g_handlerErrorLimit;
+}  // namespace
+
+void setHandlerErrorLimit(HandlerErrorLimit limit) {
+  g_handlerErrorLimit = limit;
+}
+
+HandlerErrorLimit handlerErrorLimit() {
+  return g_handlerErrorLimit;
+}
+
+void CarBinding::handlerFailed(std::string_view what, std::string_view who,
+                               std::string_view message) {
+  const HandlerErrorLimit limit = g_handlerErrorLimit;
+  if (limit.count <= 0) return;
+  Proxy* p = nullptr;
+  for (auto& entry : proxies_)
+    if (entry.second->label == who) p = entry.second.get();
+  if (!p || !p->stopped.empty()) return;
+  const double now = host_.loop().seconds();
+  auto it = std::find_if(p->failing.begin(), p->failing.end(),
+                         [&](const Proxy::Failing& f) { return f.what == what; });
+  if (it == p->failing.end()) it = p->failing.insert(it, {std::string(what), now, 0});
+  if (now - it->since > limit.window) {
+    it->since = now;
+    it->count = 0;
+  }
+  if (++it->count < limit.count) return;
+  char window[32];
+  std::snprintf(window, sizeof window, "%g", limit.window);
+  const std::string_view first = message.substr(0, message.find('\n'));
+  p->stopped = p->label + " was stopped: its " + std::string(what) + " failed " +
+               std::to_string(it->count) + " times within " + window + " s";
+  auto sent = p->car->stop();  // through the vehicle model, as any stop
+  log::error("script",
+             p->stopped + " (last: " + std::string(first) +
+                 "); the race goes on without it, and this script's commands to it are refused: "
+                 "fix the handler and save the script (a hot reload drives it again), or run "
+                 "with --handler-errors 0 to let a failing car drive on" +
+                 (sent ? "" : " (the stop was not sent: " + sent.error() + ")"));
 }
 
 AnkiCar* CarBinding::test(lua_State* L, int idx) {

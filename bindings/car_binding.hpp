@@ -6,6 +6,7 @@
 
 #include <array>
 #include <memory>
+#include <string_view>
 #include <unordered_map>
 
 #include "engine/vehicles/anki_car.hpp"
@@ -38,6 +39,17 @@ enum class CarEvent {
 };
 inline constexpr std::size_t kCarEventCount = static_cast<std::size_t>(CarEvent::Count_);
 
+// A car whose script keeps failing slows to a stop (docs/safety.md): `count` errors of one
+// handler (or of one event's listeners) of a car within `window` seconds stop that car, and the
+// world that failed commands it no more; the race goes on for the others. A hot reload (a new
+// world) may drive it again. count 0: never stop (--handler-errors 0).
+struct HandlerErrorLimit {
+  int count = 5;
+  double window = 10.0;
+};
+void setHandlerErrorLimit(HandlerErrorLimit limit);
+HandlerErrorLimit handlerErrorLimit();
+
 class CarBinding {
  public:
   explicit CarBinding(ScriptHost& host);
@@ -54,6 +66,13 @@ class CarBinding {
   bool attached() const { return attached_; }
   void push(lua_State* L, AnkiCar& car);
   static AnkiCar& check(lua_State* L, int idx);
+  // The car at idx for a command that moves it (setSpeed, changeLane, turn, …): refused once
+  // the car was stopped for a handler that kept failing (handlerFailed).
+  static AnkiCar& command(lua_State* L, int idx);
+  // An error was reported in `what` ("onPosition handler") of `who` (a car's label, "car 1
+  // (skull)"; anything else is not a car of this world and is ignored): counted against
+  // handlerErrorLimit(), and the car stopped when that is reached.
+  void handlerFailed(std::string_view what, std::string_view who, std::string_view message);
   // The car at idx, or nullptr when the value is not a car.
   static AnkiCar* test(lua_State* L, int idx);
 

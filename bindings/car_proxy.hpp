@@ -3,6 +3,7 @@
 #include <array>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "bindings/car_binding.hpp"
 #include "bindings/lua_object.hpp"
@@ -31,6 +32,15 @@ struct CarBinding::Proxy {
   // The binding's slot of the car's connection signal while attached (after the fleet's, which
   // subscribed when the car joined the fleet).
   Subscription connection;
+  // Errors of each failing handler in the current window (CarBinding::handlerFailed), and why
+  // the car was stopped for them (empty: it was not; then commands are refused).
+  struct Failing {
+    std::string what;
+    double since = 0;
+    int count = 0;
+  };
+  std::vector<Failing> failing;
+  std::string stopped;
   Proxy() { tables.fill(LUA_NOREF); }
 };
 

@@ -184,6 +184,36 @@ int guardedXpcall(lua_State* L) {
   return afterXpcall(L, lua_pcallk(L, n - 2, LUA_MULTRET, 2, 0, afterXpcall), 0);
 }
 
+// Closes `co`'s pending to-be-closed variables. Their __close functions run on `co`: the
+// interrupter is told so, or a __close that loops there could not be interrupted (the hook would go
+// on the thread that called close).
+int closeIn(lua_State* L, lua_State* co) {
+  Running running(co);
+#if LUA_VERSION_RELEASE_NUM >= 50406
+  return lua_closethread(co, L);
+#else
+  (void)L;
+  return lua_resetthread(co);
+#endif
+}
+
+// coroutine.close(co), as Lua's (lcorolib.c, luaB_close), with closeIn.
+int trackedClose(lua_State* L) {
+  lua_State* co = lua_tothread(L, 1);
+  luaL_argexpected(L, co, 1, "coroutine");
+  lua_Debug ar;
+  if (co == L) return luaL_error(L, "cannot close a running coroutine");
+  if (lua_status(co) == LUA_OK && lua_getstack(co, 0, &ar))  // it resumed the one running
+    return luaL_error(L, "cannot close a normal coroutine");
+  if (closeIn(L, co) == LUA_OK) {
+    lua_pushboolean(L, 1);
+    return 1;
+  }
+  lua_pushboolean(L, 0);
+  lua_xmove(co, L, 1);  // the error
+  return 2;
+}
+
 // coroutine.resume and coroutine.wrap that say which thread runs.
 int resumeIn(lua_State* L, lua_State* co, int nargs) {
   if (!lua_checkstack(co, nargs)) {
@@ -225,11 +255,7 @@ int wrapped(lua_State* L) {
   if (r >= 0) return r;
   int status = lua_status(co);
   if (status != LUA_OK && status != LUA_YIELD) {  // the coroutine died: close it, as 5.4 does
-#if LUA_VERSION_RELEASE_NUM >= 50406
-    lua_closethread(co, L);
-#else
-    lua_resetthread(co);
-#endif
+    closeIn(L, co);
     lua_xmove(co, L, 1);
   }
   if (lua_type(L, -1) == LUA_TSTRING) {  // where the wrapper was called, as 5.4 adds
@@ -320,6 +346,8 @@ void openCoroutineTracking(lua_State* L) {
   lua_setfield(L, -2, "resume");
   lua_pushcfunction(L, trackedWrap);
   lua_setfield(L, -2, "wrap");
+  lua_pushcfunction(L, trackedClose);
+  lua_setfield(L, -2, "close");
   lua_pop(L, 1);
   lua_pushcfunction(L, guardedXpcall);
   lua_setglobal(L, "xpcall");

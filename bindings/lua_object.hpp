@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "bindings/lua_args.hpp"
+#include "bindings/metatables.hpp"
 #include "bindings/script_host.hpp"
 
 namespace pitwall::lua {
@@ -213,6 +214,7 @@ inline void registerObjectType(lua_State* L, const ObjectType& type) {
   // The type itself, for what works on every object type (setHub).
   lua_pushlightuserdata(L, const_cast<ObjectType*>(&type));
   lua_setfield(L, -2, "__objecttype");
+  lockMetatable(L, -1);
   lua_pop(L, 1);
 }
 

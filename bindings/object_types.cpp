@@ -21,8 +21,14 @@ void pushObjectTypes(lua_State* L) {
       const char* key = lua_tostring(L, -2);
       if (object || std::strcmp(key, kTimerMetatable) == 0 ||
           std::strcmp(key, kSeatMetatable) == 0) {
+        // Its public face (bindings/metatables.hpp): what getmetatable gives a script, with the
+        // same names; the metatable itself is not handed to Lua code.
         lua_pushvalue(L, -2);
-        lua_pushvalue(L, -2);
+        lua_pushliteral(L, "__metatable");
+        if (lua_rawget(L, -3) != LUA_TTABLE) {
+          lua_pop(L, 1);
+          lua_pushvalue(L, -2);
+        }
         lua_rawset(L, out);
       }
     }

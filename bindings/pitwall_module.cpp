@@ -12,8 +12,10 @@
 #include <vector>
 
 #include "bindings/car_binding.hpp"
+#include "bindings/copy_budget.hpp"
 #include "bindings/lua_args.hpp"
 #include "bindings/lua_object.hpp"
+#include "bindings/metatables.hpp"
 #include "bindings/results.hpp"
 #include "bindings/script_host.hpp"
 #include "engine/core/console.hpp"
@@ -296,10 +298,14 @@ int writeResults(lua_State* L) {
     throw LuaError("pitwall.writeResults: columns must be a list of names, got " +
                    lua::typeName(L, 2));
   results::Table table;
+  // The copy is bounded and charged to the world's cap (bindings/copy_budget.hpp): a results
+  // file of a race is a few KB.
+  lua::CopyBudget budget(L, "pitwall.writeResults", std::size_t{64} << 20);
   for (lua_Integer i = 1, n = luaL_len(L, 2); i <= n; ++i) {
     if (lua_geti(L, 2, i) != LUA_TSTRING)
       throw LuaError("pitwall.writeResults: column " + std::to_string(i) + " is not a name");
     table.columns.emplace_back(lua_tostring(L, -1));
+    budget.add(table.columns.back().size() + 32, "column " + std::to_string(i));
     lua_pop(L, 1);
   }
   for (lua_Integer r = 1, n = luaL_len(L, 1); r <= n; ++r) {
@@ -308,6 +314,9 @@ int writeResults(lua_State* L) {
     auto& row = table.rows.emplace_back();
     for (const auto& column : table.columns) {
       int t = lua_getfield(L, -1, column.c_str());
+      std::size_t length = 0;
+      if (t == LUA_TSTRING) lua_tolstring(L, -1, &length);
+      budget.add(length + 32, "row " + std::to_string(r));
       if (t == LUA_TNUMBER)
         row.emplace_back(static_cast<double>(lua_tonumber(L, -1)));
       else if (t == LUA_TSTRING)
@@ -368,6 +377,7 @@ void openPitwallModule(ScriptHost& host) {
   lua_setfield(L, -2, "__index");
   lua_pushcfunction(L, timerToString);
   lua_setfield(L, -2, "__tostring");
+  lua::lockMetatable(L, -1);
   lua_pop(L, 1);
 
   static const luaL_Reg functions[] = {{"cars", lua::guarded<cars>},

@@ -15,6 +15,7 @@
 #include <unordered_map>
 
 #include "bindings/interrupt.hpp"
+#include "bindings/metatables.hpp"
 
 namespace pitwall::sandbox {
 
@@ -43,7 +44,7 @@ void* allocate(void* ud, void* ptr, std::size_t osize, std::size_t nsize) {
   // engine catches. Outside one (the engine pushing an event's values) it would be a panic.
   if (nsize > old && m->limit != 0 && interrupt::inCall()) {
     const std::size_t cap = m->exceeded ? m->limit + kHeadroom : m->limit;
-    if (m->used + (nsize - old) > cap) {
+    if (m->used + m->outside + (nsize - old) > cap) {
       // The retry after Lua's emergency collection: the script does hold that much. (Lua skips
       // the collection while one runs: many refusals in a row say the same.)
       const bool retry = ptr == m->refusedPtr && osize == m->refusedOld && nsize == m->refusedNew;
@@ -352,6 +353,10 @@ void restrict(lua_State* L) {
       lua_getfield(L, -2, name);
       lua_setfield(L, -2, name);
     }
+    // debug.getmetatable answers as getmetatable does (a locked metatable's public face, see
+    // bindings/metatables.hpp): Lua's own would hand out the engine's metatables themselves.
+    lua_getglobal(L, "getmetatable");
+    lua_setfield(L, -2, "getmetatable");
     lua_setglobal(L, "debug");
   }
   lua_pop(L, 1);
@@ -376,6 +381,17 @@ void restrict(lua_State* L) {
   lua_pop(L, 1);
   refuse(L, "io", "popen", kBlocks);
   refuse(L, "os", "execute", kBlocks);
+  // The metatables Lua's own libraries made are locked too: the strings' (its __index stays the
+  // string library, which scripts may extend) and the files' (a __gc planted there would run for
+  // every file handle, with hooks off).
+  lua_pushliteral(L, "");
+  if (lua_getmetatable(L, -1)) {
+    lua::lockMetatable(L, -1, true, "string");
+    lua_pop(L, 1);
+  }
+  lua_pop(L, 1);
+  if (luaL_getmetatable(L, LUA_FILEHANDLE) == LUA_TTABLE) lua::lockMetatable(L, -1);
+  lua_pop(L, 1);
   lua_getglobal(L, "io");
   if (lua_istable(L, -1)) {
     lua_getfield(L, -1, "lines");

@@ -10,7 +10,9 @@
 //   budget, debug.debug reads the terminal, the setters and the registry reach into the engine's
 //   references, getupvalue/getlocal into its C functions. load is written anew, not wrapped.
 // - No __gc finalizers (setmetatable refuses them): Lua runs them with hooks off, where nothing
-//   interrupts them, and again when the world closes.
+//   interrupts them, and again when the world closes. The metatables of strings and files are
+//   locked as the engine's own are (bindings/metatables.hpp), and debug.getmetatable is
+//   getmetatable: no script reaches a metatable that already marks objects for finalization.
 // - Nothing may block the loop: io.read, io.input, io.stdin, io.lines() on stdin, io.popen and
 //   os.execute are gone; so is package.loadlib (any function of any library). Files (io.open)
 //   stay: scripts write results.
@@ -29,6 +31,9 @@ namespace pitwall::sandbox {
 struct Memory {
   std::size_t used = 0;
   std::size_t limit = 0;
+  // What the engine keeps for this world outside Lua and charges to its cap (the copy of the race
+  // table pitwall.view.race gave the view, bindings/copy_budget.hpp).
+  std::size_t outside = 0;
   bool exceeded = false;  // the cap was reached (Lua's emergency collection did not help)
   // The last request refused: Lua retries a refused allocation once after a full collection, and
   // only that retry failing too means the script really holds that much.

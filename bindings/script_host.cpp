@@ -426,6 +426,19 @@ void ScriptHost::checkMemory() {
 void ScriptHost::reportError(const std::string& where, const std::string& message) {
   if (exitStatus_) return;  // os.exit or the memory limit: the run is ending, and said why
   ++errors_;
+  // An error in a car's handler or listeners ("onPosition handler of car 1 (skull)") counts
+  // towards stopping that car (CarBinding::handlerFailed), after the error itself is reported.
+  struct CountAfter {
+    ScriptHost& host;
+    const std::string& where;
+    const std::string& message;
+    ~CountAfter() {
+      const auto of = where.rfind(" of ");
+      if (of != std::string::npos && host.cars_)
+        host.cars_->handlerFailed(std::string_view(where).substr(0, of),
+                                  std::string_view(where).substr(of + 4), message);
+    }
+  } countAfter{*this, where, message};
   lua_State* L = L_;
   std::string text = "error in " + where + ": " + message;
   if (!inOnError_) {

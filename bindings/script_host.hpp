@@ -164,6 +164,8 @@ class ScriptHost {
   void lastWords();
   // The memory this world's allocations hold now, and its cap (sandbox.hpp).
   const sandbox::Memory& memory() const { return memory_; }
+  // The bytes the engine keeps for this world outside Lua, charged to its cap (Memory::outside).
+  void chargeOutside(std::size_t bytes) { memory_.outside = bytes; }
   // After a failed call into Lua: when the memory limit was reached, says so once and ends the
   // run (exit status 1).
   void checkMemory();

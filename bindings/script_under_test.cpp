@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "bindings/lua_args.hpp"
+#include "bindings/metatables.hpp"
 #include "bindings/pitwall_module.hpp"
 #include "bindings/reloader.hpp"
 #include "engine/core/log.hpp"
@@ -210,6 +211,7 @@ void openScriptUnderTest(lua_State* L) {
     lua_setfield(L, -2, "__gc");
     lua_pushstring(L, "script under test");
     lua_setfield(L, -2, "__name");
+    lua::lockMetatable(L, -1);
   }
   lua_pop(L, 1);
   // on pitwall.sim, which is on top of the stack

@@ -14,6 +14,7 @@
 
 #include "bindings/car_binding.hpp"
 #include "bindings/lua_args.hpp"
+#include "bindings/metatables.hpp"
 #include "bindings/pitwall_module.hpp"
 #include "bindings/script_host.hpp"
 #include "engine/drive/seats.hpp"
@@ -200,6 +201,7 @@ void openSeatModule(ScriptHost& host) {
   lua_setfield(L, -2, "__index");
   lua_pushcfunction(L, lua::guarded<seatToString>);
   lua_setfield(L, -2, "__tostring");
+  lua::lockMetatable(L, -1);
   lua_pop(L, 1);
 
   lua_getglobal(L, "pitwall");

@@ -7,6 +7,7 @@
 // Without a view they do nothing, so a script never needs to ask.
 #include <cmath>
 
+#include "bindings/copy_budget.hpp"
 #include "bindings/lua_args.hpp"
 #include "bindings/pitwall_module.hpp"
 #include "bindings/script_host.hpp"
@@ -20,6 +21,11 @@ namespace {
 
 constexpr int kMaxDepth = 16;
 constexpr std::size_t kMaxEntries = 100000;  // values in one race table, all levels
+// The bytes of one race table's copy (its strings and keys, and kValueBytes a value): a race's
+// summary is a few KB; the copy is made in C++, where neither the budget nor Ctrl-C can stop it,
+// so it is bounded to what takes well under 100 ms, and charged to the world's memory cap.
+constexpr std::size_t kMaxBytes = std::size_t{8} << 20;
+constexpr std::size_t kValueBytes = 64;  // what a JSON value costs besides its text
 
 view::Feed* feedOf(lua_State* L) {
   return ScriptHost::from(L).options().view;
@@ -27,8 +33,9 @@ view::Feed* feedOf(lua_State* L) {
 
 // A Lua value as JSON: tables with keys 1..n are arrays, others objects with string keys
 // (numbers become their text); functions and other non-data are refused with where they are.
-nlohmann::json toJson(lua_State* L, int idx, int depth, std::size_t& count,
+nlohmann::json toJson(lua_State* L, int idx, int depth, std::size_t& count, lua::CopyBudget& budget,
                       const std::string& where) {
+  budget.add(kValueBytes, where);
   if (++count > kMaxEntries)
     throw LuaError("pitwall.view.race: the table holds more than " + std::to_string(kMaxEntries) +
                    " values");
@@ -46,6 +53,7 @@ nlohmann::json toJson(lua_State* L, int idx, int depth, std::size_t& count,
     case LUA_TSTRING: {
       std::size_t n = 0;
       const char* s = lua_tolstring(L, idx, &n);
+      budget.add(n, where);
       return std::string(s, n);  // invalid UTF-8 is replaced when the feed is written
     }
     case LUA_TTABLE:
@@ -63,14 +71,16 @@ nlohmann::json toJson(lua_State* L, int idx, int depth, std::size_t& count,
   std::size_t keys = 0;
   lua_pushnil(L);
   while (lua_next(L, idx)) {
-    ++keys;
+    if (count + ++keys > kMaxEntries)  // before the copy: counting a huge table is work too
+      throw LuaError("pitwall.view.race: the table holds more than " + std::to_string(kMaxEntries) +
+                     " values");
     lua_pop(L, 1);
   }
   if (keys == static_cast<std::size_t>(n)) {  // an empty table is an empty list
     nlohmann::json a = nlohmann::json::array();
     for (lua_Integer i = 1; i <= n; ++i) {
       lua_rawgeti(L, idx, i);
-      a.push_back(toJson(L, -1, depth + 1, count, where + "[" + std::to_string(i) + "]"));
+      a.push_back(toJson(L, -1, depth + 1, count, budget, where + "[" + std::to_string(i) + "]"));
       lua_pop(L, 1);
     }
     return a;
@@ -89,7 +99,8 @@ nlohmann::json toJson(lua_State* L, int idx, int depth, std::size_t& count,
       throw LuaError("pitwall.view.race: " + where + " has a " + luaL_typename(L, -2) +
                      " key; keys are strings or numbers");
     }
-    o[key] = toJson(L, -1, depth + 1, count, where + "." + key);
+    budget.add(key.size(), where + "." + key);
+    o[key] = toJson(L, -1, depth + 1, count, budget, where + "." + key);
     lua_pop(L, 1);
   }
   return o;
@@ -98,13 +109,18 @@ nlohmann::json toJson(lua_State* L, int idx, int depth, std::size_t& count,
 int race(lua_State* L) {
   view::Feed* feed = feedOf(L);
   if (!feed) return 0;
+  ScriptHost& host = ScriptHost::from(L);
   if (lua_isnoneornil(L, 1)) {
     feed->setRace(nullptr);
+    host.chargeOutside(0);
     return 0;
   }
   luaL_checktype(L, 1, LUA_TTABLE);
   std::size_t count = 0;
-  feed->setRace(toJson(L, 1, 0, count, "race"));
+  lua::CopyBudget budget(L, "pitwall.view.race", kMaxBytes, host.memory().outside);
+  nlohmann::json race = toJson(L, 1, 0, count, budget, "race");
+  feed->setRace(std::move(race));
+  host.chargeOutside(budget.bytes());  // the feed keeps it until the next race table
   return 0;
 }
 

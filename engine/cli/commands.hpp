@@ -35,6 +35,10 @@ struct CarSource {
   double scanTimeout = 5;                 // seconds to look for cars before the script starts
   double budget = 0.1;  // --budget SECONDS a callback may run before it is interrupted; 0: off
   int luaMemory = 512;  // --lua-memory MB a script's Lua world may hold; 0: no limit
+  // --handler-errors N, --handler-errors-window SECONDS: a car whose handler fails N times within
+  // the window is stopped (bindings/car_binding.hpp); 0: never
+  int handlerErrors = 5;
+  double handlerErrorsWindow = 10;
   // --mqtt: the cars bridged by other hosts join as remote cars (docs/mqtt.md)
   MqttSettings mqtt;
   int remoteCars = 0;  // --remote-cars N: wait (up to --mqtt-timeout) until N are online

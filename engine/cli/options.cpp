@@ -32,6 +32,14 @@ CLI::Option* addCarSource(CLI::App* cmd, CarSource& source, const char* when) {
   cmd->add_option("--lua-memory", source.luaMemory,
                   "MB of memory the script's Lua world may hold (default 512; 0: no limit)")
       ->check(CLI::Range(0, 1 << 20));
+  cmd->add_option("--handler-errors", source.handlerErrors,
+                  "Stop a car whose event handler fails this many times within "
+                  "--handler-errors-window (default 5; 0: never, the car drives on)")
+      ->check(CLI::Range(0, 1000000));
+  cmd->add_option("--handler-errors-window", source.handlerErrorsWindow,
+                  "Seconds in which --handler-errors failures of one handler stop its car "
+                  "(default 10)")
+      ->check(CLI::PositiveNumber);
   return ble;
 }
 

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
+#include "bindings/car_binding.hpp"
 #include "bindings/interrupt.hpp"
 #include "bindings/sandbox.hpp"
 #include "engine/core/console.hpp"
@@ -116,6 +117,7 @@ std::unique_ptr<Session> Session::open(const CarSource& source, bool fast, const
   session->catchSignals();
   interrupt::setBudget(std::chrono::milliseconds(std::llround(source.budget * 1000)));
   sandbox::setMemoryLimit(static_cast<std::size_t>(source.luaMemory) << 20);
+  setHandlerErrorLimit({source.handlerErrors, source.handlerErrorsWindow});
   return session;
 }
 

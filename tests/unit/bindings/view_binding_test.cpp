@@ -5,6 +5,7 @@
 
 #include <algorithm>
 
+#include "bindings/sandbox.hpp"
 #include "bindings/script_host.hpp"
 #include "engine/fleet/fleet.hpp"
 #include "engine/sim/grid.hpp"
@@ -88,6 +89,55 @@ TEST_CASE("pitwall.view: data goes to the view; anything else is refused with wh
             .find("piece 1 needs an id") != std::string::npos);
   CHECK(error(L, "pitwall.view.race{title = 5, phase = 'grid'}") == "");  // odd, but data
   CHECK(feed.state()["events"].back()["text"] == "race: grid");
+}
+
+// Issue 33: with --lua-memory 64, one 1 MiB string referenced 1500 times in the table took the
+// process to 1.55 GB and held the loop ~8 s. The copy is bounded (8 MiB) and counted against the
+// world's memory cap; a refusal says which limit and leaves the last good table.
+TEST_CASE("pitwall.view.race: a copy past its size or the memory cap is refused with a sentence") {
+  Loop loop{ClockKind::Virtual};
+  Fleet fleet{loop};
+  view::Feed feed(loop, fleet, "simulator");
+  HostOptions options;
+  options.view = &feed;
+  const std::size_t saved = sandbox::memoryLimit();
+  sandbox::setMemoryLimit(std::size_t{64} << 20);
+  ScriptHost host(loop, fleet, nullptr, options);
+  sandbox::setMemoryLimit(saved);
+  lua_State* L = host.state();
+  CHECK(error(L, "pitwall.view.race{title = 'before'}") == "");
+
+  const std::string refused = error(L, R"(
+    local big = string.rep("x", 1 << 20)
+    local rows = {}
+    for i = 1, 1500 do rows[i] = {car = big} end
+    pitwall.view.race{rows = rows})");
+  CHECK_MESSAGE(refused.find("pitwall.view.race: the data is more than 8 MiB") != std::string::npos,
+                refused);
+  CHECK(refused.find("race.rows[") != std::string::npos);  // where it passed the limit
+  CHECK(refused.find("counts at every place it is used") != std::string::npos);
+  CHECK(feed.state()["race"]["title"] == "before");
+
+  // Under its own limit but past what the cap leaves: 60 MiB held, 5 MiB to copy.
+  const std::string capped = error(L, R"(
+    hold = {}
+    for i = 1, 60 do hold[i] = string.rep(string.char(64 + i % 26), 1 << 20) end
+    local rows = {}
+    for i = 1, 5 do rows[i] = hold[i] end
+    pitwall.view.race{rows = rows})");
+  CHECK_MESSAGE(
+      capped.find("that the script's memory limit of 64 MB still leaves") != std::string::npos,
+      capped);
+  CHECK(capped.find("raise --lua-memory") != std::string::npos);
+  CHECK(feed.state()["race"]["title"] == "before");
+
+  // What the feed keeps is charged to the world until the next table replaces it.
+  CHECK(error(L, "hold = nil collectgarbage() collectgarbage()") == "");
+  CHECK(error(L, "pitwall.view.race{rows = {string.rep('y', 3 << 20)}}") == "");
+  CHECK(host.memory().outside > (std::size_t{3} << 20));
+  CHECK(error(L, "pitwall.view.race{title = 'after'}") == "");
+  CHECK(host.memory().outside < 1024);
+  CHECK(feed.state()["race"]["title"] == "after");
 }
 
 TEST_CASE("pitwall.view without a view: nothing happens, nothing fails") {
