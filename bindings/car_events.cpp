@@ -145,8 +145,7 @@ void CarBinding::hookEvents(Proxy& p) {
       deliver(p, CarEvent::Disconnect, [&](EventTable& t) { t.string(kReason, reason); });
   });
   car.onMalformed = [this, &p](const DecodeError& e, std::span<const std::uint8_t> bytes) {
-    std::string what = e.message();
-    log::warn(p.car->label(), "malformed frame ignored: " + what);
+    std::string what = e.message();  // logged by the car, a count at a time in a flood
     deliver(p, CarEvent::Malformed, [&](EventTable& t) {
       t.string(kError, what);
       t.string(kHex, toHex(bytes));

@@ -103,7 +103,7 @@ void Alphabot::linkChanged(bool up, const std::string& reason) {
 
 void Alphabot::malformed(const std::string& error) {
   ++state_.malformed;
-  log::warn(kLog, label() + ": malformed packet: " + error);
+  malformedWarnings_.warn(kLog, label() + ": malformed packet: " + error);
   if (auto callback = onMalformed) callback(error);
 }
 

@@ -20,6 +20,7 @@
 
 #include "engine/core/loop.hpp"
 #include "engine/core/result.hpp"
+#include "engine/core/warning_limit.hpp"
 #include "engine/protocol/alphabot/ble_codec.hpp"
 #include "engine/protocol/alphabot/messages.hpp"
 #include "engine/protocol/alphabot/wlan_codec.hpp"
@@ -122,6 +123,8 @@ class Alphabot {
   std::string bleError_;                // BLE: an encoding refusal or a path that never came
   std::deque<std::int64_t> pingTimes_;  // BLE: pings whose PINGCLIENT read is under way
   Loop::TimerId pathTimer_ = 0;
+  // A robot or link that sends only malformed packets: the first warned, then a count each 5 s.
+  WarningLimit malformedWarnings_{loop_, "malformed packets"};
 };
 
 }  // namespace pitwall

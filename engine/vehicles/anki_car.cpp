@@ -165,10 +165,8 @@ void AnkiCar::receive(std::span<const std::uint8_t> frame) {
   auto decoded = decode(frame);
   if (!decoded) {
     ++state_.malformed;
-    if (onMalformed)
-      onMalformed(decoded.error(), frame);
-    else
-      log::warn(label(), "malformed frame ignored: " + decoded.error().message());
+    malformedWarnings_.warn(label(), "malformed frame ignored: " + decoded.error().message());
+    if (onMalformed) onMalformed(decoded.error(), frame);
     return;
   }
   ++state_.frames_in;

@@ -13,6 +13,7 @@
 #include "engine/core/loop.hpp"
 #include "engine/core/result.hpp"
 #include "engine/core/signal.hpp"
+#include "engine/core/warning_limit.hpp"
 #include "engine/protocol/anki/codec.hpp"
 #include "engine/transport/link.hpp"
 
@@ -139,6 +140,8 @@ class AnkiCar {
   double speedReportedAt_ = -1;  // loop seconds of the last frame that said the car's speed
   std::optional<double> pingSentAt_;
   std::optional<double> lastPingRtt_;
+  // A car or link that sends only malformed frames: the first warned, then a count each 5 s.
+  WarningLimit malformedWarnings_{loop_, "malformed frames ignored"};
 };
 
 }  // namespace pitwall

@@ -107,7 +107,7 @@ void MindroadRobot::received(std::span<const std::uint8_t> frame) {
   if (answer)
     contactAnswered();
   else
-    log::warn(kLog, address() + ": " + answer.error().message() + "; ignored");
+    malformedWarnings_.warn(kLog, address() + ": " + answer.error().message() + "; ignored");
 }
 
 void MindroadRobot::sendContact() {

@@ -17,6 +17,7 @@
 
 #include "engine/core/loop.hpp"
 #include "engine/core/result.hpp"
+#include "engine/core/warning_limit.hpp"
 #include "engine/protocol/mindroad/codec.hpp"
 #include "engine/transport/link.hpp"
 
@@ -114,6 +115,9 @@ class MindroadRobot {
   bool shutdownSent_ = false;  // the robot was turned off: a lost link is not retried
   std::string lastError_;
   std::uint64_t contactsSent_ = 0, instructionsSent_ = 0, contactCount_ = 0;
+  // A robot or link that sends only answers that do not decode: the first warned, then a count
+  // each 5 s.
+  WarningLimit malformedWarnings_{loop_, "answers that do not decode ignored"};
 };
 
 }  // namespace pitwall
