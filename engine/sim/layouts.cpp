@@ -2,7 +2,6 @@
 #include <array>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
 #include "engine/core/suggest.hpp"
 #include "engine/sim/track.hpp"
@@ -65,11 +64,22 @@ Result<Track, std::string> loadLayout(std::string_view nameOrPath) {
     return fail("layout '" + std::string(nameOrPath) + "' is neither a named layout (" +
                 namesList() + ") nor a file that exists" + didYouMean(nameOrPath, layoutNames()) +
                 " (give a name or the path of a layout file)");
-  std::ifstream in(path);
+  // The size first, then a read of at most one byte more than allowed (the file may grow).
+  auto tooLarge = [&](std::uintmax_t bytes) {
+    return fail(path.string() + " is " + std::to_string(bytes) + " bytes, more than the " +
+                std::to_string(kMaxLayoutFileBytes) + " a layout file may be (" +
+                std::to_string(kMaxPieces) +
+                " pieces fit in a tenth of that); give the file of a layout, not another file");
+  };
+  if (const auto bytes = std::filesystem::file_size(path, ec); !ec && bytes > kMaxLayoutFileBytes)
+    return tooLarge(bytes);
+  std::ifstream in(path, std::ios::binary);
   if (!in) return fail("cannot read layout file '" + path.string() + "'; check its permissions");
-  std::stringstream text;
-  text << in.rdbuf();
-  auto track = parseLayout(text.str(), path.stem().string());
+  std::string text(kMaxLayoutFileBytes + 1, '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (text.size() > kMaxLayoutFileBytes) return tooLarge(text.size());
+  auto track = parseLayout(text, path.stem().string());
   if (!track) return fail(path.string() + ": " + track.error());
   return track;
 }

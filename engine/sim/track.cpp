@@ -179,6 +179,32 @@ struct Parsed {
   int startAt = 0;
 };
 
+// A layout past kMaxPieces: the sentence counts its pieces (the rest only lexed, never parsed:
+// each token one piece, start two), so checking it stays linear however long the text is.
+std::string tooManyPieces(std::size_t before, std::string_view token, std::string_view rest) {
+  std::size_t count = before + (lower(token) == "start" ? 2 : 1);
+  for (std::size_t i = 0; i < rest.size();) {
+    if (rest[i] == '#') {
+      while (i < rest.size() && rest[i] != '\n') ++i;
+      continue;
+    }
+    if (std::isspace(static_cast<unsigned char>(rest[i]))) {
+      ++i;
+      continue;
+    }
+    std::size_t end = i;
+    while (end < rest.size() && !std::isspace(static_cast<unsigned char>(rest[end])) &&
+           rest[end] != '#')
+      ++end;
+    count += lower(rest.substr(i, end - i)) == "start" ? 2 : 1;
+    i = end;
+  }
+  return "a layout of " + std::to_string(count) + " pieces is more than the " +
+         std::to_string(kMaxPieces) +
+         " pieces pitwall lays out (a room-sized track has a few dozen); split "
+         "it into smaller layouts";
+}
+
 Result<Parsed, std::string> parseTokens(std::string_view text) {
   Parsed parsed;
   auto& pieces = parsed.pieces;
@@ -206,6 +232,8 @@ Result<Parsed, std::string> parseTokens(std::string_view text) {
     std::string_view token = text.substr(i, end - i);
     i = end;
     ++position;
+    if (pieces.size() + (lower(token) == "start" ? 2 : 1) > kMaxPieces)
+      return fail(tooManyPieces(pieces.size(), token, text.substr(i)));
     std::string at = " at position " + std::to_string(position);
 
     std::string_view head = token, keys;

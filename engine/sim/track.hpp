@@ -68,6 +68,12 @@ class Track {
   std::vector<Piece> pieces_;
 };
 
+// The most pieces a layout may have (start counts two): a room's track, with room to spare. It
+// bounds the overlap check (every pair of pieces) and what the view and the printer draw.
+inline constexpr std::size_t kMaxPieces = 1000;
+// The largest layout file loadLayout reads: 1000 pieces and their comments fit many times over.
+inline constexpr std::uintmax_t kMaxLayoutFileBytes = 1024 * 1024;
+
 Result<Track, std::string> parseLayout(std::string_view text, std::string name = "custom");
 // One token of a layout ("S", "L:17", "S:60,len=300", "start"), checked as parseLayout checks
 // it: its pieces (two for start: 34 and 33).

@@ -273,3 +273,38 @@ TEST_CASE("invalid custom designs are refused with a sentence naming the piece")
     if (!r.ok()) CHECK_FALSE(r.error().empty());
   }
 }
+
+// An oval with `k` straights along the top beside the start and k + 1 along the bottom: 2k + 7
+// pieces.
+std::string longOval(int k) {
+  std::string text = "start";
+  for (int i = 0; i < k; ++i) text += " S";
+  text += " L L";
+  for (int i = 0; i <= k; ++i) text += " S";
+  return text + " L L";
+}
+
+TEST_CASE("a layout of more than 1000 pieces is refused with a sentence that counts them") {
+  auto big = parseLayout(longOval(496));  // 999 pieces: within the cap, and it closes
+  REQUIRE(big.ok());
+  CHECK(big->size() == 999);
+  CHECK(errorOf(longOval(497)) ==
+        "a layout of 1001 pieces is more than the 1000 pieces pitwall lays out (a room-sized "
+        "track has a few dozen); split it into smaller layouts");
+  // a hostile length is counted past the cap, not parsed: 10⁶ more tokens, comments between
+  std::string huge = "start";
+  for (int i = 0; i < 1'000'000; ++i) huge += i % 1000 == 0 ? " S:36 # a comment\n" : " S:36";
+  CHECK(contains(errorOf(huge), "a layout of 1000002 pieces is more than the 1000 pieces"));
+}
+
+TEST_CASE("a layout file larger than 1 MB is refused unread") {
+  const auto path = std::filesystem::temp_directory_path() / "pitwall_track_test_big.layout";
+  {
+    std::ofstream out(path);
+    out << longOval(1) << "\n" << std::string(kMaxLayoutFileBytes, '#') << "\n";
+  }
+  auto r = loadLayout(path.string());
+  std::filesystem::remove(path);
+  REQUIRE_FALSE(r.ok());
+  CHECK(contains(r.error(), " is 1048597 bytes, more than the 1048576 a layout file may be"));
+}
