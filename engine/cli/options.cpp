@@ -1,5 +1,6 @@
 #include "engine/cli/options.hpp"
 
+#include <cctype>
 #include <list>
 
 namespace pitwall::cli {
@@ -83,8 +84,25 @@ struct ViewOption {
   CLI::Option* option = nullptr;
   std::string value;
   std::optional<std::string>* target = nullptr;
+  std::vector<std::string> hosts;  // --view-host
 };
 std::list<ViewOption> g_views;  // a list: the options keep pointers to the values
+std::vector<std::string> g_viewHosts;
+
+// A name a browser may reach the view by: a host name or an address, nothing else.
+std::string checkViewHost(const std::string& name) {
+  if (name.empty() || name.size() > 253)
+    return "--view-host '" + name.substr(0, 60) +
+           "': give the name a reverse proxy serves the view by, as in --view-host "
+           "race.example.org";
+  for (char c : name)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '-' || c == ':' ||
+          c == '[' || c == ']' || c == '_'))
+      return "--view-host '" + name.substr(0, 60) + "': '" + std::string(1, c) +
+             "' is not part of a host name: give a name or an address without a scheme, path or "
+             "port, as in --view-host race.example.org";
+  return {};
+}
 }  // namespace
 
 CLI::Option* addView(CLI::App* cmd, std::optional<std::string>& target) {
@@ -94,6 +112,13 @@ CLI::Option* addView(CLI::App* cmd, std::optional<std::string>& target) {
                              "Serve the race view in a browser on [HOST:]PORT (default "
                              "127.0.0.1:8080; PORT 0: any free port) — docs/view.md")
                  ->expected(0, 1);
+  cmd->add_option("--view-host", v.hosts,
+                  "With --view: another NAME browsers reach the view by (a reverse proxy's; "
+                  "repeatable). Requests for other names are refused (DNS rebinding); with it, "
+                  "driving needs the join code — docs/view.md")
+      ->check(checkViewHost)
+      ->take_all()
+      ->needs(v.option);
   return v.option;
 }
 
@@ -112,7 +137,14 @@ void addHumans(CLI::App* cmd, CarSource& source) {
 
 void takeViews() {
   for (auto& v : g_views)
-    if (v.option->count() > 0) *v.target = v.value;
+    if (v.option->count() > 0) {
+      *v.target = v.value;
+      g_viewHosts = v.hosts;
+    }
+}
+
+const std::vector<std::string>& viewHosts() {
+  return g_viewHosts;
 }
 
 }  // namespace pitwall::cli

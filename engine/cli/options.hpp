@@ -6,6 +6,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "engine/cli/commands.hpp"
 
@@ -42,8 +43,10 @@ CLI::Option* addMqtt(CLI::App* cmd, MqttSettings& mqtt, double& timeout, const c
 CLI::Option* addRemoteCars(CLI::App* cmd, CarSource& source);
 // --view [[HOST:]PORT], an option whose value may be left out: CLI11 tells whether it was given
 // only after parsing, so takeViews() copies each one to its target then.
+// With it, --view-host NAME (repeatable): the names of the given --view, from viewHosts().
 CLI::Option* addView(CLI::App* cmd, std::optional<std::string>& target);
 void takeViews();
+const std::vector<std::string>& viewHosts();
 // --humans N, --gamepads, --keyboard (run): the seats of human drivers and what holds them.
 void addHumans(CLI::App* cmd, CarSource& source);
 

@@ -14,6 +14,7 @@
 #include "bindings/car_binding.hpp"
 #include "bindings/interrupt.hpp"
 #include "bindings/sandbox.hpp"
+#include "engine/cli/options.hpp"
 #include "engine/core/console.hpp"
 #include "engine/core/log.hpp"
 #include "engine/protocol/anki/advertisement.hpp"
@@ -458,6 +459,7 @@ int Session::startView(const std::string& endpoint, const std::string& source,
     return 2;
   }
   options->assets = *assets;
+  options->names = viewHosts();
   startFeed(source);
   feed_->followLog(true);
   server_ = std::make_unique<view::Server>(loop_, *feed_, *options);
@@ -469,9 +471,13 @@ int Session::startView(const std::string& endpoint, const std::string& source,
   }
   console::noteOutput();
   std::cerr << "view: " << server_->url() << "\n";
+  if (!server_->joinCode().empty())  // docs/view.md "Pairing": only invited people drive
+    std::cerr << "view: join code " << server_->joinCode() << ": to drive, phones open "
+              << server_->driveUrl() << "\n";
   if (options->host != "127.0.0.1" && options->host != "::1")
     log::warn("view", "serving on " + options->host +
-                          ": anyone who can reach this machine can watch (read-only)");
+                          ": anyone who can reach this machine can watch (read-only); driving "
+                          "and replay controls need the join code");
   return 0;
 }
 
@@ -499,11 +505,10 @@ int Session::startSeats(const CarSource& source, const char* command) {
       source.humans == 1 ? "car 1" : "cars 1.." + std::to_string(source.humans);
   if (server_) {
     console::noteOutput();
-    std::cerr << "drive: " << server_->url() << "drive (" << cars << ": one phone a car)\n";
-    const std::string host = server_->url().substr(7, server_->url().rfind(':') - 7);
-    if (host != "127.0.0.1" && host != "[::1]")
-      log::warn("seats", "anyone who can reach this machine can take a free seat and drive " +
-                             cars + ": serve the view on a network you trust");
+    std::cerr << "drive: " << server_->driveUrl() << " (" << cars << ": one phone a car)\n";
+    if (!server_->joinCode().empty())
+      log::info("seats", "a phone takes a seat of " + cars + " only with the join code " +
+                             server_->joinCode() + " (docs/view.md \"Pairing\")");
   } else if (!source.gamepads && !source.keyboard) {
     log::warn("seats", "--humans " + std::to_string(source.humans) +
                            " and nothing to hold the seats but a script: add --view (phones on "

@@ -11,6 +11,9 @@ namespace {
 
 constexpr double kErrorEvery = 1.0;  // s: the same refusal of a drive message, said again
 constexpr const char* kDrivingOff = "driving is off in this run: start it with --humans N";
+constexpr const char* kNeedCode =
+    "this race view needs its join code to drive or control: open the address the terminal "
+    "and the race view show (/drive?code=…), or give the code";
 
 const nlohmann::json* field(const nlohmann::json& m, const char* name) {
   auto it = m.find(name);
@@ -50,12 +53,40 @@ void PageMessages::receive(const std::string& text) noexcept {
       return;
     }
     flooding_ = false;
+    if (!mayDrive(m, kind == "drive")) return;
     if (kind == "control") return control(m);
     if (kind == "seat") return seat(m);
     if (kind == "drive") return drive(m);
   } catch (const std::exception& e) {  // none expected: the last guard of the loop
     log::warn("view", std::string("a page's message was dropped: ") + e.what());
   }
+}
+
+bool PageMessages::pair(std::string_view code) {
+  if (paired_) return true;
+  auto ok = pairing_->check(client_, code, loop_.seconds());
+  if (!ok) {
+    answer(error(ok.error()));
+    return false;
+  }
+  paired_ = true;
+  answer(nlohmann::json{{"type", "paired"}}.dump());
+  return true;
+}
+
+// A page that is not paired drives nothing: its message's "code" pairs it, or it is told why
+// not (a drive message's refusal at most once a second, as every refusal of a drive).
+bool PageMessages::mayDrive(const nlohmann::json& m, bool quiet) {
+  if (paired_) return true;
+  const nlohmann::json* code = field(m, "code");
+  if (!code || !code->is_string()) {
+    if (quiet)
+      refuseDrive(kNeedCode);
+    else
+      answer(error(kNeedCode));
+    return false;
+  }
+  return pair(code->get_ref<const std::string&>());
 }
 
 void PageMessages::closed() {

@@ -20,6 +20,7 @@
 #include "engine/core/loop.hpp"
 #include "engine/core/token_bucket.hpp"
 #include "engine/view/feed.hpp"
+#include "engine/view/pairing.hpp"
 
 namespace pitwall::view {
 
@@ -30,10 +31,25 @@ class PageMessages {
   static constexpr RateLimit kLimit{.perSecond = 40, .burst = 20};
   static constexpr std::size_t kMaxAnswers = 8;  // waiting for a slow page; the oldest go first
 
-  PageMessages(Loop& loop, Feed& feed, std::string holder)
-      : loop_(loop), feed_(feed), holder_(std::move(holder)) {}
+  // `pairing`: the join code a seat, a drive and a control need (none: no code needed);
+  // `client`: the key this page's wrong codes are counted by (Pairing::clientKey).
+  PageMessages(Loop& loop, Feed& feed, std::string holder, Pairing* pairing = nullptr,
+               std::string client = {})
+      : loop_(loop),
+        feed_(feed),
+        holder_(std::move(holder)),
+        pairing_(pairing),
+        client_(std::move(client)),
+        paired_(!pairing || !pairing->required()) {}
 
   void receive(const std::string& text) noexcept;
+  // A join code the page brought (its /ws?code=…, or a message's "code"): pairs the page, or
+  // answers why not (wrong, locked out). True when the page is paired.
+  bool pair(std::string_view code);
+  bool paired() const { return paired_; }
+  // A message for this page alone, written before its next update (the join code, for the
+  // race view on this machine).
+  void tell(std::string text) { answer(std::move(text)); }
   // The page went (closed, lost, stalled): its seat, if it held one, is let go.
   void closed();
   // The next answer to write, oldest first; none when all are written.
@@ -47,10 +63,14 @@ class PageMessages {
   void refuseDrive(const std::string& why);
   void leave();
   void answer(std::string text);
+  bool mayDrive(const nlohmann::json& m, bool quiet);
 
   Loop& loop_;
   Feed& feed_;
   std::string holder_;
+  Pairing* pairing_;
+  std::string client_;
+  bool paired_;
   std::deque<std::string> answers_;
   TokenBucket bucket_;                  // the page's messages (kLimit)
   bool flooding_ = false;               // said once a flood

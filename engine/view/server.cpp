@@ -1,5 +1,7 @@
 #include "engine/view/server.hpp"
 
+#include <ifaddrs.h>
+#include <netinet/in.h>
 #include <unistd.h>
 
 #include <boost/asio/ip/tcp.hpp>
@@ -10,10 +12,13 @@
 #include <charconv>
 #include <fstream>
 #include <list>
+#include <map>
+#include <set>
 #include <sstream>
 
 #include "engine/core/data_dir.hpp"
 #include "engine/core/log.hpp"
+#include "engine/drive/seats.hpp"
 #include "engine/view/page_messages.hpp"
 
 namespace pitwall::view {
@@ -29,9 +34,77 @@ namespace {
 constexpr auto kWriteStall = std::chrono::seconds(5);  // a browser that reads nothing for this long
 constexpr auto kHeartbeat = std::chrono::seconds(1);   // an unchanged state is sent this often
 constexpr std::size_t kMaxIncoming = 64 * 1024;        // a page's message, a request's body
-constexpr auto kRequestTimeout = std::chrono::seconds(10);  // for a request to arrive whole
-constexpr std::size_t kMaxBrowsers = 64;                    // WebSockets at once
-constexpr std::size_t kMaxConnections = 128;  // HTTP connections at once (not upgraded)
+constexpr auto kRequestTimeout = std::chrono::seconds(5);  // for a request to arrive whole
+constexpr auto kSocketIdle = std::chrono::seconds(10);  // a WebSocket that answers no ping: closed
+constexpr std::size_t kMaxBrowsers = 64;                // WebSockets at once
+constexpr std::size_t kMaxConnections = 128;            // HTTP connections at once (not upgraded)
+constexpr auto kAddressesFresh = std::chrono::seconds(5);  // this machine's addresses, read again
+
+std::string_view sv(beast::string_view v) {
+  return {v.data(), v.size()};
+}
+
+std::string lower(std::string_view text) {
+  std::string out(text);
+  for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return out;
+}
+
+// The name in a Host header: lower case, without the port or a final dot; an IPv6 address
+// without its brackets. Empty when malformed.
+std::string hostName(std::string_view host) {
+  std::string_view name;
+  if (!host.empty() && host.front() == '[') {
+    auto close = host.find(']');
+    if (close == std::string_view::npos) return {};
+    std::string_view rest = host.substr(close + 1);
+    if (!rest.empty() && rest.front() != ':') return {};
+    name = host.substr(1, close - 1);
+  } else {
+    auto colon = host.find(':');
+    if (colon != std::string_view::npos && host.find(':', colon + 1) != std::string_view::npos)
+      return {};
+    name = host.substr(0, colon);
+  }
+  std::string out = lower(name);
+  if (!out.empty() && out.back() == '.') out.pop_back();
+  return out;
+}
+
+// This machine's addresses (getifaddrs), as text without an IPv6 zone.
+std::set<std::string> machineAddresses() {
+  std::set<std::string> out;
+  ifaddrs* list = nullptr;
+  if (::getifaddrs(&list) != 0) return out;
+  for (ifaddrs* i = list; i; i = i->ifa_next) {
+    if (!i->ifa_addr) continue;
+    if (i->ifa_addr->sa_family == AF_INET) {
+      const auto* in = reinterpret_cast<const sockaddr_in*>(i->ifa_addr);
+      out.insert(asio::ip::address_v4(ntohl(in->sin_addr.s_addr)).to_string());
+    } else if (i->ifa_addr->sa_family == AF_INET6) {
+      const auto* in6 = reinterpret_cast<const sockaddr_in6*>(i->ifa_addr);
+      asio::ip::address_v6::bytes_type bytes;
+      std::copy(std::begin(in6->sin6_addr.s6_addr), std::end(in6->sin6_addr.s6_addr),
+                bytes.begin());
+      out.insert(asio::ip::address_v6(bytes).to_string());
+    }
+  }
+  ::freeifaddrs(list);
+  return out;
+}
+
+std::string machineName() {
+  char name[256] = {};
+  if (::gethostname(name, sizeof name - 1) != 0) return {};
+  return lower(name);
+}
+
+// A loopback address (127.0.0.0/8, ::1, or a v4-mapped 127.x).
+bool loopback(const asio::ip::address& a) {
+  if (a.is_v6() && a.to_v6().is_v4_mapped())
+    return asio::ip::make_address_v4(asio::ip::v4_mapped, a.to_v6()).is_loopback();
+  return a.is_loopback();
+}
 constexpr auto kAcceptRetry = std::chrono::milliseconds(250);  // after a failed accept()
 
 std::string_view contentType(const std::filesystem::path& path) {
@@ -68,7 +141,19 @@ std::optional<std::filesystem::path> assetPath(const std::filesystem::path& root
 
 struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   Impl(Loop& l, Feed& f, ServerOptions o)
-      : loop(l), feed(f), options(std::move(o)), acceptor(l.io()), retry(l.io()) {}
+      : loop(l),
+        feed(f),
+        options(std::move(o)),
+        acceptor(l.io()),
+        retry(l.io()),
+        pairing(needsCode(options), options.code) {}
+
+  // The join code is needed unless the view is on loopback alone (and not behind a proxy).
+  static bool needsCode(const ServerOptions& o) {
+    beast::error_code ec;
+    auto a = asio::ip::make_address(o.host, ec);
+    return o.alwaysPair || !o.names.empty() || ec || !loopback(a);
+  }
 
   struct Http;
   struct Socket;
@@ -84,21 +169,33 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   std::list<std::weak_ptr<Socket>> sockets;
   std::size_t open = 0;
   std::uint64_t phones = 0;  // the controller pages seen: each WebSocket a holder "phone#k"
+  Pairing pairing;
+  std::set<std::string> proxies;    // --view-host: requests for these names may be forwarded
+  std::set<std::string> names;      // the names a Host may give (with the machine's, read at start)
+  std::set<std::string> addresses;  // this machine's, read again when a Host is not among them
+  std::chrono::steady_clock::time_point addressesRead{};
 
   void accept();
   void closeAll();
+  bool serves(const std::string& name);
+  void admit(tcp::socket socket);
+  bool roomForSocket(const std::string& client);
+  std::string driveUrl() const;
 };
 
 // One WebSocket: the state, then updates paced to the rate, one write in flight at most.
 struct Server::Impl::Socket : std::enable_shared_from_this<Socket> {
-  Socket(std::shared_ptr<Impl> s, tcp::socket&& sock)
+  Socket(std::shared_ptr<Impl> s, tcp::socket&& sock, std::string who)
       : server(std::move(s)),
+        client(std::move(who)),
         ws(std::move(sock)),
         pace(server->loop.io()),
         stall(server->loop.io()),
-        page(server->loop, server->feed, "phone#" + std::to_string(++server->phones)) {}
+        page(server->loop, server->feed, "phone#" + std::to_string(++server->phones),
+             &server->pairing, client) {}
 
   std::shared_ptr<Impl> server;
+  std::string client;  // whose slot this is (Pairing::clientKey of the address or forwarded one)
   websocket::stream<beast::tcp_stream> ws;
   asio::steady_timer pace, stall;
   beast::flat_buffer in;
@@ -110,14 +207,28 @@ struct Server::Impl::Socket : std::enable_shared_from_this<Socket> {
   std::chrono::steady_clock::time_point lastWrite{};  // the last message written
   std::chrono::steady_clock::time_point lastLook{};   // the last update built (the pace)
 
-  void start(http::request<http::string_body> request) {
+  // `code`: the join code in the page's /ws?code=…, if any; `local`: a browser on this
+  // machine, not forwarded (the race view beside the terminal), which is told the code.
+  void start(http::request<http::string_body> request, std::optional<std::string> code,
+             bool local) {
     server->open++;
+    if (code) page.pair(*code);
+    if (server->pairing.required() && (local || page.paired()))
+      page.tell(nlohmann::json{
+          {"type", "pairing"}, {"code", server->pairing.code()}, {"drive", server->driveUrl()}}
+                    .dump());
     // A small send buffer: a browser that stops reading is noticed (and closed) in seconds,
     // not after the kernel has buffered megabytes of updates for it.
     beast::error_code ignored;
     beast::get_lowest_layer(ws).socket().set_option(asio::socket_base::send_buffer_size(64 * 1024),
                                                     ignored);
-    ws.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
+    // A WebSocket that answers no ping for kSocketIdle is closed: an idle squatter frees its
+    // slot (a browser answers pings by itself, a page in the background too).
+    auto timeouts = websocket::stream_base::timeout::suggested(beast::role_type::server);
+    timeouts.handshake_timeout = kRequestTimeout;
+    timeouts.idle_timeout = kSocketIdle;
+    timeouts.keep_alive_pings = true;
+    ws.set_option(timeouts);
     ws.read_message_max(kMaxIncoming);
     ws.async_accept(request, [self = shared_from_this()](beast::error_code ec) {
       if (ec) return self->close();
@@ -210,6 +321,9 @@ struct Server::Impl::Http : std::enable_shared_from_this<Http> {
   beast::flat_buffer buffer;
   std::optional<http::request_parser<http::string_body>> parser;
   std::shared_ptr<void> response;  // kept alive while it is written
+  std::string peer;                // the address it comes from (Pairing::clientKey)
+  bool peerLoopback = false;
+  bool closed = false;
 
   void read() {
     parser.emplace();
@@ -264,30 +378,70 @@ struct Server::Impl::Http : std::enable_shared_from_this<Http> {
     respond(std::move(res));
   }
 
+  // Who sent the request: the peer, or — through a --view-host proxy on this machine — the
+  // last address the proxy put in X-Forwarded-For.
+  std::string client(const http::request<http::string_body>& req, bool& forwarded) const {
+    forwarded = false;
+    auto host = req.find(http::field::host);
+    if (!peerLoopback || host == req.end()) return peer;
+    const std::string name = hostName(sv(host->value()));
+    if (!server->proxies.contains(name)) return peer;
+    forwarded = true;
+    auto xff = req.find("X-Forwarded-For");
+    if (xff == req.end()) return peer;
+    std::string_view list = sv(xff->value());
+    std::string_view last =
+        list.substr(list.rfind(',') == std::string_view::npos ? 0 : list.rfind(',') + 1);
+    while (!last.empty() && last.front() == ' ') last.remove_prefix(1);
+    while (!last.empty() && last.back() == ' ') last.remove_suffix(1);
+    beast::error_code ec;
+    auto a = asio::ip::make_address(std::string(last), ec);
+    return ec ? peer : Pairing::clientKey(a.to_string());
+  }
+
+  // DNS rebinding: a page of another site whose name now resolves here sends its own name as
+  // Host (and Origin); only the names the view serves are answered.
+  std::optional<std::string> refusal(const http::request<http::string_body>& req) {
+    auto host = req.find(http::field::host);
+    if (host == req.end())
+      return "a request without a Host header (the race view answers HTTP/1.1 with Host)";
+    const std::string name = hostName(sv(host->value()));
+    if (name.empty() || !server->serves(name))
+      return "the race view does not serve the name '" + std::string(host->value()).substr(0, 100) +
+             "': open it by this machine's address or name (or give --view-host NAME for a "
+             "reverse proxy's)";
+    if (auto origin = req.find(http::field::origin); origin != req.end()) {
+      const std::string o = lower(sv(origin->value()));
+      const std::string h = lower(sv(host->value()));
+      if (o != "http://" + h && o != "https://" + h)
+        return "the race view is for its own page, not for " +
+               std::string(origin->value()).substr(0, 200);
+    }
+    return std::nullopt;
+  }
+
   void handle(http::request<http::string_body> req) {
     std::string target(req.target());
+    if (auto why = refusal(req))
+      return text(req, http::status::forbidden, "text/plain", *why + "\n");
     if (websocket::is_upgrade(req)) {
-      if (target != "/ws")
+      if (target != "/ws" && !target.starts_with("/ws?"))
         return text(req, http::status::not_found, "text/plain", "WebSocket only on /ws\n");
-      // Only the view's own page: another site open in the same browser may not connect (it
-      // could not be stopped from sending what it likes). Tools that are no browser send no
-      // Origin.
-      if (auto origin = req.find(http::field::origin); origin != req.end()) {
-        auto host = req.find(http::field::host);
-        if (host == req.end() ||
-            std::string(origin->value()) != "http://" + std::string(host->value()))
-          return text(req, http::status::forbidden, "text/plain",
-                      "the race view's WebSocket is for its own page, not for " +
-                          std::string(origin->value()).substr(0, 200) + "\n");
-      }
-      if (server->open >= kMaxBrowsers)
+      bool forwarded = false;
+      const std::string who = client(req, forwarded);
+      if (!server->roomForSocket(who))
         return text(
             req, http::status::service_unavailable, "text/plain",
             "the view serves " + std::to_string(kMaxBrowsers) + " browsers at most; close one\n");
+      std::optional<std::string> code;
+      if (auto at = target.find("code="); at != std::string::npos) {
+        auto end = target.find('&', at);
+        code = target.substr(at + 5, end == std::string::npos ? std::string::npos : end - at - 5);
+      }
       stream.expires_never();
-      auto socket = std::make_shared<Socket>(server, stream.release_socket());
+      auto socket = std::make_shared<Socket>(server, stream.release_socket(), who);
       server->sockets.push_back(socket);
-      socket->start(std::move(req));
+      socket->start(std::move(req), std::move(code), peerLoopback && !forwarded);
       return;
     }
     if (req.method() != http::verb::get && req.method() != http::verb::head)
@@ -311,11 +465,92 @@ struct Server::Impl::Http : std::enable_shared_from_this<Http> {
   }
 
   void close() {
+    closed = true;
     beast::error_code ignored;
     stream.socket().shutdown(tcp::socket::shutdown_both, ignored);
     stream.close();
   }
 };
+
+bool Server::Impl::serves(const std::string& name) {
+  if (name == "localhost" || name.ends_with(".localhost")) return true;  // RFC 6761: loopback
+  if (names.contains(name)) return true;
+  beast::error_code ec;
+  auto a = asio::ip::make_address(name, ec);
+  if (ec) return false;
+  if (loopback(a)) return true;
+  const std::string text = a.to_string();
+  if (addresses.contains(text)) return true;
+  // a new address (DHCP, a hotspot turned on): read them again, at most every few seconds
+  auto now = std::chrono::steady_clock::now();
+  if (now - addressesRead < kAddressesFresh) return false;
+  addressesRead = now;
+  addresses = machineAddresses();
+  return addresses.contains(text);
+}
+
+// Fair shares (docs/view.md "Limits"): when every HTTP slot is taken, the client that holds the
+// most gives up its oldest connection (an idle keep-alive or a slow request, most often), so a
+// squatter holding many cannot keep a newcomer out.
+void Server::Impl::admit(tcp::socket socket) {
+  beast::error_code ec;
+  auto remote = socket.remote_endpoint(ec);
+  if (ec) return;  // gone already
+  auto http = std::make_shared<Http>(shared_from_this(), std::move(socket));
+  http->peer = Pairing::clientKey(remote.address().to_string());
+  http->peerLoopback = loopback(remote.address());
+  std::erase_if(https, [](const auto& w) {
+    auto h = w.lock();
+    return !h || h->closed;
+  });
+  if (https.size() >= kMaxConnections) {
+    std::map<std::string, std::size_t> count;
+    for (auto& w : https) count[w.lock()->peer]++;
+    auto most = std::max_element(count.begin(), count.end(),
+                                 [](auto& a, auto& b) { return a.second < b.second; });
+    for (auto& w : https)  // the list is oldest first
+      if (auto h = w.lock(); h->peer == most->first) {
+        h->close();
+        break;
+      }
+    std::erase_if(https, [](const auto& w) {
+      auto h = w.lock();
+      return !h || h->closed;
+    });
+  }
+  https.push_back(http);
+  http->read();
+}
+
+// A WebSocket slot for `client`: free, or taken from the client that holds the most (more than
+// `client` would): a socket of theirs that holds no seat first, the oldest first.
+bool Server::Impl::roomForSocket(const std::string& client) {
+  std::erase_if(sockets, [](const auto& w) {
+    auto s = w.lock();
+    return !s || s->closed;
+  });
+  if (open < kMaxBrowsers) return true;
+  std::map<std::string, std::size_t> count;
+  for (auto& w : sockets) count[w.lock()->client]++;
+  auto most = std::max_element(count.begin(), count.end(),
+                               [](auto& a, auto& b) { return a.second < b.second; });
+  if (most == count.end() || most->second <= count[client] + 1) return false;
+  const drive::Seats* seats = feed.seats();
+  std::shared_ptr<Socket> victim;
+  for (auto& w : sockets) {
+    auto s = w.lock();
+    if (s->client != most->first) continue;
+    if (!victim) victim = s;
+    if (!seats || !seats->heldBy(s->page.holder())) {
+      victim = s;
+      break;
+    }
+  }
+  log::info("view", "a browser of " + most->first + " (which had " + std::to_string(most->second) +
+                        ") closed to make room for " + client);
+  victim->close();
+  return true;
+}
 
 void Server::Impl::accept() {
   acceptor.async_accept([self = shared_from_this()](beast::error_code ec, tcp::socket socket) {
@@ -334,16 +569,7 @@ void Server::Impl::accept() {
       return;
     }
     self->acceptFailing = false;
-    self->https.remove_if([](const auto& w) { return w.expired(); });
-    self->sockets.remove_if([](const auto& w) { return w.expired(); });
-    if (self->https.size() >= kMaxConnections) {
-      beast::error_code ignored;  // more connections than any audience: this one is closed
-      socket.close(ignored);
-    } else {
-      auto http = std::make_shared<Http>(self, std::move(socket));
-      self->https.push_back(http);
-      http->read();
-    }
+    self->admit(std::move(socket));
     self->accept();
   });
 }
@@ -386,6 +612,18 @@ Result<bool, std::string> Server::start() {
   }
   a.listen(asio::socket_base::max_listen_connections, ec);
   if (ec) return Unexpected{"cannot listen on " + where + ": " + ec.message()};
+  // the names a browser may reach the view by (besides loopback and the machine's addresses)
+  for (const auto& n : impl_->options.names) {
+    impl_->names.insert(hostName(n));
+    impl_->proxies.insert(hostName(n));
+  }
+  if (std::string name = machineName(); !name.empty()) {
+    impl_->names.insert(name);
+    if (name.find('.') == std::string::npos) impl_->names.insert(name + ".local");  // mDNS
+  }
+  impl_->names.insert(address.to_string());
+  impl_->addresses = machineAddresses();
+  impl_->addressesRead = std::chrono::steady_clock::now();
   impl_->accept();
   return true;
 }
@@ -413,6 +651,37 @@ std::string Server::url() const {
 
 std::size_t Server::clients() const {
   return impl_->open;
+}
+
+std::string Server::joinCode() const {
+  return impl_->pairing.required() ? impl_->pairing.code() : std::string();
+}
+
+std::string Server::driveUrl() const {
+  return impl_->driveUrl();
+}
+
+std::string Server::Impl::driveUrl() const {
+  // bound to every address: one a phone can reach (the first that is not loopback)
+  std::string host = options.host;
+  beast::error_code ec;
+  auto bound = asio::ip::make_address(host, ec);
+  if (!ec && bound.is_unspecified()) {
+    std::string best;
+    for (const auto& a : machineAddresses()) {
+      auto addr = asio::ip::make_address(a, ec);
+      if (ec || loopback(addr) || (addr.is_v6() && addr.to_v6().is_link_local())) continue;
+      if (bound.is_v4() && !addr.is_v4()) continue;
+      if (best.empty() || (addr.is_v4() && best.find(':') != std::string::npos)) best = a;
+    }
+    if (!best.empty()) host = best;
+  }
+  if (host.find(':') != std::string::npos) host = "[" + host + "]";
+  auto ep = acceptor.local_endpoint(ec);
+  std::string url =
+      "http://" + host + ":" + std::to_string(ec ? options.port : ep.port()) + "/drive";
+  if (pairing.required()) url += "?code=" + pairing.code();
+  return url;
 }
 
 Result<ServerOptions, std::string> parseEndpoint(const std::string& text) {

@@ -3,6 +3,9 @@
 //   GET /            the page, and its assets, from the installed data folder
 //   GET /drive       the controller page (drive.html): a phone takes a seat and drives it
 //   GET /api/state   the feed's whole state as JSON
+// Every request's Host must be a name the view serves (loopback, this machine's addresses and
+// name, the bound address, --view-host) and its Origin, when sent, that Host: a page on another
+// site, even one whose name was made to resolve here (DNS rebinding), is refused (403).
 //   GET /ws          a WebSocket: the state, then updates at most `maxRate` a second; a page
 //                    may send replay controls and, with the feed's seats, seat/drive/leave
 //                    (each WebSocket is one holder; closing it frees its seat)
@@ -13,6 +16,7 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "engine/core/loop.hpp"
 #include "engine/core/result.hpp"
@@ -25,6 +29,12 @@ struct ServerOptions {
   std::uint16_t port = 0;          // 0: any free port
   std::filesystem::path assets;    // the page's folder (index.html, view.js, vendor/…)
   double maxRate = 30;             // updates a second per browser, at most
+  // --view-host: more names a browser may reach the view by (a reverse proxy's). Requests whose
+  // Host is one of them, from this machine, are taken as forwarded: X-Forwarded-For names the
+  // client. Any name here makes the join code needed.
+  std::vector<std::string> names;
+  bool alwaysPair = false;  // the join code is needed on loopback too (tests)
+  std::string code;         // the join code when one is needed; empty: a new one (getrandom)
 };
 
 // "[HOST:]PORT" from the command line; an empty text is the default port. The error says what
@@ -49,6 +59,10 @@ class Server {
   std::uint16_t port() const;
   std::string url() const;
   std::size_t clients() const;  // open WebSockets
+  // The code that pairs a phone (docs/view.md "Pairing"); empty when none is needed (loopback,
+  // no --view-host). driveUrl(): the controller page's address, with the code.
+  std::string joinCode() const;
+  std::string driveUrl() const;
 
  private:
   struct Impl;

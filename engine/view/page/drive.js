@@ -1,8 +1,13 @@
 // The controller page (docs/view.md "The controller page (/drive)"): a phone takes a seat of a
 // run started with --humans N and drives its car over the race view's WebSocket (/ws):
-//   → {"type":"seat","seat":N (0: any free),"player":"name"}   ← {"type":"seat","seat":N} or error
+//   → {"type":"seat","seat":N (0: any free),"player":"name","code":"123456"}
+//                                                     ← {"type":"seat","seat":N} or error
 //   → {"type":"drive","throttle":0..1,"lane":-1|0|1}            10 a second, and on each change
 //   → {"type":"leave"}
+// Pairing (docs/view.md "Pairing"): off loopback the engine takes a seat only with the join
+// code. The page reads it from its address (/drive?code=…), keeps it for the tab (so a
+// reconnection pairs again), opens /ws?code=… and sends it with every seat message; a page
+// without it asks for it (#pair).
 // The engine stops the car when this page goes silent for 1 s or disconnects; the page itself
 // returns the throttle to 0 whenever the finger leaves the bar (dead man's handle).
 //
@@ -18,6 +23,7 @@
 //   #throttle[data-value]            the throttle bar (0..1 as sent); pointer events
 //   #lane-left, #lane-right, #leave  buttons
 //   #position, #lap, #gap, #speed    the car's place in the race
+//   #pair, #code, #pair-go           asks for the join code when the engine wants one
 "use strict";
 
 const HEARTBEAT_MS = 100;     // 10 drive messages a second keep the seat live
@@ -32,11 +38,26 @@ const page = {
   race: null,
   seat: null,         // the seat number this page holds
   wanted: null,       // the seat to take again after a reconnection
+  asked: null,        // the seat last asked for (taken again once the code is given)
   throttle: 0,
   lastSent: 0,
   pending: null,      // a timer for a change sent a little later
   heartbeat: null,
+  code: joinCode(),   // the join code from the address or this tab's memory; "" if none
 };
+
+function joinCode() {
+  const fromUrl = new URLSearchParams(location.search).get("code");
+  try {
+    if (fromUrl) sessionStorage.setItem("pitwall.code", fromUrl);
+    return fromUrl || sessionStorage.getItem("pitwall.code") || "";
+  } catch { return fromUrl || ""; /* storage off */ }
+}
+
+function setCode(code) {
+  page.code = code.trim();
+  try { sessionStorage.setItem("pitwall.code", page.code); } catch { /* storage off */ }
+}
 
 // ---------------------------------------------------------------------------------------------
 // Messages.
@@ -82,7 +103,10 @@ function playerName() {
 
 function takeSeat(number) {
   try { localStorage.setItem("pitwall.player", $("#player").value); } catch { /* private mode */ }
-  send({ type: "seat", seat: number, player: playerName() });
+  page.asked = number;
+  const msg = { type: "seat", seat: number, player: playerName() };
+  if (page.code) msg.code = page.code;
+  send(msg);
 }
 
 function holding(number) {
@@ -278,7 +302,8 @@ function setConnection(live) {
 }
 
 function connect() {
-  const ws = new WebSocket(`${location.protocol === "https:" ? "wss" : "ws"}://${location.host}/ws`);
+  const query = page.code ? `?code=${encodeURIComponent(page.code)}` : "";
+  const ws = new WebSocket(`${location.protocol === "https:" ? "wss" : "ws"}://${location.host}/ws${query}`);
   page.socket = ws;
   let retried = false;
   const retry = () => {
@@ -313,8 +338,11 @@ function connect() {
       render();
     } else if (msg.type === "seat") {
       holding(msg.seat);
+    } else if (msg.type === "paired") {
+      $("#pair").hidden = true;
     } else if (msg.type === "error") {
       const text = String(msg.message || "refused");
+      if (/join code/.test(text)) $("#pair").hidden = false;
       const taken = /is held by|every seat is taken/.test(text);
       if (taken && page.seat == null) page.wanted = null;
       notice(taken ? `Seat taken: ${text}` : text, taken ? "taken" : /driving is off/.test(text) ? "off" : "error");
@@ -323,6 +351,13 @@ function connect() {
   ws.onclose = retry;
   ws.onerror = () => { retry(); try { ws.close(); } catch { /* already closed */ } };
 }
+
+$("#code").value = page.code;
+$("#pair").addEventListener("submit", (ev) => {
+  ev.preventDefault();
+  setCode($("#code").value);
+  takeSeat(page.asked ?? 0);
+});
 
 setThrottle(0, false);
 connect();

@@ -19,6 +19,12 @@
 //   #replay                         replay controls, shown only when `replay` is non-null
 //   #drive-link                     the link to the controller page (/drive), shown only when
 //                                   the state has seats (a run with --humans N)
+//   #join, #join-code, #join-url    the join code and the controller page's address with it,
+//                                   shown to a browser on the engine's machine (or one that
+//                                   came with the code) when the engine needs one
+//
+// Pairing (docs/view.md "Pairing"): off loopback, replay controls need the join code too; the
+// page takes it from its address (?code=…), keeps it for the tab and opens /ws?code=….
 "use strict";
 
 const SVG_NS = "http://www.w3.org/2000/svg";
@@ -390,7 +396,7 @@ function renderReplay() {
 
 function control(msg) {
   if (socket && socket.readyState === WebSocket.OPEN)
-    socket.send(JSON.stringify({ type: "control", ...msg }));
+    socket.send(JSON.stringify({ type: "control", ...msg, ...(joinCode ? { code: joinCode } : {}) }));
 }
 $("#replay-play").addEventListener("click", () => view.replay && control({ pause: !view.replay.paused }));
 $("#replay-seek").addEventListener("input", () => { seeking = true; });
@@ -538,6 +544,27 @@ function showDriveLink(seats) {
 }
 
 let socket = null;
+let joinCode = (() => {
+  const fromUrl = new URLSearchParams(location.search).get("code");
+  try {
+    if (fromUrl) sessionStorage.setItem("pitwall.code", fromUrl);
+    return fromUrl || sessionStorage.getItem("pitwall.code") || "";
+  } catch { return fromUrl || ""; /* storage off */ }
+})();
+
+// {"type":"pairing","code":"123456","drive":"http://…/drive?code=123456"}: shown by the title,
+// for the players to type or open.
+function showPairing(msg) {
+  const code = String(msg.code || "");
+  const url = String(msg.drive || "");
+  $("#join").hidden = !code;
+  $("#join-code").textContent = code;
+  $("#join-url").textContent = url;
+  $("#join-url").href = url;
+  if (url) $("#drive-link").href = url;
+  if (code && !joinCode) joinCode = code;
+}
+
 function setConnection(live) {
   const el = $("#connection");
   el.textContent = live ? "live" : "engine gone";
@@ -546,7 +573,8 @@ function setConnection(live) {
 }
 
 function connect() {
-  const ws = new WebSocket(`${location.protocol === "https:" ? "wss" : "ws"}://${location.host}/ws`);
+  const query = joinCode ? `?code=${encodeURIComponent(joinCode)}` : "";
+  const ws = new WebSocket(`${location.protocol === "https:" ? "wss" : "ws"}://${location.host}/ws${query}`);
   socket = ws;
   let retried = false;
   const retry = () => {
@@ -561,6 +589,7 @@ function connect() {
     try { msg = JSON.parse(ev.data); } catch { return; }
     if (msg.type === "state") { onState(msg); setConnection(true); }
     else if (msg.type === "update") onUpdate(msg);
+    else if (msg.type === "pairing") showPairing(msg);
     else if (msg.type === "error") addEvents([{ t: view.time, level: "error", text: msg.message }], false);
   };
   ws.onclose = retry;

@@ -16,6 +16,7 @@
 #include "engine/fleet/fleet.hpp"
 #include "engine/sim/track.hpp"
 #include "engine/sim/world.hpp"
+#include "engine/view/pairing.hpp"
 #include "engine/view/server.hpp"
 #include "tests/support/run_until.hpp"
 #include "tests/support/sim_cars.hpp"
@@ -40,7 +41,8 @@ struct Rig {
   view::Feed feed{loop, fleet, "simulator"};
   std::unique_ptr<view::Server> server;
 
-  explicit Rig(int humans, int cars = 2, drive::SeatsOptions seatOptions = {}) {
+  explicit Rig(int humans, int cars = 2, drive::SeatsOptions seatOptions = {},
+               const std::function<void(view::ServerOptions&)>& configure = {}) {
     assets = std::filesystem::temp_directory_path() /
              ("pitwall-drive-test-" + std::to_string(::getpid()));
     std::filesystem::create_directories(assets);
@@ -64,6 +66,7 @@ struct Rig {
     view::ServerOptions o;
     o.port = 0;
     o.assets = assets;
+    if (configure) configure(o);
     server = std::make_unique<view::Server>(loop, feed, o);
     REQUIRE(server->start());
   }
@@ -362,4 +365,159 @@ TEST_CASE("view drive: GET /drive serves the controller page") {
     CHECK(res.body().find("<title>drive</title>") != std::string::npos);
     CHECK(std::string(res[beast::http::field::content_type]).starts_with("text/html"));
   });
+}
+
+// Pairing (docs/view.md "Pairing"): off loopback — here forced with alwaysPair, as the view on
+// 0.0.0.0 would be — a seat is taken only with the join code, and a code cannot be guessed.
+namespace {
+constexpr const char* kCode = "424242";
+void needCode(view::ServerOptions& o) {
+  o.alwaysPair = true;
+  o.code = kCode;
+}
+nlohmann::json withCode(nlohmann::json m, const std::string& code) {
+  m["code"] = code;
+  return m;
+}
+bool says(const nlohmann::json& answer, const std::string& part) {
+  return answer["type"] == "error" &&
+         answer["message"].get<std::string>().find(part) != std::string::npos;
+}
+}  // namespace
+
+TEST_CASE("view drive: off loopback a page without the join code cannot take a seat or drive") {
+  Rig rig(2, 2, {}, needCode);
+  CHECK(rig.server->joinCode() == kCode);
+  CHECK(rig.server->driveUrl().ends_with("/drive?code=424242"));
+  rig.with([&](std::uint16_t port) {
+    Phone spectator(port, "127.0.0.2", "/ws");
+    spectator.send(seatMessage(1, "Eve"));
+    auto refused = spectator.answer();
+    CHECK_MESSAGE(says(refused, "needs its join code"), refused.dump());
+    spectator.send(driveMessage(1.0));
+    CHECK(says(spectator.answer(), "needs its join code"));
+    spectator.send(R"({"type":"control","pause":true})");
+    CHECK(says(spectator.answer(), "needs its join code"));
+    // still read-only: the seats it sees are free
+    spectator.seatsWhere([](const nlohmann::json& s) { return s[0]["held"] == false; });
+
+    // the code in the page's address (/ws?code=…), or in its seat message
+    Phone invited(port, "127.0.0.3", std::string("/ws?code=") + kCode);
+    invited.send(seatMessage(1, "Anna"));
+    CHECK(invited.answer()["seat"] == 1);
+    Phone typed(port, "127.0.0.4", "/ws");
+    typed.send(withCode(seatMessage(2, "Ben"), kCode));
+    CHECK(typed.answer()["seat"] == 2);
+    // what every page sees: both seats held (by the paired phones)
+    spectator.seatsWhere(
+        [](const nlohmann::json& s) { return s[0]["held"] == true && s[1]["held"] == true; });
+  });
+}
+
+TEST_CASE("view drive: wrong join codes lock their address out; another address still pairs") {
+  Rig rig(1, 1, {}, needCode);
+  rig.with([&](std::uint16_t port) {
+    Phone guesser(port, "127.0.0.5", "/ws");
+    for (int i = 1; i <= view::Pairing::kFreeTries; ++i) {
+      guesser.send(withCode(seatMessage(1, "Eve"), std::to_string(100000 + i)));
+      auto m = guesser.answer();
+      CHECK_MESSAGE(says(m, "wrong join code"), m.dump());
+      if (i == view::Pairing::kFreeTries) CHECK_MESSAGE(says(m, "no more tries from"), m.dump());
+    }
+    // locked out: the right code is refused too, and so is a new page from the same address
+    guesser.send(withCode(seatMessage(1, "Eve"), kCode));
+    auto locked = guesser.answer();
+    CHECK_MESSAGE(says(locked, "too many wrong join codes from 127.0.0.5: try again in"),
+                  locked.dump());
+    Phone again(port, "127.0.0.5", std::string("/ws?code=") + kCode);
+    again.send(seatMessage(1, "Eve"));
+    CHECK(says(again.answer(), "too many wrong join codes"));
+    // a phone elsewhere is not held back by the guesser
+    Phone phone(port, "127.0.0.6", std::string("/ws?code=") + kCode);
+    phone.send(seatMessage(1, "Anna"));
+    CHECK(phone.answer()["seat"] == 1);
+  });
+}
+
+TEST_CASE("view drive: the race view on the engine's machine is told the join code") {
+  Rig rig(1, 1, {}, needCode);
+  rig.with([&](std::uint16_t port) {
+    WsClient view(port);
+    for (;;) {
+      auto m = view.read();
+      if (m["type"] != "pairing") continue;
+      CHECK(m["code"] == kCode);
+      CHECK(m["drive"].get<std::string>().ends_with("/drive?code=424242"));
+      break;
+    }
+  });
+}
+
+TEST_CASE("view drive: on loopback no join code is needed (and none is shown)") {
+  Rig rig(1, 1);
+  CHECK(rig.server->joinCode().empty());
+  CHECK(rig.server->driveUrl().ends_with("/drive"));
+  rig.with([&](std::uint16_t port) { seatedPhone(port, 1, "Anna"); });
+}
+
+TEST_CASE("view drive: replay controls need the join code off loopback") {
+  Rig rig(0, 1, {}, needCode);
+  int controls = 0;
+  rig.feed.onControl = [&](const nlohmann::json&) { ++controls; };
+  rig.with([&](std::uint16_t port) {
+    Phone viewer(port, "127.0.0.2", "/ws");
+    viewer.send(R"({"type":"control","pause":true})");
+    CHECK(says(viewer.answer(), "needs its join code"));
+    Phone owner(port, "127.0.0.3", std::string("/ws?code=") + kCode);
+    owner.send(R"({"type":"control","pause":true})");
+    owner.send(seatMessage(1, "x"));  // an answer after the control: the control was taken
+    CHECK(says(owner.answer(), "--humans N"));
+  });
+  CHECK(controls == 1);
+}
+
+// Fairness (issue 33): squatters on several addresses — TCP connections that send nothing,
+// requests that never end (slowloris), kept-alive connections left idle, WebSockets that never
+// read (so never answer a ping) — fill every slot; a phone with the code still gets its seat.
+TEST_CASE("view drive: 200 idle and slow connections from 10 addresses do not keep a phone out") {
+  Rig rig(1, 1, {}, needCode);
+  namespace asio = boost::asio;
+  rig.with(
+      [&](std::uint16_t port) {
+        asio::io_context io;
+        std::vector<std::unique_ptr<asio::ip::tcp::socket>> idle;
+        std::vector<std::unique_ptr<WsClient>> silent;
+        for (int i = 0; i < 200; ++i) {
+          const std::string from = "127.0.0." + std::to_string(2 + i % 10);
+          const int kind = i % 20;
+          try {
+            if (kind >= 9 && kind < 16) {  // a WebSocket that never reads
+              silent.push_back(std::make_unique<WsClient>(port, from, "/ws"));
+              continue;
+            }
+            auto s = std::make_unique<asio::ip::tcp::socket>(io);
+            WsClient::connectFrom(*s, from, port);
+            if (kind >= 5 && kind < 9)  // slowloris: a header that never ends
+              asio::write(*s, asio::buffer(std::string("GET / HTTP/1.1\r\nHost: 127.0.0.1\r\n")));
+            else if (kind >= 16)  // a kept-alive connection, left idle after one request
+              asio::write(
+                  *s,
+                  asio::buffer(std::string("GET /api/state HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n")));
+            idle.push_back(std::move(s));
+          } catch (const std::exception&) {
+            // a squatter refused or pushed out by another squatter: the point of the test
+          }
+        }
+        CHECK(silent.size() + idle.size() >= 150);
+        const auto start = std::chrono::steady_clock::now();
+        Phone phone(port, "127.0.0.1", std::string("/ws?code=") + kCode);
+        phone.send(seatMessage(1, "Anna"));
+        auto m = phone.answer();
+        const auto took = std::chrono::steady_clock::now() - start;
+        CHECK_MESSAGE(m["seat"] == 1, m.dump());
+        CHECK_MESSAGE(took < std::chrono::seconds(2),
+                      "the phone took " << std::chrono::duration<double>(took).count()
+                                        << " s to get its seat");
+      },
+      std::chrono::seconds(60));
 }

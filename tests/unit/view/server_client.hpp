@@ -48,7 +48,7 @@ inline void runClient(Loop& loop, std::uint16_t port,
 inline boost::beast::http::response<boost::beast::http::string_body> httpGet(
     std::uint16_t port, const std::string& target,
     boost::beast::http::verb verb = boost::beast::http::verb::get,
-    const std::string& extraHeader = "") {
+    const std::string& extraHeader = "", const std::string& host = "127.0.0.1") {
   namespace asio = boost::asio;
   namespace beast = boost::beast;
   namespace http = beast::http;
@@ -56,7 +56,7 @@ inline boost::beast::http::response<boost::beast::http::string_body> httpGet(
   beast::tcp_stream stream(io);
   stream.connect(asio::ip::tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
   std::string req =
-      std::string(http::to_string(verb)) + " " + target + " HTTP/1.1\r\nHost: 127.0.0.1\r\n";
+      std::string(http::to_string(verb)) + " " + target + " HTTP/1.1\r\nHost: " + host + "\r\n";
   if (!extraHeader.empty()) req += "X-Big: " + extraHeader + "\r\n";
   req += "Connection: close\r\n\r\n";
   beast::error_code wec;
@@ -77,6 +77,25 @@ struct WsClient {
     ws.next_layer().connect(
         boost::asio::ip::tcp::endpoint(boost::asio::ip::make_address("127.0.0.1"), port));
     ws.handshake("127.0.0.1", "/ws");
+  }
+  // From the loopback address `from` (all of 127/8 is this machine: each a client of its own),
+  // on `target` (/ws?code=…), with the given Host and, when not empty, Origin.
+  WsClient(std::uint16_t port, const std::string& from, const std::string& target,
+           const std::string& host = "127.0.0.1", const std::string& origin = "") {
+    connectFrom(ws.next_layer(), from, port);
+    if (!origin.empty())
+      ws.set_option(boost::beast::websocket::stream_base::decorator(
+          [origin](boost::beast::websocket::request_type& req) {
+            req.set(boost::beast::http::field::origin, origin);
+          }));
+    ws.handshake(host, target);
+  }
+  static void connectFrom(boost::asio::ip::tcp::socket& s, const std::string& from,
+                          std::uint16_t port) {
+    namespace asio = boost::asio;
+    s.open(asio::ip::tcp::v4());
+    s.bind(asio::ip::tcp::endpoint(asio::ip::make_address(from), 0));
+    s.connect(asio::ip::tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
   }
   void send(const char* text) { send(std::string(text)); }
   void send(const std::string& text) {

@@ -3,6 +3,7 @@
 // engine's loop runs here; each client runs in a thread of its own (a browser is another process).
 #include <doctest/doctest.h>
 
+#include <unistd.h>
 #include <atomic>
 #include <boost/asio/connect.hpp>
 #include <boost/asio/ip/tcp.hpp>
@@ -311,8 +312,9 @@ TEST_CASE("view server: another site's page may not connect; HEAD has no body; l
       asio::io_context io;
       tcp::socket s(io);
       s.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
-      asio::write(s, asio::buffer(std::string(
-                         "HEAD /api/state HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n")));
+      asio::write(s,
+                  asio::buffer(std::string(
+                      "HEAD /api/state HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n")));
       std::string all;
       beast::error_code ec;
       char buf[4096];
@@ -391,4 +393,64 @@ TEST_CASE(
   else
     CHECK(next.error().find("PITWALL_VIEW_DIR") != std::string::npos);
   unsetenv("PITWALL_VIEW_DIR");
+}
+
+// DNS rebinding (issue 33): a page of attacker.example whose name was made to resolve to this
+// machine sends its own name as Host and as Origin — they match each other, so only the Host
+// check tells it from the view's own page.
+TEST_CASE("view server: a page whose name was rebound here is refused on /ws and on the page") {
+  Rig rig;
+  rig.with([&](std::uint16_t port) {
+    const std::string p = ":" + std::to_string(port);
+    auto handshake = [&](const std::string& host, const std::string& origin) {
+      try {
+        WsClient c(port, "127.0.0.1", "/ws", host, origin);
+        return c.read()["type"] == "state";
+      } catch (const std::exception&) {
+        return false;
+      }
+    };
+    CHECK_FALSE(handshake("attacker.example" + p, "http://attacker.example" + p));
+    CHECK_FALSE(handshake("attacker.example", ""));  // a tool without Origin: the Host still
+    auto page = httpGet(port, "/", http::verb::get, "", "attacker.example" + p);
+    CHECK(page.result() == http::status::forbidden);
+    CHECK(page.body().find("does not serve the name 'attacker.example" + p) != std::string::npos);
+    CHECK(page.body().find("--view-host") != std::string::npos);
+    CHECK(httpGet(port, "/api/state", http::verb::get, "", "attacker.example").result() ==
+          http::status::forbidden);
+    // the names it serves: loopback by address and by name, this machine's name
+    CHECK(handshake("127.0.0.1" + p, "http://127.0.0.1" + p));
+    CHECK(handshake("127.0.0.7" + p, "http://127.0.0.7" + p));
+    CHECK(handshake("[::1]" + p, "http://[::1]" + p));
+    CHECK(handshake("localhost" + p, "http://localhost" + p));
+    CHECK(handshake("LocalHost." + p, ""));
+    char name[256] = {};
+    REQUIRE(::gethostname(name, sizeof name - 1) == 0);
+    CHECK(handshake(std::string(name) + p, "http://" + std::string(name) + p));
+    CHECK(httpGet(port, "/", http::verb::get, "", "localhost" + p).result() == http::status::ok);
+    // a served Host with another site's Origin, a malformed Host
+    CHECK_FALSE(handshake("127.0.0.1" + p, "http://attacker.example" + p));
+    CHECK(httpGet(port, "/", http::verb::get, "", "127.0.0.1:1:2").result() ==
+          http::status::forbidden);
+  });
+}
+
+TEST_CASE("view server: --view-host adds a reverse proxy's name, and only that") {
+  Assets assets;
+  Loop loop{ClockKind::Real};
+  Fleet fleet{loop};
+  view::Feed feed{loop, fleet, "simulator"};
+  view::ServerOptions o;
+  o.assets = assets.dir;
+  o.names = {"Race.Example.org"};
+  view::Server server(loop, feed, o);
+  REQUIRE(server.start());
+  CHECK(server.joinCode().size() == 6);  // behind a proxy, phones come from anywhere
+  runClient(loop, server.port(), [&](std::uint16_t port) {
+    CHECK(httpGet(port, "/", http::verb::get, "", "race.example.org").result() == http::status::ok);
+    WsClient proxied(port, "127.0.0.1", "/ws", "race.example.org", "https://race.example.org");
+    CHECK(proxied.read()["type"] == "state");
+    CHECK(httpGet(port, "/", http::verb::get, "", "other.example.org").result() ==
+          http::status::forbidden);
+  });
 }
