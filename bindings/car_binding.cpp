@@ -427,6 +427,13 @@ void CarBinding::handlerFailed(std::string_view what, std::string_view who,
                                std::string_view message) {
   const HandlerErrorLimit limit = g_handlerErrorLimit;
   if (limit.count <= 0) return;
+  // A car's own event handlers and listeners ("onPosition handler", "onPosition listeners",
+  // core.lua's "onPosition listener"); not the race library's drivers ("update of driver x"),
+  // which report each error and are called on (docs/racing.md).
+  auto endsWith = [&](std::string_view end) {
+    return what.size() >= end.size() && what.substr(what.size() - end.size()) == end;
+  };
+  if (!endsWith(" handler") && !endsWith(" listeners") && !endsWith(" listener")) return;
   Proxy* p = nullptr;
   for (auto& entry : proxies_)
     if (entry.second->label == who) p = entry.second.get();

@@ -69,9 +69,9 @@ class CarBinding {
   // The car at idx for a command that moves it (setSpeed, changeLane, turn, …): refused once
   // the car was stopped for a handler that kept failing (handlerFailed).
   static AnkiCar& command(lua_State* L, int idx);
-  // An error was reported in `what` ("onPosition handler") of `who` (a car's label, "car 1
-  // (skull)"; anything else is not a car of this world and is ignored): counted against
-  // handlerErrorLimit(), and the car stopped when that is reached.
+  // An error was reported in `what` ("onPosition handler", "onPosition listeners") of `who` (a
+  // car's label, "car 1 (skull)"; anything else is not a car of this world and is ignored):
+  // counted against handlerErrorLimit(), and the car stopped when that is reached.
   void handlerFailed(std::string_view what, std::string_view who, std::string_view message);
   // The car at idx, or nullptr when the value is not a car.
   static AnkiCar* test(lua_State* L, int idx);
