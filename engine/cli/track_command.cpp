@@ -105,6 +105,15 @@ Command addTrackCommand(CLI::App& app) {
                    "repeatable (as track print --code)")
       ->allow_extra_args(false)
       ->type_name("NAME=MM");
+  verifyCmd
+      ->add_option("--draw-mb", verify->draw_mb,
+                   "Memory librsvg may take to draw the file, MB (default 512); more is refused")
+      ->check(CLI::Range(16, 65536));
+  verifyCmd
+      ->add_option("--draw-seconds", verify->draw_seconds,
+                   "CPU seconds librsvg may take to draw the file (default 20; twice that in "
+                   "wall-clock time); longer is refused")
+      ->check(CLI::Range(1, 3600));
 
   return {track, [=] {
             if (printCmd->parsed()) return cli::trackPrint(*printing);

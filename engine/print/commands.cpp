@@ -110,7 +110,8 @@ int verifyPiece(const VerifyRequest& options) {
                 << " is not a number; give one in the range `pitwall track verify --help` shows\n";
       return 2;
     }
-  auto loaded = loadPieceSvg(options.file, options.dpi);
+  auto loaded =
+      loadPieceSvg(options.file, options.dpi, DrawLimits{options.draw_mb, options.draw_seconds});
   if (!loaded) {
     std::cerr << "pitwall track verify: " << loaded.error() << "\n";
     return 2;

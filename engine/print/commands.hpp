@@ -21,7 +21,8 @@ struct PrintRequest {
 };
 int printPieces(const PrintRequest& request);
 
-// pitwall track verify FILE.svg [--dpi N] [--blur MM] [--misalign MM] [--code NAME=VALUE]…:
+// pitwall track verify FILE.svg [--dpi N] [--blur MM] [--misalign MM] [--code NAME=VALUE]…
+// [--draw-mb N] [--draw-seconds N]:
 // reads a printed piece back with the code dimensions its metadata gives (or --code's) as a
 // car's sensor would; 0 all as designed, 1 not, 2 bad input.
 struct VerifyRequest {
@@ -30,6 +31,8 @@ struct VerifyRequest {
   double blur_mm = 0.25;
   double misalign_mm = 0.5;
   std::vector<std::string> code;  // over the file's own dimensions
+  int draw_mb = 512;              // what librsvg may spend drawing it (raster.hpp DrawLimits)
+  int draw_seconds = 20;
 };
 int verifyPiece(const VerifyRequest& request);
 

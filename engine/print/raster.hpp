@@ -29,9 +29,23 @@ struct Raster {
 Raster renderPiece(const sim::Piece& piece, double px_per_mm, const sim::CodeGeometry& g = {},
                    const DrawOptions& options = {}, double scale = 1.0);
 
+// A piece SVG is refused unread above this size (`track print` writes well under 1 MB).
+inline constexpr std::uint64_t kMaxSvgBytes = 16 * 1024 * 1024;
+
+// What librsvg may spend on one SVG: it parses and draws it in a child process with its address
+// space (beyond what this process maps) and CPU time limited, and at most twice the seconds in
+// wall-clock time (track verify --draw-mb, --draw-seconds).
+struct DrawLimits {
+  int megabytes = 512;
+  int seconds = 20;
+};
+
 // An SVG file rendered at `dpi` at the size its width and height say (as a printer would print
 // it, scaled if they were changed), and its metadata; the raster's sheet is the metadata's. An
-// error sentence names the file and says what to do.
-Result<std::pair<Raster, PieceSvg>, std::string> loadPieceSvg(const std::string& path, double dpi);
+// error sentence names the file and says what to do. A file larger than kMaxSvgBytes, or one
+// that declares XML entities, is refused before librsvg sees it; one that takes more than
+// `limits` to draw is refused with a sentence that says which limit.
+Result<std::pair<Raster, PieceSvg>, std::string> loadPieceSvg(const std::string& path, double dpi,
+                                                              const DrawLimits& limits = {});
 
 }  // namespace pitwall::print
