@@ -138,6 +138,8 @@ void MqttBridge::joined(AnkiCar& car) {
   topics::CarInfo info;
   info.id = id;
   info.name = car.identity().name;
+  info.pitwall = true;
+  info.host = host_;
   info.address = car.link().address();
   if (info.address.starts_with("ble:")) info.address = info.address.substr(4);
   info.identifier = car.identity().identifier;

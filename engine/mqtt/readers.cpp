@@ -72,6 +72,13 @@ Result<CarInfo, std::string> readInformation(std::string_view car, std::string_v
   // optional: the product id, and pitwall's name
   if (auto product = unsignedKey<std::uint16_t>(*j, "productId")) info.product_id = *product;
   if (auto name = key<std::string>(*j, "name")) info.name = *name;
+  // pitwall's bridge says so, with its host; the seed's controller sends neither key
+  if (auto bridge = key<std::string>(*j, "bridge"); bridge && *bridge == "pitwall") {
+    auto host = key<std::string>(*j, "host");
+    if (!host) return Unexpected{host.error() + " (a pitwall bridge names its host)"};
+    info.pitwall = true;
+    info.host = *host;
+  }
   return info;
 }
 

@@ -188,7 +188,6 @@ void RemoteCars::handle(std::string_view topic, std::string_view payload) {
       std::set<std::string> named;
       for (const auto& id : *list)
         if (Car* car = track(id, topic)) {
-          if (car->host != parts->id) car->forgetBridge();  // another bridge has it now
           car->host = parts->id;
           car->listed = car->everListed = true;
           named.insert(id);
@@ -210,21 +209,23 @@ void RemoteCars::handle(std::string_view topic, std::string_view payload) {
   const std::string& id = parts->id;
   if (parts->rest == "E/frame") {
     auto it = cars_.find(id);
-    if (it == cars_.end() || !it->second.link) return;
+    // Only a pitwall bridge's car reads E/frame (its S/Information says so); a frame for any
+    // other comes from no bridge of its own.
+    if (it == cars_.end() || !it->second.link || !it->second.pitwall()) return;
     auto bytes = topics::readFrameEvent(payload, limits_);
     if (!bytes) return complain(bytes.error());
-    it->second.frames = true;  // a pitwall bridge: its E/Messages say the same again
-    it->second.seed = false;
     it->second.link->frame(*bytes);
   } else if (parts->rest.starts_with("E/Messages/")) {
     auto it = cars_.find(id);
-    if (it == cars_.end() || !it->second.link || !it->second.link->connected() || it->second.frames)
+    // Only a car of the seed's controller reads them: a pitwall bridge publishes them too, but
+    // its E/frame carries every message already.
+    if (it == cars_.end() || !it->second.link || !it->second.link->connected() ||
+        !it->second.seed())
       return;
     auto message =
         topics::readMessageEvent(std::string_view(parts->rest).substr(11), payload, limits_);
     if (!message) return complain(message.error());
-    if (!*message) return;   // a message without a counterpart here
-    it->second.seed = true;  // whole-message events without E/frame: the seed's controller
+    if (!*message) return;  // a message without a counterpart here
     auto frame = anki::encode(**message);
     it->second.link->frame(frame.span());
   } else if (parts->rest == "S/Information") {
@@ -260,10 +261,6 @@ std::string RemoteCars::uniqueName(const topics::CarInfo& info) const {
   return name;
 }
 
-void RemoteCars::Car::forgetBridge() {
-  frames = seed = false;
-}
-
 bool RemoteCars::Car::present() const {
   // A host's S/Cars, once it named the car, decides (the seed's controller publishes no
   // S/CarStatus when it drops a car, and the one left retained may say either); a car no
@@ -273,7 +270,7 @@ bool RemoteCars::Car::present() const {
 }
 
 void RemoteCars::update(const std::string& id, Car& car) {
-  bool up = brokerUp_ && car.present() && car.info && hostUp(car.host);
+  bool up = brokerUp_ && car.present() && car.info && car.infoCurrent() && hostUp(car.host);
   if (!car.link) {
     if (!up) return;
     if (linkedCount() >= kMaxRemoteCars)
@@ -288,13 +285,15 @@ void RemoteCars::update(const std::string& id, Car& car) {
     auto& added = fleet_.add(std::move(link), std::move(identity));
     log::info(kLog, added.label() + " is " + id + (car.host.empty() ? "" : " on host " + car.host));
   }
-  std::string reason = !car.present()      ? "its bridge reports it offline"
-                       : !car.info         ? "its bridge has no information on it"
+  std::string reason = !car.present() ? "its bridge reports it offline"
+                       : !car.info    ? "its bridge has no information on it"
+                       : !car.infoCurrent()
+                           ? "host " + car.host + " has it, but its information is host " +
+                                 car.info->host + "'s (waiting for " + car.host + "'s)"
                        : !hostUp(car.host) ? "host " + car.host + " is offline"
                        : !brokerUp_        ? "lost the MQTT broker"
                                            : "connected through the MQTT broker";
   bool was = car.link->connected();
-  if (up && !was) car.forgetBridge();  // whoever bridges it now shows what it sends anew
   car.link->set(up, reason);
   if (was != up && onChange) onChange();
 }
@@ -306,10 +305,11 @@ std::optional<std::string> RemoteCars::sendCommand(const std::string& car,
   if (!message) return message.error().message();
   if (std::holds_alternative<anki::SdkMode>(*message)) return std::nullopt;
   auto it = cars_.find(car);
-  if (it != cars_.end() && it->second.seed && !topics::controllerIntentPayload(*message)) {
+  if (it != cars_.end() && it->second.seed() && !topics::controllerIntentPayload(*message)) {
     // Its bridge would drop it without a word: refuse it here, saying why.
-    return "car " + car + " is bridged by the seed's controller (it sends no E/frame), which " +
-           "has no intent for " + std::string(anki::name(*message)) +
+    return "car " + car +
+           " is bridged by the seed's controller (its S/Information names no pitwall bridge), " +
+           "which has no intent for " + std::string(anki::name(*message)) +
            "; it takes speed, lane, turn, battery, version and ping";
   }
   auto payload = topics::intentPayload(*message);

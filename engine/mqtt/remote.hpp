@@ -5,10 +5,12 @@
 //  - up while its bridge has it (its host's S/Cars lists it, or before any S/Cars named it, its
 //    S/CarStatus says online) and its host's S/HostStatus (when known) says true; down, with the
 //    reason, when either turns false or this client loses the broker;
-//  - its frames are the bridge's Anki/Car/<car>/E/frame events, fed to AnkiCar::receive, so the
-//    car's state and its Lua events are exactly those of a local car. A car of the seed's
-//    controller has no E/frame: its E/Messages/ANKI_VEHICLE_MSG_V2C_… events are turned back
-//    into the messages they were made from (topics::readMessageEvent);
+//  - its kind comes from its S/Information: a pitwall bridge's says "bridge":"pitwall" and its
+//    host. Its frames are then the bridge's Anki/Car/<car>/E/frame events, fed to
+//    AnkiCar::receive, so the car's state and its Lua events are exactly those of a local car.
+//    Any other car is the seed's controller's, which has no E/frame: its
+//    E/Messages/ANKI_VEHICLE_MSG_V2C_… events are turned back into the messages they were made
+//    from (topics::readMessageEvent). Each kind reads one stream only, so no event comes twice;
 //  - a command becomes an intent on Anki/Car/<car>/I (topics::intentPayload, the controller's
 //    form where it has one), QoS 1, which the owning bridge validates again and executes.
 //    sdk-mode is the bridge's business (it keeps its cars in SDK mode) and is accepted without
@@ -71,10 +73,15 @@ class RemoteCars {
     std::string host;            // from the hosts' S/Cars; empty while unknown
     bool listed = false;         // in its host's S/Cars now
     bool everListed = false;     // some S/Cars named it
-    bool frames = false;         // E/frame seen: its E/Messages are not needed
-    bool seed = false;           // E/Messages without E/frame: the seed's controller bridges it
     bool present() const;        // its bridge has it connected
-    void forgetBridge();         // frames and seed, learnt anew from the next events
+    // Its kind, from what its bridge says in S/Information (topics::CarInfo::pitwall), never
+    // from which events came first: a pitwall bridge's car is fed by E/frame and takes every
+    // command; any other is the seed's controller's, fed by E/Messages, and takes its intents.
+    bool pitwall() const { return info && info->pitwall; }
+    bool seed() const { return info && !info->pitwall; }
+    // The information is the word of the host that has the car now: a pitwall bridge's
+    // S/Information names its host, and once another host's S/Cars lists the car, it is stale.
+    bool infoCurrent() const { return !pitwall() || host.empty() || info->host == host; }
   };
   void message(std::string_view topic, std::string_view payload);
   void handle(std::string_view topic, std::string_view payload);

@@ -174,12 +174,17 @@ std::vector<Publication> commandStatus(std::string_view car, const anki::Message
 
 std::vector<Publication> carJoined(const CarInfo& info, const CarState& state, Millis now) {
   // seed 000 §4.4.4.10 and §4.4.4.12
-  return {status(carTopic(info.id, "S/Information"), Json{{"address", info.address},
-                                                          {"identifier", info.identifier},
-                                                          {"model", anki::modelName(info.model_id)},
-                                                          {"modelId", info.model_id},
-                                                          {"productId", info.product_id},
-                                                          {"name", info.name}}),
+  Json information{{"address", info.address},
+                   {"identifier", info.identifier},
+                   {"model", anki::modelName(info.model_id)},
+                   {"modelId", info.model_id},
+                   {"productId", info.product_id},
+                   {"name", info.name}};
+  if (info.pitwall) {  // what a remote reader knows the car's kind by (CarInfo)
+    information["bridge"] = "pitwall";
+    information["host"] = info.host;
+  }
+  return {status(carTopic(info.id, "S/Information"), information),
           status(carTopic(info.id, "S/DiscoveryTime"), Json{{"timestamp", now}}),
           carOnline(info.id, state, now)};
 }

@@ -67,6 +67,12 @@ struct CarInfo {
   std::uint8_t model_id = 0;
   std::uint16_t product_id = 0xBEEF;
   std::string name;  // the car's name in pitwall ("groundshock"); pitwall's extra key
+  // pitwall's extra keys "bridge":"pitwall" and "host":"<host>": the car is bridged by a pitwall
+  // bridge on that host, which publishes its every frame on E/frame and takes the message intent.
+  // The seed's controller sends neither, so a remote reader knows a car's kind from its
+  // S/Information, before any event arrives (docs/mqtt.md "Remote cars").
+  bool pitwall = false;
+  std::string host;  // with `pitwall`: the bridge's host id
 };
 
 // ---- car → broker ----

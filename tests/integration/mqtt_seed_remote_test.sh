@@ -36,7 +36,7 @@ for step in speed lane ping battery version positions uturn stopped; do
 done
 contains "battery and version from E/Messages" "check battery true 3950" "$out"
 contains "lights refused with the reason" "check lights false" "$out"
-contains "the script's error names the controller" "set-lights was not sent: car $CAR is bridged by the seed's controller (it sends no E/frame), which has no intent for set-lights" "$out"
+contains "the script's error names the controller" "set-lights was not sent: car $CAR is bridged by the seed's controller (its S/Information names no pitwall bridge), which has no intent for set-lights" "$out"
 
 intents=$(grep '^intent ' "$TMP/controller.out")
 contains "speed went as the controller's form" "intent Anki/Car/$CAR/I {\"speed\":600,\"acceleration\":2000}" "$intents"

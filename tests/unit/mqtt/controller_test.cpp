@@ -40,9 +40,20 @@ const std::string kBase = "Anki/Car/" + kId + "/";
 const std::string kControllerInfo =
     R"({"address":"d2:05:ef:fe:02:cb","identifier":2018915346,"model":"Skull","modelId":9,)"
     R"("productId":61374})";
-const std::string kPitwallInfo =
-    R"({"address":"D2:05:EF:FE:02:CB","identifier":305419896,"model":"Skull","modelId":9,)"
-    R"("productId":48879,"name":"skull"})";
+// What a pitwall bridge on host pitA publishes for a car (topics::carJoined, as MqttBridge calls
+// it): with "bridge":"pitwall" and "host":"pitA", which the controller never sends.
+std::string pitwallInfo(const std::string& id, const std::string& host = "pitA") {
+  topics::CarInfo info;
+  info.id = id;
+  info.address = "D2:05:EF:FE:02:CB";
+  info.identifier = 305419896;
+  info.model_id = 9;
+  info.name = "skull";
+  info.pitwall = true;
+  info.host = host;
+  return topics::carJoined(info, CarState{}, 1).at(0).payload;
+}
+const std::string kPitwallInfo = pitwallInfo(kId);
 
 struct Publisher {
   MqttClient client;
@@ -298,13 +309,13 @@ TEST_CASE_FIXTURE(
   pub.pitwallHasIt();
   REQUIRE(runUntil(loop, [&] { return car.state().connected; }));
   pub.event(kBase + "E/frame", frameEvent(anki::BatteryResponse{3999}));
-  REQUIRE(runUntil(loop, [&] { return car.state().battery_mv == 3999; }));  // E/frame seen
+  REQUIRE(runUntil(loop, [&] { return car.state().battery_mv == 3999; }));  // E/frame read
 
   pub.intents.clear();
   auto lights = car.lights(0x44);
   if (!lights) MESSAGE("lights refused: ", lights.error());
   CHECK_MESSAGE(lights.ok(),
-                "a pitwall bridge's car (E/frame seen) is still treated as the "
+                "a pitwall bridge's car (its S/Information says so) is still treated as the "
                 "controller's: lights refused");
 }
 
@@ -321,6 +332,108 @@ TEST_CASE_FIXTURE(
   auto lights = car.lights(0x44);
   if (!lights) MESSAGE("lights refused: ", lights.error());
   CHECK(lights.ok());
+}
+
+// A position update on piece 36 as the seed's controller's whole-message event.
+const std::string kPositionMessage =
+    R"({"message_id":39,"offset":-23.5,"speed":512,"flag":71,"pieceId":36,"pieceLocation":5,)"
+    R"("isReverse":false,"last_des_speed":500,"last_rec_lane_change_cmd":0,)"
+    R"("last_exe_lane_change_cmd":0,"last_des_lane_change_speed":0})";
+const std::string kPositionTopic = "E/Messages/ANKI_VEHICLE_MSG_V2C_LOCALIZATION_POSITION_UPDATE";
+
+TEST_CASE_FIXTURE(
+    Tree,
+    "mqtt remote: a pitwall bridge's car whose first E/frame is withheld takes every command as "
+    "the same message") {
+  // Issue 33: the remote reader took a pitwall bridge's car for the seed's controller's until its
+  // first E/frame came, so an E/Messages that came first (its E/frame lost, or overtaken by a
+  // status message at the broker) made every command the controller has no intent for refused —
+  // and the message read twice. The car's S/Information says what bridges it now.
+  const std::string other = "pitA-sim-00000002", otherBase = "Anki/Car/" + other + "/";
+  pub.retain("Anki/Host/pitA/S/HostStatus", R"({"value":true})");
+  pub.retain(kBase + "S/Information", kPitwallInfo);
+  pub.retain(otherBase + "S/Information", pitwallInfo(other));
+  pub.retain("Anki/Host/pitA/S/Cars", "[\"" + kId + "\",\"" + other + "\"]");
+  b = std::make_unique<Remote>(loop, broker);
+  REQUIRE(runUntil(loop, [&] { return b->synced && b->remote.onlineCount() == 2; }));
+  auto byId = [&](const std::string& id) {
+    AnkiCar* found = nullptr;
+    for (auto* c : b->fleet.cars())
+      if (c->link().address() == "mqtt:" + id) found = c;
+    REQUIRE(found);
+    return found;
+  };
+  AnkiCar& car = *byId(kId);
+  AnkiCar& marker = *byId(other);
+
+  // The whole-message event of a position update without its E/frame, then the other car's
+  // E/frame: both QoS 0 from one publisher, so the second marks that the first was handled.
+  pub.event(kBase + kPositionTopic, kPositionMessage);
+  pub.event(otherBase + "E/frame", frameEvent(anki::BatteryResponse{3999}));
+  REQUIRE(runUntil(loop, [&] { return marker.state().battery_mv == 3999; }));
+  CHECK_MESSAGE(car.state().piece != 36,
+                "a pitwall bridge's E/Messages were read: its E/frame carries the same message, "
+                "so every event would come twice");
+
+  // Commands the controller has no intent for travel as pitwall's message intent, unchanged.
+  const std::vector<anki::Message> sent{anki::SetSpeed{550, 800, true}, anki::SetLights{0x44},
+                                        anki::SetOffset{-68}};
+  for (const auto& r : {car.setSpeed(550, 800, true), car.lights(0x44), car.setOffset(-68)}) {
+    if (!r.ok()) MESSAGE("refused: ", r.error());
+    CHECK(r.ok());
+  }
+  auto messageIntents = [&] {
+    std::vector<std::pair<std::string, std::string>> out;
+    for (const auto& i : pub.intents)
+      if (i.second.find(R"("type":"message")") != std::string::npos) out.push_back(i);
+    return out;
+  };
+  REQUIRE(runUntil(loop, [&] { return messageIntents().size() == sent.size(); }));
+  for (std::size_t i = 0; i < sent.size(); ++i) {
+    CAPTURE(i);
+    CHECK(messageIntents()[i] ==
+          std::pair<std::string, std::string>{kBase + "I", *topics::intentPayload(sent[i])});
+  }
+}
+
+TEST_CASE_FIXTURE(Tree,
+                  "mqtt remote: a car of the seed's controller is known as one before any event") {
+  pub.controllerHasIt();
+  AnkiCar& car = remoteCar();
+  auto lights = car.lights(0x44);  // no E/Messages has come yet: its S/Information says enough
+  REQUIRE_FALSE(lights.ok());
+  CHECK(lights.error().find("bridged by the seed's controller (its S/Information names no pitwall "
+                            "bridge), which has no intent for set-lights") != std::string::npos);
+  pub.intents.clear();
+  REQUIRE(car.setSpeed(600, 2000).ok());  // its own intents go as they are
+  REQUIRE(runUntil(loop, [&] { return !pub.intents.empty(); }));
+  CHECK(pub.intents.back() ==
+        std::pair<std::string, std::string>{kBase + "I", R"({"speed":600,"acceleration":2000})"});
+}
+
+TEST_CASE_FIXTURE(Tree,
+                  "mqtt remote: a car another host lists is down until that host's S/Information "
+                  "comes, then of its kind") {
+  pub.pitwallHasIt();
+  AnkiCar& car = remoteCar();
+  // The seed's controller (host "host") lists the car while its S/Information is still pitA's:
+  // pitA's word about the car is not the controller's.
+  pub.retain("Anki/Host/host/S/HostStatus", R"({"value":true})");
+  pub.retain("Anki/Host/host/S/Cars", "[\"" + kId + "\"]");
+  REQUIRE(runUntil(loop, [&] { return !car.state().connected; }));
+  CHECK(b->downs.back() ==
+        "host host has it, but its information is host pitA's (waiting for "
+        "host's)");
+  CHECK_FALSE(car.lights(0x44).ok());
+  pub.retain(kBase + "S/Information", kControllerInfo);
+  REQUIRE(runUntil(loop, [&] { return car.state().connected; }));
+  // the controller's car now: its E/Messages are read, lights refused
+  pub.event(kBase + kPositionTopic, kPositionMessage);
+  REQUIRE(runUntil(loop, [&] { return car.state().piece == 36; }));
+  auto lights = car.lights(0x44);
+  REQUIRE_FALSE(lights.ok());
+  CHECK(lights.error().find("bridged by the seed's controller") != std::string::npos);
+  CHECK(b->fleet.cars().size() == 1);
 }
 
 TEST_CASE_FIXTURE(Tree, "mqtt controller: S/Cars flipped hundreds of times never grows the fleet") {

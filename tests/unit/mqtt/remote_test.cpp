@@ -515,8 +515,8 @@ TEST_CASE("mqtt remote: a car of the seed's controller: its S/Cars decides, E/Me
   REQUIRE_FALSE(lights.ok());
   CHECK(lights.error() ==
         "car 1 (skull): set-lights was not sent: car d205effe02cb is bridged by the seed's "
-        "controller (it sends no E/frame), which has no intent for set-lights; it takes speed, "
-        "lane, turn, battery, version and ping");
+        "controller (its S/Information names no pitwall bridge), which has no intent for "
+        "set-lights; it takes speed, lane, turn, battery, version and ping");
 
   // connecting false: S/Cars {} and a blank S/Information; the stale CarStatus keeps nothing up
   retain("Anki/Host/host/S/Cars", "{}");

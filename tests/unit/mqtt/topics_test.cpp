@@ -188,7 +188,7 @@ TEST_CASE("mqtt topics: commands sent publish the desired speed and lane") {
 }
 
 TEST_CASE("mqtt topics: a car that joins publishes its information, discovery time and status") {
-  CarInfo info{kCar, "E8:5A:0F:11:22:33", 0x12345678, 9, 0xBEEF, "skull"};
+  CarInfo info{kCar, "E8:5A:0F:11:22:33", 0x12345678, 9, 0xBEEF, "skull", true, "pit1"};
   CarState state;
   state.on_charger = true;
   auto ps = carJoined(info, state, kNow);
@@ -197,7 +197,7 @@ TEST_CASE("mqtt topics: a car that joins publishes its information, discovery ti
       std::vector<Publication>{
           {"Anki/Car/" + kCar + "/S/Information",
            R"({"address":"E8:5A:0F:11:22:33","identifier":305419896,"model":"Skull",)"
-           R"("modelId":9,"productId":48879,"name":"skull"})",
+           R"("modelId":9,"productId":48879,"name":"skull","bridge":"pitwall","host":"pit1"})",
            1, true},
           {"Anki/Car/" + kCar + "/S/DiscoveryTime", R"({"timestamp":1700000000123})", 1, true},
           {"Anki/Car/" + kCar + "/S/CarStatus",
@@ -264,11 +264,20 @@ TEST_CASE("mqtt topics: the reading side splits topics and reads status payloads
   CHECK(read->identifier == 0x12345678u);
   CHECK(read->model_id == 9);
   CHECK(read->address == "E8:5A:0F:11:22:33");
-  // the seed's payload, without pitwall's name
+  CHECK_FALSE(read->pitwall);
+  // a car's kind is what its S/Information says: a pitwall bridge names itself and its host
+  info.pitwall = true;
+  info.host = "pit1";
+  auto pitwall = readInformation(kCar, carJoined(info, CarState{}, kNow)[0].payload);
+  REQUIRE(pitwall);
+  CHECK(pitwall->pitwall);
+  CHECK(pitwall->host == "pit1");
+  // the seed's payload, without pitwall's name, bridge or host: the seed's controller's car
   auto seed =
       readInformation(kCar, R"({"address":"a","identifier":1,"model":"Skull","modelId":9})");
   REQUIRE(seed);
   CHECK(seed->name.empty());
+  CHECK_FALSE(seed->pitwall);
   CHECK(readInformation(kCar, R"({"address":"a","identifier":-1,"modelId":9})").error() ==
         "\"identifier\" must be an integer 0..4294967295, not -1");
   CHECK(readInformation(kCar, R"({"address":"a","identifier":1,"modelId":256})").error() ==
@@ -294,6 +303,11 @@ TEST_CASE("mqtt topics: the reading side splits topics and reads status payloads
         "a car id must be a string, not an integer (1)");
   CHECK(readHostCars(R"({"x":1})").error() == "must be an array of car ids, not an object");
   CHECK(readHostCars("7").error() == "must be an array of car ids, not an integer (7)");
+  CHECK(readInformation(kCar, R"({"address":"a","identifier":1,"modelId":9,"bridge":"pitwall"})")
+            .error() == "missing key \"host\" (a pitwall bridge names its host)");
+  CHECK(readInformation(kCar, R"({"address":"a","identifier":1,"modelId":9,"bridge":"pitwall",)"
+                              R"("host":7})")
+            .error() == "\"host\" has the wrong type (7) (a pitwall bridge names its host)");
   // the controller blanks S/Information when it drops a car
   auto blank = readInformation(
       kCar, R"({"address":"","identifier":"","model":"","modelId":"","productId":""})");
