@@ -19,6 +19,17 @@ namespace asio = boost::asio;
 using asio::ip::tcp;
 using asio::ip::udp;
 
+namespace {
+// A peer that goes away shows as the end of the stream (it closed: FIN), as a reset (it closed
+// with data of ours unread, or its process died: RST — which of the two depends only on whether
+// our last bytes had been read), or, to a write after either, as a broken pipe. Each is the peer
+// closing the connection, and is said so the same way.
+bool peerClosed(const boost::system::error_code& ec) {
+  return ec == asio::error::eof || ec == asio::error::connection_reset ||
+         ec == asio::error::broken_pipe || ec == asio::error::connection_aborted;
+}
+}  // namespace
+
 // Everything the asynchronous handlers touch lives here, shared with them: a handler that runs
 // after the link was closed (or destroyed), or that belongs to an earlier connection, finds
 // `closed` set or another `attempt` and does nothing.
@@ -159,7 +170,7 @@ struct SocketLink::State : std::enable_shared_from_this<SocketLink::State> {
     auto handler = [self, mine](boost::system::error_code ec, std::size_t n) {
       if (self->closed || mine != self->attempt) return;
       if (ec) {
-        if (ec == asio::error::eof)
+        if (peerClosed(ec))
           return self->failed(mine, self->options.peer + " closed the connection");
         return self->failed(mine, "lost " + self->options.peer + ": " + ec.message());
       }
@@ -177,6 +188,7 @@ struct SocketLink::State : std::enable_shared_from_this<SocketLink::State> {
     auto self = shared_from_this();
     auto handler = [self, mine](boost::system::error_code ec, std::size_t) {
       if (self->closed || mine != self->attempt) return;
+      if (peerClosed(ec)) return self->failed(mine, self->options.peer + " closed the connection");
       if (ec)
         return self->failed(mine, "lost " + self->options.peer + " while sending: " + ec.message());
       self->queue.pop_front();
