@@ -135,6 +135,14 @@ MINDROAD_PORT=$PORT MINDROAD_SIDES=3 timeout 50 $PITWALL run "$SRC/examples/mind
 RUN_PID=$!
 PIDS+=("$RUN_PID")
 wait_for "$TMP/square.out" "side 1 of 3 done" 15 || fail "the square did not start: $(cat "$TMP/square.err")"
+# The robot dies with steering unread: frozen first, it reads nothing while the script steers
+# every 0.1 s, so its death is a reset, not an end of stream (which of the two a plain kill gives
+# is a matter of timing; both must read "closed the connection").
+kill -STOP "$ROBOT_PID"
+unread() { ss -tnH state established "( sport = :$PORT )" | awk '$1 > 0 { found = 1 } END { exit !found }'; }
+deadline=$((SECONDS + 10))
+until unread || [ $SECONDS -ge $deadline ]; do sleep 0.02; done
+unread && echo "ok: the frozen robot has steering unread" || fail "no unread bytes at the robot: $(ss -tn)"
 kill -9 "$ROBOT_PID"; wait "$ROBOT_PID" 2>/dev/null
 wait_for "$TMP/square.out" "lost contact: tcp 127.0.0.1:$PORT" 5 &&
   echo "ok: onLost reaches the script with a clear reason" || fail "onLost did not reach the script: $(cat "$TMP/square.out")"
