@@ -36,6 +36,25 @@ kill -INT "$pid"
 await_end "pitwall after Ctrl-C" 10 130
 show_if_failed "pitwall's stderr" "$TMP/err"
 
+# Pairing (docs/view.md "Pairing"): on 0.0.0.0 a seat needs the join code the run prints; the
+# pages are opened by 127.0.0.1 (a name the view serves) with the code the terminal printed.
+"$PITWALL" run "$SRC/tests/view/drive_race.lua" --view 0.0.0.0:0 --humans 2 --cars 2 \
+  --duration 300 > "$TMP/pair.out" 2> "$TMP/pair.err" &
+pid=$!
+if wait_for "$TMP/pair.err" '^view: join code [0-9]{6}: ' 20; then
+  code=$(grep -oE '^view: join code [0-9]{6}' "$TMP/pair.err" | head -1 | grep -oE '[0-9]{6}$')
+  port=$(grep -oE '^view: http://0\.0\.0\.0:[0-9]+/' "$TMP/pair.err" | head -1 | grep -oE '[0-9]+/$' | tr -d /)
+  contains "the drive line carries the code" "/drive?code=$code (cars 1..2" "$(cat "$TMP/pair.err")"
+  timeout -k 5 240 node "$CHECK/drive_check.mjs" "http://127.0.0.1:$port/" --code "$code" \
+    --timeout 30 --chromium "$CHROMIUM" --artifacts "$ART"
+  check "pairing check exit status" 0 "$?"
+else
+  fail "pitwall --view 0.0.0.0:0 printed no join code within 20 s"
+fi
+kill -INT "$pid"
+await_end "pitwall on 0.0.0.0 after Ctrl-C" 10 130
+show_if_failed "the pairing run's stderr" "$TMP/pair.err"
+
 # Done when: two people with phones and two AI drivers run a race (examples/party.lua, one lap)
 # to its end, with the race view showing it.
 LAPS=1 WAIT=120 SHOW=10 "$PITWALL" run "$SRC/examples/party.lua" --view 127.0.0.1:0 --humans 2 --cars 4 \

@@ -21,8 +21,9 @@
 import { check, fail, finish, launch, parseArgs, pass, passWhen, settings, watchPage } from "./check_lib.mjs";
 
 const { opts, positional } = parseArgs("drive_check",
-  "URL [--timeout SECONDS] [--chromium PATH] [--artifacts DIR] [--party]",
-  { "--artifacts": ["artifacts", String], "--party": ["party"] }, [1, "give the view's URL"]);
+  "URL [--timeout SECONDS] [--chromium PATH] [--artifacts DIR] [--party | --code CODE]",
+  { "--artifacts": ["artifacts", String], "--party": ["party"], "--code": ["code", String] },
+  [1, "give the view's URL"]);
 const url = positional[0].endsWith("/") ? positional[0] : `${positional[0]}/`;
 const timeoutMs = settings.timeoutMs;
 
@@ -60,13 +61,13 @@ async function until(name, ok, describe, always) {
 const browser = await launch({ chromium: opts.chromium });
 
 const log = { errors: [], requests: [] };  // of every phone
-async function phone(name) {
+async function phone(name, query = "") {
   // each phone a browser of its own (its own storage), phone-sized
   const context = await browser.createBrowserContext();
   const page = await context.newPage();
   await page.setViewport({ width: 390, height: 780, deviceScaleFactor: 1 });
   watchPage(page, log, name);
-  const response = await page.goto(`${url}drive`, { waitUntil: "load", timeout: timeoutMs });
+  const response = await page.goto(`${url}drive${query}`, { waitUntil: "load", timeout: timeoutMs });
   check(`${name}: /drive loads`, response && response.ok(), `HTTP ${response && response.status()}`);
   return page;
 }
@@ -218,8 +219,52 @@ async function twoPhones() {
     [...log.errors, ...log.requests].join("; "));
 }
 
+// Pairing (--code CODE: a run on 0.0.0.0, docs/view.md "Pairing"): the race view on the
+// engine's machine shows the code; a phone without it is refused a seat and asked for the code,
+// and takes the seat once it is typed; a phone that came by /drive?code= takes a seat at once,
+// and keeps the code for its tab (back on /drive without it, it takes its seat again).
+async function pairing() {
+  const viewPage = await (await browser.createBrowserContext()).newPage();
+  await viewPage.goto(url, { waitUntil: "load", timeout: timeoutMs });
+  if (await passWhen(viewPage, "the race view shows the join code",
+      () => !document.querySelector("#join").hidden && document.querySelector("#join-code").textContent !== "")) {
+    const shown = await viewPage.$eval("#join-code", (el) => el.textContent);
+    const link = await viewPage.$eval("#join-url", (el) => el.textContent);
+    check("the race view's code is the terminal's", shown === opts.code, `${shown} vs ${opts.code}`);
+    check("the race view shows /drive?code= with it", link.endsWith(`/drive?code=${opts.code}`), link);
+  }
+  if (opts.artifacts) await viewPage.screenshot({ path: `${opts.artifacts}/drive-join-code.png` });
+  await viewPage.close();
+
+  const stranger = await phone("a phone without the code");
+  await passWhen(stranger, "a phone without the code: live, seats to pick",
+    () => document.querySelector("#connection")?.textContent === "live" && !document.querySelector("#pick").hidden &&
+      document.querySelectorAll("#seats button[data-number]").length === 2);
+  await stranger.type("#player", "Eve");
+  await stranger.click('#seats button[data-number="1"]');
+  await passWhen(stranger, "a phone without the code is refused and asked for it",
+    () => !document.querySelector("#pair").hidden && /join code/.test(document.querySelector("#notice").textContent));
+  check("a phone without the code holds no seat", await stranger.$eval("#drive", (d) => d.hidden));
+  await until("the refused phone took nothing", (s) => !seatOf(s, 1).held, (s) => JSON.stringify(seatOf(s, 1)));
+  if (opts.artifacts) await stranger.screenshot({ path: `${opts.artifacts}/drive-asks-code.png` });
+  await stranger.type("#code", opts.code);
+  await stranger.click("#pair-go");
+  await passWhen(stranger, "with the code typed, the phone holds seat 1",
+    () => !document.querySelector("#drive").hidden && document.querySelector("#drive").dataset.seat === "1");
+
+  const invited = await phone("a phone with the code", `?code=${opts.code}`);
+  await takeSeat(invited, "a phone with the code", 2, "Ben");
+  // reconnection: the same tab on /drive without the code still has it
+  await invited.goto(`${url}drive`, { waitUntil: "load", timeout: timeoutMs });
+  await takeSeat(invited, "the same tab on /drive, without ?code=", 2, "");
+  await until("both seats are held by the paired phones",
+    (s) => seatOf(s, 1).held && seatOf(s, 2).held, (s) => JSON.stringify(s.seats));
+  check("no script errors or failed requests", log.errors.length + log.requests.length === 0,
+    [...log.errors, ...log.requests].join("; "));
+}
+
 try {
-  await (opts.party ? party() : twoPhones());
+  await (opts.party ? party() : opts.code ? pairing() : twoPhones());
 } catch (e) {
   fail("drive check", String(e.stack || e));
 } finally {
