@@ -40,6 +40,10 @@ The REPL's history file (default ~/.pitwall_history).
 .B PITWALL_INPUT_DIR
 The folder run --gamepads watches for gamepads (evdev event nodes), instead of /dev/input.
 .TP
+.B PITWALL_WATCHDOG
+Seconds the engine's loop may stand still in a real-time run before the watchdog sends every car
+its stop from outside the loop (default 1; 0 turns the watchdog off).
+.TP
 .B PITWALL_PRINT_MODULE
 The print module that track print and track verify load, instead of ../lib/pitwall/pitwall_print.so
 beside the binary.
@@ -58,7 +62,9 @@ Definitions of the Lua API for the Lua language server (pitwall types DIR copies
 The documentation: README.md and docs/.
 [EXIT STATUS]
 0 when the script or the command succeeded; 1 when a script failed or a test did not pass;
-2 for a usage error (an unknown command or option, a missing script, a bad value).
+2 for a usage error (an unknown command or option, a missing script, a bad value); 130 after
+Ctrl-C, SIGTERM or a hang-up; 141 when the output's reader went away (the cars stopped first).
+Ctrl-Z stops the cars, then suspends the run.
 SECTIONS
 } >"$include"
 

@@ -66,13 +66,24 @@ int run(const RunOptions& options) {
     }
   }
   Loop& loop = session.loop();
+  // Everything that can refuse the start comes before the first car is connected, and the record
+  // is opened (truncated) only once nothing can: a refused start leaves an old record as it was
+  // and no car driven (docs/safety.md).
   if (options.view) {
     if (int status = session.startView(*options.view, options.ble ? "ble" : "simulator", "run");
         status != 0)
       return status;
   }
-  if (int status = session.connectCars("run"); status != 0) return status;
   if (int status = session.startSeats(options, "run"); status != 0) return status;
+  if (int status = session.connectCars("run"); status != 0) return status;
+  try {
+    session.openRecord();
+  } catch (const std::exception& e) {
+    std::cerr << "pitwall run: " << e.what() << "\n";
+    session.finish();
+    loop.run();
+    return 2;
+  }
 
   HostOptions host;
   host.seed = options.seed;

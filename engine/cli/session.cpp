@@ -43,6 +43,7 @@ Session::Session(ClockKind clock) : loop_(clock), fleet_(loop_) {
 }
 
 Session::~Session() {
+  watchdog_.reset();
   signals_.reset();
   if (recorder_) recorder_->flush();
   scripts_.reset();
@@ -140,7 +141,34 @@ void interruptLua() {
 void Session::catchSignals() {
   StopSignals::setAsyncHook(interruptLua);
   signals_ = std::make_unique<StopSignals>(loop_);
+  // The stop that does not need the loop: a real-time loop that has not turned for a second
+  // (C code that never returns, a stall) gets every car stopped from a thread of its own.
+  // $PITWALL_WATCHDOG sets the seconds (0: none), for tests of the last-resort exit alone.
+  if (loop_.clockKind() == ClockKind::Real) {
+    double seconds = 1;
+    if (const char* env = std::getenv("PITWALL_WATCHDOG"); env && *env) {
+      char* end = nullptr;
+      double given = std::strtod(env, &end);
+      if (end && !*end && given >= 0 && given <= 86400)
+        seconds = given;
+      else
+        log::warn("pitwall", std::string("$PITWALL_WATCHDOG is not a number of seconds from 0 to "
+                                         "86400: ") +
+                                 env + "; the watchdog waits 1 s");
+    }
+    if (seconds > 0)
+      watchdog_ = std::make_unique<Watchdog>(
+          loop_, std::chrono::milliseconds(std::llround(seconds * 1000)));
+  }
   signals_->onSignal = [this](int sig, int count) {
+    if (sig == SIGTSTP) return suspend();
+    if (sig == SIGPIPE) {
+      outputGone_ = interrupted_ = true;
+      log::warn("pitwall",
+                "the output's reader went away (a pipe closed: head, grep -m, a quit less, a "
+                "dropped connection): stopping the cars; the rest of the output is dropped");
+      return finish();
+    }
     if (count >= 2) {  // a second one: leave now, the stops sent all the same
       log::warn("pitwall", "leaving now");
       if (scripts_) scripts_->shutDown();
@@ -158,12 +186,41 @@ void Session::catchSignals() {
   };
 }
 
+// Ctrl-Z: the cars first, the process after, as a game pauses. The cars get their stop and
+// refuse every command while the stops travel (100 ms, kFlush: a script that commands them
+// every 20 ms cannot send them off again); then the process suspends itself. `fg` resumes the
+// engine — timers, the script, the view — and never the cars: they take commands again and stay
+// stopped until the script or a driver gives one.
+void Session::suspend() {
+  if (suspending_) return;
+  suspending_ = true;
+  const bool cars = !finishing_ && !spectator_;
+  if (cars) fleet_.pauseAll("the run is suspended (Ctrl-Z)");
+  log::warn("pitwall", cars ? "suspended (Ctrl-Z): the cars are stopped; fg resumes the run, and "
+                              "the cars stay stopped until the script or a driver commands them"
+                            : "suspended (Ctrl-Z)");
+  if (recorder_) recorder_->flush();
+  loop_.after(kFlush, [this] {
+    if (recorder_) recorder_->flush();
+    std::cout.flush();
+    std::fflush(stdout);
+    if (watchdog_) watchdog_->hold(true);  // a suspended loop is not a stuck one
+    ::raise(SIGSTOP);                      // here until SIGCONT (fg, bg, kill -CONT)
+    if (watchdog_) watchdog_->hold(false);
+    suspending_ = false;
+    if (finishing_) return;
+    fleet_.resumeAll();
+    log::info("pitwall", "resumed: the cars take commands again");
+  });
+}
+
 void Session::releaseSigint() {
   if (signals_) signals_->releaseSigint();
 }
 
 int Session::exitStatus(int otherwise) {
   if (scripts_ && host().exitStatus()) return *host().exitStatus();
+  if (outputGone_) return 141;  // as a process that SIGPIPE ended (128 + 13), after the stop
   if (interrupted_) return 130;
   return otherwise;
 }
@@ -347,8 +404,15 @@ int Session::connectRemoteCars(const char* command) {
 
 int Session::connectCars(const char* command) {
   int status = connectLocalCars(command);
-  if (status != 0 || source_.mqtt.url.empty()) return status;
-  return connectRemoteCars(command);
+  if (status == 0 && !source_.mqtt.url.empty()) status = connectRemoteCars(command);
+  // A start refused once some cars are connected (too few remote cars, a broker that refused or
+  // never answered, a simulated car that did not connect) still ends through the stop path: the
+  // connected cars' last frame is their stop.
+  if (status != 0 && !finishing_) {
+    finish();
+    loop_.run();
+  }
+  return status;
 }
 
 int Session::connectLocalCars(const char* command) {
@@ -372,7 +436,7 @@ int Session::connectLocalCars(const char* command) {
 }
 
 void Session::record(const std::string& path) {
-  recorder_ = std::make_unique<Recorder>(path);
+  recorder_ = std::make_unique<Recorder>(path, Recorder::Later{});
   flushRecordPeriodically();
   // What a replay needs beside the frames (docs/cli.md "Record format"): the layout on the
   // record's first line, each car's "carName" on its first line.
@@ -391,6 +455,10 @@ void Session::record(const std::string& path) {
     recorder_->write(loop_.seconds(), car.identity().number, d == AnkiCar::Direction::Tx, f, m,
                      extra);
   });
+}
+
+void Session::openRecord() {
+  if (recorder_) recorder_->open();
 }
 
 // A killed run loses at most the last 100 ms of its record: in real time the record reaches

@@ -7,6 +7,7 @@
 
 #include "bindings/reloader.hpp"
 #include "engine/cli/commands.hpp"
+#include "engine/core/emergency_stops.hpp"
 #include "engine/core/loop.hpp"
 #include "engine/core/stop_signals.hpp"
 #include "engine/drive/gamepads.hpp"
@@ -61,7 +62,10 @@ class Session {
   ScriptHost& host() { return scripts_->host(); }  // the Lua world now (hot reload replaces it)
   Reloader& scripts() { return *scripts_; }
 
-  void record(const std::string& path);  // throws std::runtime_error naming the file
+  // --record: checked now (throws std::runtime_error naming the file), opened by openRecord()
+  // once the start can no longer be refused; the frames before it are kept until then.
+  void record(const std::string& path);
+  void openRecord();  // throws std::runtime_error naming the file
   // Puts `count` cars on the starting grid and runs the loop until all are connected.
   bool addGridCars(int count);
   // Finds and connects the real cars (runs the loop until every car had a first attempt).
@@ -115,10 +119,14 @@ class Session {
   int connectRemoteCars(const char* command);
   bool finishing_ = false;
   bool spectator_ = false;
+  bool suspending_ = false;  // Ctrl-Z: the cars paused, the process about to stop
+  bool outputGone_ = false;  // SIGPIPE on stdout/stderr ended the run (status 141)
   void catchSignals();
+  void suspend();
   void flushRecordPeriodically();
   CarSource source_;
   std::unique_ptr<StopSignals> signals_;
+  std::unique_ptr<Watchdog> watchdog_;  // real time: stops the cars when the loop is stuck
   bool interrupted_ = false;
 };
 

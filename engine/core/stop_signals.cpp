@@ -1,6 +1,7 @@
 #include "engine/core/stop_signals.hpp"
 
 #include <fcntl.h>
+#include <poll.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -11,6 +12,8 @@
 
 #include <boost/asio/read.hpp>
 
+#include "engine/core/emergency_stops.hpp"
+
 namespace pitwall {
 
 namespace {
@@ -19,7 +22,19 @@ std::atomic<int> g_writeFd{-1};
 std::atomic<int> g_count{0};  // signals received
 std::atomic<int> g_acted{0};  // signals the loop has acted on
 std::atomic<StopSignals::AsyncHook> g_hook{nullptr};
+std::atomic<int> g_other{0};  // SIGPIPE/SIGTSTP bytes written and not yet read by a virtual loop
 static_assert(std::atomic<int>::is_always_lock_free);
+
+// Wakes the loop with the signal's number (a full pipe already says it). `counted`: a stop
+// signal, which g_count counts; otherwise g_other keeps a virtual loop reading until it is read.
+void tellLoop(int sig, bool counted) {
+  int fd = g_writeFd.load(std::memory_order_relaxed);
+  if (fd < 0) return;
+  if (!counted) g_other.fetch_add(1, std::memory_order_relaxed);
+  char byte = static_cast<char>(sig);
+  ssize_t written = ::write(fd, &byte, 1);
+  (void)written;
+}
 
 void onStopSignal(int sig) {
   int saved = errno;
@@ -32,17 +47,59 @@ void onStopSignal(int sig) {
   int count = g_count.fetch_add(1, std::memory_order_relaxed) + 1;
   if (auto hook = g_hook.load(std::memory_order_relaxed)) hook();
   if (count >= 3 && g_acted.load(std::memory_order_relaxed) < 2) {
-    static const char kMsg[] = "\npitwall: the loop did not answer two signals: leaving now\n";
+    // The last word: every car that can be reached without the loop gets its stop first.
+    emergency::sendAll();
+    static const char kMsg[] =
+        "\npitwall: the loop did not answer two signals: every car sent its stop from outside "
+        "the loop; leaving now\n";
     ssize_t ignored = ::write(STDERR_FILENO, kMsg, sizeof kMsg - 1);
     (void)ignored;
     ::_exit(130);
   }
-  int fd = g_writeFd.load(std::memory_order_relaxed);
-  if (fd >= 0) {
-    char byte = static_cast<char>(sig);
-    ssize_t written = ::write(fd, &byte, 1);  // a full pipe already says it
-    (void)written;
+  tellLoop(sig, true);
+  errno = saved;
+}
+
+// Whether `fd`'s reader has gone: a pipe whose read end closed (head, grep -m1, a quit less)
+// polls POLLERR; a socket whose peer left, POLLHUP. Async-signal-safe (poll).
+bool readerGone(int fd) {
+  struct pollfd p {
+    fd, 0, 0
+  };
+  return ::poll(&p, 1, 0) == 1 && (p.revents & (POLLERR | POLLHUP)) != 0;
+}
+
+std::atomic<bool> g_pipeSeen{false};
+
+// SIGPIPE: a write to a reader that went away. Only stdout's and stderr's count: the engine's
+// sockets write with MSG_NOSIGNAL and handle EPIPE themselves, and a socket of a library that
+// does not is no reason to stop a race. The output that is gone is pointed at /dev/null (the
+// rest of the run's output is dropped, never a second signal), the Lua code running is
+// interrupted, and the loop is told once. Not a stop signal's count: Ctrl-C after it is still a
+// first Ctrl-C.
+void onPipe(int) {
+  int saved = errno;
+  bool out = readerGone(STDOUT_FILENO), err = readerGone(STDERR_FILENO);
+  if (out || err) {
+    int null = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
+    if (null >= 0) {
+      if (out) ::dup2(null, STDOUT_FILENO);
+      if (err) ::dup2(null, STDERR_FILENO);
+      ::close(null);
+    }
+    if (!g_pipeSeen.exchange(true, std::memory_order_relaxed)) {
+      if (auto hook = g_hook.load(std::memory_order_relaxed)) hook();
+      tellLoop(SIGPIPE, false);
+    }
   }
+  errno = saved;
+}
+
+// SIGTSTP (Ctrl-Z): the loop stops the cars and then suspends the process itself (SIGSTOP); the
+// handler only tells it. Not a stop signal's count either.
+void onSuspend(int) {
+  int saved = errno;
+  tellLoop(SIGTSTP, false);
   errno = saved;
 }
 
@@ -72,6 +129,24 @@ StopSignals::StopSignals(Loop& loop) : loop_(loop), pipe_(loop.io()) {
   ::sigaction(SIGHUP, nullptr, &oldHup_);
   hupCaught_ = oldHup_.sa_handler != SIG_IGN;
   if (hupCaught_) ::sigaction(SIGHUP, &sa, nullptr);
+  // SIGPIPE's default action ends the process with every car at its speed: `pitwall run … |
+  // head` must end through the stop path instead.
+  g_pipeSeen.store(false, std::memory_order_relaxed);
+  g_other.store(0, std::memory_order_relaxed);
+  struct sigaction pipe {};
+  pipe.sa_handler = onPipe;
+  sigemptyset(&pipe.sa_mask);
+  ::sigaction(SIGPIPE, &pipe, &oldPipe_);
+  // SIGTSTP's default action freezes the loop with the cars at speed. Kept ignored when it was
+  // ignored at start (a shell without job control).
+  ::sigaction(SIGTSTP, nullptr, &oldTstp_);
+  tstpCaught_ = oldTstp_.sa_handler != SIG_IGN;
+  if (tstpCaught_) {
+    struct sigaction tstp {};
+    tstp.sa_handler = onSuspend;
+    sigemptyset(&tstp.sa_mask);
+    ::sigaction(SIGTSTP, &tstp, nullptr);
+  }
   if (loop.clockKind() == ClockKind::Virtual)
     loop.setPassCheck([this] { drain(); });
   else
@@ -83,6 +158,8 @@ StopSignals::~StopSignals() {
   if (!sigintReleased_) ::sigaction(SIGINT, &oldInt_, nullptr);
   ::sigaction(SIGTERM, &oldTerm_, nullptr);
   if (hupCaught_) ::sigaction(SIGHUP, &oldHup_, nullptr);
+  ::sigaction(SIGPIPE, &oldPipe_, nullptr);
+  if (tstpCaught_) ::sigaction(SIGTSTP, &oldTstp_, nullptr);
   g_writeFd.store(-1, std::memory_order_relaxed);
   boost::system::error_code ignored;
   pipe_.close(ignored);
@@ -108,18 +185,30 @@ void StopSignals::await() {
 
 void StopSignals::drain() {
   // One relaxed load per pass while no signal came; the handler counts before it writes, so a
-  // count seen ahead of its byte is read on a later pass.
-  if (g_count.load(std::memory_order_relaxed) == drained_) return;
+  // count seen ahead of its byte is read on a later pass. SIGPIPE and SIGTSTP are not counted:
+  // their bytes are read by the next read of the pipe, so a virtual run reads once per pass
+  // while it has not had them all (an unanswered read costs a syscall, and only in that case).
+  if (g_count.load(std::memory_order_relaxed) == drained_ &&
+      !g_other.load(std::memory_order_relaxed))
+    return;
   char bytes[16];
   ssize_t n = ::read(pipe_.native_handle(), bytes, sizeof bytes);
   for (ssize_t i = 0; i < n; ++i) {
-    ++drained_;
-    deliver(static_cast<unsigned char>(bytes[i]));
+    int sig = static_cast<unsigned char>(bytes[i]);
+    if (sig == SIGPIPE || sig == SIGTSTP)
+      g_other.fetch_sub(1, std::memory_order_relaxed);
+    else
+      ++drained_;
+    deliver(sig);
   }
 }
 
 void StopSignals::deliver(int sig) {
   if (sig == SIGINT && sigintReleased_) return;
+  if (sig == SIGPIPE || sig == SIGTSTP) {  // neither counts towards "leave now"
+    if (onSignal) onSignal(sig, 0);
+    return;
+  }
   int count = g_acted.fetch_add(1, std::memory_order_relaxed) + 1;
   if (onSignal) onSignal(sig, count);
 }

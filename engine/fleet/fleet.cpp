@@ -57,6 +57,15 @@ void Fleet::stopAll() {
       if (auto sent = car->stop(); !sent) log::warn(car->label(), sent.error());
 }
 
+void Fleet::pauseAll(const std::string& why) {
+  for (auto* car : cars_)
+    if (auto sent = car->pause(why); !sent) log::warn(car->label(), sent.error());
+}
+
+void Fleet::resumeAll() {
+  for (auto* car : cars_) car->resume();
+}
+
 void Fleet::haltAll() {
   halted_ = true;
   for (auto* car : cars_)

@@ -43,6 +43,11 @@ class Fleet {
   // The end of the run: every car gets its stop and takes no command after it (AnkiCar::halt);
   // so does a car added after it.
   void haltAll();
+  // Ctrl-Z (docs/safety.md): every connected car gets its stop and refuses every other command,
+  // with `why`, until resumeAll(); after it they take commands again and stay stopped until one
+  // comes.
+  void pauseAll(const std::string& why);
+  void resumeAll();
 
  private:
   struct Entry;

@@ -1,6 +1,7 @@
 #include "engine/record/recorder.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -69,26 +70,75 @@ void catchCrashes() {
 
 Recorder::Recorder(const std::string& path)
     : path_(path), buffer_(new char[kCapacity]), lastFlush_(std::chrono::steady_clock::now()) {
-  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd_ < 0) {
+  try {
+    open();
+  } catch (...) {
     delete[] buffer_;
-    throw std::runtime_error("cannot open record file " + path + ": " + std::strerror(errno));
+    throw;
   }
+}
+
+Recorder::Recorder(const std::string& path, Later)
+    : path_(path), buffer_(new char[kCapacity]), lastFlush_(std::chrono::steady_clock::now()) {
+  // Would open() succeed? A file that is there must be writable (and not a folder); one that is
+  // not needs a writable folder. Nothing is created or truncated here.
+  std::string why;
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0) {
+    if (S_ISDIR(st.st_mode))
+      why = std::strerror(EISDIR);
+    else if (::access(path.c_str(), W_OK) != 0)
+      why = std::strerror(errno);
+  } else if (errno == ENOENT) {
+    auto slash = path.rfind('/');
+    std::string folder = slash == std::string::npos ? "."
+                         : slash == 0               ? "/"
+                                                    : path.substr(0, slash);
+    if (::access(folder.c_str(), W_OK | X_OK) != 0) why = std::strerror(errno);
+  } else {
+    why = std::strerror(errno);
+  }
+  if (!why.empty()) {
+    delete[] buffer_;
+    throw std::runtime_error("cannot open record file " + path + ": " + why);
+  }
+}
+
+void Recorder::open() {
+  if (fd_ >= 0) return;
+  int fd = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0)
+    throw std::runtime_error("cannot open record file " + path_ + ": " + std::strerror(errno));
+  fd_ = fd;
+  if (!early_.empty() && !writeAll(fd_, early_.data(), early_.size())) {
+    failed_ = true;
+    log::error("record", "cannot write " + path_ + ": " + std::strerror(errno));
+  }
+  early_.clear();
+  early_.shrink_to_fit();
   g_buffer.store(buffer_, std::memory_order_relaxed);
-  g_used.store(0, std::memory_order_relaxed);
+  g_used.store(used_, std::memory_order_relaxed);
   g_fd.store(fd_, std::memory_order_relaxed);
   catchCrashes();
 }
 
 Recorder::~Recorder() {
   flush();
-  g_fd.store(-1, std::memory_order_relaxed);
-  g_buffer.store(nullptr, std::memory_order_relaxed);
-  ::close(fd_);
+  if (fd_ >= 0) {
+    g_fd.store(-1, std::memory_order_relaxed);
+    g_buffer.store(nullptr, std::memory_order_relaxed);
+    ::close(fd_);
+  }
   delete[] buffer_;
 }
 
 void Recorder::flush() {
+  if (fd_ < 0) {  // not opened yet: the lines wait in memory (a start's few frames)
+    early_.append(buffer_, used_);
+    used_ = 0;
+    lastFlush_ = std::chrono::steady_clock::now();
+    return;
+  }
   if (used_ > 0 && !failed_ && !writeAll(fd_, buffer_, used_)) {
     failed_ = true;  // said once; the run goes on without its record
     log::error("record", "cannot write " + path_ + ": " + std::strerror(errno));
@@ -111,7 +161,10 @@ void Recorder::write(double t, int car, bool tx, std::span<const std::uint8_t> f
   ++lines_;
   if (used_ + line.size() > kCapacity) flush();
   if (line.size() > kCapacity) {  // never: a frame is at most 20 bytes
-    if (!failed_) writeAll(fd_, line.data(), line.size());
+    if (fd_ < 0)
+      early_.append(line);
+    else if (!failed_)
+      writeAll(fd_, line.data(), line.size());
   } else {
     std::memcpy(buffer_ + used_, line.data(), line.size());
     used_ += line.size();

@@ -20,6 +20,15 @@ class Recorder {
  public:
   // Throws std::runtime_error naming the file when it cannot be opened.
   explicit Recorder(const std::string& path);
+  // A record of a run that may still be refused at start (docs/safety.md): the file is only
+  // checked now (it could be written), not opened, so a refused start leaves an old record as it
+  // was; lines are kept in memory until open() truncates the file and writes them. Throws as
+  // above when the file could not be written.
+  struct Later {};
+  Recorder(const std::string& path, Later);
+  // The file is opened (truncated) and what was kept reaches it. Throws as the constructor.
+  void open();
+  bool opened() const { return fd_ >= 0; }
   ~Recorder();  // flushes
   Recorder(const Recorder&) = delete;
   Recorder& operator=(const Recorder&) = delete;
@@ -41,6 +50,7 @@ class Recorder {
   std::size_t lines_ = 0;
   std::chrono::steady_clock::time_point lastFlush_;
   bool failed_ = false;
+  std::string early_;  // lines kept before open()
 };
 
 }  // namespace pitwall

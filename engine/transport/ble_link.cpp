@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cstring>
 
+#include "engine/core/emergency_stops.hpp"
 #include "engine/core/log.hpp"
 
 namespace pitwall::ble {
@@ -74,7 +75,10 @@ void BleLink::subscribe() {
 
 void BleLink::acquireWrite() {
   gatt_.acquire(writeChar_, "AcquireWrite", [this](const sdbus::Error* error, int fd) {
-    if (!error) writeFd_.assign(fd);
+    if (!error) {
+      writeFd_.assign(fd);
+      registerEmergency();
+    }
     up();
   });
 }
@@ -88,8 +92,24 @@ void BleLink::up() {
 
 void BleLink::closeChannels() {
   notify_.close();
+  closeWrite();
+}
+
+void BleLink::closeWrite() {
+  emergency::remove(std::exchange(emergencySlot_, -1));
   boost::system::error_code ec;
   if (writeFd_.is_open()) writeFd_.close(ec);
+}
+
+void BleLink::setEmergencyStop(std::span<const std::uint8_t> frame) {
+  emergencyStop_.assign(frame.begin(), frame.end());
+  emergency::remove(std::exchange(emergencySlot_, -1));
+  registerEmergency();
+}
+
+void BleLink::registerEmergency() {
+  if (emergencySlot_ < 0 && writeFd_.is_open() && !emergencyStop_.empty())
+    emergencySlot_ = emergency::add(writeFd_.native_handle(), emergencyStop_);
 }
 
 void BleLink::value(const std::vector<std::uint8_t>& frame) {
@@ -105,8 +125,7 @@ bool BleLink::send(std::span<const std::uint8_t> frame) {
     if (n < 0 && errno != EAGAIN && errno != EWOULDBLOCK) {
       log::debug(address(), std::string("write socket failed (") + std::strerror(errno) +
                                 "): writes through WriteValue");
-      boost::system::error_code ec;
-      writeFd_.close(ec);
+      closeWrite();
     }
   }
   writeValue(frame);

@@ -37,6 +37,7 @@ class BleLink : public Link {
   // Asks BlueZ to disconnect; done() when it has (or after the disconnect timeout).
   void disconnect(std::function<void()> done) { gatt_.disconnect(std::move(done)); }
   std::string address() const override { return gatt_.label(); }
+  void setEmergencyStop(std::span<const std::uint8_t> frame) override;
 
   // From the Central, which follows BlueZ's tree for all links.
   const std::string& devicePath() const { return gatt_.devicePath(); }
@@ -60,11 +61,15 @@ class BleLink : public Link {
   void up();
   void closeChannels();
   void writeValue(std::span<const std::uint8_t> frame);
+  void closeWrite();         // the write socket, after its emergency slot is given back
+  void registerEmergency();  // the write socket and the stop frame, when both are there
 
   GattClient gatt_;
   std::string readChar_, writeChar_;
   NotifySocket notify_;
   boost::asio::posix::stream_descriptor writeFd_;
+  std::vector<std::uint8_t> emergencyStop_;
+  int emergencySlot_ = -1;
   std::shared_ptr<bool> alive_;
 };
 

@@ -39,6 +39,12 @@ class Link {
   // its offset only in its localization updates, which come once it drives: nullopt.
   virtual std::optional<double> knownOffset() const { return std::nullopt; }
 
+  // The frame that stops the device, from its model (docs/safety.md "A stop that does not need
+  // the loop"): a link that writes through a socket of its own registers it with that socket
+  // (engine/core/emergency_stops.hpp) whenever the socket is open, so the watchdog and the
+  // last-resort exit can stop the device without the loop. Others ignore it.
+  virtual void setEmergencyStop(std::span<const std::uint8_t> frame) { (void)frame; }
+
   void onFrame(FrameHandler h) { frameHandler_ = std::move(h); }
   void onState(StateHandler h) { stateHandler_ = std::move(h); }
 

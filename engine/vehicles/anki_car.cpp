@@ -19,6 +19,8 @@ AnkiCar::AnkiCar(Loop& loop, Link& link, CarIdentity identity)
   link_.onState([this](bool up, const std::string& why) { linkStateChanged(up, why); });
   state_.connected = link_.connected();
   state_.offset_mm = link_.knownOffset().value_or(0);
+  // What stop() sends, for the stop that does not need the loop (engine/core/emergency_stops.hpp)
+  link_.setEmergencyStop(encode(SetSpeed{0, static_cast<int16_t>(kStopAccel), false}).span());
 }
 
 std::string AnkiCar::label() const {
@@ -32,6 +34,9 @@ AnkiCar::Sent AnkiCar::send(const Message& message) {
   if (halted_ && !std::holds_alternative<Disconnect>(message))
     return Unexpected{label() + " was stopped for the end of the run and takes no more commands; " +
                       std::string(name(message)) + " was not sent"};
+  if (!paused_.empty() && !std::holds_alternative<Disconnect>(message))
+    return Unexpected{label() + ": " + paused_ + "; " + std::string(name(message)) +
+                      " was not sent"};
   if (!link_.connected())
     return Unexpected{label() + " is not connected; " + std::string(name(message)) +
                       " was not sent"};
@@ -61,8 +66,17 @@ AnkiCar::Sent AnkiCar::stop() {
   return setSpeed(0, kStopAccel);
 }
 
+AnkiCar::Sent AnkiCar::pause(const std::string& why) {
+  if (halted_) return true;  // stopped for good already
+  paused_.clear();
+  auto sent = link_.connected() ? stop() : Sent{true};
+  paused_ = why;
+  return sent;
+}
+
 AnkiCar::Sent AnkiCar::halt() {
   if (halted_) return true;
+  paused_.clear();
   auto sent = link_.connected() ? stop() : Sent{true};
   halted_ = true;
   return sent;

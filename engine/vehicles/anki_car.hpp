@@ -105,6 +105,12 @@ class AnkiCar {
   // but a disconnect is sent, whoever asks (a script, the REPL, an MQTT intent). Final.
   Sent halt();
   bool halted() const { return halted_; }
+  // A pause (Ctrl-Z, docs/safety.md): a stop, when connected, and until resume() every command
+  // but a disconnect is refused with "`why`: … was not sent". Unlike halt() it ends: after
+  // resume() the car takes commands again (it stays stopped until one comes).
+  Sent pause(const std::string& why);
+  void resume() { paused_.clear(); }
+  bool paused() const { return !paused_.empty(); }
 
   // Events. Handlers are called on the loop; the message has already updated state().
   std::function<void(const anki::Message&)> onMessage;
@@ -137,6 +143,7 @@ class AnkiCar {
   CarIdentity identity_;
   CarState state_;
   bool halted_ = false;
+  std::string paused_;           // why the car takes no command now (pause()), or empty
   double speedReportedAt_ = -1;  // loop seconds of the last frame that said the car's speed
   std::optional<double> pingSentAt_;
   std::optional<double> lastPingRtt_;

@@ -35,6 +35,42 @@ wait_for() {
   done
 }
 
+# The last frame sent to each car, as "CAR NAME SPEED" (SPEED only for set-speed).
+last_tx_per_car() {
+  python3 - "$1" <<'PY'
+import json, sys
+last = {}
+for line in open(sys.argv[1]):
+    r = json.loads(line)
+    if r["dir"] == "tx":
+        last[r["car"]] = r["msg"]
+for car in sorted(last):
+    m = last[car]
+    print(car, m["name"], m.get("speed_mm_s", ""))
+PY
+}
+
+# expect_stopped NAME RECORD CARS: the last frame to each of cars 1..CARS in RECORD is its stop
+expect_stopped() {
+  local want="" i
+  for i in $(seq 1 "$3"); do want+="$i set-speed 0"$'\n'; done
+  check "$1: the last frame to every car is its stop" "${want%$'\n'}" "$(last_tx_per_car "$2")"
+}
+
+# wait_bounded PID: PID's exit status; a run that outlives 30 s is killed (status 137) so that a
+# signal that never arrives fails the check instead of hanging the test.
+# (The timer is killed with SIGKILL, which runs no trap: a subshell killed right after its fork
+# still has the test's EXIT trap and would remove $TMP. Its sleep, orphaned, holds no pipe.)
+wait_bounded() {
+  (sleep 30 && kill -9 "$1") >/dev/null 2>&1 &
+  local watchdog=$! status
+  wait "$1"
+  status=$?
+  kill -9 "$watchdog" 2>/dev/null
+  wait "$watchdog" 2>/dev/null
+  return $status
+}
+
 finish() {
   [ "$FAILURES" -eq 0 ] || { echo "$FAILURES check(s) failed"; exit 1; }
 }

@@ -7,6 +7,8 @@
 --   error   the main chunk dies
 --   exit    os.exit(3) inside pcall, then a command
 --   memory  an allocation loop behind pcall (run it with --lua-memory and --budget 0)
+--   wedge   C code that never returns: a pattern that backtracks for hours (the watchdog and
+--           the last-resort exit, ble_way_out_test.sh)
 local mode = os.getenv("MODE") or "none"
 local cars = pitwall.cars()
 local function command()
@@ -14,8 +16,14 @@ local function command()
 end
 pitwall.every(0.02, command)
 pitwall.every(0.02, function() pitwall.after(0, command) end)
+-- CHATTY=1: a line on every position update too, as a script that reports laps prints
+-- (way_out_test.sh pipes it into head)
+local chatty = os.getenv("CHATTY")
 for _, car in ipairs(cars) do
-  car.onPosition = function() car:setSpeed(800) end
+  car.onPosition = function(_, ev)
+    car:setSpeed(800)
+    if chatty then print(car.name, ev.piece, ev.speed) end
+  end
 end
 -- It claims the library's last words too (run after the stops, ScriptHost::lastWords): one more
 -- command, then it hogs the loop (not in the memory mode, which runs without a budget).
@@ -26,6 +34,11 @@ end
 command()
 print("driving")
 io.stdout:flush()
+if mode == "wedge" then
+  print("wedging")
+  io.stdout:flush()
+  string.find(string.rep("a", 5000), ".-.-.-.-.-b")
+end
 pitwall.sleep(1)
 if mode == "stop" then
   pitwall.stop()

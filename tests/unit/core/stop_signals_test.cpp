@@ -2,6 +2,9 @@
 
 #include <doctest/doctest.h>
 
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <csignal>
 #include <utility>
 #include <vector>
@@ -80,4 +83,35 @@ TEST_CASE("SIGHUP ends a run as SIGTERM does, unless it was ignored (nohup)") {
     CHECK((during.sa_handler == SIG_IGN));
   }
   ::sigaction(SIGHUP, &before, nullptr);
+}
+
+// SIGTSTP (Ctrl-Z) reaches the loop, which stops the cars before it suspends the process; it is
+// not a stop signal's count: a Ctrl-C after it is a first one.
+TEST_CASE("SIGTSTP reaches the loop with count 0 and does not count towards leaving") {
+  CHECK(signalsSeen({{10, SIGTSTP}, {100, SIGTERM}}, SIGTERM) ==
+        std::vector<int>{SIGTSTP * 100 + 0, SIGTERM * 100 + 1});
+}
+
+// SIGPIPE counts only when stdout's or stderr's reader went away: a socket that meets a closed
+// peer (a library writing without MSG_NOSIGNAL) ends nothing, and the process survives it.
+TEST_CASE("SIGPIPE from a socket is not a reader going away") {
+  Loop loop(ClockKind::Real);
+  StopSignals signals(loop);
+  std::vector<int> got;
+  signals.onSignal = [&](int sig, int count) {
+    got.push_back(sig * 100 + count);
+    if (sig == SIGTERM) loop.stop();
+  };
+  int fds[2];
+  REQUIRE(::socketpair(AF_UNIX, SOCK_STREAM, 0, fds) == 0);
+  ::close(fds[1]);
+  loop.after(10ms, [&] {
+    char byte = 1;
+    CHECK(::write(fds[0], &byte, 1) == -1);  // SIGPIPE, then EPIPE
+    CHECK(errno == EPIPE);
+  });
+  loop.after(100ms, [] { std::raise(SIGTERM); });
+  loop.run();
+  ::close(fds[0]);
+  CHECK(got == std::vector<int>{SIGTERM * 100 + 1});
 }

@@ -1,0 +1,146 @@
+#include "engine/core/emergency_stops.hpp"
+
+#include <pthread.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <array>
+#include <cerrno>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
+
+#include "engine/core/log.hpp"
+
+namespace pitwall {
+
+namespace emergency {
+namespace {
+
+struct Slot {
+  std::atomic<int> fd{-1};  // published after the frame (release), read before it (acquire)
+  std::atomic<bool> taken{false};
+  std::uint8_t frame[kFrameMax] = {};
+  std::size_t size = 0;
+};
+std::array<Slot, kSlots> g_slots;
+static_assert(std::atomic<int>::is_always_lock_free && std::atomic<bool>::is_always_lock_free);
+
+}  // namespace
+
+int add(int fd, std::span<const std::uint8_t> stopFrame) {
+  if (fd < 0 || stopFrame.empty() || stopFrame.size() > kFrameMax) return -1;
+  for (std::size_t i = 0; i < kSlots; ++i) {
+    Slot& slot = g_slots[i];
+    bool expected = false;
+    if (!slot.taken.compare_exchange_strong(expected, true)) continue;
+    std::memcpy(slot.frame, stopFrame.data(), stopFrame.size());
+    slot.size = stopFrame.size();
+    slot.fd.store(fd, std::memory_order_release);
+    return static_cast<int>(i);
+  }
+  log::warn("watchdog",
+            "more than " + std::to_string(kSlots) + " cars: this one has no stop outside the loop");
+  return -1;
+}
+
+void remove(int slot) {
+  if (slot < 0 || slot >= static_cast<int>(kSlots)) return;
+  g_slots[slot].fd.store(-1, std::memory_order_release);
+  g_slots[slot].taken.store(false, std::memory_order_release);
+}
+
+int sendAll() {
+  int saved = errno;
+  int sent = 0;
+  for (Slot& slot : g_slots) {
+    int fd = slot.fd.load(std::memory_order_acquire);
+    if (fd < 0) continue;
+    if (::send(fd, slot.frame, slot.size, MSG_DONTWAIT | MSG_NOSIGNAL) ==
+        static_cast<ssize_t>(slot.size))
+      ++sent;
+  }
+  errno = saved;
+  return sent;
+}
+
+int count() {
+  int n = 0;
+  for (const Slot& slot : g_slots) n += slot.fd.load(std::memory_order_acquire) >= 0;
+  return n;
+}
+
+}  // namespace emergency
+
+namespace {
+constexpr auto kBeat = std::chrono::milliseconds(100);
+}
+
+std::int64_t Watchdog::nowMs() {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+Watchdog::Watchdog(Loop& loop, std::chrono::milliseconds limit)
+    : loop_(loop), limit_(limit), lastBeat_(nowMs()) {
+  beat();
+  // Signals are the loop thread's: the thread starts with every signal blocked (it inherits the
+  // mask), so Ctrl-C's handler runs where the Lua code it interrupts runs.
+  sigset_t all, old;
+  sigfillset(&all);
+  ::pthread_sigmask(SIG_SETMASK, &all, &old);
+  thread_ = std::thread([this] { watch(); });
+  ::pthread_sigmask(SIG_SETMASK, &old, nullptr);
+}
+
+Watchdog::~Watchdog() {
+  quit_ = true;
+  thread_.join();
+  loop_.cancel(timer_);
+}
+
+void Watchdog::hold(bool on) {
+  if (!on) lastBeat_ = nowMs();
+  held_ = on;
+}
+
+void Watchdog::beat() {
+  lastBeat_ = nowMs();
+  if (stuck_.exchange(false)) {
+    double seconds = static_cast<double>(nowMs() - firedAt_.load()) / 1000 +
+                     static_cast<double>(limit_.count()) / 1000;
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "the loop was stuck for about %.1f s: the watchdog sent every car its stop; "
+                  "the cars stay stopped until they are commanded again",
+                  seconds);
+    log::warn("watchdog", text);
+  }
+  timer_ = loop_.after(kBeat, [this] { beat(); });
+}
+
+void Watchdog::watch() {
+  // A thread of its own; it only reads atomics, sends the registered stops and writes to stderr.
+  while (!quit_) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    if (held_ || stuck_) continue;
+    std::int64_t silent = nowMs() - lastBeat_.load();
+    if (silent < limit_.count()) continue;
+    firedAt_ = nowMs();
+    int sent = emergency::sendAll();
+    stuck_ = true;
+    ++fired_;
+    char text[200];
+    int n = std::snprintf(text, sizeof text,
+                          "\npitwall: the engine's loop has not turned for %.1f s: the watchdog "
+                          "sent %d car%s its stop\n",
+                          static_cast<double>(silent) / 1000, sent, sent == 1 ? "" : "s");
+    if (n > 0) {
+      ssize_t ignored = ::write(STDERR_FILENO, text, static_cast<std::size_t>(n));
+      (void)ignored;
+    }
+  }
+}
+
+}  // namespace pitwall
