@@ -232,6 +232,8 @@ async function pairing() {
     const link = await viewPage.$eval("#join-url", (el) => el.textContent);
     check("the race view's code is the terminal's", shown === opts.code, `${shown} vs ${opts.code}`);
     check("the race view shows /drive?code= with it", link.endsWith(`/drive?code=${opts.code}`), link);
+    await passWhen(viewPage, "the race view draws the address as a QR code",
+      () => { const q = document.querySelector("#join-qr"); return !q.hidden && q.complete && q.naturalWidth > 60; });
   }
   if (opts.artifacts) await viewPage.screenshot({ path: `${opts.artifacts}/drive-join-code.png` });
   await viewPage.close();

@@ -22,6 +22,8 @@
 //   #join, #join-code, #join-url    the join code and the controller page's address with it,
 //                                   shown to a browser on the engine's machine (or one that
 //                                   came with the code) when the engine needs one
+//   #join-qr                        that address as a QR code (vendor/qrcode.js,
+//                                   qrcode-generator), for a phone's camera
 //
 // Pairing (docs/view.md "Pairing"): off loopback, replay controls need the join code too; the
 // page takes it from its address (?code=…), keeps it for the tab and opens /ws?code=….
@@ -562,6 +564,15 @@ function showPairing(msg) {
   $("#join-url").textContent = url;
   $("#join-url").href = url;
   if (url) $("#drive-link").href = url;
+  const qr = $("#join-qr");
+  qr.hidden = true;
+  if (url && typeof qrcode === "function") {
+    const q = qrcode(0, "M");  // the smallest version that holds the address
+    q.addData(url);
+    q.make();
+    qr.src = q.createDataURL(3, 2);
+    qr.hidden = false;
+  }
   if (code && !joinCode) joinCode = code;
 }
 
