@@ -437,7 +437,9 @@ void CarBinding::handlerFailed(std::string_view what, std::string_view who,
   Proxy* p = nullptr;
   for (auto& entry : proxies_)
     if (entry.second->label == who) p = entry.second.get();
-  if (!p || !p->stopped.empty()) return;
+  // A paused car (Ctrl-Z) or one halted for the end of the run refuses every command: an error
+  // that refusal raised in a handler is not the script's fault, and is not counted.
+  if (!p || !p->stopped.empty() || p->car->paused() || p->car->halted()) return;
   const double now = host_.loop().seconds();
   auto it = std::find_if(p->failing.begin(), p->failing.end(),
                          [&](const Proxy::Failing& f) { return f.what == what; });

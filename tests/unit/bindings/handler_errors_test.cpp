@@ -15,6 +15,7 @@
 #include "engine/sim/track.hpp"
 #include "engine/sim/world.hpp"
 #include "tests/support/sim_cars.hpp"
+#include "tests/unit/capture_link.hpp"
 
 using namespace pitwall;
 using namespace std::chrono_literals;
@@ -144,4 +145,45 @@ TEST_CASE("errors spread wider than the window do not stop the car") {
   CHECK(race.count("once in a while") >= 1);
   CHECK(race.count("was stopped") == 0);
   CHECK(race.truth(1).speed_mm_s > 0);
+}
+
+// Ctrl-Z pauses every car: each command is refused ("the run is suspended") until SIGCONT. A
+// handler that commands on every event raises that refusal, which is not the script's fault: it
+// is not counted, and after the pause the script drives the car again.
+TEST_CASE("errors a pause causes do not stop the car") {
+  setHandlerErrorLimit({3, 10.0});
+  struct Restore {
+    ~Restore() { setHandlerErrorLimit({}); }
+  } restore;
+  setenv("PITWALL_SCRIPTS", PITWALL_SOURCE_DIR "/scripts", 1);
+  Loop loop{ClockKind::Virtual};
+  Fleet fleet{loop};
+  auto owned = std::make_unique<testing::CaptureLink>();
+  testing::CaptureLink& link = *owned;
+  AnkiCar& car = fleet.add(std::move(owned), CarIdentity{0, "skull", 9, 1});
+  link.setConnected(true);
+  std::vector<std::string> logged;
+  log::setSink([&](log::Level, std::string_view line) { logged.emplace_back(line); });
+  ScriptHost host(loop, fleet, nullptr, HostOptions{});
+  REQUIRE(host.startString(R"(
+    pitwall.cars()[1].onPosition = function(c) c:setSpeed(500) end
+  )",
+                           "paused"));
+  REQUIRE(car.pause("the run is suspended (Ctrl-Z)"));
+  for (int i = 0; i < 10; ++i) {
+    anki::PositionUpdate m;
+    m.piece_id = 39;
+    link.carSends(m);
+  }
+  car.resume();
+  link.carSends(anki::PositionUpdate{});
+  log::setSink(nullptr);
+  int suspended = 0, stopped = 0;
+  for (const auto& l : logged) {
+    suspended += l.find("the run is suspended (Ctrl-Z)") != std::string::npos;
+    stopped += l.find("was stopped: its") != std::string::npos;
+  }
+  CHECK(suspended >= 1);  // the refusals were raised in the handler
+  CHECK(stopped == 0);
+  CHECK(car.state().target_speed_mm_s == 500);  // commanded again after the pause
 }
