@@ -9,7 +9,10 @@ pitwall.cars()[2].onPosition = function(car, ev)
   error("skull says no at piece " .. ev.piece)
 end
 LUA
-out=$($PITWALL run "$TMP/flood.lua" --fast --duration 20 --cars 2 2>"$TMP/err"); rc=$?
+# --handler-errors 0: the car drives on, as this is about the log (the stop for a handler that keeps
+# failing: handler_errors_test.sh)
+out=$($PITWALL run "$TMP/flood.lua" --fast --duration 20 --cars 2 --handler-errors 0 \
+  2>"$TMP/err"); rc=$?
 check "exit status" 0 "$rc"
 calls=$(printf '%s\n' "$out" | grep -c '^call$')
 [ "$calls" -ge 50 ] && echo "ok: the handler failed on every event ($calls)" ||
