@@ -521,3 +521,38 @@ TEST_CASE("view drive: 200 idle and slow connections from 10 addresses do not ke
       },
       std::chrono::seconds(60));
 }
+
+// Behind --view-host, every phone comes from the proxy's address: the proxy's X-Forwarded-For
+// tells them apart — and only then (a client that names itself elsewhere is not believed).
+TEST_CASE("view drive: behind --view-host, wrong codes are counted per forwarded client") {
+  Rig rig(1, 1, {}, [](view::ServerOptions& o) {
+    o.names = {"race.example.org"};
+    o.code = kCode;
+  });
+  rig.with([&](std::uint16_t port) {
+    auto guess = [&](const std::string& host, const std::string& xff, const std::string& code) {
+      Phone p(port, "127.0.0.1", "/ws", host, "", xff);
+      p.send(withCode(seatMessage(1, "Eve"), code));
+      return p.answer();
+    };
+    for (int i = 0; i < view::Pairing::kFreeTries; ++i)
+      guess("race.example.org", "10.9.9.9, 203.0.113.7", "000000");
+    auto locked = guess("race.example.org", "203.0.113.7", kCode);
+    CHECK_MESSAGE(says(locked, "too many wrong join codes from 203.0.113.7"), locked.dump());
+    // another phone through the same proxy is not held back
+    auto other = guess("race.example.org", "203.0.113.8", kCode);
+    CHECK_MESSAGE(other["seat"] == 1, other.dump());
+  });
+  rig.with([&](std::uint16_t port) {
+    // not through the proxy's name: X-Forwarded-For is the client's own word, not taken
+    for (int i = 0; i < view::Pairing::kFreeTries; ++i) {
+      Phone p(port, "127.0.0.9", "/ws", "127.0.0.1", "", "198.51.100." + std::to_string(i));
+      p.send(withCode(seatMessage(1, "Eve"), "000000"));
+      (void)p.answer();
+    }
+    Phone p(port, "127.0.0.9", "/ws", "127.0.0.1", "", "198.51.100.99");
+    p.send(withCode(seatMessage(1, "Eve"), kCode));
+    auto locked = p.answer();
+    CHECK_MESSAGE(says(locked, "too many wrong join codes from 127.0.0.9"), locked.dump());
+  });
+}

@@ -79,15 +79,17 @@ struct WsClient {
     ws.handshake("127.0.0.1", "/ws");
   }
   // From the loopback address `from` (all of 127/8 is this machine: each a client of its own),
-  // on `target` (/ws?code=…), with the given Host and, when not empty, Origin.
+  // on `target` (/ws?code=…), with the given Host and, when not empty, Origin and
+  // X-Forwarded-For (as a reverse proxy would add it).
   WsClient(std::uint16_t port, const std::string& from, const std::string& target,
-           const std::string& host = "127.0.0.1", const std::string& origin = "") {
+           const std::string& host = "127.0.0.1", const std::string& origin = "",
+           const std::string& forwardedFor = "") {
     connectFrom(ws.next_layer(), from, port);
-    if (!origin.empty())
-      ws.set_option(boost::beast::websocket::stream_base::decorator(
-          [origin](boost::beast::websocket::request_type& req) {
-            req.set(boost::beast::http::field::origin, origin);
-          }));
+    ws.set_option(boost::beast::websocket::stream_base::decorator(
+        [origin, forwardedFor](boost::beast::websocket::request_type& req) {
+          if (!origin.empty()) req.set(boost::beast::http::field::origin, origin);
+          if (!forwardedFor.empty()) req.set("X-Forwarded-For", forwardedFor);
+        }));
     ws.handshake(host, target);
   }
   static void connectFrom(boost::asio::ip::tcp::socket& s, const std::string& from,
