@@ -44,6 +44,8 @@ int repl(const ReplOptions& options) {
     session.startHost(host);
   } catch (const std::exception& e) {
     std::cerr << "pitwall repl: " << e.what() << "\n";
+    session.finish();  // the cars are connected: they get their stop
+    loop.run();
     return 1;
   }
 

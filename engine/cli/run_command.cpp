@@ -94,6 +94,8 @@ int run(const RunOptions& options) {
     session.startHost(host);
   } catch (const std::exception& e) {
     std::cerr << "pitwall run: " << e.what() << "\n";
+    session.finish();  // the cars are connected: they get their stop
+    loop.run();
     return 1;
   }
 
