@@ -188,6 +188,14 @@ TEST_CASE("the sandbox's back doors, tried one by one, are each refused or harml
         collectgarbage() collectgarbage()
         assert(not ran, "a finalizer added after setmetatable ran"))",
        ""},
+      {"a class that gains __gc after its first object: the next setmetatable refuses it",
+       R"(
+        local Class = {}
+        Class.__index = Class
+        local first = setmetatable({}, Class)
+        Class.__gc = function() while true do end end
+        local second = setmetatable({}, Class))",
+       "a __gc finalizer is refused"},
       {"an object's own table (its uservalue) takes no finalizer", R"(
         local uv = debug.getuservalue(pitwall.after(1, print), 1)
         if type(uv) == "table" then setmetatable(uv, { __gc = print }) end
