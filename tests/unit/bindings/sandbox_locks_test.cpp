@@ -244,3 +244,54 @@ TEST_CASE("the sandbox's back doors, tried one by one, are each refused or harml
     }
   }
 }
+
+// Many attempts at once: every metamethod name, on every engine value a script can hold, through
+// both getters, with plain and raw writes. A write to a new field must be refused with the
+// sentence; whatever went into a face (raw writes, fields it has) must change nothing the engine
+// does: no planted function ever runs, objects made afterwards still work, collecting runs none.
+TEST_CASE("every metamethod on every engine value, by every way in, is refused or inert") {
+  LockedWorld w;
+  CHECK(w.run(R"(
+    local events = { "__gc", "__close", "__mode", "__index", "__newindex", "__call", "__tostring",
+      "__len", "__eq", "__lt", "__le", "__concat", "__unm", "__add", "__name", "__metatable",
+      "__pairs", "__methods", "__fields", "__events", "__idiv", "__band", "__shl", "__bnot" }
+    local ran = 0
+    local planted = function() ran = ran + 1 while true do end end
+    local values = {
+      timer = function() return pitwall.after(10, print) end,
+      car = function() return pitwall.cars()[1] end,
+      string = function() return "" end,
+      file = function() return io.stdout end,
+    }
+    local tried, refused = 0, 0
+    for name, make in pairs(values) do
+      for _, get in ipairs { getmetatable, debug.getmetatable } do
+        for _, key in ipairs(events) do
+          local face = get(make())
+          assert(type(face) == "table", name .. ": no face")
+          local had = rawget(face, key) ~= nil
+          local ok, err = pcall(function() face[key] = planted end)
+          tried = tried + 1
+          if not had then
+            assert(not ok, name .. "." .. key .. " was set")
+            assert(err:find("the engine's metatables are locked", 1, true), err)
+            refused = refused + 1
+          end
+          rawset(face, key, planted)  -- changes the copy alone
+          assert(not pcall(setmetatable, face, {}), name .. ": the face's metatable changed")
+        end
+      end
+    end
+    assert(tried == 4 * 2 * #events, tried)
+    assert(refused >= 4 * (#events - 5), refused)  -- a face has at most 5 fields of its own
+    -- the engine's values behave as before
+    for i = 1, 20 do pitwall.after(1, print):cancel() end
+    assert(tostring(pitwall.after(1, print)):find("^timer"), "a timer's __tostring")
+    assert(tostring(pitwall.cars()[1]):find("^car 1"), "a car's __tostring")
+    assert(("abc"):upper() == "ABC", "string methods")
+    assert(#"abc" == 3 and "a" .. "b" == "ab", "string operators")
+    io.stdout:write("")
+    collectgarbage() collectgarbage()
+    assert(ran == 0, "a planted function ran " .. ran .. " times")
+  )") == "");
+}
