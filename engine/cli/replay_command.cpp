@@ -24,6 +24,7 @@ namespace pitwall::cli {
 namespace {
 
 constexpr std::size_t kBadLinesShown = 20;  // then a count: a binary file is not 10⁶ lines
+static_assert(kBadLinesShown <= kBadLinesKept, "the summary keeps the lines shown");
 constexpr auto kProgressEvery = std::chrono::milliseconds(100);  // the view's replay object
 
 double micro(double seconds) {
@@ -112,33 +113,49 @@ int replay(const ReplayOptions& options) {
     std::cerr << "pitwall replay: " << file << " is a folder; give a --record file\n";
     return 2;
   }
+  if (std::filesystem::exists(file, ec) && !std::filesystem::is_regular_file(file, ec)) {
+    std::cerr << "pitwall replay: " << file
+              << " is not a file (a pipe or a device); a replay reads its record twice, from a "
+                 "file: save it to a file first\n";
+    return 2;
+  }
   std::ifstream in(file, std::ios::binary);
   if (!in) {
     std::cerr << "pitwall replay: cannot read " << file << ": " << std::strerror(errno) << "\n";
     return 2;
   }
-  Record record = readRecord(in);
+  // One pass to count and check; the frames are read again as they are played (RecordPlayer):
+  // neither pass keeps more than a line, a frame and the first bad lines.
+  RecordSummary record = scanRecord(in);
   if (in.bad()) {
     std::cerr << "pitwall replay: cannot read " << file << ": " << std::strerror(errno) << "\n";
     return 2;
   }
-  for (std::size_t i = 0; i < record.bad.size() && i < kBadLinesShown; ++i)
-    std::cerr << file << ":" << record.bad[i].line << ": " << record.bad[i].why << "\n";
-  if (record.bad.size() > kBadLinesShown)
-    std::cerr << file << ": " << record.bad.size() - kBadLinesShown << " more bad lines\n";
-  if (record.frames.empty()) {
+  const auto& bad = record.bad;
+  for (std::size_t i = 0; i < bad.first.size() && i < kBadLinesShown; ++i)
+    std::cerr << file << ":" << bad.first[i].line << ": " << bad.first[i].why << "\n";
+  if (bad.count > kBadLinesShown)
+    std::cerr << file << ": " << bad.count - kBadLinesShown << " more bad lines\n";
+  if (record.frames == 0) {
     std::cerr << "pitwall replay: " << file
-              << (record.bad.empty() ? " is empty"
-                                     : " has no line that is a frame (" +
-                                           std::to_string(record.bad.size()) + " bad lines)")
+              << (bad.count == 0 ? " is empty"
+                                 : " has no line that is a frame (" + std::to_string(bad.count) +
+                                       " bad lines)")
               << "; a record is what `pitwall run --record FILE` writes\n";
     return 1;
   }
-  if (!record.bad.empty())
-    log::warn("replay", std::to_string(record.bad.size()) + " bad line" +
-                            (record.bad.size() == 1 ? "" : "s") + " of " + file +
-                            " left out; replaying the " + std::to_string(record.frames.size()) +
-                            " frames that are whole");
+  if (bad.count > 0)
+    log::warn("replay", std::to_string(bad.count) + " bad line" + (bad.count == 1 ? "" : "s") +
+                            " of " + file + " left out; replaying the " +
+                            std::to_string(record.frames) + " frames that are whole");
+  in.clear();
+  in.seekg(0);
+  if (!in) {
+    std::cerr << "pitwall replay: cannot read " << file
+              << " from its start again (a replay reads a record twice): give a file, not a "
+                 "pipe\n";
+    return 2;
+  }
 
   // The track drawn: --track, else the record's own layout, else the default oval.
   std::optional<sim::Track> track;
@@ -168,7 +185,7 @@ int replay(const ReplayOptions& options) {
     feed = &session->startFeed("replay");
   }
 
-  RecordPlayer player(loop, session->fleet(), std::move(record.frames));
+  RecordPlayer player(loop, session->fleet(), in, record);
   // The feed and the log tell the record's time; both let go of the player before it goes.
   struct Clocks {
     view::Feed* feed;

@@ -10,30 +10,22 @@ namespace {
 constexpr double kResolution = 1e-6;
 }  // namespace
 
-RecordPlayer::RecordPlayer(Loop& loop, Fleet& fleet, std::vector<RecordedFrame> frames)
-    : loop_(loop), fleet_(fleet), frames_(std::move(frames)) {
-  times_.reserve(frames_.size());
-  double last = 0;
-  for (const auto& f : frames_) {
-    last = std::max(last, f.t);
-    times_.push_back(last);
-    cars_[f.car];
-  }
-  std::map<int, std::string> names;  // as the record keeps them (a car's first line)
-  for (const auto& f : frames_)
-    if (!f.name.empty()) names.emplace(f.car, f.name);
-  for (auto& [number, c] : cars_) {
+RecordPlayer::RecordPlayer(Loop& loop, Fleet& fleet, std::istream& in, const RecordSummary& summary)
+    : loop_(loop), fleet_(fleet), stream_(in, 0), duration_(summary.duration) {
+  for (const auto& [number, out] : summary.framesOut) {
     numbers_.push_back(number);
+    Car& c = cars_[number];
+    c.framesOut = out;
     auto link = std::make_unique<ReplayLink>("car " + std::to_string(number));
     c.link = link.get();
     CarIdentity identity;
-    auto named = names.find(number);
-    identity.name = named != names.end() ? named->second : "car" + std::to_string(number);
+    auto named = summary.names.find(number);
+    identity.name = named != summary.names.end() ? named->second : "car" + std::to_string(number);
     c.car = &fleet_.add(std::move(link), identity);
   }
-  for (const auto& f : frames_)
-    if (f.tx) ++cars_[f.car].framesOut;
   for (auto& [number, c] : cars_) c.link->connect();
+  stream_.rewind();
+  readNext();
 }
 
 RecordPlayer::~RecordPlayer() {
@@ -91,24 +83,34 @@ void RecordPlayer::seek(double seconds) {
   if (target < position()) {
     if (onRewind) onRewind();
     for (auto& [number, c] : cars_) c.car->rewind();
-    next_ = 0;
+    stream_.rewind();
+    nextTime_ = 0;
+    readNext();
   }
   deliverUpTo(target);
   anchor(target);
   schedule();
 }
 
-void RecordPlayer::deliver(std::size_t index) {
-  const RecordedFrame& f = frames_[index];
-  if (f.tx) return;
-  delivering_ = times_[index];
-  cars_[f.car].link->deliver(f.bytes);
+void RecordPlayer::readNext() {
+  next_ = stream_.next();
+  if (next_) nextTime_ = std::max(nextTime_, next_->t);
+}
+
+void RecordPlayer::deliverNext() {
+  const RecordedFrame f = std::move(*next_);
+  const double time = nextTime_;
+  readNext();
+  auto c = cars_.find(f.car);  // a car the summary did not see: the file changed since
+  if (f.tx || c == cars_.end()) return;
+  delivering_ = time;
+  c->second.link->deliver(f.bytes);
   delivering_.reset();
 }
 
 void RecordPlayer::deliverUpTo(double position) {
   const bool wasEnded = ended();
-  while (next_ < frames_.size() && times_[next_] <= position + kResolution) deliver(next_++);
+  while (next_ && nextTime_ <= position + kResolution) deliverNext();
   if (ended() && !wasEnded && onEnd) onEnd();
 }
 
@@ -116,12 +118,12 @@ void RecordPlayer::schedule() {
   if (timer_) loop_.cancel(timer_);
   timer_ = 0;
   if (!playing_ || paused_ || ended()) return;
-  const double wait = std::max(0.0, (times_[next_] - anchorPos_) / speed_);
+  const double wait = std::max(0.0, (nextTime_ - anchorPos_) / speed_);
   timer_ = loop_.at(anchorLoop_ + fromSeconds(wait), [this] {
     timer_ = 0;
     // at least the frame this timer was for: a loop time rounded to nanoseconds may lie a hair
     // before the frame's time
-    deliverUpTo(std::max(elapsedPosition(), times_[next_]));
+    deliverUpTo(std::max(elapsedPosition(), nextTime_));
     schedule();
   });
 }

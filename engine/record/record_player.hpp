@@ -12,7 +12,9 @@
 // knew and the frames from the start are delivered again at once, up to the target.
 #include <cstdint>
 #include <functional>
+#include <istream>
 #include <map>
+#include <optional>
 #include <vector>
 
 #include "engine/core/loop.hpp"
@@ -27,7 +29,10 @@ class RecordPlayer {
   // Adds the cars to `fleet` (in order of their recorded numbers, each connected at once), so
   // fleet car k is the k-th smallest number of the record: the same numbers as in the run when
   // the run's cars are all in it.
-  RecordPlayer(Loop& loop, Fleet& fleet, std::vector<RecordedFrame> frames);
+  // The frames are read from `in` as they are played (RecordStream), never all held: `summary`
+  // (scanRecord of the same file) says which cars there are and how long it lasts. `in` must be
+  // a file's (a seek backwards reads it again from its start) and outlive the player.
+  RecordPlayer(Loop& loop, Fleet& fleet, std::istream& in, const RecordSummary& summary);
   ~RecordPlayer();
   RecordPlayer(const RecordPlayer&) = delete;
   RecordPlayer& operator=(const RecordPlayer&) = delete;
@@ -39,10 +44,10 @@ class RecordPlayer {
 
   // Seconds into the record: while a frame is delivered, its time.
   double position() const;
-  double duration() const { return times_.empty() ? 0 : times_.back(); }
+  double duration() const { return duration_; }
   double speed() const { return speed_; }
   bool paused() const { return paused_; }
-  bool ended() const { return next_ >= frames_.size(); }
+  bool ended() const { return !next_; }
 
   // The recorded car numbers, ascending, and the fleet's car for one of them.
   const std::vector<int>& recordedCars() const { return numbers_; }
@@ -56,15 +61,18 @@ class RecordPlayer {
 
  private:
   void deliverUpTo(double position);
-  void deliver(std::size_t index);
+  void deliverNext();  // delivers next_ and reads the one after it
+  void readNext();
   void schedule();
   void anchor(double position);
   double elapsedPosition() const;
 
   Loop& loop_;
   Fleet& fleet_;
-  std::vector<RecordedFrame> frames_;
-  std::vector<double> times_;  // when each frame plays: its t, never before the one before
+  RecordStream stream_;
+  double duration_ = 0;
+  std::optional<RecordedFrame> next_;  // the next frame to play; nothing at the end
+  double nextTime_ = 0;                // when it plays: its t, never before the one before
   std::vector<int> numbers_;
   struct Car {
     AnkiCar* car = nullptr;
@@ -72,7 +80,6 @@ class RecordPlayer {
     std::uint64_t framesOut = 0;
   };
   std::map<int, Car> cars_;
-  std::size_t next_ = 0;
   Loop::TimerId timer_ = 0;
   bool playing_ = false, paused_ = false;
   double speed_ = 1;

@@ -158,67 +158,124 @@ std::string timeText(double t) {
 }
 }  // namespace
 
-Record readRecord(std::istream& in) {
-  Record record;
-  std::string buffer(kMaxLineBytes + 1, '\0');
-  double lastTime = 0;
-  for (std::size_t number = 1;; ++number) {
-    in.getline(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+void BadLines::add(BadLine bad) {
+  ++count;
+  if (keep == 0) return;
+  if (first.size() >= keep && bad.line > first.back().line) return;
+  auto at = std::upper_bound(first.begin(), first.end(), bad.line,
+                             [](std::size_t l, const BadLine& b) { return l < b.line; });
+  first.insert(at, std::move(bad));
+  if (first.size() > keep) first.pop_back();
+}
+
+RecordStream::RecordStream(std::istream& in, std::size_t keepBad)
+    : in_(in), buffer_(kMaxLineBytes + 1, '\0') {
+  bad_.keep = keepBad;
+}
+
+bool RecordStream::rewind() {
+  in_.clear();
+  in_.seekg(0);
+  number_ = 0;
+  end_ = !in_;
+  lastTime_ = before_ = 0;
+  pending_.reset();
+  const std::size_t keep = bad_.keep;
+  bad_ = BadLines{};
+  bad_.keep = keep;
+  return !end_;
+}
+
+std::optional<RecordedFrame> RecordStream::parseNext() {
+  std::istream& in = in_;
+  while (!end_) {
+    const std::size_t number = ++number_;
+    in.getline(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
     const auto got = static_cast<std::size_t>(in.gcount());
     if (in.eof() && got == 0) break;
+    if (in.bad()) break;
     if (in.fail() && !in.eof()) {  // longer than the buffer: skipped unread
       in.clear();
       in.ignore(std::numeric_limits<std::streamsize>::max(), '\n');
       std::size_t length = got + static_cast<std::size_t>(in.gcount()) - (in.eof() ? 0 : 1);
-      record.bad.push_back({number, "a line of " + std::to_string(length) + " bytes, longer than " +
-                                        std::to_string(kMaxLineBytes) +
-                                        ": not a frame of a record"});
+      bad_.add({number, "a line of " + std::to_string(length) + " bytes, longer than " +
+                            std::to_string(kMaxLineBytes) + ": not a frame of a record"});
       if (in.eof()) break;
       continue;
     }
-    std::string_view line(buffer.data(), got - (in.eof() ? 0 : 1));  // without the newline
+    end_ = in.eof();
+    std::string_view line(buffer_.data(), got - (in.eof() ? 0 : 1));  // without the newline
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-    if (line.find_first_not_of(" \t") == line.npos) {
-      if (in.eof()) break;
-      continue;
-    }
-    auto parsed = parseRecordLine(line, 0);  // the time's order is checked here, below
+    if (line.find_first_not_of(" \t") == line.npos) continue;
+    auto parsed = parseRecordLine(line, 0);  // the time's order is checked by next()
     if (auto* frame = std::get_if<RecordedFrame>(&parsed)) {
       frame->line = number;
-      if (frame->t < lastTime - kBackwardsSlack) {
-        // One frame from far ahead (an edited or damaged time) must not take every frame after
-        // it: when this one follows the frame before that one, that one is the odd one out.
-        auto& frames = record.frames;
-        const double before = frames.size() >= 2 ? frames[frames.size() - 2].t : 0;
-        if (!frames.empty() && frame->t >= before - kBackwardsSlack &&
-            frames.back().t - frame->t > kOddJump) {
-          BadLine odd{frames.back().line, "\"t\" " + timeText(frames.back().t) +
-                                              " lies ahead of the frames around it (the next is "
-                                              "at " +
-                                              timeText(frame->t) + ")"};
-          auto at = std::upper_bound(record.bad.begin(), record.bad.end(), odd.line,
-                                     [](std::size_t l, const BadLine& b) { return l < b.line; });
-          record.bad.insert(at, std::move(odd));
-          frames.pop_back();
-          lastTime = frames.empty() ? 0 : std::max(before, frames.back().t);
-        } else {
-          record.bad.push_back({number, "\"t\" " + timeText(frame->t) +
-                                            " goes back in time (the frame before was at " +
-                                            timeText(lastTime) + ")"});
-          if (in.eof()) break;
-          continue;
-        }
-      }
-      lastTime = std::max(lastTime, frame->t);
-      if (!frame->name.empty()) record.names.emplace(frame->car, frame->name);
-      if (record.layout.empty()) record.layout = frame->layout;
-      record.frames.push_back(std::move(*frame));
-    } else {
-      record.bad.push_back({number, std::move(std::get<std::string>(parsed))});
+      return std::move(*frame);
     }
-    if (in.eof()) break;
+    bad_.add({number, std::move(std::get<std::string>(parsed))});
   }
+  end_ = true;
+  return std::nullopt;
+}
+
+std::optional<RecordedFrame> RecordStream::next() {
+  for (;;) {
+    auto frame = parseNext();
+    if (!frame) {  // the end: the frame held back is the last
+      auto last = std::move(pending_);
+      pending_.reset();
+      return last;
+    }
+    if (frame->t < lastTime_ - kBackwardsSlack) {
+      // One frame from far ahead (an edited or damaged time) must not take every frame after
+      // it: when this one follows the frame before that one, that one is the odd one out.
+      if (pending_ && frame->t >= before_ - kBackwardsSlack && pending_->t - frame->t > kOddJump) {
+        bad_.add({pending_->line, "\"t\" " + timeText(pending_->t) +
+                                      " lies ahead of the frames around it (the next is at " +
+                                      timeText(frame->t) + ")"});
+        pending_.reset();
+        lastTime_ = before_;
+      } else {
+        bad_.add({frame->line, "\"t\" " + timeText(frame->t) +
+                                   " goes back in time (the frame before was at " +
+                                   timeText(lastTime_) + ")"});
+        continue;
+      }
+    }
+    lastTime_ = std::max(lastTime_, frame->t);
+    auto out = std::move(pending_);
+    pending_ = std::move(frame);
+    if (out) {
+      before_ = out->t;
+      return out;
+    }
+  }
+}
+
+Record readRecord(std::istream& in) {
+  Record record;
+  RecordStream stream(in, std::numeric_limits<std::size_t>::max());
+  while (auto frame = stream.next()) {
+    if (!frame->name.empty()) record.names.emplace(frame->car, frame->name);
+    if (record.layout.empty()) record.layout = frame->layout;
+    record.frames.push_back(std::move(*frame));
+  }
+  record.bad = stream.bad().first;
   return record;
+}
+
+RecordSummary scanRecord(std::istream& in) {
+  RecordSummary summary;
+  RecordStream stream(in, summary.bad.keep);
+  while (auto frame = stream.next()) {
+    ++summary.frames;
+    summary.duration = std::max(summary.duration, frame->t);
+    summary.framesOut[frame->car] += frame->tx ? 1 : 0;
+    if (!frame->name.empty()) summary.names.emplace(frame->car, frame->name);
+    if (summary.layout.empty()) summary.layout = std::move(frame->layout);
+  }
+  summary.bad = stream.bad();
+  return summary;
 }
 
 }  // namespace pitwall

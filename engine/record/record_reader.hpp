@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <istream>
 #include <map>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <variant>
@@ -34,12 +35,35 @@ struct BadLine {
   std::string why;       // "not JSON: …", "\"car\" must be an integer 1..64, not 0", …
 };
 
+inline constexpr std::size_t kBadLinesKept = 20;
+
+// The bad lines of a record: the first `keep` (in line order) with their numbers and why, and
+// how many in all. A file of nothing but bad lines costs a count, not a copy of each.
+struct BadLines {
+  std::vector<BadLine> first;
+  std::size_t count = 0;
+  std::size_t keep = kBadLinesKept;
+  void add(BadLine bad);
+};
+
+// A whole record in memory: for tests and small files. `pitwall replay` streams (RecordStream).
 struct Record {
   std::vector<RecordedFrame> frames;  // in file order; times never go backwards by more than
                                       // kBackwardsSlack
-  std::vector<BadLine> bad;
-  std::map<int, std::string> names;  // the cars' names, where the record keeps them
-  std::string layout;                // the track's layout text; empty: the record keeps none
+  std::vector<BadLine> bad;           // every one
+  std::map<int, std::string> names;   // the cars' names, where the record keeps them
+  std::string layout;                 // the track's layout text; empty: the record keeps none
+};
+
+// What a replay needs to know before it plays: one pass over the file, nothing of it kept but
+// these (memory does not grow with the record's length).
+struct RecordSummary {
+  std::size_t frames = 0;
+  double duration = 0;  // the last frame's time (the latest of all)
+  BadLines bad;
+  std::map<int, std::string> names;        // as in Record
+  std::map<int, std::uint64_t> framesOut;  // every recorded car's number: its tx frames
+  std::string layout;                      // as in Record
 };
 
 inline constexpr std::size_t kMaxLineBytes = 64 * 1024;
@@ -52,7 +76,36 @@ inline constexpr std::size_t kMaxRecordedLayout = 8192;  // bytes of a layout's 
 
 // One line (without its newline) against the time of the last good frame; the frame, or why not.
 std::variant<RecordedFrame, std::string> parseRecordLine(std::string_view line, double lastTime);
-// Every line of `in`. Blank lines are skipped silently.
+
+// The frames of a record one at a time, as they are read: the same frames and bad lines as
+// readRecord gives, in the same order, holding one line and one frame (a frame far ahead of the
+// frames around it is told only by the frame after it: each frame is handed on once the next is
+// read).
+class RecordStream {
+ public:
+  explicit RecordStream(std::istream& in, std::size_t keepBad = kBadLinesKept);
+  // The next frame that is whole, or nothing at the end of the file (or a read error: in.bad()).
+  std::optional<RecordedFrame> next();
+  // Back to the first line (the stream must be a file's); the bad lines are counted again.
+  bool rewind();
+  const BadLines& bad() const { return bad_; }
+
+ private:
+  std::optional<RecordedFrame> parseNext();  // a line that parses, its time not yet checked
+
+  std::istream& in_;
+  std::string buffer_;
+  std::size_t number_ = 0;  // the last line read
+  bool end_ = false;
+  double lastTime_ = 0;
+  double before_ = 0;  // the time of the frame handed on before pending_ (0: none)
+  std::optional<RecordedFrame> pending_;
+  BadLines bad_;
+};
+
+// Every line of `in`, every frame and bad line kept. Blank lines are skipped silently.
 Record readRecord(std::istream& in);
+// One pass over `in` for a replay: counts, cars, names, duration and the first bad lines.
+RecordSummary scanRecord(std::istream& in);
 
 }  // namespace pitwall
