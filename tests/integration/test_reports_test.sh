@@ -104,7 +104,11 @@ mkfifo "$TMP/ready"
 READY="$TMP/ready" $PITWALL test "$S" --filter crash --filter alpha --filter random -j 1 \
   --budget 0 >"$TMP/crash.out" 2>&1 &
 RUN_PID=$!
-read -r -t 20 line <"$TMP/ready"
+# Opened read-write, the fifo does not block the open itself: a run that never gets to write
+# (it failed to start) makes the read time out and the test fail, not hang until ctest kills it.
+exec 5<>"$TMP/ready"
+read -r -t 20 line <&5
+exec 5<&-
 check "the crashing scenario spins" "spinning" "$line"
 child=$(pgrep -P "$RUN_PID")
 kill -SEGV "$child"
