@@ -539,9 +539,15 @@ int Session::startView(const std::string& endpoint, const std::string& source,
   }
   console::noteOutput();
   std::cerr << "view: " << server_->url() << "\n";
-  if (!server_->joinCode().empty())  // docs/view.md "Pairing": only invited people drive
+  if (server_->joinCode().empty() || source == "mqtt") {
+    // loopback: no code; a spectator (pitwall view): nothing to drive or control
+  } else if (source == "replay") {  // docs/view.md "Pairing": only invited people control it
+    std::cerr << "view: join code " << server_->joinCode()
+              << ": the replay's controls are for pages opened as " << server_->viewUrl() << "\n";
+  } else {  // docs/view.md "Pairing": only invited people drive
     std::cerr << "view: join code " << server_->joinCode() << ": to drive, phones open "
               << server_->driveUrl() << "\n";
+  }
   if (options->host != "127.0.0.1" && options->host != "::1")
     log::warn("view", "serving on " + options->host +
                           ": anyone who can reach this machine can watch (read-only); driving "

@@ -180,7 +180,7 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   bool serves(const std::string& name);
   void admit(tcp::socket socket);
   bool roomForSocket(const std::string& client);
-  std::string driveUrl() const;
+  std::string driveUrl(std::string_view page = "drive") const;
 };
 
 // One WebSocket: the state, then updates paced to the rate, one write in flight at most.
@@ -661,7 +661,11 @@ std::string Server::driveUrl() const {
   return impl_->driveUrl();
 }
 
-std::string Server::Impl::driveUrl() const {
+std::string Server::viewUrl() const {
+  return impl_->driveUrl("");
+}
+
+std::string Server::Impl::driveUrl(std::string_view page) const {
   // bound to every address: one a phone can reach (the first that is not loopback)
   std::string host = options.host;
   beast::error_code ec;
@@ -678,8 +682,8 @@ std::string Server::Impl::driveUrl() const {
   }
   if (host.find(':') != std::string::npos) host = "[" + host + "]";
   auto ep = acceptor.local_endpoint(ec);
-  std::string url =
-      "http://" + host + ":" + std::to_string(ec ? options.port : ep.port()) + "/drive";
+  std::string url = "http://" + host + ":" + std::to_string(ec ? options.port : ep.port()) + "/" +
+                    std::string(page);
   if (pairing.required()) url += "?code=" + pairing.code();
   return url;
 }

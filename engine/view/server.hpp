@@ -60,9 +60,11 @@ class Server {
   std::string url() const;
   std::size_t clients() const;  // open WebSockets
   // The code that pairs a phone (docs/view.md "Pairing"); empty when none is needed (loopback,
-  // no --view-host). driveUrl(): the controller page's address, with the code.
+  // no --view-host). driveUrl(): the controller page's address, with the code; viewUrl(): the
+  // race view's (its replay controls), with the code. Both by an address a phone can reach.
   std::string joinCode() const;
   std::string driveUrl() const;
+  std::string viewUrl() const;
 
  private:
   struct Impl;
