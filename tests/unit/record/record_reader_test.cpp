@@ -204,3 +204,47 @@ TEST_CASE("record reader: the cars' names and the layout a record keeps; odd one
   CHECK(r.names.size() == 1);
   CHECK(r.names.at(1) == "skull");  // a car's first name stays
 }
+
+TEST_CASE("record scan: bad lines are counted, only the first 20 kept, in line order") {
+  auto line = [](double t, int car, const char* dir) {
+    return R"({"t":)" + std::to_string(t) + R"(,"car":)" + std::to_string(car) + R"(,"dir":")" +
+           dir + R"(","hex":"01 17","carName":"c)" + std::to_string(car) + "\"}\n";
+  };
+  // a frame from far ahead (line 2) is told only by the frame after it, after 10 000 bad lines:
+  // it still takes its place in line order among the first kept
+  std::string text = line(1.0, 1, "rx") + line(900.0, 2, "rx");
+  for (int i = 0; i < 10'000; ++i) text += "junk\n";
+  text += line(1.5, 2, "tx") + line(2.0, 3, "rx");
+  std::istringstream in(text);
+  RecordSummary s = scanRecord(in);
+  CHECK(s.frames == 3);
+  CHECK(s.duration == doctest::Approx(2.0));
+  CHECK(s.bad.count == 10'001);
+  REQUIRE(s.bad.first.size() == kBadLinesKept);
+  CHECK(s.bad.first[0].line == 2);
+  CHECK(s.bad.first[0].why.find("lies ahead of the frames around it") != std::string::npos);
+  CHECK(s.bad.first[1].line == 3);
+  CHECK(s.bad.first.back().line == kBadLinesKept + 1);
+  // every car with a frame, its tx frames counted; the names its frames carry
+  CHECK(s.framesOut == std::map<int, std::uint64_t>{{1, 0}, {2, 1}, {3, 0}});
+  CHECK(s.names == std::map<int, std::string>{{1, "c1"}, {2, "c2"}, {3, "c3"}});
+}
+
+TEST_CASE("record stream: the same frames as readRecord, one at a time, again after a rewind") {
+  std::string text;
+  for (int i = 0; i < 50; ++i)
+    text += R"({"t":)" + std::to_string(i * 0.1) + R"(,"car":1,"dir":"rx","hex":"01 17"})" +
+            (i % 7 == 3 ? "\ngarbage\n" : "\n");
+  const Record whole = read(text);
+  std::istringstream in(text);
+  RecordStream stream(in);
+  for (int pass = 0; pass < 2; ++pass) {
+    CAPTURE(pass);
+    std::vector<std::size_t> lines;
+    while (auto f = stream.next()) lines.push_back(f->line);
+    REQUIRE(lines.size() == whole.frames.size());
+    for (std::size_t i = 0; i < lines.size(); ++i) CHECK(lines[i] == whole.frames[i].line);
+    CHECK(stream.bad().count == whole.bad.size());
+    REQUIRE(stream.rewind());
+  }
+}
