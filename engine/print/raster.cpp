@@ -22,6 +22,7 @@
 #include <chrono>
 #include <csignal>
 #include <iostream>
+#include <new>
 
 namespace pitwall::print {
 
@@ -301,8 +302,14 @@ Result<std::pair<Raster, PieceSvg>, std::string> loadPieceSvg(const std::string&
           static_cast<double>(size[0]) * size[1] <= kMaxPixels) {
         r.width = size[0];
         r.height = size[1];
-        r.dark.resize(static_cast<std::size_t>(r.width) * static_cast<std::size_t>(r.height));
-        whole = readAll(fd, r.dark.data(), r.dark.size(), deadline, late);
+        try {  // this process's own limit (ulimit -v) may not hold the raster
+          r.dark.resize(static_cast<std::size_t>(r.width) * static_cast<std::size_t>(r.height));
+          whole = readAll(fd, r.dark.data(), r.dark.size(), deadline, late);
+        } catch (const std::bad_alloc&) {
+          why = "is " + std::to_string(r.width) + " × " + std::to_string(r.height) +
+                " pixels at this --dpi, more than this process has memory for: use a lower "
+                "--dpi";
+        }
       }
     }
   }
