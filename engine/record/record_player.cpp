@@ -1,6 +1,7 @@
 #include "engine/record/record_player.hpp"
 
 #include <algorithm>
+#include <chrono>
 
 namespace pitwall {
 
@@ -8,6 +9,7 @@ namespace {
 // Frames recorded within a microsecond of a position are due at it (the record's resolution;
 // a loop time rounds to nanoseconds).
 constexpr double kResolution = 1e-6;
+constexpr auto kSlice = std::chrono::milliseconds(20);
 }  // namespace
 
 RecordPlayer::RecordPlayer(Loop& loop, Fleet& fleet, std::istream& in, const RecordSummary& summary)
@@ -50,6 +52,7 @@ double RecordPlayer::elapsedPosition() const {
 
 double RecordPlayer::position() const {
   if (delivering_) return *delivering_;
+  if (seekTarget_) return caught_;  // a seek under way: as far as it has come
   return std::clamp(elapsedPosition(), 0.0, duration());
 }
 
@@ -85,9 +88,39 @@ void RecordPlayer::seek(double seconds) {
     for (auto& [number, c] : cars_) c.car->rewind();
     stream_.rewind();
     nextTime_ = 0;
+    caught_ = 0;
     readNext();
   }
-  deliverUpTo(target);
+  if (!seekTarget_) seekWasEnded_ = ended();
+  seekTarget_ = target;
+  ++seekGeneration_;
+  if (timer_) loop_.cancel(timer_);
+  timer_ = 0;
+  catchUp();
+}
+
+// The frames up to a seek's target, delivered at once — in slices on the real clock: at most
+// kSlice of work, then the loop turns (the view answers, signals are acted on, the watchdog
+// hears from it) and the next slice follows. A seek across a million frames took seconds of one
+// callback (docs/safety.md: the loop turns at least every 100 ms).
+void RecordPlayer::catchUp() {
+  if (!seekTarget_) return;
+  const bool sliced = loop_.clockKind() == ClockKind::Real;
+  const auto until = std::chrono::steady_clock::now() + kSlice;
+  std::size_t n = 0;
+  while (next_ && nextTime_ <= *seekTarget_ + kResolution) {
+    deliverNext();
+    if (sliced && (++n % 256) == 0 && std::chrono::steady_clock::now() >= until) {
+      std::weak_ptr<bool> alive = alive_;
+      loop_.post([this, alive, generation = seekGeneration_] {
+        if (!alive.expired() && generation == seekGeneration_) catchUp();
+      });
+      return;
+    }
+  }
+  const double target = *seekTarget_;
+  seekTarget_.reset();
+  if (ended() && !seekWasEnded_ && onEnd) onEnd();
   anchor(target);
   schedule();
 }
@@ -103,6 +136,7 @@ void RecordPlayer::deliverNext() {
   readNext();
   auto c = cars_.find(f.car);  // a car the summary did not see: the file changed since
   if (f.tx || c == cars_.end()) return;
+  caught_ = time;
   delivering_ = time;
   c->second.link->deliver(f.bytes);
   delivering_.reset();
@@ -117,7 +151,7 @@ void RecordPlayer::deliverUpTo(double position) {
 void RecordPlayer::schedule() {
   if (timer_) loop_.cancel(timer_);
   timer_ = 0;
-  if (!playing_ || paused_ || ended()) return;
+  if (!playing_ || paused_ || ended() || seekTarget_) return;  // a seek schedules when done
   const double wait = std::max(0.0, (nextTime_ - anchorPos_) / speed_);
   timer_ = loop_.at(anchorLoop_ + fromSeconds(wait), [this] {
     timer_ = 0;

@@ -14,6 +14,7 @@
 #include <functional>
 #include <istream>
 #include <map>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -39,7 +40,10 @@ class RecordPlayer {
 
   void play();  // from position 0
   void pause(bool paused);
-  void seek(double seconds);    // clamped to 0..duration()
+  // Clamped to 0..duration(). On the real clock the frames up to it are delivered in slices of
+  // 20 ms of work with the loop turning between them (position() says how far it has come);
+  // on a virtual clock at once.
+  void seek(double seconds);
   void setSpeed(double speed);  // > 0
 
   // Seconds into the record: while a frame is delivered, its time.
@@ -61,6 +65,7 @@ class RecordPlayer {
 
  private:
   void deliverUpTo(double position);
+  void catchUp();      // the next slice of a seek
   void deliverNext();  // delivers next_ and reads the one after it
   void readNext();
   void schedule();
@@ -86,6 +91,11 @@ class RecordPlayer {
   TimePoint anchorLoop_{0};
   double anchorPos_ = 0;
   std::optional<double> delivering_;  // the time of the frame being delivered
+  double caught_ = 0;                 // the time of the last frame delivered
+  std::optional<double> seekTarget_;  // a seek under way
+  bool seekWasEnded_ = false;
+  std::uint64_t seekGeneration_ = 0;  // a slice of an older seek does nothing
+  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };
 
 }  // namespace pitwall

@@ -1,0 +1,98 @@
+#include "engine/record/record_player.hpp"
+
+#include <doctest/doctest.h>
+
+#include <cstdio>
+#include <sstream>
+
+using namespace pitwall;
+using namespace std::chrono_literals;
+
+namespace {
+// A record of `frames` ping responses from car 1, one a millisecond.
+std::string pings(int frames) {
+  std::string text;
+  text.reserve(static_cast<std::size_t>(frames) * 48);
+  char line[96];
+  for (int i = 0; i < frames; ++i) {
+    std::snprintf(line, sizeof line,
+                  R"({"t":%.6f,"car":1,"dir":"rx","hex":"01 17"})"
+                  "\n",
+                  i / 1000.0);
+    text += line;
+  }
+  return text;
+}
+}  // namespace
+
+// A seek across many frames on the real clock is delivered in slices: the loop turns in between
+// (a ticker of its own fires while the seek is under way, as the view's requests and the signals
+// would be answered), and in the end every frame up to the target was delivered once.
+TEST_CASE("record player: a long seek on the real clock lets the loop turn between slices") {
+  const int kFrames = 400000;
+  std::istringstream scan(pings(kFrames));
+  RecordSummary summary = scanRecord(scan);
+  REQUIRE(summary.framesOut.size() == 1);
+  std::istringstream in(pings(kFrames));
+  Loop loop(ClockKind::Real);
+  Fleet fleet(loop);
+  RecordPlayer player(loop, fleet, in, summary);
+  AnkiCar* car = player.car(1);
+  REQUIRE(car != nullptr);
+  int ticksDuringSeek = 0;
+  bool seeking = false;
+  std::function<void()> tick = [&] {
+    if (seeking) ++ticksDuringSeek;
+    loop.after(1ms, tick);
+  };
+  loop.after(1ms, tick);
+  bool ended = false;
+  player.onEnd = [&] {
+    ended = true;
+    seeking = false;
+    loop.stop();
+  };
+  player.pause(true);
+  loop.post([&] {
+    seeking = true;
+    player.seek(player.duration());
+    CHECK(player.position() < player.duration());  // under way: as far as it has come
+  });
+  auto guard = loop.after(60s, [&] { loop.stop(); });
+  loop.run();
+  loop.cancel(guard);
+  CHECK(ended);
+  CHECK(car->state().frames_in == static_cast<std::uint64_t>(kFrames));
+  CHECK(ticksDuringSeek > 0);
+  CHECK(player.position() == doctest::Approx(player.duration()));
+}
+
+// A second seek while one is under way takes over: backwards, the cars start again from the
+// record's start and reach the new target, each frame up to it delivered once after the rewind.
+TEST_CASE("record player: a seek under way gives way to the next one") {
+  const int kFrames = 400000;
+  std::istringstream scan(pings(kFrames));
+  RecordSummary summary = scanRecord(scan);
+  std::istringstream in(pings(kFrames));
+  Loop loop(ClockKind::Real);
+  Fleet fleet(loop);
+  RecordPlayer player(loop, fleet, in, summary);
+  int rewinds = 0;
+  player.onRewind = [&] { ++rewinds; };
+  player.pause(true);
+  loop.post([&] {
+    player.seek(player.duration());
+    loop.post([&] { player.seek(0.1); });  // behind the first slice (256 frames at least)
+  });
+  auto guard = loop.after(60s, [&] { loop.stop(); });
+  // paused: once the seek is done the position stays at its target
+  std::function<void()> poll = [&] {
+    if (rewinds == 1 && player.position() == doctest::Approx(0.1).epsilon(1e-9)) return loop.stop();
+    loop.after(1ms, poll);
+  };
+  loop.after(1ms, poll);
+  loop.run();
+  loop.cancel(guard);
+  CHECK(rewinds == 1);
+  CHECK(player.position() == doctest::Approx(0.1));
+}
