@@ -428,12 +428,15 @@ void CarBinding::handlerFailed(std::string_view what, std::string_view who,
   const HandlerErrorLimit limit = g_handlerErrorLimit;
   if (limit.count <= 0) return;
   // A car's own event handlers and listeners ("onPosition handler", "onPosition listeners",
-  // core.lua's "onPosition listener"); not the race library's drivers ("update of driver x"),
-  // which report each error and are called on (docs/racing.md).
+  // core.lua's "onPosition listener"), and the update of the race library's driver of the car
+  // ("update of driver cruiser"), which drivers.run calls on after each error (docs/racing.md):
+  // a driver whose update keeps failing would leave its car at its last speed.
   auto endsWith = [&](std::string_view end) {
     return what.size() >= end.size() && what.substr(what.size() - end.size()) == end;
   };
-  if (!endsWith(" handler") && !endsWith(" listeners") && !endsWith(" listener")) return;
+  if (!endsWith(" handler") && !endsWith(" listeners") && !endsWith(" listener") &&
+      what.rfind("update of driver ", 0) != 0)
+    return;
   Proxy* p = nullptr;
   for (auto& entry : proxies_)
     if (entry.second->label == who) p = entry.second.get();

@@ -42,13 +42,14 @@ bool sameFile(const std::string& a, const std::string& b) {
   return !ec && ca == cb;
 }
 
-// The message a failed expectation raised last (scripts/pitwall/test.lua), if any.
-std::string lastExpectation(lua_State* L) {
+// The message a failed expectation raised last (scripts/pitwall/test.lua), if any; `field`
+// "_failedAt": the same with the file and line of the expectation in front.
+std::string lastExpectation(lua_State* L, const char* field = "_failed") {
   std::string text;
   lua_getglobal(L, "package");
   if (lua_istable(L, -1) && lua_getfield(L, -1, "loaded") == LUA_TTABLE &&
       lua_getfield(L, -1, "pitwall.test") == LUA_TTABLE &&
-      lua_getfield(L, -1, "_failed") == LUA_TSTRING)
+      lua_getfield(L, -1, field) == LUA_TSTRING)
     text = lua_tostring(L, -1);
   lua_settop(L, 0);
   return text;
@@ -135,11 +136,16 @@ ScenarioResult runScenario(const std::string& file, const ScenarioSettings& sett
   loop.run();  // ends through Session::finish, which every way out of a run calls
   out.simulated = loop.seconds();
   finishTiming();
+  std::string expected = lastExpectation(session.host().state());
   if (auto& failure = session.host().failure()) {
     readFailure(*failure, file, out);
-    std::string expected = lastExpectation(session.host().state());
     bool expectation = !expected.empty() && std::string_view(out.message).ends_with(expected);
     out.status = expectation ? ScenarioResult::Status::Failed : ScenarioResult::Status::Errored;
+  } else if (!expected.empty()) {
+    // An expectation failed and its error was taken by the script (pitwall.onError, a pcall):
+    // still a failure — a scenario that handles its own errors must not swallow its checks.
+    readFailure(lastExpectation(session.host().state(), "_failedAt"), file, out);
+    out.status = ScenarioResult::Status::Failed;
   } else if (auto exit = session.host().exitStatus()) {
     out.status = ScenarioResult::Status::Errored;
     out.message = "the scenario called os.exit(" + std::to_string(*exit) +

@@ -10,6 +10,10 @@ end
 -- The runner tells a failed expectation from any other error by the message kept here.
 local function fail(message, level)
   expect._failed = message
+  -- where, for a failure the script's own pitwall.onError or pcall took (the runner still fails it)
+  local info = debug.getinfo((level or 2) + 1, "Sl")
+  expect._failedAt = info and info.currentline > 0 and (info.short_src .. ":" .. info.currentline .. ": " .. message)
+    or message
   error(message, (level or 2) + 1)
 end
 

@@ -22,10 +22,13 @@ b:setSpeed(600)
 sim.run(10)
 
 expect.eq(#errors, 2, "errors reported")
-expect.truthy(errors[1].message:find("boom in a handler", 1, true), "the handler's message")
-expect.truthy(errors[1].message:find("stack traceback", 1, true), "with a traceback")
-expect.truthy(errors[1].where:find("onPosition handler of car 1", 1, true), "names the handler and car")
-expect.truthy(errors[2].where:find("pitwall.after", 1, true), "names the timer")
+-- in the order they came: the timer's (0.5 s) may come before or after the third position update
+local handler, timer = errors[1], errors[2]
+if handler.where:find("pitwall.after", 1, true) then handler, timer = timer, handler end
+expect.truthy(handler.message:find("boom in a handler", 1, true), "the handler's message")
+expect.truthy(handler.message:find("stack traceback", 1, true), "with a traceback")
+expect.truthy(handler.where:find("onPosition handler of car 1", 1, true), "names the handler and car")
+expect.truthy(timer.where:find("pitwall.after", 1, true), "names the timer")
 expect.gt(aPositions, 20, "the failing handler is still called afterwards")
 expect.gt(aTransitions, 5, "the same car's other handler carries on")
 expect.gt(bPositions, 20, "the other car carries on")

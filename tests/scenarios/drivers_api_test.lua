@@ -1,6 +1,6 @@
 -- The driver API: loading, the context (ahead, nearby, upcoming, limit, a field that grows),
 -- drivers.run's task (start, update every period, finish on stop), a driver whose update
--- raises is reported and still called, and ctx.limit caps the cruiser.
+-- raises now and then is reported and still called, and ctx.limit caps the cruiser.
 -- tags: drivers
 local sim = require "pitwall.sim"
 local track = require "pitwall.track"
@@ -50,7 +50,8 @@ expect.ge(#up, 2, "pieces ahead")
 expect.eq(up[2].index, map:next(up[1].index), "in driving order")
 for _, car in ipairs { b, c } do sim.lift(car) end
 
--- A driver that raises every third update: reported, and called on.
+-- A driver that raises every seventh update: reported, and called on. (Five failures of a
+-- driver's update within 10 s stop its car: driver_errors_test.lua; three here do not.)
 local errors = {}
 pitwall.onError = function(message, where) errors[#errors + 1] = where .. ": " .. message end
 local calls, started, finished = 0, 0, 0
@@ -59,7 +60,7 @@ local bad = {
   start = function() started = started + 1 end,
   update = function(self, car, ctx)
     calls = calls + 1
-    if calls % 3 == 0 then error("boom " .. calls) end
+    if calls % 7 == 0 then error("boom " .. calls) end
   end,
   finish = function() finished = finished + 1 end,
 }
@@ -67,8 +68,8 @@ local handle = drivers.run(a, bad, drivers.context(a, map, { a }))
 sim.run(2.05)
 expect.eq(started, 1, "start once")
 expect.near(calls, 21, 1, "update every 0.1 s")
-expect.near(#errors, 7, 1, "every raise reported")
-expect.truthy(errors[1]:find("boom 3", 1, true), "the message: " .. errors[1])
+expect.near(#errors, 3, 0, "every raise reported")
+expect.truthy(errors[1]:find("boom 7", 1, true), "the message: " .. errors[1])
 expect.truthy(errors[1]:find("update of driver bad", 1, true), "where: " .. errors[1])
 expect.truthy(handle:stop(), "stop")
 expect.falsy(handle:stop(), "stopped once")
