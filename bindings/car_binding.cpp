@@ -466,6 +466,16 @@ void CarBinding::handlerFailed(std::string_view what, std::string_view who,
                  (sent ? "" : " (the stop was not sent: " + sent.error() + ")"));
 }
 
+void CarBinding::handlerFailedIn(std::string_view where, std::string_view message) {
+  for (auto& entry : proxies_) {
+    const std::string& label = entry.second->label;
+    if (where.size() < label.size() + 4) continue;
+    std::string_view end = where.substr(where.size() - label.size() - 4);
+    if (end.substr(0, 4) == " of " && end.substr(4) == label)
+      return handlerFailed(where.substr(0, where.size() - end.size()), label, message);
+  }
+}
+
 AnkiCar* CarBinding::test(lua_State* L, int idx) {
   auto** p = static_cast<CarBinding::Proxy**>(luaL_testudata(L, idx, kMetatable));
   return p ? (*p)->car : nullptr;

@@ -19,17 +19,17 @@ class EventNames;
 }
 
 // The car's events, in one list: CarEvent::Position is "onPosition", … (docs/lua-api.md).
-#define PITWALL_CAR_EVENTS(X)                                                                     \
-  X(Position)                                                                                     \
-  X(Transition)                                                                                   \
-  X(Intersection)                                                                                 \
-  X(Delocalized)                                                                                  \
-  X(Offset)                                                                                       \
-  X(Battery)                                                                                      \
-  X(Version)                                                                                      \
-  X(Ping)                                                                                         \
-  X(Status) X(Collision) X(Speed) X(LaneChange) X(Recovery) X(Connect) X(Disconnect) X(Malformed) \
-      X(Message)
+#define PITWALL_CAR_EVENTS(X) \
+  X(Position)                 \
+  X(Transition)               \
+  X(Intersection)             \
+  X(Delocalized)              \
+  X(Offset)                   \
+  X(Battery)                  \
+  X(Version)                  \
+  X(Ping)                     \
+  X(Status)                   \
+  X(Collision) X(Speed) X(LaneChange) X(Recovery) X(Connect) X(Disconnect) X(Malformed) X(Message)
 
 enum class CarEvent {
 #define PITWALL_CAR_EVENT_ENUM(name) name,
@@ -73,6 +73,9 @@ class CarBinding {
   // car's label, "car 1 (skull)"; anything else is not a car of this world and is ignored):
   // counted against handlerErrorLimit(), and the car stopped when that is reached.
   void handlerFailed(std::string_view what, std::string_view who, std::string_view message);
+  // The same for an error reported at `where` ("onPosition handler of car 1 (king of hill)"):
+  // the car is the one whose label ends it (a name may hold " of " too).
+  void handlerFailedIn(std::string_view where, std::string_view message);
   // The car at idx, or nullptr when the value is not a car.
   static AnkiCar* test(lua_State* L, int idx);
 

@@ -433,10 +433,7 @@ void ScriptHost::reportError(const std::string& where, const std::string& messag
     const std::string& where;
     const std::string& message;
     ~CountAfter() {
-      const auto of = where.rfind(" of ");
-      if (of != std::string::npos && host.cars_)
-        host.cars_->handlerFailed(std::string_view(where).substr(0, of),
-                                  std::string_view(where).substr(of + 4), message);
+      if (host.cars_) host.cars_->handlerFailedIn(where, message);
     }
   } countAfter{*this, where, message};
   lua_State* L = L_;

@@ -11,6 +11,7 @@
 #include "bindings/lua_args.hpp"
 #include "bindings/pitwall_module.hpp"
 #include "bindings/script_host.hpp"
+#include "engine/core/printable.hpp"
 #include "engine/view/feed.hpp"
 
 namespace pitwall {
@@ -99,8 +100,11 @@ nlohmann::json toJson(lua_State* L, int idx, int depth, std::size_t& count, lua:
       throw LuaError("pitwall.view.race: " + where + " has a " + luaL_typename(L, -2) +
                      " key; keys are strings or numbers");
     }
-    budget.add(key.size(), where + "." + key);
-    o[key] = toJson(L, -1, depth + 1, count, budget, where + "." + key);
+    // the path names at most 40 bytes of a key: a 1 MiB key over 100 000 values would otherwise
+    // be copied into the path of each of them (work no budget counts)
+    const std::string path = where + "." + printable(key, 40);
+    budget.add(key.size(), path);
+    o[key] = toJson(L, -1, depth + 1, count, budget, path);
     lua_pop(L, 1);
   }
   return o;

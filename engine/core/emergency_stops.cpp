@@ -24,6 +24,10 @@ struct Slot {
   std::size_t size = 0;
 };
 std::array<Slot, kSlots> g_slots;
+// sendAll()s under way (the watchdog's thread, a signal handler): remove() waits for them, so a
+// socket is never closed — and its number given to another file — between a sender's read of
+// it and its send(2).
+std::atomic<int> g_sending{0};
 static_assert(std::atomic<int>::is_always_lock_free && std::atomic<bool>::is_always_lock_free);
 
 }  // namespace
@@ -46,20 +50,26 @@ int add(int fd, std::span<const std::uint8_t> stopFrame) {
 
 void remove(int slot) {
   if (slot < 0 || slot >= static_cast<int>(kSlots)) return;
-  g_slots[slot].fd.store(-1, std::memory_order_release);
+  g_slots[slot].fd.store(-1, std::memory_order_seq_cst);
+  // A sender that read the socket before the store may still be sending to it: wait for it
+  // (a few send(2) calls at most). On the thread a signal handler interrupts, the handler's
+  // sendAll finishes before this goes on, so this never waits for itself.
+  while (g_sending.load(std::memory_order_seq_cst) != 0) std::this_thread::yield();
   g_slots[slot].taken.store(false, std::memory_order_release);
 }
 
 int sendAll() {
   int saved = errno;
+  g_sending.fetch_add(1, std::memory_order_seq_cst);
   int sent = 0;
   for (Slot& slot : g_slots) {
-    int fd = slot.fd.load(std::memory_order_acquire);
+    int fd = slot.fd.load(std::memory_order_seq_cst);
     if (fd < 0) continue;
     if (::send(fd, slot.frame, slot.size, MSG_DONTWAIT | MSG_NOSIGNAL) ==
         static_cast<ssize_t>(slot.size))
       ++sent;
   }
+  g_sending.fetch_sub(1, std::memory_order_seq_cst);
   errno = saved;
   return sent;
 }

@@ -126,6 +126,8 @@ void Feed::setRace(nlohmann::json race) {
   };
   std::string before = phaseOf(race_), after = phaseOf(race);
   race_ = std::move(race);
+  // dumped once here, not again for every update that a car's move makes
+  raceText_ = race_.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   ++changes_;
   if (!after.empty() && after != before) {
     auto title = race_.find("title");
@@ -276,12 +278,13 @@ nlohmann::json Feed::update(std::uint64_t& cursor, std::uint64_t& trackSeen) con
 std::string Feed::updateText(std::uint64_t& cursor, std::uint64_t& trackSeen) const {
   constexpr auto kReplace = nlohmann::json::error_handler_t::replace;
   if (sharedAt_ != changes_) {
-    nlohmann::json shared = {{"cars", carsJson(false)},
-                             {"race", race_.is_null() ? nlohmann::json(nullptr) : race_},
-                             {"replay", replay_.is_null() ? nlohmann::json(nullptr) : replay_},
-                             {"seats", seatsJson()}};
-    shared_ = shared.dump(-1, ' ', false, kReplace);
-    shared_ = shared_.substr(1, shared_.size() - 2);  // its members, without the braces
+    // the race's text as setRace dumped it: a script's table (up to pitwall.view.race's 8 MiB)
+    // is not copied and dumped again for every move of a car
+    shared_ =
+        R"("cars":)" + carsJson(false).dump(-1, ' ', false, kReplace) + R"(,"race":)" + raceText_ +
+        R"(,"replay":)" +
+        (replay_.is_null() ? nlohmann::json(nullptr) : replay_).dump(-1, ' ', false, kReplace) +
+        R"(,"seats":)" + seatsJson().dump(-1, ' ', false, kReplace);
     sharedAt_ = changes_;
   }
   std::string text = R"({"type":"update","time":)" + nlohmann::json(round3(now())).dump() + "," +

@@ -97,6 +97,7 @@ class Feed {
   std::string trackSource_ = "none";
   std::uint64_t trackVersion_ = 0;
   nlohmann::json race_;
+  std::string raceText_ = "null";  // race_ dumped (setRace)
   nlohmann::json replay_;
   struct Event {
     std::uint64_t seq;

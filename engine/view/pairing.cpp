@@ -83,8 +83,11 @@ Result<bool, std::string> Pairing::check(const std::string& client, std::string_
   }
   if (it == tries_.end()) {
     if (tries_.size() >= kMaxClients) {
-      // forget a client whose lock-out is over; none: every unknown client is refused until one is
-      std::erase_if(tries_, [now](const auto& e) { return e.second.lockedUntil <= now; });
+      // forget only a client silent for the longest lock-out: forgetting one whose lock-out is
+      // merely over (or that has a try or two left) would start its count again, and an attacker
+      // cycling through more addresses than the table holds would never be locked out. None:
+      // every unknown client is refused until one is (the right code still pairs, above)
+      std::erase_if(tries_, [now](const auto& e) { return e.second.last + kMaxLockout <= now; });
       if (tries_.size() >= kMaxClients)
         return Unexpected{"too many clients are guessing the join code: try again in a minute"};
     }

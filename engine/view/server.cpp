@@ -179,7 +179,7 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   void closeAll();
   bool serves(const std::string& name);
   void admit(tcp::socket socket);
-  bool roomForSocket(const std::string& client);
+  bool roomForSocket(const std::string& client, const std::function<bool()>& pairs);
   std::string driveUrl(std::string_view page = "drive") const;
 };
 
@@ -429,19 +429,29 @@ struct Server::Impl::Http : std::enable_shared_from_this<Http> {
         return text(req, http::status::not_found, "text/plain", "WebSocket only on /ws\n");
       bool forwarded = false;
       const std::string who = client(req, forwarded);
-      if (!server->roomForSocket(who))
-        return text(
-            req, http::status::service_unavailable, "text/plain",
-            "the view serves " + std::to_string(kMaxBrowsers) + " browsers at most; close one\n");
       std::optional<std::string> code;
       if (auto at = target.find("code="); at != std::string::npos) {
         auto end = target.find('&', at);
         code = target.substr(at + 5, end == std::string::npos ? std::string::npos : end - at - 5);
       }
+      // A phone that brings the join code is never kept out by spectators: when the slots are
+      // full it takes an unpaired page's. Its code is checked (and a wrong one counted) once,
+      // here; the page pairs with it again without counting.
+      auto pairs = [&] {
+        return code && server->pairing.required() &&
+               static_cast<bool>(server->pairing.check(who, *code, server->loop.seconds()));
+      };
+      if (!server->roomForSocket(who, pairs))
+        return text(
+            req, http::status::service_unavailable, "text/plain",
+            "the view serves " + std::to_string(kMaxBrowsers) + " browsers at most; close one\n");
       stream.expires_never();
       auto socket = std::make_shared<Socket>(server, stream.release_socket(), who);
       server->sockets.push_back(socket);
-      socket->start(std::move(req), std::move(code), peerLoopback && !forwarded);
+      // local (shown the join code): this machine's own browser. Behind --view-host the proxy is
+      // on loopback and may rewrite Host to 127.0.0.1 (nginx's default), so nobody is local then
+      socket->start(std::move(req), std::move(code),
+                    peerLoopback && !forwarded && server->options.names.empty());
       return;
     }
     if (req.method() != http::verb::get && req.method() != http::verb::head)
@@ -523,8 +533,9 @@ void Server::Impl::admit(tcp::socket socket) {
 }
 
 // A WebSocket slot for `client`: free, or taken from the client that holds the most (more than
-// `client` would): a socket of theirs that holds no seat first, the oldest first.
-bool Server::Impl::roomForSocket(const std::string& client) {
+// `client` would): a socket of theirs that holds no seat first, the oldest first; else, when the
+// newcomer brings the join code (`pairs()`), from the oldest page that is not paired, whoever's.
+bool Server::Impl::roomForSocket(const std::string& client, const std::function<bool()>& pairs) {
   std::erase_if(sockets, [](const auto& w) {
     auto s = w.lock();
     return !s || s->closed;
@@ -534,7 +545,18 @@ bool Server::Impl::roomForSocket(const std::string& client) {
   for (auto& w : sockets) count[w.lock()->client]++;
   auto most = std::max_element(count.begin(), count.end(),
                                [](auto& a, auto& b) { return a.second < b.second; });
-  if (most == count.end() || most->second <= count[client] + 1) return false;
+  if (most == count.end() || most->second <= count[client] + 1) {
+    if (!pairs()) return false;
+    for (auto& w : sockets) {  // oldest first
+      auto s = w.lock();
+      if (s->page.paired()) continue;
+      log::info("view", "a spectator's page of " + s->client + " closed to make room for " +
+                            client + ", who brings the join code");
+      s->close();
+      return true;
+    }
+    return false;
+  }
   const drive::Seats* seats = feed.seats();
   std::shared_ptr<Socket> victim;
   for (auto& w : sockets) {

@@ -522,6 +522,27 @@ TEST_CASE("view drive: 200 idle and slow connections from 10 addresses do not ke
       std::chrono::seconds(60));
 }
 
+// The other squatting: every WebSocket slot held by a different address, one each (64 aliases
+// of a LAN attacker). A page without the code is turned away; a phone with it takes the oldest
+// unpaired page's slot and its seat.
+TEST_CASE("view drive: 64 spectators from 64 addresses do not keep a phone with the code out") {
+  Rig rig(1, 1, {}, needCode);
+  rig.with(
+      [&](std::uint16_t port) {
+        std::vector<std::unique_ptr<WsClient>> spectators;
+        for (int i = 0; i < 64; ++i)
+          spectators.push_back(
+              std::make_unique<WsClient>(port, "127.0.1." + std::to_string(i + 1), "/ws"));
+        // one more without the code: no room, and nobody is pushed out for it
+        CHECK_THROWS(WsClient(port, "127.0.2.1", "/ws"));
+        Phone phone(port, "127.0.0.1", std::string("/ws?code=") + kCode);
+        phone.send(seatMessage(1, "Anna"));
+        auto m = phone.answer();
+        CHECK_MESSAGE(m["seat"] == 1, m.dump());
+      },
+      std::chrono::seconds(60));
+}
+
 // Behind --view-host, every phone comes from the proxy's address: the proxy's X-Forwarded-For
 // tells them apart — and only then (a client that names itself elsewhere is not believed).
 TEST_CASE("view drive: behind --view-host, wrong codes are counted per forwarded client") {

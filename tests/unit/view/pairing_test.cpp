@@ -85,8 +85,16 @@ TEST_CASE("pairing: the table of guessers is bounded") {
   auto r = p.check("new", "000000", 2);
   REQUIRE_FALSE(r);
   CHECK(r.error().find("too many clients are guessing") != std::string::npos);
-  // once their lock-outs are over, they are forgotten and the newcomer is counted
-  auto later = p.check("new", "000000", 1000);
+  // the right code still pairs
+  CHECK(p.check("new", "123456", 2));
+  // their lock-outs over (30 s) but not an hour gone: still remembered, so cycling through more
+  // addresses than the table holds never starts a count afresh
+  auto soon = p.check("new", "000000", 1000);
+  REQUIRE_FALSE(soon);
+  CHECK(soon.error().find("too many clients are guessing") != std::string::npos);
+  CHECK_FALSE(p.check("c0", "000000", 1000).error().find("tries left") != std::string::npos);
+  // an hour without a wrong code from them: forgotten, and the newcomer is counted
+  auto later = p.check("new", "000000", 1 + Pairing::kMaxLockout + 1);
   REQUIRE_FALSE(later);
   CHECK(later.error().find("4 tries left") != std::string::npos);
 }
