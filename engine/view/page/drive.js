@@ -43,16 +43,8 @@ const page = {
   lastSent: 0,
   pending: null,      // a timer for a change sent a little later
   heartbeat: null,
-  code: joinCode(),   // the join code from the address or this tab's memory; "" if none
+  code: pitwallJoinCode(),   // the join code from the address or this tab's memory; "" if none
 };
-
-function joinCode() {
-  const fromUrl = new URLSearchParams(location.search).get("code");
-  try {
-    if (fromUrl) sessionStorage.setItem("pitwall.code", fromUrl);
-    return fromUrl || sessionStorage.getItem("pitwall.code") || "";
-  } catch { return fromUrl || ""; /* storage off */ }
-}
 
 function setCode(code) {
   page.code = code.trim();

@@ -546,13 +546,7 @@ function showDriveLink(seats) {
 }
 
 let socket = null;
-let joinCode = (() => {
-  const fromUrl = new URLSearchParams(location.search).get("code");
-  try {
-    if (fromUrl) sessionStorage.setItem("pitwall.code", fromUrl);
-    return fromUrl || sessionStorage.getItem("pitwall.code") || "";
-  } catch { return fromUrl || ""; /* storage off */ }
-})();
+let joinCode = pitwallJoinCode();
 
 // {"type":"pairing","code":"123456","drive":"http://…/drive?code=123456"}: shown by the title,
 // for the players to type or open.
