@@ -149,48 +149,54 @@ TEST_CASE("a robot that disappears is reported down, and the link reconnects whe
   REQUIRE(runUntil(loop, [&] { return !ev.all<PingReply>().empty(); }));
 }
 
+namespace {
+// A link connected to a robot played by a bare socket (`peer`), for the ways a peer goes.
+struct BarePeer {
+  Loop loop{ClockKind::Real};
+  tcp::acceptor acceptor{loop.io(), tcp::endpoint(boost::asio::ip::make_address("127.0.0.1"), 0)};
+  tcp::socket peer{loop.io()};
+  bool accepted = false;
+  SocketLink link{loop, robotLinkOptions(acceptor.local_endpoint().port())};
+  Events ev;
+  BarePeer() {
+    acceptor.async_accept(peer, [this](boost::system::error_code ec) { accepted = !ec; });
+    ev.hook(link);
+    REQUIRE(runUntil(loop, [this] { return accepted && link.connected(); }));
+  }
+  // The link's second state (after up) is down, saying the robot closed the connection.
+  void expectClosedByRobot() {
+    REQUIRE(runUntil(loop, [this] { return ev.states.size() == 2; }));
+    CHECK_FALSE(ev.states[1].first);
+    CHECK(ev.states[1].second == "the robot closed the connection");
+  }
+};
+}  // namespace
+
 TEST_CASE("a robot that closes with our bytes unread (a reset) is reported as closing, too") {
   // The kernel answers the close of a socket with unread data by a reset, not an end of stream:
   // whether a robot's last instructions were read when it went away is a matter of timing, so
   // both must read the same (issue 33: "Connection reset by peer" once, in the integration test).
-  Loop loop(ClockKind::Real);
-  tcp::acceptor acceptor(loop.io(), tcp::endpoint(boost::asio::ip::make_address("127.0.0.1"), 0));
-  tcp::socket peer(loop.io());
-  bool accepted = false;
-  acceptor.async_accept(peer, [&](boost::system::error_code ec) { accepted = !ec; });
-  SocketLink link(loop, robotLinkOptions(acceptor.local_endpoint().port()));
-  Events ev;
-  ev.hook(link);
-  REQUIRE(runUntil(loop, [&] { return accepted && link.connected(); }));
+  BarePeer b;
+  Loop& loop = b.loop;
+  tcp::socket& peer = b.peer;
+  SocketLink& link = b.link;
   CHECK(link.send(wlan::encode(Ping{1})));
   bool unread = false;  // our bytes wait in the robot's socket, unread
   peer.async_wait(tcp::socket::wait_read, [&](boost::system::error_code ec) { unread = !ec; });
   REQUIRE(runUntil(loop, [&] { return unread; }));
   REQUIRE(peer.available() > 0);
   peer.close();  // with data unread: a reset
-  REQUIRE(runUntil(loop, [&] { return ev.states.size() == 2; }));
-  CHECK_FALSE(ev.states[1].first);
-  CHECK(ev.states[1].second == "the robot closed the connection");
+  b.expectClosedByRobot();
 }
 
 TEST_CASE("a write to a robot that has gone is reported as the robot closing, too") {
   // The robot resets the connection (an abortive close) before the link has read of it: the
   // next instruction's write fails first (a reset, or a broken pipe), and says the same.
-  Loop loop(ClockKind::Real);
-  tcp::acceptor acceptor(loop.io(), tcp::endpoint(boost::asio::ip::make_address("127.0.0.1"), 0));
-  tcp::socket peer(loop.io());
-  bool accepted = false;
-  acceptor.async_accept(peer, [&](boost::system::error_code ec) { accepted = !ec; });
-  SocketLink link(loop, robotLinkOptions(acceptor.local_endpoint().port()));
-  Events ev;
-  ev.hook(link);
-  REQUIRE(runUntil(loop, [&] { return accepted && link.connected(); }));
-  peer.set_option(boost::asio::socket_base::linger(true, 0));
-  peer.close();                             // a reset, on loopback delivered before close() returns
-  CHECK(link.send(wlan::encode(Ping{1})));  // tried at once: the write fails before any read
-  REQUIRE(runUntil(loop, [&] { return ev.states.size() == 2; }));
-  CHECK_FALSE(ev.states[1].first);
-  CHECK(ev.states[1].second == "the robot closed the connection");
+  BarePeer b;
+  b.peer.set_option(boost::asio::socket_base::linger(true, 0));
+  b.peer.close();  // a reset, on loopback delivered before close() returns
+  CHECK(b.link.send(wlan::encode(Ping{1})));  // tried at once: the write fails before any read
+  b.expectClosedByRobot();
 }
 
 TEST_CASE("a robot that is not there: the first failure is reported once, with the reason") {
