@@ -127,6 +127,8 @@ int simRobotAlphabot(const SimRobotOptions& options) {
   signals.async_wait([&](const boost::system::error_code& ec, int sig) {
     if (ec) return;
     log::info(kComponent, sig == SIGINT ? "interrupted" : "terminated");
+    // what the robot was last told, as a test reads it (robot_way_out_test.sh)
+    log::info(kComponent, robot.moving() ? "the robot is moving" : "the robot is at rest");
     server->close();
     loop.stop();
   });

@@ -205,7 +205,13 @@ void Session::suspend() {
     std::cout.flush();
     std::fflush(stdout);
     if (watchdog_) watchdog_->hold(true);  // a suspended loop is not a stuck one
-    ::raise(SIGSTOP);                      // here until SIGCONT (fg, bg, kill -CONT)
+    // and, with no Lua code left to run before the stop, every stop outside the loop: the
+    // robots the fleet does not hold (an Alphabot, a MindRoad robot) get theirs too
+    if (!finishing_ && !spectator_) {
+      emergency::sendAll();
+      emergency::runStoppers();
+    }
+    ::raise(SIGSTOP);  // here until SIGCONT (fg, bg, kill -CONT)
     if (watchdog_) watchdog_->hold(false);
     suspending_ = false;
     if (finishing_) return;

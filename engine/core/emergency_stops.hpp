@@ -8,9 +8,15 @@
 // second, and the last-resort exit of the stop signals' handler. send() is async-signal-safe and
 // thread-safe: a fixed table of slots, each an atomic socket and its frame, and send(2) with
 // MSG_DONTWAIT | MSG_NOSIGNAL. A link takes its slot back before it closes the socket.
+//
+// A link whose stop needs more than one send(2) — a WriteValue call or an MQTT publish, each on
+// a connection of its own, made there and then — registers a stopper instead: a function that
+// only the watchdog's thread runs (it is not async-signal-safe). The last-resort exit asks that
+// thread for them and waits for it, a bounded time, before it leaves.
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <thread>
 
@@ -28,10 +34,29 @@ inline constexpr std::size_t kFrameMax = 20;
 int add(int fd, std::span<const std::uint8_t> stopFrame);
 // The slot is free again; call before closing its socket. -1 is ignored.
 void remove(int slot);
+// A slot whose socket is a byte stream (TCP) is busy while a frame is partly written: no stop
+// goes to it then, as a stop inside another frame would garble both. -1 is ignored.
+void setBusy(int slot, bool busy);
 // Sends every registered stop once; how many went out. Async-signal-safe.
 int sendAll();
 // Registered slots (tests).
 int count();
+
+// A stop sent from the watchdog's thread: true when it went out. It must bound its own time
+// (a second at most) and own what it uses (no pointer to a link). An id; removeStopper waits
+// for a run under way, so a link may destroy what the stopper reaches only after it.
+using Stopper = std::function<bool()>;
+int addStopper(Stopper stopper);
+void removeStopper(int id);  // 0 is ignored
+// Runs every stopper once; how many went out. Not async-signal-safe (the watchdog's thread).
+int runStoppers();
+// Stoppers registered (tests).
+int stopperCount();
+
+// The last-resort exit: asks a running watchdog to run the stoppers now and waits for it at
+// most `limit`; false when no watchdog runs, there is no stopper, or the time ran out.
+// Async-signal-safe.
+bool askWatchdog(std::chrono::milliseconds limit);
 
 }  // namespace emergency
 

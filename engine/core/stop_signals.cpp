@@ -49,6 +49,8 @@ void onStopSignal(int sig) {
   if (count >= 3 && g_acted.load(std::memory_order_relaxed) < 2) {
     // The last word: every car that can be reached without the loop gets its stop first.
     emergency::sendAll();
+    // the stops that need a connection of their own: the watchdog's thread makes them
+    emergency::askWatchdog(std::chrono::milliseconds(1500));
     static const char kMsg[] =
         "\npitwall: the loop did not answer two signals: every car sent its stop from outside "
         "the loop; leaving now\n";

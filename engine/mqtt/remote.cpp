@@ -19,6 +19,7 @@ constexpr RateLimit kWarnings{10, 20};
 class RemoteLink : public Link {
  public:
   RemoteLink(RemoteCars& owner, std::string id) : owner_(owner), id_(std::move(id)) {}
+  ~RemoteLink() override { emergency::removeStopper(std::exchange(stopper_, 0)); }
 
   bool send(std::span<const std::uint8_t> frame) override {
     refusal_.clear();
@@ -35,10 +36,17 @@ class RemoteLink : public Link {
   // disconnect message as an intent, and the car's status follows from its bridge.
   void disconnect() override {}
   std::string address() const override { return "mqtt:" + id_; }
+  // The stop outside the loop: the car's intent, published by the watchdog's thread on a
+  // connection of its own while the car is online.
+  void setEmergencyStop(std::span<const std::uint8_t> frame) override {
+    stop_.assign(frame.begin(), frame.end());
+    registerEmergency();
+  }
 
   void set(bool up, const std::string& reason) {
     if (up == up_) return;
     up_ = up;
+    registerEmergency();
     deliverState(up, reason);
   }
   void frame(std::span<const std::uint8_t> bytes) {
@@ -48,8 +56,17 @@ class RemoteLink : public Link {
  private:
   RemoteCars& owner_;
   std::string id_;
+  void registerEmergency() {
+    emergency::removeStopper(std::exchange(stopper_, 0));
+    if (up_ && !stop_.empty())
+      if (auto stopper = owner_.emergencyStopper(id_, stop_))
+        stopper_ = emergency::addStopper(stopper);
+  }
+
   bool up_ = false;
   std::string refusal_;  // why the last send() was refused
+  std::vector<std::uint8_t> stop_;
+  int stopper_ = 0;
 };
 
 RemoteCars::RemoteCars(Loop& loop, Fleet& fleet, MqttClient& client, topics::PayloadLimits limits)
@@ -317,6 +334,18 @@ std::optional<std::string> RemoteCars::sendCommand(const std::string& car,
   if (!client_.publish("Anki/Car/" + car + "/I", *payload, 1, false))
     return "not connected to the MQTT broker";
   return std::nullopt;
+}
+
+emergency::Stopper RemoteCars::emergencyStopper(const std::string& car,
+                                                std::span<const std::uint8_t> frame) const {
+  if (readOnly_) return nullptr;
+  auto message = anki::decode(frame);
+  if (!message) return nullptr;
+  auto payload = topics::intentPayload(*message);
+  if (!payload) return nullptr;
+  return [options = client_.options(), topic = "Anki/Car/" + car + "/I", payload = *payload] {
+    return publishOnce(options, topic, payload, 1, std::chrono::milliseconds(800));
+  };
 }
 
 }  // namespace pitwall

@@ -29,6 +29,7 @@
 #include <set>
 #include <string>
 
+#include "engine/core/emergency_stops.hpp"
 #include "engine/core/token_bucket.hpp"
 #include "engine/fleet/fleet.hpp"
 #include "engine/mqtt/topics.hpp"
@@ -64,6 +65,10 @@ class RemoteCars {
   // Used by RemoteLink: publishes the command's intent; nullopt when published, else why not.
   std::optional<std::string> sendCommand(const std::string& car,
                                          std::span<const std::uint8_t> frame);
+  // Used by RemoteLink: the stop `frame` as an intent published on a connection of its own,
+  // for the watchdog's thread (engine/core/emergency_stops.hpp); null for a spectator.
+  emergency::Stopper emergencyStopper(const std::string& car,
+                                      std::span<const std::uint8_t> frame) const;
 
  private:
   struct Car {

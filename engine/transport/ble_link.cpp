@@ -8,6 +8,7 @@
 
 #include "engine/core/emergency_stops.hpp"
 #include "engine/core/log.hpp"
+#include "engine/transport/emergency_write.hpp"
 
 namespace pitwall::ble {
 
@@ -88,11 +89,13 @@ void BleLink::up() {
                             (notifyAcquired() ? "socket" : "signal") + ", writes by " +
                             (writeAcquired() ? "socket" : "call"));
   gatt_.ready();
+  registerEmergency();
 }
 
 void BleLink::closeChannels() {
   notify_.close();
   closeWrite();
+  emergency::removeStopper(std::exchange(emergencyStopper_, 0));
 }
 
 void BleLink::closeWrite() {
@@ -104,12 +107,20 @@ void BleLink::closeWrite() {
 void BleLink::setEmergencyStop(std::span<const std::uint8_t> frame) {
   emergencyStop_.assign(frame.begin(), frame.end());
   emergency::remove(std::exchange(emergencySlot_, -1));
+  emergency::removeStopper(std::exchange(emergencyStopper_, 0));
   registerEmergency();
 }
 
 void BleLink::registerEmergency() {
-  if (emergencySlot_ < 0 && writeFd_.is_open() && !emergencyStop_.empty())
-    emergencySlot_ = emergency::add(writeFd_.native_handle(), emergencyStop_);
+  if (emergencyStop_.empty()) return;
+  if (writeFd_.is_open()) {
+    emergency::removeStopper(std::exchange(emergencyStopper_, 0));
+    if (emergencySlot_ < 0)
+      emergencySlot_ = emergency::add(writeFd_.native_handle(), emergencyStop_);
+  } else if (emergencyStopper_ == 0 && !writeChar_.empty() && gatt_.up()) {
+    // writes go through WriteValue: so does the stop, on a connection of its own
+    emergencyStopper_ = emergency::addStopper(writeValueStopper(writeChar_, emergencyStop_, false));
+  }
 }
 
 void BleLink::value(const std::vector<std::uint8_t>& frame) {
@@ -126,6 +137,7 @@ bool BleLink::send(std::span<const std::uint8_t> frame) {
       log::debug(address(), std::string("write socket failed (") + std::strerror(errno) +
                                 "): writes through WriteValue");
       closeWrite();
+      registerEmergency();
     }
   }
   writeValue(frame);

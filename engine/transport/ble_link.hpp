@@ -61,8 +61,9 @@ class BleLink : public Link {
   void up();
   void closeChannels();
   void writeValue(std::span<const std::uint8_t> frame);
-  void closeWrite();         // the write socket, after its emergency slot is given back
-  void registerEmergency();  // the write socket and the stop frame, when both are there
+  void closeWrite();  // the write socket, after its emergency slot is given back
+  // The stop outside the loop: the write socket's slot, or a stopper writing with WriteValue
+  void registerEmergency();
 
   GattClient gatt_;
   std::string readChar_, writeChar_;
@@ -70,6 +71,7 @@ class BleLink : public Link {
   boost::asio::posix::stream_descriptor writeFd_;
   std::vector<std::uint8_t> emergencyStop_;
   int emergencySlot_ = -1;
+  int emergencyStopper_ = 0;
   std::shared_ptr<bool> alive_;
 };
 

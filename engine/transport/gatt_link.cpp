@@ -8,6 +8,7 @@
 
 #include "engine/core/log.hpp"
 #include "engine/core/numbers.hpp"
+#include "engine/transport/emergency_write.hpp"
 
 namespace pitwall {
 
@@ -80,6 +81,7 @@ GattLink::GattLink(Loop& loop, std::string address, GattProfile profile, GattLin
 
 GattLink::~GattLink() {
   *alive_ = false;
+  emergency::removeStopper(std::exchange(emergencyStopper_, 0));
   loop_.cancel(retry_);
   loop_.cancel(scanTimer_);
   closeSockets();
@@ -176,6 +178,7 @@ void GattLink::connect(const std::string& devicePath) {
         lastError_.clear();
         reportedDown_ = false;
         log::info(address(), "connected");
+        registerEmergency(true);
         deliverState(true, "connected");
       } else {
         reportDown(reason);
@@ -248,6 +251,7 @@ void GattLink::closeSockets() {
 }
 
 void GattLink::reportDown(const std::string& why) {
+  registerEmergency(false);
   lastError_ = why;
   // Once per outage: the first failed attempt, or the loss of a link that was up.
   if (reportedDown_) return;
@@ -292,6 +296,20 @@ void GattLink::reconnect(const std::string& reason) {
   gatt_->disconnect([this, alive, reason] {
     if (!alive.expired()) retryLater(reason);
   });
+}
+
+// ---- the stop outside the loop ----
+
+void GattLink::setEmergencyStop(std::span<const std::uint8_t> frame) {
+  emergencyStop_.assign(frame.begin(), frame.end());
+  registerEmergency(connected());
+}
+
+void GattLink::registerEmergency(bool up) {
+  emergency::removeStopper(std::exchange(emergencyStopper_, 0));
+  if (!up || emergencyStop_.size() < 2 || emergencyStop_[0] >= paths_.size()) return;
+  emergencyStopper_ = emergency::addStopper(ble::writeValueStopper(
+      paths_[emergencyStop_[0]], {emergencyStop_.begin() + 1, emergencyStop_.end()}, true));
 }
 
 // ---- frames ----

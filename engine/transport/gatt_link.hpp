@@ -91,6 +91,8 @@ class GattLink : public Link {
   std::string address() const override { return "ble:" + address_; }
   // Down: why ("ble:…: not connected (…)"); up: the last failed write or read, or empty.
   std::string refusal() const override;
+  // [index, value…]: written with WriteValue from the watchdog's thread while the link is up
+  void setEmergencyStop(std::span<const std::uint8_t> frame) override;
 
   int attempts() const { return attempts_; }
   // Notifications by socket (AcquireNotify) rather than by PropertiesChanged, for tests.
@@ -110,6 +112,7 @@ class GattLink : public Link {
   void reportDown(const std::string& why);
   void closeSockets();
   void stopScan();
+  void registerEmergency(bool up);
 
   Loop& loop_;
   std::string address_;
@@ -124,6 +127,8 @@ class GattLink : public Link {
   bool closed_ = false, reportedDown_ = false;
   std::string scanning_;  // the adapter discovering for us
   Loop::TimerId retry_ = 0, scanTimer_ = 0;
+  std::vector<std::uint8_t> emergencyStop_;
+  int emergencyStopper_ = 0;
   std::shared_ptr<bool> alive_;
 };
 

@@ -48,6 +48,36 @@ void checkPublishTopic(std::string_view topic, std::string_view what) {
                                 "without the wildcards + and #)");
 }
 
+// Sets what a connection needs from the options (no delay, credentials, TLS, the will) on a new
+// client; an error sentence, or empty.
+std::string configure(mosquitto* mosq, const MqttOptions& o) {
+  std::string error;
+  auto check = [&](int rc, const std::string& what) {
+    if (rc == MOSQ_ERR_SUCCESS || !error.empty()) return;
+    error = "MQTT: " + what + ": " + mosquitto_strerror(rc);
+  };
+  // Nagle's algorithm holds a small packet while an earlier one is unacknowledged, and the peer
+  // delays its ACK (Linux: 40 ms): a burst of publications would wait that long
+  // (docs/performance.md "MQTT bridge"). Bursts are coalesced with Batch instead.
+  check(mosquitto_int_option(mosq, MOSQ_OPT_TCP_NODELAY, 1), "cannot set TCP_NODELAY");
+  if (!o.username.empty())
+    check(mosquitto_username_pw_set(mosq, o.username.c_str(),
+                                    o.password.empty() ? nullptr : o.password.c_str()),
+          "cannot set the username");
+  if (o.tls) {
+    if (o.caFile.empty())
+      check(mosquitto_int_option(mosq, MOSQ_OPT_TLS_USE_OS_CERTS, 1), "cannot use the OS CAs");
+    else
+      check(mosquitto_tls_set(mosq, o.caFile.c_str(), nullptr, nullptr, nullptr, nullptr),
+            "cannot use the CA file '" + o.caFile + "'");
+  }
+  if (o.will)
+    check(mosquitto_will_set(mosq, o.will->topic.c_str(), static_cast<int>(o.will->payload.size()),
+                             o.will->payload.data(), o.will->qos, o.will->retain),
+          "cannot set the last will");
+  return error;
+}
+
 }  // namespace
 
 Result<MqttUrl, std::string> parseMqttUrl(std::string_view url) {
@@ -148,31 +178,10 @@ MqttClient::MqttClient(Loop& loop, MqttOptions options)
   mosquitto_message_callback_set(mosq_, &MqttClient::handleMessage);
   mosquitto_log_callback_set(mosq_, &MqttClient::handleLog);
   mosquitto_publish_callback_set(mosq_, &MqttClient::handlePublish);
-  auto check = [&](int rc, const char* what) {
-    if (rc == MOSQ_ERR_SUCCESS) return;
-    std::string message = std::string("MQTT: ") + what + ": " + mosquitto_strerror(rc);
+  if (std::string error = configure(mosq_, o); !error.empty()) {
     mosquitto_destroy(mosq_);
-    throw std::invalid_argument(message);
-  };
-  // Nagle's algorithm holds a small packet while an earlier one is unacknowledged, and the peer
-  // delays its ACK (Linux: 40 ms): a burst of publications would wait that long
-  // (docs/performance.md "MQTT bridge"). Bursts are coalesced with Batch instead.
-  check(mosquitto_int_option(mosq_, MOSQ_OPT_TCP_NODELAY, 1), "cannot set TCP_NODELAY");
-  if (!o.username.empty())
-    check(mosquitto_username_pw_set(mosq_, o.username.c_str(),
-                                    o.password.empty() ? nullptr : o.password.c_str()),
-          "cannot set the username");
-  if (o.tls) {
-    if (o.caFile.empty())
-      check(mosquitto_int_option(mosq_, MOSQ_OPT_TLS_USE_OS_CERTS, 1), "cannot use the OS CAs");
-    else
-      check(mosquitto_tls_set(mosq_, o.caFile.c_str(), nullptr, nullptr, nullptr, nullptr),
-            ("cannot use the CA file '" + o.caFile + "'").c_str());
+    throw std::invalid_argument(error);
   }
-  if (o.will)
-    check(mosquitto_will_set(mosq_, o.will->topic.c_str(), static_cast<int>(o.will->payload.size()),
-                             o.will->payload.data(), o.will->qos, o.will->retain),
-          "cannot set the last will");
 }
 
 MqttClient::~MqttClient() {
@@ -528,6 +537,46 @@ void MqttClient::handleLog(mosquitto*, void* self, int level, const char* text) 
   // OpenSSL's reasons for a failed handshake reach us only as log lines.
   if (level & (MOSQ_LOG_ERR | MOSQ_LOG_WARNING))
     static_cast<MqttClient*>(self)->lastLogError_ = text;
+}
+
+bool publishOnce(const MqttOptions& options, const std::string& topic, const std::string& payload,
+                 int qos, std::chrono::milliseconds limit) {
+  initLibrary();
+  MqttOptions o = options;
+  o.will.reset();  // a goodbye of its own would be the main connection's will twice
+  struct Progress {
+    int connected = -1;  // the CONNACK's code once it came
+    int mid = -1;
+    bool delivered = false;
+  } progress;
+  mosquitto* mosq = mosquitto_new(nullptr, true, &progress);  // a random client id of its own
+  if (!mosq) return false;
+  mosquitto_connect_callback_set(
+      mosq, [](mosquitto*, void* p, int rc) { static_cast<Progress*>(p)->connected = rc; });
+  mosquitto_publish_callback_set(mosq, [](mosquitto*, void* p, int mid) {
+    auto* progress = static_cast<Progress*>(p);
+    if (mid == progress->mid) progress->delivered = true;
+  });
+  const auto deadline = std::chrono::steady_clock::now() + limit;
+  auto within = [&] { return std::chrono::steady_clock::now() < deadline; };
+  bool sent = false;
+  if (configure(mosq, o).empty() &&
+      mosquitto_connect_async(mosq, o.host.c_str(), o.port, 5) == MOSQ_ERR_SUCCESS) {
+    while (within() && progress.connected < 0)
+      if (mosquitto_loop(mosq, 20, 1) != MOSQ_ERR_SUCCESS) break;
+    if (progress.connected == 0 &&
+        mosquitto_publish(mosq, &progress.mid, topic.c_str(), static_cast<int>(payload.size()),
+                          payload.data(), qos, false) == MOSQ_ERR_SUCCESS) {
+      // QoS 0 is out once written; QoS 1 and 2 once the broker acknowledged
+      while (within() && !progress.delivered)
+        if (mosquitto_loop(mosq, 20, 1) != MOSQ_ERR_SUCCESS) break;
+      sent = progress.delivered;
+      mosquitto_disconnect(mosq);
+      mosquitto_loop(mosq, 20, 1);
+    }
+  }
+  mosquitto_destroy(mosq);
+  return sent;
 }
 
 }  // namespace pitwall

@@ -7,6 +7,7 @@
 // thread, inside those calls. After an unexpected loss the client reconnects with backoff (0.5 s
 // doubling to 8 s) and re-subscribes what was subscribed. docs/mqtt.md describes the design.
 #include <boost/asio/posix/stream_descriptor.hpp>
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -157,5 +158,11 @@ class MqttClient {
   Loop::TimerId attemptTimer_ = 0;
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };
+
+// One publication on a connection of its own, made and closed here, in at most `limit`; true
+// once it is out (QoS 0) or the broker acknowledged it (QoS 1, 2). Blocking: for a thread other
+// than the loop's (the watchdog's stop of a remote car, engine/core/emergency_stops.hpp).
+bool publishOnce(const MqttOptions& options, const std::string& topic, const std::string& payload,
+                 int qos, std::chrono::milliseconds limit);
 
 }  // namespace pitwall

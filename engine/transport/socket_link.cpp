@@ -1,16 +1,20 @@
 // A TCP or UDP link on the engine loop (socket_link.hpp).
 #include "engine/transport/socket_link.hpp"
 
+#include <sys/socket.h>
+
 #include <algorithm>
 #include <array>
 #include <boost/asio/connect.hpp>
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/ip/udp.hpp>
 #include <boost/asio/write.hpp>
+#include <cerrno>
 #include <deque>
 #include <optional>
 #include <vector>
 
+#include "engine/core/emergency_stops.hpp"
 #include "engine/core/numbers.hpp"
 
 namespace pitwall {
@@ -63,7 +67,20 @@ struct SocketLink::State : std::enable_shared_from_this<SocketLink::State> {
     timer.reset();
   }
 
+  // The stop outside the loop (engine/core/emergency_stops.hpp): the socket's slot while it is
+  // up. A TCP slot is busy while the queue holds a frame: a frame goes out whole at once when
+  // it can (SocketLink::send), so a queued one is one the kernel took part of, or none of yet.
+  std::vector<std::uint8_t> emergencyStop;
+  int emergencySlot = -1;
+  void registerEmergency() {
+    if (emergencySlot >= 0 || !up || emergencyStop.empty()) return;
+    int fd = tcpSocket ? tcpSocket->native_handle() : udpSocket ? udpSocket->native_handle() : -1;
+    emergencySlot = emergency::add(fd, emergencyStop);
+    if (tcpSocket) emergency::setBusy(emergencySlot, !queue.empty());
+  }
+
   void closeSockets() {
+    emergency::remove(std::exchange(emergencySlot, -1));
     boost::system::error_code ignored;
     if (tcpSocket) tcpSocket->close(ignored);
     if (udpSocket) udpSocket->close(ignored);
@@ -126,6 +143,7 @@ struct SocketLink::State : std::enable_shared_from_this<SocketLink::State> {
     pending.clear();
     read(attempt);
     if (!queue.empty()) write(attempt);
+    registerEmergency();
     if (link) link->deliverState(true, "");
   }
 
@@ -192,7 +210,8 @@ struct SocketLink::State : std::enable_shared_from_this<SocketLink::State> {
       if (ec)
         return self->failed(mine, "lost " + self->options.peer + " while sending: " + ec.message());
       self->queue.pop_front();
-      if (!self->queue.empty()) self->write(mine);
+      if (!self->queue.empty()) return self->write(mine);
+      emergency::setBusy(self->emergencySlot, false);
     };
     // Asio tries a write at once when nothing else is queued on the socket: a frame sent just
     // before close() is already in the kernel when the socket closes.
@@ -233,9 +252,26 @@ bool SocketLink::send(std::span<const std::uint8_t> frame) {
   auto& s = *state_;
   if (!s.up) return false;
   const bool idle = s.queue.empty();
+  if (idle && s.tcpSocket) {
+    // Whole at once when the kernel takes it: then no frame is ever half out while the loop
+    // stands, and the watchdog's stop can follow it (registerEmergency).
+    ssize_t n = ::send(s.tcpSocket->native_handle(), frame.data(), frame.size(),
+                       MSG_DONTWAIT | MSG_NOSIGNAL);
+    if (n == static_cast<ssize_t>(frame.size())) return true;
+    if (n > 0) frame = frame.subspan(static_cast<std::size_t>(n));
+    // else an error, which the asynchronous write meets and reports, or a full buffer
+  }
   s.queue.emplace_back(frame.begin(), frame.end());
+  if (s.tcpSocket) emergency::setBusy(s.emergencySlot, true);
   if (idle) s.write(s.attempt);
   return true;
+}
+
+void SocketLink::setEmergencyStop(std::span<const std::uint8_t> frame) {
+  auto& s = *state_;
+  s.emergencyStop.assign(frame.begin(), frame.end());
+  emergency::remove(std::exchange(s.emergencySlot, -1));
+  s.registerEmergency();
 }
 
 bool SocketLink::connected() const {

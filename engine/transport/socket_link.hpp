@@ -50,6 +50,8 @@ class SocketLink : public Link {
   SocketLink& operator=(const SocketLink&) = delete;
 
   bool send(std::span<const std::uint8_t> frame) override;
+  // The stop the watchdog sends on the socket itself (engine/core/emergency_stops.hpp).
+  void setEmergencyStop(std::span<const std::uint8_t> frame) override;
   bool connected() const override;
   // Closes for good: what was just sent is flushed before the close (a stop sent before
   // disconnect() reaches the device); no reconnection, no more handlers.

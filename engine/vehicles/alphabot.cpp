@@ -54,6 +54,14 @@ Alphabot::Alphabot(Loop& loop, std::unique_ptr<Link> link, AlphabotOptions optio
     : loop_(loop), link_(std::move(link)), options_(options) {
   link_->onFrame([this](std::span<const std::uint8_t> frame) { received(frame); });
   link_->onState([this](bool up, const std::string& reason) { linkChanged(up, reason); });
+  // What close() sends, for the stop that does not need the loop (engine/core/emergency_stops.hpp)
+  const ab::Request stop = ab::Drive{0, 0};
+  if (options_.wire == AlphabotOptions::Wire::Wlan) {
+    link_->setEmergencyStop(ab::wlan::encode(stop, options_.codec));
+  } else if (auto value = ab::ble::encode(stop)) {
+    link_->setEmergencyStop(
+        gatt::write(static_cast<std::uint8_t>(value->characteristic), value->bytes));
+  }
 }
 
 Alphabot::~Alphabot() {

@@ -41,6 +41,9 @@ MindroadRobot::MindroadRobot(Loop& loop, std::unique_ptr<Link> link, MindroadOpt
     : loop_(loop), link_(std::move(link)), options_(std::move(options)) {
   link_->onFrame([this](std::span<const std::uint8_t> frame) { received(frame); });
   link_->onState([this](bool up, const std::string& reason) { linkChanged(up, reason); });
+  // What close() sends, for the stop that does not need the loop (engine/core/emergency_stops.hpp):
+  // sooner than the robot's own watchdog
+  link_->setEmergencyStop(encode(Stop{}).span());
   log::debug(kLog, "connecting to " + address());
 }
 

@@ -3,6 +3,7 @@
 # - the watchdog: C code that never returns holds the loop; within about a second, every car
 #   gets its stop from a thread outside the loop
 # - the last-resort exit (a third signal the wedged loop never answered) sends the stops first
+# - both where BlueZ refuses AcquireWrite (--no-acquire): the stops then go by WriteValue
 # - Ctrl-Z stops the cars before the process stops
 # - a start refused for --keyboard without a terminal connects no car; one refused by a broker
 #   that cannot be reached, after the cars connected, stops them
@@ -45,6 +46,42 @@ check "watchdog: both cars were told to stop while the loop was stuck" "$both_st
 kill -9 $RUN_PID
 wait $RUN_PID 2>/dev/null
 exec 4<&-
+
+# --- the watchdog where BlueZ gives no write socket (writes go by WriteValue, on the loop's own
+# bus connection): the stops go as WriteValue calls on a connection the watchdog's thread makes
+start_fake --adapters 1 --cars 2 --no-acquire
+run_bg watchdog-call MODE=wedge
+read -r -t 20 -u 4 line
+check "watchdog, WriteValue: the script wedges the loop" "wedging" "$line"
+wait_for "$TMP/watchdog-call.err" "has not turned for" 20
+contains "watchdog, WriteValue: stderr says it stopped the cars" "the watchdog sent 2 cars its stop" \
+  "$(cat "$TMP/watchdog-call.err")"
+stop_fake
+check "watchdog, WriteValue: both cars were told to stop while the loop was stuck" \
+  "$both_stopped" "$(target_speeds)"
+kill -9 $RUN_PID
+wait $RUN_PID 2>/dev/null
+exec 4<&-
+
+# --- the last-resort exit over WriteValue: a signal handler cannot make a D-Bus call; it asks
+# the watchdog's thread (whose own limit, 60 s, is far off) and waits for it before it leaves
+start_fake --adapters 1 --cars 2 --no-acquire
+run_bg last-resort-call MODE=wedge PITWALL_WATCHDOG=60
+read -r -t 20 -u 4 line
+check "last resort, WriteValue: the script wedges the loop" "wedging" "$line"
+cat <&4 >/dev/null 2>&1 &
+for _ in $(seq 1 100); do
+  kill -INT $RUN_PID 2>/dev/null || break
+  kill -TERM $RUN_PID 2>/dev/null || break
+  sleep 0.05
+done
+wait_bounded $RUN_PID
+check "last resort, WriteValue: exit status" 130 $?
+exec 4<&-
+check "last resort, WriteValue: not the watchdog's doing" "" \
+  "$(grep "has not turned for" "$TMP/last-resort-call.err")"
+stop_fake
+check "last resort, WriteValue: both cars were told to stop" "$both_stopped" "$(target_speeds)"
 
 # --- the last-resort exit: no watchdog (PITWALL_WATCHDOG=0), the loop wedged, signals until
 # the handler itself ends the process

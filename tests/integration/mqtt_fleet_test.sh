@@ -2,7 +2,8 @@
 # two simulated cars, host B runs a race with them as remote cars (--cars 0 --remote-cars 2), then
 # a mixed race with one local car besides. The race finishes with results for every car, host A's
 # cars really drove (their own S/Speed/Actual on the tree), and they are stopped after each run,
-# also after a script that never stops commanding.
+# also after a script that never stops commanding, and while host B's loop is wedged (its
+# watchdog).
 source "$(dirname "$0")/mqtt_lib.sh"
 
 count() { grep -cE -- "$2" "$1" 2>/dev/null || true; }
@@ -122,6 +123,27 @@ wait $NAG
 check "nagging script (Ctrl-C): exit status" 130 "$?"
 exec 4<&-
 cars_stopped "nagging script (Ctrl-C)" "$from"
+
+# ---- host B's loop wedged in C code (a pattern that backtracks for hours): its watchdog
+# publishes the stop intents on a connection of its own; host A's cars stop while B is stuck.
+rm -f "$TMP/nag.fifo"
+from=$(wc -l <"$ALL")
+mkfifo "$TMP/nag.fifo"
+MODE=wedge $PITWALL run "$SRC/tests/integration/nagging.lua" --cars 0 --mqtt "$MQTT_URL" \
+  --remote-cars 2 </dev/null >"$TMP/nag.fifo" 2>"$TMP/wedge.err" &
+NAG=$!
+exec 4<"$TMP/nag.fifo"
+read -r -t 20 -u 4 line
+check "wedged host B: driving" "driving" "$line"
+read -r -t 20 -u 4 line
+check "wedged host B: the script wedges the loop" "wedging" "$line"
+wait_for "$TMP/wedge.err" "has not turned for" 20
+contains "wedged host B: stderr says the watchdog stopped both cars" \
+  "the watchdog sent 2 cars its stop" "$(cat "$TMP/wedge.err")"
+cars_stopped "wedged host B" "$from"  # while host B is still wedged
+kill -9 $NAG
+wait $NAG 2>/dev/null
+exec 4<&-
 
 kill -TERM "$BRIDGE"
 wait "$BRIDGE"

@@ -6,7 +6,10 @@
 #include <unistd.h>
 
 #include <array>
+#include <atomic>
 #include <cstdint>
+#include <stdexcept>
+#include <thread>
 #include <vector>
 
 using namespace pitwall;
@@ -108,4 +111,92 @@ TEST_CASE("the watchdog does not fire on a loop that turns, nor while held") {
   });
   loop.run();
   CHECK(watchdog.fired() == 0);
+}
+
+TEST_CASE("emergency stops: a busy slot (a frame half out on a byte stream) gets no stop") {
+  Pair a;
+  int slot = emergency::add(a.ours, kStop);
+  REQUIRE(slot >= 0);
+  emergency::setBusy(slot, true);
+  CHECK(emergency::sendAll() == 0);
+  CHECK(a.received(0).empty());
+  emergency::setBusy(slot, false);
+  CHECK(emergency::sendAll() == 1);
+  CHECK(a.received(1000) == kStop);
+  emergency::setBusy(slot, true);
+  emergency::remove(slot);
+  // a slot taken again starts free of the old one's busy mark
+  slot = emergency::add(a.ours, kStop);
+  CHECK(emergency::sendAll() == 1);
+  CHECK(a.received(1000) == kStop);
+  emergency::remove(slot);
+}
+
+TEST_CASE(
+    "emergency stoppers: each runs once a call, a removed one never, a throwing one "
+    "does not keep the others from theirs") {
+  int ran = 0, other = 0;
+  int id = emergency::addStopper([&] { return ++ran > 0; });
+  int failing = emergency::addStopper([&]() -> bool { throw std::runtime_error("no bus"); });
+  int unsent = emergency::addStopper([&] {
+    ++other;
+    return false;
+  });
+  CHECK(emergency::stopperCount() == 3);
+  CHECK(emergency::runStoppers() == 1);
+  CHECK(ran == 1);
+  CHECK(other == 1);
+  emergency::removeStopper(id);
+  emergency::removeStopper(failing);
+  CHECK(emergency::runStoppers() == 0);
+  CHECK(ran == 1);
+  CHECK(other == 2);
+  emergency::removeStopper(unsent);
+  emergency::removeStopper(0);  // ignored
+  CHECK(emergency::stopperCount() == 0);
+}
+
+// The adversary again: the loop wedged in a callback; the stopper (a D-Bus call or an MQTT
+// publish in the product) runs on the watchdog's thread, not on the wedged one.
+TEST_CASE("the watchdog runs the stoppers when the loop does not turn") {
+  Loop loop{ClockKind::Real};
+  std::atomic<int> stops{0};
+  std::atomic<bool> onLoopThread{false};
+  const auto loopThread = std::this_thread::get_id();
+  int id = emergency::addStopper([&] {
+    onLoopThread = std::this_thread::get_id() == loopThread;
+    ++stops;
+    return true;
+  });
+  {
+    Watchdog watchdog{loop, std::chrono::milliseconds(300)};
+    loop.after(10ms, [&] {
+      for (int i = 0; i < 2000 && stops == 0; ++i) std::this_thread::sleep_for(10ms);
+    });
+    loop.after(50ms, [&] { loop.stop(); });
+    loop.run();
+    CHECK(watchdog.fired() == 1);
+  }
+  emergency::removeStopper(id);
+  CHECK(stops == 1);
+  CHECK_FALSE(onLoopThread);
+}
+
+// The last-resort exit cannot make a D-Bus call from a signal handler: it asks the watchdog's
+// thread, and waits for it a bounded time; without a watchdog or a stopper it does not wait.
+TEST_CASE("askWatchdog: the stoppers run on the watchdog's thread while the asker waits") {
+  std::atomic<int> stops{0};
+  CHECK_FALSE(emergency::askWatchdog(2000ms));  // no watchdog, no stopper: at once
+  int id = emergency::addStopper([&] { return ++stops > 0; });
+  CHECK_FALSE(emergency::askWatchdog(2000ms));  // a stopper but no watchdog
+  CHECK(stops == 0);
+  {
+    Loop loop{ClockKind::Real};
+    Watchdog watchdog{loop, std::chrono::milliseconds(10000)};
+    CHECK(emergency::askWatchdog(5000ms));  // the loop is not even running: the thread answers
+    CHECK(stops == 1);
+    CHECK(watchdog.fired() == 0);
+  }
+  emergency::removeStopper(id);
+  CHECK_FALSE(emergency::askWatchdog(2000ms));
 }
