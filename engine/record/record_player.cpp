@@ -10,6 +10,9 @@ namespace {
 // a loop time rounds to nanoseconds).
 constexpr double kResolution = 1e-6;
 constexpr auto kSlice = std::chrono::milliseconds(20);
+// Lines read for one frame before the loop turns: a few milliseconds of bad lines (about 5 µs a
+// line), so a record with a million of them in a row holds no callback long.
+constexpr std::size_t kLinesPerRead = 4096;
 }  // namespace
 
 RecordPlayer::RecordPlayer(Loop& loop, Fleet& fleet, std::istream& in, const RecordSummary& summary)
@@ -87,6 +90,8 @@ void RecordPlayer::seek(double seconds) {
     if (onRewind) onRewind();
     for (auto& [number, c] : cars_) c.car->rewind();
     stream_.rewind();
+    reading_ = false;
+    ++readGeneration_;
     nextTime_ = 0;
     caught_ = 0;
     readNext();
@@ -110,6 +115,7 @@ void RecordPlayer::catchUp() {
   std::size_t n = 0;
   while (next_ && nextTime_ <= *seekTarget_ + kResolution) {
     deliverNext();
+    if (reading_) return;  // readOn goes on with the seek
     if (sliced && (++n % 256) == 0 && std::chrono::steady_clock::now() >= until) {
       std::weak_ptr<bool> alive = alive_;
       loop_.post([this, alive, generation = seekGeneration_] {
@@ -118,6 +124,7 @@ void RecordPlayer::catchUp() {
       return;
     }
   }
+  if (reading_) return;  // readOn goes on with the seek
   const double target = *seekTarget_;
   seekTarget_.reset();
   if (ended() && !seekWasEnded_ && onEnd) onEnd();
@@ -126,8 +133,26 @@ void RecordPlayer::catchUp() {
 }
 
 void RecordPlayer::readNext() {
-  next_ = stream_.next();
-  if (next_) nextTime_ = std::max(nextTime_, next_->t);
+  next_ = stream_.next(kLinesPerRead);
+  if (next_) {
+    nextTime_ = std::max(nextTime_, next_->t);
+    return;
+  }
+  if (stream_.done() || reading_) return;
+  reading_ = true;
+  std::weak_ptr<bool> alive = alive_;
+  loop_.post([this, alive, generation = readGeneration_] {
+    if (!alive.expired() && generation == readGeneration_) readOn();
+  });
+}
+
+void RecordPlayer::readOn() {
+  reading_ = false;
+  readNext();
+  if (reading_) return;  // more bad lines: after the loop has turned again
+  if (seekTarget_) return catchUp();
+  if (ended() && playing_ && onEnd) onEnd();  // the bad lines ran to the end of the file
+  schedule();
 }
 
 void RecordPlayer::deliverNext() {
@@ -151,7 +176,8 @@ void RecordPlayer::deliverUpTo(double position) {
 void RecordPlayer::schedule() {
   if (timer_) loop_.cancel(timer_);
   timer_ = 0;
-  if (!playing_ || paused_ || ended() || seekTarget_) return;  // a seek schedules when done
+  // a seek schedules when done, and so does a read that goes on
+  if (!playing_ || paused_ || !next_ || seekTarget_) return;
   const double wait = std::max(0.0, (nextTime_ - anchorPos_) / speed_);
   timer_ = loop_.at(anchorLoop_ + fromSeconds(wait), [this] {
     timer_ = 0;

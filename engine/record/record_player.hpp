@@ -51,7 +51,7 @@ class RecordPlayer {
   double duration() const { return duration_; }
   double speed() const { return speed_; }
   bool paused() const { return paused_; }
-  bool ended() const { return !next_; }
+  bool ended() const { return !next_ && !reading_; }
 
   // The recorded car numbers, ascending, and the fleet's car for one of them.
   const std::vector<int>& recordedCars() const { return numbers_; }
@@ -67,7 +67,10 @@ class RecordPlayer {
   void deliverUpTo(double position);
   void catchUp();      // the next slice of a seek
   void deliverNext();  // delivers next_ and reads the one after it
+  // Reads the next frame, at most kLinesPerRead lines at once: a long run of bad lines is read
+  // on after the loop has turned (readOn), then the seek or the playback goes on.
   void readNext();
+  void readOn();
   void schedule();
   void anchor(double position);
   double elapsedPosition() const;
@@ -95,6 +98,8 @@ class RecordPlayer {
   std::optional<double> seekTarget_;  // a seek under way
   bool seekWasEnded_ = false;
   std::uint64_t seekGeneration_ = 0;  // a slice of an older seek does nothing
+  bool reading_ = false;              // a read goes on after the loop has turned
+  std::uint64_t readGeneration_ = 0;  // a read of the file before a rewind does nothing
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };
 

@@ -186,9 +186,11 @@ bool RecordStream::rewind() {
   return !end_;
 }
 
-std::optional<RecordedFrame> RecordStream::parseNext() {
+std::optional<RecordedFrame> RecordStream::parseNext(std::size_t& lines) {
   std::istream& in = in_;
   while (!end_) {
+    if (lines == 0) return std::nullopt;  // not the end: more another time
+    --lines;
     const std::size_t number = ++number_;
     in.getline(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
     const auto got = static_cast<std::size_t>(in.gcount());
@@ -218,10 +220,11 @@ std::optional<RecordedFrame> RecordStream::parseNext() {
   return std::nullopt;
 }
 
-std::optional<RecordedFrame> RecordStream::next() {
+std::optional<RecordedFrame> RecordStream::next(std::size_t lines) {
   for (;;) {
-    auto frame = parseNext();
-    if (!frame) {  // the end: the frame held back is the last
+    auto frame = parseNext(lines);
+    if (!frame && !end_) return std::nullopt;  // the lines ran out first
+    if (!frame) {                              // the end: the frame held back is the last
       auto last = std::move(pending_);
       pending_.reset();
       return last;

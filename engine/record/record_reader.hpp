@@ -9,6 +9,7 @@
 // checked before a document is built, numbers are range-checked before they are narrowed.
 #include <cstdint>
 #include <istream>
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
@@ -85,13 +86,19 @@ class RecordStream {
  public:
   explicit RecordStream(std::istream& in, std::size_t keepBad = kBadLinesKept);
   // The next frame that is whole, or nothing at the end of the file (or a read error: in.bad()).
-  std::optional<RecordedFrame> next();
+  std::optional<RecordedFrame> next() { return next(std::numeric_limits<std::size_t>::max()); }
+  // The same, reading at most `lines` lines: nothing, with done() false, when they ran out
+  // before a frame came (a long run of bad lines) — call again, after the loop has turned.
+  std::optional<RecordedFrame> next(std::size_t lines);
+  // The end of the file reached and every frame handed on.
+  bool done() const { return end_ && !pending_; }
   // Back to the first line (the stream must be a file's); the bad lines are counted again.
   bool rewind();
   const BadLines& bad() const { return bad_; }
 
  private:
-  std::optional<RecordedFrame> parseNext();  // a line that parses, its time not yet checked
+  // A line that parses, its time not yet checked; nothing at the end or when `lines` ran out.
+  std::optional<RecordedFrame> parseNext(std::size_t& lines);
 
   std::istream& in_;
   std::string buffer_;

@@ -96,3 +96,81 @@ TEST_CASE("record player: a seek under way gives way to the next one") {
   CHECK(rewinds == 1);
   CHECK(player.position() == doctest::Approx(0.1));
 }
+
+namespace {
+// Two frames with `bad` bad lines between them (and after the last: the end is bad lines too).
+std::string badRun(int bad) {
+  std::string text = R"({"t":0.000000,"car":1,"dir":"rx","hex":"01 17"})"
+                     "\n";
+  text.reserve(static_cast<std::size_t>(bad) * 24 + 200);
+  for (int i = 0; i < bad; ++i) text += "not a frame of a record\n";
+  text += R"({"t":0.500000,"car":1,"dir":"rx","hex":"01 17"})"
+          "\n";
+  for (int i = 0; i < bad; ++i) text += "{\"t\": broken\n";
+  return text;
+}
+}  // namespace
+
+// The adversary: 200,000 bad lines in a row between two frames and after the last. The player
+// reads them a few thousand at a time with the loop turning between (a ticker of its own fires
+// meanwhile), both for a seek across them and for playback, and every frame is delivered once.
+TEST_CASE("record player: a long run of bad lines is read with the loop turning") {
+  const int kBad = 200000;  // about fifty reads
+  const std::string text = badRun(kBad);
+  std::istringstream scan(text);
+  RecordSummary summary = scanRecord(scan);
+  REQUIRE(summary.framesOut.size() == 1);
+
+  SUBCASE("a seek across them") {
+    std::istringstream in(text);
+    Loop loop(ClockKind::Real);
+    Fleet fleet(loop);
+    RecordPlayer player(loop, fleet, in, summary);
+    int ticks = 0;
+    bool ended = false;
+    std::function<void()> tick = [&] {
+      ++ticks;
+      loop.after(1ms, tick);
+    };
+    player.onEnd = [&] {
+      ended = true;
+      loop.stop();
+    };
+    player.pause(true);
+    loop.post([&] {
+      loop.after(1ms, tick);
+      player.seek(player.duration());
+    });
+    auto guard = loop.after(60s, [&] { loop.stop(); });
+    loop.run();
+    loop.cancel(guard);
+    CHECK(ended);
+    CHECK(player.car(1)->state().frames_in == 2);
+    CHECK(ticks > 2);  // the loop turned while the bad lines were read
+  }
+  SUBCASE("playback across them") {
+    std::istringstream in(text);
+    Loop loop(ClockKind::Real);
+    Fleet fleet(loop);
+    RecordPlayer player(loop, fleet, in, summary);
+    int ticks = 0;
+    bool ended = false;
+    std::function<void()> tick = [&] {
+      ++ticks;
+      loop.after(1ms, tick);
+    };
+    loop.after(1ms, tick);
+    player.onEnd = [&] {
+      ended = true;
+      loop.stop();
+    };
+    player.setSpeed(100);  // the half second between the frames in 5 ms
+    player.play();
+    auto guard = loop.after(60s, [&] { loop.stop(); });
+    loop.run();
+    loop.cancel(guard);
+    CHECK(ended);
+    CHECK(player.car(1)->state().frames_in == 2);
+    CHECK(ticks > 2);
+  }
+}
