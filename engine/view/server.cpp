@@ -1,9 +1,5 @@
 #include "engine/view/server.hpp"
 
-#include <ifaddrs.h>
-#include <netinet/in.h>
-#include <unistd.h>
-
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/steady_timer.hpp>
 #include <boost/beast/core.hpp>
@@ -16,9 +12,10 @@
 #include <set>
 #include <sstream>
 
-#include "engine/core/data_dir.hpp"
 #include "engine/core/log.hpp"
 #include "engine/drive/seats.hpp"
+#include "engine/view/assets.hpp"
+#include "engine/view/host_check.hpp"
 #include "engine/view/page_messages.hpp"
 
 namespace pitwall::view {
@@ -38,104 +35,12 @@ constexpr auto kRequestTimeout = std::chrono::seconds(5);  // for a request to a
 constexpr auto kSocketIdle = std::chrono::seconds(10);  // a WebSocket that answers no ping: closed
 constexpr std::size_t kMaxBrowsers = 64;                // WebSockets at once
 constexpr std::size_t kMaxConnections = 128;            // HTTP connections at once (not upgraded)
-constexpr auto kAddressesFresh = std::chrono::seconds(5);  // this machine's addresses, read again
 
 std::string_view sv(beast::string_view v) {
   return {v.data(), v.size()};
 }
 
-std::string lower(std::string_view text) {
-  std::string out(text);
-  for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return out;
-}
-
-// The name in a Host header: lower case, without the port or a final dot; an IPv6 address
-// without its brackets. Empty when malformed.
-std::string hostName(std::string_view host) {
-  std::string_view name;
-  if (!host.empty() && host.front() == '[') {
-    auto close = host.find(']');
-    if (close == std::string_view::npos) return {};
-    std::string_view rest = host.substr(close + 1);
-    if (!rest.empty() && rest.front() != ':') return {};
-    name = host.substr(1, close - 1);
-  } else {
-    auto colon = host.find(':');
-    if (colon != std::string_view::npos && host.find(':', colon + 1) != std::string_view::npos)
-      return {};
-    name = host.substr(0, colon);
-  }
-  std::string out = lower(name);
-  if (!out.empty() && out.back() == '.') out.pop_back();
-  return out;
-}
-
-// This machine's addresses (getifaddrs), as text without an IPv6 zone.
-std::set<std::string> machineAddresses() {
-  std::set<std::string> out;
-  ifaddrs* list = nullptr;
-  if (::getifaddrs(&list) != 0) return out;
-  for (ifaddrs* i = list; i; i = i->ifa_next) {
-    if (!i->ifa_addr) continue;
-    if (i->ifa_addr->sa_family == AF_INET) {
-      const auto* in = reinterpret_cast<const sockaddr_in*>(i->ifa_addr);
-      out.insert(asio::ip::address_v4(ntohl(in->sin_addr.s_addr)).to_string());
-    } else if (i->ifa_addr->sa_family == AF_INET6) {
-      const auto* in6 = reinterpret_cast<const sockaddr_in6*>(i->ifa_addr);
-      asio::ip::address_v6::bytes_type bytes;
-      std::copy(std::begin(in6->sin6_addr.s6_addr), std::end(in6->sin6_addr.s6_addr),
-                bytes.begin());
-      out.insert(asio::ip::address_v6(bytes).to_string());
-    }
-  }
-  ::freeifaddrs(list);
-  return out;
-}
-
-std::string machineName() {
-  char name[256] = {};
-  if (::gethostname(name, sizeof name - 1) != 0) return {};
-  return lower(name);
-}
-
-// A loopback address (127.0.0.0/8, ::1, or a v4-mapped 127.x).
-bool loopback(const asio::ip::address& a) {
-  if (a.is_v6() && a.to_v6().is_v4_mapped())
-    return asio::ip::make_address_v4(asio::ip::v4_mapped, a.to_v6()).is_loopback();
-  return a.is_loopback();
-}
 constexpr auto kAcceptRetry = std::chrono::milliseconds(250);  // after a failed accept()
-
-std::string_view contentType(const std::filesystem::path& path) {
-  const std::string ext = path.extension().string();
-  if (ext == ".html") return "text/html; charset=utf-8";
-  if (ext == ".js" || ext == ".mjs") return "text/javascript; charset=utf-8";
-  if (ext == ".css") return "text/css; charset=utf-8";
-  if (ext == ".json") return "application/json";
-  if (ext == ".svg") return "image/svg+xml";
-  if (ext == ".png") return "image/png";
-  if (ext == ".ico") return "image/x-icon";
-  return "application/octet-stream";
-}
-
-// A request's path mapped into the assets folder; none for anything that could leave it.
-std::optional<std::filesystem::path> assetPath(const std::filesystem::path& root,
-                                               std::string_view target) {
-  if (auto q = target.find('?'); q != std::string_view::npos) target = target.substr(0, q);
-  if (target.empty() || target[0] != '/') return std::nullopt;
-  std::string rel(target.substr(1));
-  if (rel.empty()) rel = "index.html";
-  for (char c : rel)
-    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-' ||
-          c == '/'))
-      return std::nullopt;
-  // never absolute (root / "/etc/passwd" is /etc/passwd), never up, never empty parts
-  if (rel.front() == '/' || rel.find("..") != std::string::npos ||
-      rel.find("//") != std::string::npos)
-    return std::nullopt;
-  return root / rel;
-}
 
 }  // namespace
 
@@ -170,14 +75,10 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   std::size_t open = 0;
   std::uint64_t phones = 0;  // the controller pages seen: each WebSocket a holder "phone#k"
   Pairing pairing;
-  std::set<std::string> proxies;    // --view-host: requests for these names may be forwarded
-  std::set<std::string> names;      // the names a Host may give (with the machine's, read at start)
-  std::set<std::string> addresses;  // this machine's, read again when a Host is not among them
-  std::chrono::steady_clock::time_point addressesRead{};
+  HostCheck hosts;  // the names a Host may give (DNS rebinding)
 
   void accept();
   void closeAll();
-  bool serves(const std::string& name);
   void admit(tcp::socket socket);
   bool roomForSocket(const std::string& client, const std::function<bool()>& pairs);
   std::string driveUrl(std::string_view page = "drive") const;
@@ -385,7 +286,7 @@ struct Server::Impl::Http : std::enable_shared_from_this<Http> {
     auto host = req.find(http::field::host);
     if (!peerLoopback || host == req.end()) return peer;
     const std::string name = hostName(sv(host->value()));
-    if (!server->proxies.contains(name)) return peer;
+    if (!server->hosts.proxied(name)) return peer;
     forwarded = true;
     auto xff = req.find("X-Forwarded-For");
     if (xff == req.end()) return peer;
@@ -402,22 +303,12 @@ struct Server::Impl::Http : std::enable_shared_from_this<Http> {
   // DNS rebinding: a page of another site whose name now resolves here sends its own name as
   // Host (and Origin); only the names the view serves are answered.
   std::optional<std::string> refusal(const http::request<http::string_body>& req) {
-    auto host = req.find(http::field::host);
-    if (host == req.end())
-      return "a request without a Host header (the race view answers HTTP/1.1 with Host)";
-    const std::string name = hostName(sv(host->value()));
-    if (name.empty() || !server->serves(name))
-      return "the race view does not serve the name '" + std::string(host->value()).substr(0, 100) +
-             "': open it by this machine's address or name (or give --view-host NAME for a "
-             "reverse proxy's)";
-    if (auto origin = req.find(http::field::origin); origin != req.end()) {
-      const std::string o = lower(sv(origin->value()));
-      const std::string h = lower(sv(host->value()));
-      if (o != "http://" + h && o != "https://" + h)
-        return "the race view is for its own page, not for " +
-               std::string(origin->value()).substr(0, 200);
-    }
-    return std::nullopt;
+    auto header = [&](http::field field) -> std::optional<std::string_view> {
+      auto it = req.find(field);
+      if (it == req.end()) return std::nullopt;
+      return sv(it->value());
+    };
+    return server->hosts.refusal(header(http::field::host), header(http::field::origin));
   }
 
   void handle(http::request<http::string_body> req) {
@@ -481,23 +372,6 @@ struct Server::Impl::Http : std::enable_shared_from_this<Http> {
     stream.close();
   }
 };
-
-bool Server::Impl::serves(const std::string& name) {
-  if (name == "localhost" || name.ends_with(".localhost")) return true;  // RFC 6761: loopback
-  if (names.contains(name)) return true;
-  beast::error_code ec;
-  auto a = asio::ip::make_address(name, ec);
-  if (ec) return false;
-  if (loopback(a)) return true;
-  const std::string text = a.to_string();
-  if (addresses.contains(text)) return true;
-  // a new address (DHCP, a hotspot turned on): read them again, at most every few seconds
-  auto now = std::chrono::steady_clock::now();
-  if (now - addressesRead < kAddressesFresh) return false;
-  addressesRead = now;
-  addresses = machineAddresses();
-  return addresses.contains(text);
-}
 
 // Fair shares (docs/view.md "Limits"): when every HTTP slot is taken, the client that holds the
 // most gives up its oldest connection (an idle keep-alive or a slow request, most often), so a
@@ -635,17 +509,7 @@ Result<bool, std::string> Server::start() {
   a.listen(asio::socket_base::max_listen_connections, ec);
   if (ec) return Unexpected{"cannot listen on " + where + ": " + ec.message()};
   // the names a browser may reach the view by (besides loopback and the machine's addresses)
-  for (const auto& n : impl_->options.names) {
-    impl_->names.insert(hostName(n));
-    impl_->proxies.insert(hostName(n));
-  }
-  if (std::string name = machineName(); !name.empty()) {
-    impl_->names.insert(name);
-    if (name.find('.') == std::string::npos) impl_->names.insert(name + ".local");  // mDNS
-  }
-  impl_->names.insert(address.to_string());
-  impl_->addresses = machineAddresses();
-  impl_->addressesRead = std::chrono::steady_clock::now();
+  impl_->hosts.start(address.to_string(), impl_->options.names);
   impl_->accept();
   return true;
 }
@@ -739,22 +603,6 @@ Result<ServerOptions, std::string> parseEndpoint(const std::string& text) {
   o.host = host;
   o.port = static_cast<std::uint16_t>(value);
   return o;
-}
-
-Result<std::filesystem::path, std::string> findAssets() {
-  std::vector<std::filesystem::path> places;
-  if (const char* env = std::getenv("PITWALL_VIEW_DIR"); env && *env) places.emplace_back(env);
-  for (const auto& data : dataDirCandidates()) places.push_back(data / "web");
-  std::string looked;
-  for (const auto& p : places) {
-    std::error_code ec;
-    if (std::filesystem::exists(p / "index.html", ec))
-      return std::filesystem::weakly_canonical(p, ec);
-    looked += (looked.empty() ? "" : ", ") + p.string();
-  }
-  return Unexpected{
-      "the race view's page is not installed (looked in " + looked +
-      "); build it (./dev build), install pitwall, or set PITWALL_VIEW_DIR to its folder"};
 }
 
 }  // namespace pitwall::view

@@ -20,6 +20,7 @@
 
 #include "engine/core/loop.hpp"
 #include "engine/core/result.hpp"
+#include "engine/view/assets.hpp"
 #include "engine/view/feed.hpp"
 
 namespace pitwall::view {
@@ -41,10 +42,6 @@ struct ServerOptions {
 // was wrong and what to write.
 inline constexpr std::uint16_t kDefaultPort = 8080;
 Result<ServerOptions, std::string> parseEndpoint(const std::string& text);
-// Where the page's assets are: $PITWALL_VIEW_DIR, else web/ in each place pitwall's data may be
-// (engine/core/data_dir.hpp: $PITWALL_DATA, the installed or the build tree's share/pitwall).
-// The error names the places looked at.
-Result<std::filesystem::path, std::string> findAssets();
 
 class Server {
  public:
