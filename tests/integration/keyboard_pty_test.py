@@ -139,6 +139,8 @@ def run_hung_up():
     if pid == 0:
         err = os.open(log, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
         os.dup2(err, 2)  # the log outlives the terminal
+        # as a terminal's shell starts it: a test run under nohup would pass SIGHUP on ignored
+        signal.signal(signal.SIGHUP, signal.SIG_DFL)
         os.execve(PITWALL, [PITWALL, "run", SCRIPT, "--humans", "1", "--keyboard", "--duration",
                             "30", "--record", record], dict(os.environ, TERM="xterm"))
     seen = ""

@@ -63,6 +63,10 @@ TEST_CASE("stop signals reach a real run through the pipe") {
 // process with no stop for any car: it ends the run as SIGTERM does. Ignored before (nohup), it
 // stays ignored. Afterwards the handler that was there comes back.
 TEST_CASE("SIGHUP ends a run as SIGTERM does, unless it was ignored (nohup)") {
+  // as a terminal's shell starts a run: a test run started under nohup inherits SIGHUP ignored
+  struct sigaction inherited {};
+  ::sigaction(SIGHUP, nullptr, &inherited);
+  std::signal(SIGHUP, SIG_DFL);
   struct sigaction before {};
   ::sigaction(SIGHUP, nullptr, &before);
   CHECK(signalsSeen({{10, SIGHUP}}, SIGHUP) == std::vector<int>{SIGHUP * 100 + 1});
@@ -82,7 +86,7 @@ TEST_CASE("SIGHUP ends a run as SIGTERM does, unless it was ignored (nohup)") {
     ::sigaction(SIGHUP, nullptr, &during);
     CHECK((during.sa_handler == SIG_IGN));
   }
-  ::sigaction(SIGHUP, &before, nullptr);
+  ::sigaction(SIGHUP, &inherited, nullptr);
 }
 
 // SIGTSTP (Ctrl-Z) reaches the loop, which stops the cars before it suspends the process; it is
