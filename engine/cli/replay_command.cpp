@@ -157,8 +157,21 @@ int replay(const ReplayOptions& options) {
     return 2;
   }
 
-  // The track drawn: --track, else the record's own layout, else the default oval.
+  // The track drawn: --track, else the record's own layout, else the default oval. A summary
+  // and a script follow the cars on --track or the record's layout too, when there is one: the
+  // transitions carry a car along it where position updates are missing (a real car on a curve
+  // at speed), so no lap is lost.
   std::optional<sim::Track> track;
+  if (!options.view && (options.track || !record.layout.empty())) {
+    auto layout = options.track ? sim::loadLayout(*options.track)
+                                : sim::parseLayout(record.layout, "recorded");
+    if (layout)
+      track = std::move(*layout);
+    else if (options.track) {
+      std::cerr << "pitwall replay: " << layout.error() << "\n";
+      return 2;
+    }
+  }
   if (options.view) {
     auto layout = options.track           ? sim::loadLayout(*options.track)
                   : record.layout.empty() ? sim::loadLayout("oval")
@@ -183,6 +196,7 @@ int replay(const ReplayOptions& options) {
     feed->setTrack(std::move(track), "layout");
   } else {
     feed = &session->startFeed("replay");
+    if (track) feed->setTrack(std::move(track), "layout");
   }
 
   RecordPlayer player(loop, session->fleet(), in, record);
@@ -283,9 +297,9 @@ Command addReplayCommand(CLI::App& app) {
       ->check(CLI::Range(0.1, 100.0))
       ->needs(view);
   cmd->add_option("--track", replay->track,
-                  "With --view: the layout drawn, a name or a file (default: the record's own; "
-                  "oval for a record that keeps none)")
-      ->needs(view);
+                  "The layout the record's cars drove, a name or a file (default: the record's "
+                  "own): laps are counted along it where position updates are missing; with "
+                  "--view also the layout drawn (oval for a record that keeps none)");
   auto* script = cmd->add_option(
       "--script", replay->script,
       "Deliver the recorded events to this Lua script's handlers, in virtual time; its commands "

@@ -54,11 +54,19 @@ void CarTracker::crossFinish(double now) {
   crossedSinceStartPiece_ = true;
 }
 
+// The id of the piece the car is on: the map's, once it is localized on a known track (the
+// transitions carry it on from piece to piece when position updates are missing, as on a real
+// car's curves at speed), else the one it last reported.
+int CarTracker::currentPieceId() const {
+  if (track_ && index_) return track_->pieces()[*index_].id;
+  return lastPieceId_;
+}
+
 void CarTracker::update(const anki::Message& message, const CarState& state, double now) {
   if (const auto* p = std::get_if<anki::PositionUpdate>(&message)) {
     const bool reverse = state.reverse;
     // A lap whose transition frame was lost: the first report after the line counts it.
-    if (p->piece_id == anki::kFinishAfter && lastPieceId_ == anki::kFinishBefore && !reverse &&
+    if (p->piece_id == anki::kFinishAfter && currentPieceId() == anki::kFinishBefore && !reverse &&
         !crossedSinceStartPiece_)
       crossFinish(now);
     if (p->piece_id == anki::kFinishBefore) crossedSinceStartPiece_ = false;
@@ -74,19 +82,51 @@ void CarTracker::update(const anki::Message& message, const CarState& state, dou
     }
     fraction_ = codeFraction(piece, key, p->location_id);
     positionTime_ = now;
+    // on the start piece: the next transition is the line, whatever the count said
+    if (p->piece_id == anki::kFinishBefore && !reverse && lapPieces_ && sinceLine_)
+      *sinceLine_ = *lapPieces_ - 1;
   } else if (std::holds_alternative<anki::TransitionUpdate>(message)) {
-    // The car left the piece it last reported: 34 → 33 driving forward is the finish line.
-    if (lastPieceId_ == anki::kFinishBefore && !state.reverse && !crossedSinceStartPiece_)
-      crossFinish(now);
-    if (track_ && index_) {
-      const std::size_t n = track_->size();
-      index_ = state.reverse ? (*index_ + n - 1) % n : (*index_ + 1) % n;
-      fraction_ = state.reverse ? 1 : 0;
-      positionTime_ = now;
-    }
+    transition(state.reverse, now);
   } else if (std::holds_alternative<anki::Delocalized>(message)) {
     index_.reset();
+    sinceLine_.reset();
   }
+}
+
+// The car left the piece it was on: 34 → 33 driving forward is the finish line. Known by the
+// piece it was on (reported, or carried on by the map), or — with no map and no position
+// update on the start piece — by the number of pieces a lap has, once two laps have shown it.
+void CarTracker::transition(bool reverse, double now) {
+  bool crossed = false;
+  if (currentPieceId() == anki::kFinishBefore && !reverse && !crossedSinceStartPiece_) {
+    crossed = true;
+  } else if (!track_ && !reverse && lapPieces_ && sinceLine_ && *sinceLine_ + 1 == *lapPieces_) {
+    crossed = true;  // the pieces of a lap since the last crossing: this is the line
+  }
+  if (crossed) {
+    crossFinish(now);
+    // the pieces of one lap, from two crossings in a row that the start piece's reports showed
+    if (sinceLine_ && !reverse) {
+      const int pieces = *sinceLine_ + 1;
+      if (lapPieces_ && *lapPieces_ != pieces)
+        lapPieces_.reset();  // a different loop: learn again
+      else
+        lapPieces_ = pieces;
+    }
+    sinceLine_ = 0;
+  } else if (sinceLine_) {
+    ++*sinceLine_;
+  }
+  if (track_ && index_) {
+    const std::size_t n = track_->size();
+    index_ = reverse ? (*index_ + n - 1) % n : (*index_ + 1) % n;
+    fraction_ = reverse ? 1 : 0;
+    positionTime_ = now;
+    // carried onto the start piece: the next transition is the line
+    if (track_->pieces()[*index_].id == anki::kFinishBefore && !reverse)
+      crossedSinceStartPiece_ = false;
+  }
+  if (reverse) sinceLine_.reset();
 }
 
 }  // namespace pitwall::view

@@ -3,7 +3,9 @@
 // piece of the track (matched by id along the driving order), the fraction of it, and its laps.
 // The view's feed and `pitwall replay` follow every car through one of these. A lap ends on the
 // transition from the start piece (34) to the piece after the finish line (33) driving forward
-// (as pitwall.laps counts it); the first crossing starts lap 1.
+// (as pitwall.laps counts it); the first crossing starts lap 1. A real car at speed sends no
+// position update on most curves, so the transitions carry the car on along the map, and a lap
+// whose start piece sent none still ends at the line (docs/view.md "Cars").
 #include <optional>
 #include <vector>
 
@@ -31,6 +33,8 @@ class CarTracker {
 
  private:
   void crossFinish(double now);
+  void transition(bool reverse, double now);
+  int currentPieceId() const;
   std::optional<std::size_t> locate(int pieceId, bool reverse) const;
   double codeFraction(const sim::Piece& piece, long key, int location);
 
@@ -43,6 +47,10 @@ class CarTracker {
   int lastPieceId_ = -1;
   bool crossedSinceStartPiece_ = false;
   std::optional<double> lastCrossing_;
+  // Without a map: transitions since the line (none: not known), and the pieces of a lap once
+  // two crossings in a row showed it
+  std::optional<int> sinceLine_;
+  std::optional<int> lapPieces_;
   std::vector<double> lapTimes_;
   std::optional<double> best_;
 };

@@ -1,0 +1,99 @@
+// The view's lap counter and localization (engine/view/tracker.cpp) under what real cars send
+// (../shared/realdata): a transition (0x29) at every piece boundary, and position updates
+// (0x27) that thin out with speed — on a curve at race speed usually none at all.
+#include "engine/view/tracker.hpp"
+
+#include <doctest/doctest.h>
+
+#include <random>
+
+#include "engine/sim/track.hpp"
+
+using namespace pitwall;
+
+namespace {
+
+// Drives `laps` laps of `track` from its first piece, a position update on each piece kept with
+// chance `keep(piece index, lap)`, a transition at every boundary; time advances 1 s a piece.
+template <class Keep>
+view::CarTracker drive(const sim::Track& track, const sim::Track* map, int laps, Keep keep) {
+  view::CarTracker tracker;
+  tracker.setTrack(map);
+  CarState state;
+  double now = 0;
+  const auto& pieces = track.pieces();
+  for (int lap = 0; lap < laps; ++lap) {
+    for (std::size_t i = 0; i < pieces.size(); ++i) {
+      if (keep(i, lap)) {
+        anki::PositionUpdate p;
+        p.piece_id = pieces[i].id;
+        p.location_id = 1;
+        tracker.update(p, state, now + 0.5);
+      }
+      now += 1;
+      tracker.update(anki::TransitionUpdate{}, state, now);
+    }
+  }
+  return tracker;
+}
+
+}  // namespace
+
+TEST_CASE("tracker: every lap counted with every position update, and with most of them lost") {
+  auto oval = sim::loadLayout("oval");
+  REQUIRE(oval);
+  const sim::Track& track = *oval;
+  const int kLaps = 12;
+  // the car starts on the start piece's first half: the first crossing starts lap 1
+  const auto full = drive(track, &track, kLaps, [](std::size_t, int) { return true; });
+  const int expected = full.laps();
+  CHECK(expected >= kLaps - 2);
+  for (double t : full.lapTimes()) CHECK(t == doctest::Approx(track.size()));
+
+  SUBCASE("with the map: one position update to localize, then transitions only") {
+    auto thin =
+        drive(track, &track, kLaps, [](std::size_t i, int lap) { return lap == 0 && i == 0; });
+    CHECK(thin.laps() == expected);
+    CHECK(thin.lapTimes() == full.lapTimes());
+  }
+  SUBCASE("with the map: any share of position updates lost, many seeds") {
+    for (unsigned seed = 1; seed <= 50; ++seed) {
+      std::mt19937 random(seed);
+      const double lost = std::uniform_real_distribution<double>(0.25, 1.0)(random);
+      auto thin = drive(track, &track, kLaps, [&](std::size_t i, int lap) {
+        if (lap == 0 && i == 0) return true;  // localized once, where the full run starts
+        return std::uniform_real_distribution<double>(0, 1)(random) >= lost;
+      });
+      CAPTURE(seed);
+      CAPTURE(lost);
+      CHECK(thin.laps() == expected);
+    }
+  }
+  SUBCASE("without a map: the start piece seen for two laps, then no position update at all") {
+    auto thin = drive(track, nullptr, kLaps, [&](std::size_t i, int lap) {
+      return lap < 3 && track.pieces()[i].id == anki::kFinishBefore;
+    });
+    CHECK(thin.laps() == expected);
+    CHECK(thin.lapTimes() == full.lapTimes());
+  }
+  SUBCASE("without a map: the start piece's updates lost at random after the first laps") {
+    for (unsigned seed = 1; seed <= 50; ++seed) {
+      std::mt19937 random(seed);
+      auto thin = drive(track, nullptr, kLaps, [&](std::size_t, int lap) {
+        return lap < 3 || std::uniform_real_distribution<double>(0, 1)(random) < 0.3;
+      });
+      CAPTURE(seed);
+      CHECK(thin.laps() == expected);
+    }
+  }
+}
+
+TEST_CASE("tracker: without a map and without the start piece's reports no lap is invented") {
+  auto oval = sim::loadLayout("oval");
+  REQUIRE(oval);
+  auto none = drive(*oval, nullptr, 6, [&](std::size_t i, int) {
+    return oval->pieces()[i].id != anki::kFinishBefore &&
+           oval->pieces()[i].id != anki::kFinishAfter;
+  });
+  CHECK(none.laps() == 0);
+}
