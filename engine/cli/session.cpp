@@ -159,6 +159,19 @@ void Session::catchSignals() {
     if (seconds > 0)
       watchdog_ = std::make_unique<Watchdog>(
           loop_, std::chrono::milliseconds(std::llround(seconds * 1000)));
+    // Falling behind real time is said, once, with what to do (docs/simulator.md "Real time").
+    lag_ = std::make_unique<LagMonitor>(loop_);
+    lag_->onBehind = [](double meanLateMs) {
+      char text[320];
+      std::snprintf(text, sizeof text,
+                    "the engine is falling behind real time: its loop ran %.0f ms late on average "
+                    "over the last 2 s (long Lua callbacks, or a machine too busy); cars and "
+                    "timers are seen late. Give the callbacks less to do, close other programs, "
+                    "or race the simulator in virtual time (--fast)",
+                    meanLateMs);
+      log::warn("pitwall", text);
+    };
+    lag_->onCaughtUp = [] { log::info("pitwall", "the engine keeps up with real time again"); };
   }
   signals_->onSignal = [this](int sig, int count) {
     if (sig == SIGTSTP) return suspend();

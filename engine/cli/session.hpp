@@ -8,6 +8,7 @@
 #include "bindings/reloader.hpp"
 #include "engine/cli/commands.hpp"
 #include "engine/core/emergency_stops.hpp"
+#include "engine/core/lag_monitor.hpp"
 #include "engine/core/loop.hpp"
 #include "engine/core/stop_signals.hpp"
 #include "engine/drive/gamepads.hpp"
@@ -127,6 +128,7 @@ class Session {
   CarSource source_;
   std::unique_ptr<StopSignals> signals_;
   std::unique_ptr<Watchdog> watchdog_;  // real time: stops the cars when the loop is stuck
+  std::unique_ptr<LagMonitor> lag_;     // real time: says when the loop falls behind
   bool interrupted_ = false;
 };
 

@@ -17,6 +17,9 @@ constexpr double kOverlapMm = 40;    // lanes closer than this overlap
 constexpr double kLookaheadMm = 50;  // beyond any one tick's closing distance (2 × 7.5 mm)
 constexpr double kReleaseMm = 5;     // a contact ends once the gap opens by this much
 
+// The most a late tick makes up for at once (World::State::tick).
+constexpr Duration kMaxCatchUp = std::chrono::seconds(1);
+
 // Identifiers the world hands out when a spec leaves it 0: recognisable, and stable per index.
 constexpr std::uint32_t kIdentifierBase = 0x51A00000;
 
@@ -67,19 +70,36 @@ struct World::State {
   // has something to do, so an idle world leaves the loop free to finish.
   void wake() {
     if (timer || cars.empty()) return;
-    TimePoint next = (env.loop.now() / kTick + 1) * kTick;
-    timer = env.loop.at(next, [this] { tick(); });
+    schedule((env.loop.now() / kTick + 1) * kTick);
   }
 
+  void schedule(TimePoint at) {
+    due = at;
+    timer = env.loop.at(at, [this] { tick(); });
+  }
+
+  // On the real clock the loop may run a tick late (a script's long callback, a loaded
+  // machine): the cars move on by the wall clock, as real cars do, with every tick they missed
+  // (at most kMaxCatchUp; a longer stall — a suspended run — is skipped). On a virtual clock a
+  // tick is never late: one step each.
   void tick() {
     timer = 0;
-    TimePoint now = env.loop.now();
+    const TimePoint now = env.loop.now();
+    const auto missed = now > due ? (now - due) / kTick : 0;
+    const auto steps = std::min<std::int64_t>(missed + 1, kMaxCatchUp / kTick);
     const double dt = toSeconds(kTick);
-    for (auto& car : cars) car->plan(dt);
-    resolveCollisions();
-    for (auto& car : cars) car->commit();
-    bool busy = std::any_of(cars.begin(), cars.end(), [](auto& c) { return c->active(); });
-    if (busy) timer = env.loop.at(now + kTick, [this] { tick(); });
+    bool busy = true;
+    for (std::int64_t k = 0; k < steps && busy; ++k) {
+      for (auto& car : cars) car->plan(dt);
+      resolveCollisions();
+      for (auto& car : cars) car->commit();
+      busy = std::any_of(cars.begin(), cars.end(), [](auto& c) { return c->active(); });
+    }
+    lateTicks += static_cast<std::uint64_t>(steps - 1);
+    if (!busy) return;
+    TimePoint next = due + steps * kTick;
+    if (next <= now) next = (now / kTick + 1) * kTick;  // past the catch-up's cap: skipped
+    schedule(next);
   }
 
   // Car indices sorted by (lap position, index), and each car's rank in that order. Positions
@@ -213,6 +233,8 @@ struct World::State {
   std::vector<std::uint8_t> contact;  // n × n: car i touches car j ahead of it
   std::vector<std::pair<std::size_t, std::size_t>> touching;  // the pairs set in `contact`
   Loop::TimerId timer = 0;
+  TimePoint due{0};             // when the scheduled tick is due
+  std::uint64_t lateTicks = 0;  // ticks made up for after the loop ran late
 };
 
 World::World(Loop& loop, Track track, std::uint64_t seed)
@@ -222,6 +244,9 @@ World::~World() = default;
 
 const Track& World::track() const {
   return state_->track;
+}
+std::uint64_t World::lateTicks() const {
+  return state_->lateTicks;
 }
 Loop& World::loop() {
   return state_->env.loop;

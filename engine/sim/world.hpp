@@ -93,6 +93,9 @@ class World {
   std::vector<SimCar*> cars();
   void setNoise(Noise noise);
   const Noise& noise() const;
+  // Ticks made up for because the loop ran them late (real time only; docs/simulator.md
+  // "Real time"): the cars moved on by the wall clock meanwhile.
+  std::uint64_t lateTicks() const;
 
  private:
   struct State;

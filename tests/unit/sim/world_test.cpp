@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <set>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -400,4 +401,51 @@ TEST_CASE("1000 cars on the grid of ovalLayoutFor(1000) drive off without touchi
   }
   CHECK(collisions == 0);
   CHECK(atSpeed == 1000);
+}
+
+// Real cars do not wait for the engine: when a long callback holds the loop, a simulated car on
+// the real clock moves on by the wall clock too (the ticks it missed are made up at once), as a
+// real one would have driven on meanwhile. The adversary holds the loop 400 ms in one callback.
+TEST_CASE("real time: a car moves on by the wall clock while the loop is held") {
+  Loop loop(ClockKind::Real);
+  World world(loop, namedLayout("oval").value(), 1);
+  SimCar& car = world.addCar({.name = "car", .piece_index = 2, .offset_mm = 0});
+  car.connect([](std::span<const std::uint8_t>) {}, [] {});
+  car.receive(anki::encode(anki::SdkMode{true, 1}).span());
+  car.receive(anki::encode(anki::SetSpeed{400, 25000}).span());
+  double before = 0, after = 0;
+  TimePoint heldFrom{0}, heldUntil{0};
+  // at full speed (reached within 20 ms at 25000 mm/s²), the loop held 400 ms
+  loop.after(300ms, [&] {
+    before = car.truth().lap_distance_mm;
+    heldFrom = loop.now();
+    std::this_thread::sleep_for(400ms);
+    heldUntil = loop.now();
+  });
+  // the first tick after the hold, and nothing else in between
+  loop.after(301ms, [&] {
+    loop.after(6ms, [&] {
+      after = car.truth().lap_distance_mm;
+      loop.stop();
+    });
+  });
+  auto guard = loop.after(20s, [&] { loop.stop(); });
+  loop.run();
+  loop.cancel(guard);
+  const double held = toSeconds(heldUntil - heldFrom);
+  REQUIRE(held >= 0.4);
+  double moved = after - before;
+  if (moved < 0) moved += world.track().lapLength(0);
+  // the distance of the time held (and the few ms after), not the one or two ticks of the old
+  // way (which made the simulation fall behind the wall clock)
+  CHECK(moved >= 400 * held * 0.9);
+  CHECK(world.lateTicks() >= 70);
+}
+
+TEST_CASE("virtual time: no tick is ever late") {
+  Rig rig;
+  SimCar& car = rig.add({.name = "car", .piece_index = 2});
+  rig.send(car, anki::SetSpeed{800, 25000});
+  rig.runUntil(5);
+  CHECK(rig.world.lateTicks() == 0);
 }
