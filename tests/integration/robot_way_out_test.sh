@@ -40,20 +40,25 @@ run_bg() {
   check "$name: the script is driving" "driving" "$line"
 }
 
-# sim_robot: `pitwall sim-robot alphabot` on a free port; sets PORT and ROBOT_PID
+# sim_robot: `pitwall sim-robot alphabot` on a free port; sets PORT, ROBOT_PID and ROBOT (its
+# files: each robot its own, as a file named again is truncated by the new robot's shell only
+# after this one may have read the old robot's port from it)
+ROBOTS=0
 sim_robot() {
-  $PITWALL sim-robot alphabot >"$TMP/robot.out" 2>"$TMP/robot.err" &
+  ROBOTS=$((ROBOTS + 1))
+  ROBOT="$TMP/robot$ROBOTS"
+  $PITWALL sim-robot alphabot >"$ROBOT.out" 2>"$ROBOT.err" &
   ROBOT_PID=$!
   PIDS+=($ROBOT_PID)
-  wait_for "$TMP/robot.out" "listening on" 5 || fail "sim-robot did not start: $(cat "$TMP/robot.err")"
-  PORT=$(sed -n 's/^listening on .*:\([0-9]*\)$/\1/p' "$TMP/robot.out")
+  wait_for "$ROBOT.out" "listening on" 5 || fail "sim-robot did not start: $(cat "$ROBOT.err")"
+  PORT=$(sed -n 's/^listening on .*:\([0-9]*\)$/\1/p' "$ROBOT.out")
 }
 # stop_robot: interrupts the simulated robot, which then says what it was last told
 stop_robot() {
   kill -INT $ROBOT_PID
   wait_bounded $ROBOT_PID
 }
-robot_state() { sed -n 's/.*\(the robot is [a-z ]*\)$/\1/p' "$TMP/robot.err"; }
+robot_state() { sed -n 's/.*\(the robot is [a-z ]*\)$/\1/p' "$ROBOT.err"; }
 
 # --- WLAN, the watchdog: the loop wedged; nobody sends a signal
 sim_robot
