@@ -17,100 +17,71 @@ target_speeds() {
 }
 both_stopped=$'E0:00:00:00:00:01 target=0\nE0:00:00:00:00:02 target=0'
 
-# run_bg NAME ENV…: nagging.lua over --ble in the background, its stdout read through a FIFO on
-# fd 4 until "driving"
+# run_bg NAME ENV…: nagging.lua over --ble in the background, its stdout on fd 4 (run_fifo)
 run_bg() {
   local name=$1
   shift
-  rm -f "$TMP/run.fifo"
-  mkfifo "$TMP/run.fifo"
-  env "$@" $PITWALL run "$NAGGING" --ble --scan-timeout 0.5 >"$TMP/run.fifo" \
-    2>"$TMP/$name.err" &
-  RUN_PID=$!
-  exec 4<"$TMP/run.fifo"
-  read -r -t 20 -u 4 line
-  check "$name: the script is driving" "driving" "$line"
+  run_fifo "$name" env "$@" $PITWALL run "$NAGGING" --ble --scan-timeout 0.5
 }
 
-# --- the watchdog: the loop wedged in string.find; nobody sends a signal
-start_fake --adapters 1 --cars 2
-run_bg watchdog MODE=wedge
-read -r -t 20 -u 4 line
-check "watchdog: the script wedges the loop" "wedging" "$line"
-wait_for "$TMP/watchdog.err" "has not turned for" 20
-contains "watchdog: stderr says it stopped the cars" "the watchdog sent 2 cars its stop" \
-  "$(cat "$TMP/watchdog.err")"
-stop_fake  # while pitwall is still wedged: what the cars were last told
-check "watchdog: both cars were told to stop while the loop was stuck" "$both_stopped" \
-  "$(target_speeds)"
-kill -9 $RUN_PID
-wait $RUN_PID 2>/dev/null
-exec 4<&-
+# watchdog_case NAME FAKE_ARGS…: the loop wedged in string.find, nobody sends a signal: the
+# watchdog stops both cars while the loop is still stuck
+watchdog_case() {
+  local name=$1
+  shift
+  start_fake --adapters 1 --cars 2 "$@"
+  run_bg "$name" MODE=wedge
+  expect_wedged "$name"
+  contains "$name: stderr says it stopped the cars" "the watchdog sent 2 cars its stop" \
+    "$(cat "$TMP/$name.err")"
+  stop_fake  # while pitwall is still wedged: what the cars were last told
+  check "$name: both cars were told to stop while the loop was stuck" "$both_stopped" \
+    "$(target_speeds)"
+  end_fifo
+}
 
+# last_resort_case NAME WATCHDOG_SECONDS FAKE_ARGS…: the loop wedged, signals until the
+# handler itself ends the process; it sends the stops first
+last_resort_case() {
+  local name=$1 watchdog=$2
+  shift 2
+  start_fake --adapters 1 --cars 2 "$@"
+  run_bg "$name" MODE=wedge PITWALL_WATCHDOG="$watchdog"
+  read -r -t 20 -u 4 line
+  check "$name: the script wedges the loop" "wedging" "$line"
+  cat <&4 >/dev/null 2>&1 &
+  for _ in $(seq 1 100); do  # two kinds, so that no two are pending at once and merge
+    kill -INT $RUN_PID 2>/dev/null || break
+    kill -TERM $RUN_PID 2>/dev/null || break
+    sleep 0.05
+  done
+  wait_bounded $RUN_PID
+  check "$name: exit status" 130 $?
+  exec 4<&-
+  contains "$name: the handler sent the stops and left" \
+    "every car sent its stop from outside the loop; leaving now" "$(cat "$TMP/$name.err")"
+  check "$name: not the watchdog's doing" "" "$(grep "has not turned for" "$TMP/$name.err")"
+  stop_fake
+  check "$name: both cars were told to stop" "$both_stopped" "$(target_speeds)"
+}
+
+# --- the watchdog, through the cars' write sockets
+watchdog_case watchdog
 # --- the watchdog where BlueZ gives no write socket (writes go by WriteValue, on the loop's own
 # bus connection): the stops go as WriteValue calls on a connection the watchdog's thread makes
-start_fake --adapters 1 --cars 2 --no-acquire
-run_bg watchdog-call MODE=wedge
-read -r -t 20 -u 4 line
-check "watchdog, WriteValue: the script wedges the loop" "wedging" "$line"
-wait_for "$TMP/watchdog-call.err" "has not turned for" 20
-contains "watchdog, WriteValue: stderr says it stopped the cars" "the watchdog sent 2 cars its stop" \
-  "$(cat "$TMP/watchdog-call.err")"
-stop_fake
-check "watchdog, WriteValue: both cars were told to stop while the loop was stuck" \
-  "$both_stopped" "$(target_speeds)"
-kill -9 $RUN_PID
-wait $RUN_PID 2>/dev/null
-exec 4<&-
-
+watchdog_case watchdog-call --no-acquire
+# --- the last-resort exit with no watchdog (PITWALL_WATCHDOG=0): through the write sockets
+last_resort_case last-resort 0
 # --- the last-resort exit over WriteValue: a signal handler cannot make a D-Bus call; it asks
 # the watchdog's thread (whose own limit, 60 s, is far off) and waits for it before it leaves
-start_fake --adapters 1 --cars 2 --no-acquire
-run_bg last-resort-call MODE=wedge PITWALL_WATCHDOG=60
-read -r -t 20 -u 4 line
-check "last resort, WriteValue: the script wedges the loop" "wedging" "$line"
-cat <&4 >/dev/null 2>&1 &
-for _ in $(seq 1 100); do
-  kill -INT $RUN_PID 2>/dev/null || break
-  kill -TERM $RUN_PID 2>/dev/null || break
-  sleep 0.05
-done
-wait_bounded $RUN_PID
-check "last resort, WriteValue: exit status" 130 $?
-exec 4<&-
-check "last resort, WriteValue: not the watchdog's doing" "" \
-  "$(grep "has not turned for" "$TMP/last-resort-call.err")"
-stop_fake
-check "last resort, WriteValue: both cars were told to stop" "$both_stopped" "$(target_speeds)"
-
-# --- the last-resort exit: no watchdog (PITWALL_WATCHDOG=0), the loop wedged, signals until
-# the handler itself ends the process
-start_fake --adapters 1 --cars 2
-run_bg last-resort MODE=wedge PITWALL_WATCHDOG=0
-read -r -t 20 -u 4 line
-check "last resort: the script wedges the loop" "wedging" "$line"
-cat <&4 >/dev/null 2>&1 &
-for _ in $(seq 1 100); do  # two kinds, so that no two are pending at once and merge
-  kill -INT $RUN_PID 2>/dev/null || break
-  kill -TERM $RUN_PID 2>/dev/null || break
-  sleep 0.05
-done
-wait_bounded $RUN_PID
-check "last resort: exit status" 130 $?
-exec 4<&-
-contains "last resort: the handler sent the stops and left" \
-  "every car sent its stop from outside the loop; leaving now" "$(cat "$TMP/last-resort.err")"
-stop_fake
-check "last resort: both cars were told to stop" "$both_stopped" "$(target_speeds)"
+last_resort_case last-resort-call 60 --no-acquire
 
 # --- Ctrl-Z: the stops reach the cars before the process stops
 start_fake --adapters 1 --cars 2
 run_bg tstp MODE=none
 cat <&4 >/dev/null 2>&1 &
 kill -TSTP $RUN_PID
-deadline=$((SECONDS + 20))
-until [ "$(sed 's/.*) //' /proc/$RUN_PID/stat | cut -d' ' -f1)" = T ] || [ $SECONDS -ge $deadline ]
-do sleep 0.02; done
+wait_suspended $RUN_PID
 stop_fake  # the fake ends while pitwall is suspended: what the cars were last told
 check "Ctrl-Z: both cars were stopped before the process stopped" "$both_stopped" \
   "$(target_speeds)"

@@ -71,6 +71,44 @@ wait_bounded() {
   return $status
 }
 
+# run_fifo NAME COMMAND…: COMMAND in the background (its pid in RUN_PID), stdin /dev/null,
+# stderr in $TMP/NAME.err, stdout read through a FIFO on fd 4 until its first line, which must
+# be "driving" (tests/integration/nagging.lua and the like say it once they command the cars).
+run_fifo() {
+  local name=$1 line
+  shift
+  rm -f "$TMP/run.fifo"
+  mkfifo "$TMP/run.fifo"
+  "$@" </dev/null >"$TMP/run.fifo" 2>"$TMP/$name.err" &
+  RUN_PID=$!
+  exec 4<"$TMP/run.fifo"
+  read -r -t 20 -u 4 line
+  check "$name: the script is driving" "driving" "$line"
+}
+
+# expect_wedged NAME: the script run by run_fifo says it wedges its loop in C code, and the
+# watchdog (engine/core/emergency_stops) then says on stderr that it sent N cars their stop.
+expect_wedged() {
+  local line
+  read -r -t 20 -u 4 line
+  check "$1: the script wedges the loop" "wedging" "$line"
+  wait_for "$TMP/$1.err" "has not turned for" 20 || fail "$1: the watchdog said nothing"
+}
+
+# end_fifo: kills the run_fifo run for good (SIGKILL: it may be wedged) and closes fd 4.
+end_fifo() {
+  kill -9 "$RUN_PID" 2>/dev/null
+  wait "$RUN_PID" 2>/dev/null
+  exec 4<&-
+}
+
+# wait_suspended PID: until PID is stopped (Ctrl-Z suspended it), at most 20 s.
+wait_suspended() {
+  local deadline=$((SECONDS + 20))
+  until [ "$(sed 's/.*) //' "/proc/$1/stat" 2>/dev/null | cut -d' ' -f1)" = T ] ||
+    [ $SECONDS -ge $deadline ]; do sleep 0.02; done
+}
+
 finish() {
   [ "$FAILURES" -eq 0 ] || { echo "$FAILURES check(s) failed"; exit 1; }
 }

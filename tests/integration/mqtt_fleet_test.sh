@@ -108,42 +108,29 @@ none 0 --duration 2
 exit 3
 error 1
 MODES
-rm -f "$TMP/nag.fifo"
+# nag_bg NAME MODE: host B's nagging script in the background, its stdout on fd 4 (run_fifo)
+nag_bg() {
+  run_fifo "$1" env MODE="$2" $PITWALL run "$SRC/tests/integration/nagging.lua" --cars 0 \
+    --mqtt "$MQTT_URL" --remote-cars 2
+}
 from=$(wc -l <"$ALL")
-mkfifo "$TMP/nag.fifo"
-MODE=none $PITWALL run "$SRC/tests/integration/nagging.lua" --cars 0 --mqtt "$MQTT_URL" \
-  --remote-cars 2 </dev/null >"$TMP/nag.fifo" 2>"$TMP/nag.err" &
-NAG=$!
-exec 4<"$TMP/nag.fifo"
-read -r -t 20 -u 4 line
-check "nagging script (Ctrl-C): driving" "driving" "$line"
-kill -INT $NAG
+nag_bg "nagging script (Ctrl-C)" none
+kill -INT $RUN_PID
 cat <&4 >/dev/null 2>&1 &
-wait $NAG
+wait $RUN_PID
 check "nagging script (Ctrl-C): exit status" 130 "$?"
 exec 4<&-
 cars_stopped "nagging script (Ctrl-C)" "$from"
 
 # ---- host B's loop wedged in C code (a pattern that backtracks for hours): its watchdog
 # publishes the stop intents on a connection of its own; host A's cars stop while B is stuck.
-rm -f "$TMP/nag.fifo"
 from=$(wc -l <"$ALL")
-mkfifo "$TMP/nag.fifo"
-MODE=wedge $PITWALL run "$SRC/tests/integration/nagging.lua" --cars 0 --mqtt "$MQTT_URL" \
-  --remote-cars 2 </dev/null >"$TMP/nag.fifo" 2>"$TMP/wedge.err" &
-NAG=$!
-exec 4<"$TMP/nag.fifo"
-read -r -t 20 -u 4 line
-check "wedged host B: driving" "driving" "$line"
-read -r -t 20 -u 4 line
-check "wedged host B: the script wedges the loop" "wedging" "$line"
-wait_for "$TMP/wedge.err" "has not turned for" 20
+nag_bg wedged-host-B wedge
+expect_wedged wedged-host-B
 contains "wedged host B: stderr says the watchdog stopped both cars" \
-  "the watchdog sent 2 cars its stop" "$(cat "$TMP/wedge.err")"
+  "the watchdog sent 2 cars its stop" "$(cat "$TMP/wedged-host-B.err")"
 cars_stopped "wedged host B" "$from"  # while host B is still wedged
-kill -9 $NAG
-wait $NAG 2>/dev/null
-exec 4<&-
+end_fifo
 
 kill -TERM "$BRIDGE"
 wait "$BRIDGE"

@@ -25,19 +25,12 @@ if os.getenv("MODE") == "wedge" then
 end
 LUA
 
-# run_bg NAME ENV…: robot.lua in the background, its stdout read through a FIFO on fd 4 until
-# "driving"
+# run_bg NAME ENV…: robot.lua in the background, its stdout on fd 4 (run_fifo)
 run_bg() {
   local name=$1
   shift
-  rm -f "$TMP/run.fifo"
-  mkfifo "$TMP/run.fifo"
-  env "$@" $PITWALL run "$TMP/robot.lua" --cars 0 >"$TMP/run.fifo" 2>"$TMP/$name.err" &
-  RUN_PID=$!
+  run_fifo "$name" env "$@" $PITWALL run "$TMP/robot.lua" --cars 0
   PIDS+=($RUN_PID)
-  exec 4<"$TMP/run.fifo"
-  read -r -t 20 -u 4 line
-  check "$name: the script is driving" "driving" "$line"
 }
 
 # sim_robot: `pitwall sim-robot alphabot` on a free port; sets PORT, ROBOT_PID and ROBOT (its
@@ -63,35 +56,27 @@ robot_state() { sed -n 's/.*\(the robot is [a-z ]*\)$/\1/p' "$ROBOT.err"; }
 # --- WLAN, the watchdog: the loop wedged; nobody sends a signal
 sim_robot
 run_bg wlan-watchdog PORT=$PORT MODE=wedge
-read -r -t 20 -u 4 line
-check "wlan watchdog: the script wedges the loop" "wedging" "$line"
-wait_for "$TMP/wlan-watchdog.err" "has not turned for" 20
+expect_wedged wlan-watchdog
 contains "wlan watchdog: stderr says it stopped the robot" "the watchdog sent 1 car its stop" \
   "$(cat "$TMP/wlan-watchdog.err")"
 stop_robot
 check "wlan watchdog: the robot was stopped while the loop was stuck" "the robot is at rest" \
   "$(robot_state)"
-kill -9 $RUN_PID
-wait $RUN_PID 2>/dev/null
-exec 4<&-
+end_fifo
 
 # --- WLAN, the control: the same run without a wedge leaves a moving robot to the interrupt
 sim_robot
 run_bg wlan-control PORT=$PORT MODE=none
 stop_robot
 check "wlan control: a robot the script drives is moving" "the robot is moving" "$(robot_state)"
-kill -9 $RUN_PID
-wait $RUN_PID 2>/dev/null
-exec 4<&-
+end_fifo
 
 # --- WLAN, Ctrl-Z: the robot is stopped before the process stops
 sim_robot
 run_bg wlan-tstp PORT=$PORT MODE=none
 cat <&4 >/dev/null 2>&1 &
 kill -TSTP $RUN_PID
-deadline=$((SECONDS + 20))
-until [ "$(sed 's/.*) //' /proc/$RUN_PID/stat | cut -d' ' -f1)" = T ] || [ $SECONDS -ge $deadline ]
-do sleep 0.02; done
+wait_suspended $RUN_PID
 stop_robot
 check "wlan Ctrl-Z: the robot was stopped before the process stopped" "the robot is at rest" \
   "$(robot_state)"
@@ -105,24 +90,18 @@ exec 4<&-
 start_bus
 start_fake --cars 0 --alphabots 1
 run_bg ble-watchdog MODE=wedge
-read -r -t 20 -u 4 line
-check "ble watchdog: the script wedges the loop" "wedging" "$line"
-wait_for "$TMP/ble-watchdog.err" "has not turned for" 20
+expect_wedged ble-watchdog
 contains "ble watchdog: stderr says it stopped the robot" "the watchdog sent 1 car its stop" \
   "$(cat "$TMP/ble-watchdog.err")"
 stop_fake  # while pitwall is still wedged
 contains "ble watchdog: the robot was stopped while the loop was stuck" "speed=0" \
   "$(grep "^AB:00:00:00:00:01" "$TMP/fake.out")"
-kill -9 $RUN_PID
-wait $RUN_PID 2>/dev/null
-exec 4<&-
+end_fifo
 
 # --- BLE, the control: without the wedge the fake's robot is left driving when pitwall dies
 start_fake --cars 0 --alphabots 1
 run_bg ble-control MODE=none
-kill -9 $RUN_PID
-wait $RUN_PID 2>/dev/null
-exec 4<&-
+end_fifo
 stop_fake
 contains "ble control: a robot the script drives is left at its speed" "speed=40" \
   "$(grep "^AB:00:00:00:00:01" "$TMP/fake.out")"

@@ -3,6 +3,7 @@
 #include <doctest/doctest.h>
 
 #include <cstdio>
+#include <functional>
 #include <sstream>
 
 using namespace pitwall;
@@ -121,56 +122,51 @@ TEST_CASE("record player: a long run of bad lines is read with the loop turning"
   RecordSummary summary = scanRecord(scan);
   REQUIRE(summary.framesOut.size() == 1);
 
-  SUBCASE("a seek across them") {
+  // Plays `text` with a ticker of its own on the loop; `start` begins the playback or the seek.
+  struct Outcome {
+    bool ended = false;
+    std::uint64_t frames = 0;
+    int ticks = 0;
+  };
+  auto play = [&](const std::function<void(Loop&, RecordPlayer&)>& start) {
     std::istringstream in(text);
     Loop loop(ClockKind::Real);
     Fleet fleet(loop);
     RecordPlayer player(loop, fleet, in, summary);
-    int ticks = 0;
-    bool ended = false;
+    Outcome out;
     std::function<void()> tick = [&] {
-      ++ticks;
-      loop.after(1ms, tick);
-    };
-    player.onEnd = [&] {
-      ended = true;
-      loop.stop();
-    };
-    player.pause(true);
-    loop.post([&] {
-      loop.after(1ms, tick);
-      player.seek(player.duration());
-    });
-    auto guard = loop.after(60s, [&] { loop.stop(); });
-    loop.run();
-    loop.cancel(guard);
-    CHECK(ended);
-    CHECK(player.car(1)->state().frames_in == 2);
-    CHECK(ticks > 2);  // the loop turned while the bad lines were read
-  }
-  SUBCASE("playback across them") {
-    std::istringstream in(text);
-    Loop loop(ClockKind::Real);
-    Fleet fleet(loop);
-    RecordPlayer player(loop, fleet, in, summary);
-    int ticks = 0;
-    bool ended = false;
-    std::function<void()> tick = [&] {
-      ++ticks;
+      ++out.ticks;
       loop.after(1ms, tick);
     };
     loop.after(1ms, tick);
     player.onEnd = [&] {
-      ended = true;
+      out.ended = true;
       loop.stop();
     };
-    player.setSpeed(100);  // the half second between the frames in 5 ms
-    player.play();
+    start(loop, player);
     auto guard = loop.after(60s, [&] { loop.stop(); });
     loop.run();
     loop.cancel(guard);
-    CHECK(ended);
-    CHECK(player.car(1)->state().frames_in == 2);
-    CHECK(ticks > 2);
+    out.frames = player.car(1)->state().frames_in;
+    return out;
+  };
+
+  SUBCASE("a seek across them") {
+    auto out = play([](Loop& loop, RecordPlayer& player) {
+      player.pause(true);
+      loop.post([&player] { player.seek(player.duration()); });
+    });
+    CHECK(out.ended);
+    CHECK(out.frames == 2);
+    CHECK(out.ticks > 2);  // the loop turned while the bad lines were read
+  }
+  SUBCASE("playback across them") {
+    auto out = play([](Loop&, RecordPlayer& player) {
+      player.setSpeed(100);  // the half second between the frames in 5 ms
+      player.play();
+    });
+    CHECK(out.ended);
+    CHECK(out.frames == 2);
+    CHECK(out.ticks > 2);
   }
 }
