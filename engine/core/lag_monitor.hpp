@@ -8,6 +8,7 @@
 #include <chrono>
 #include <deque>
 #include <functional>
+#include <utility>
 
 #include "engine/core/loop.hpp"
 
@@ -28,7 +29,7 @@ class LagMonitor {
   static constexpr double kBehindMs = 10;  // two ticks
   static constexpr double kCaughtUpMs = 5;
   static constexpr double kStallMs = 250;  // the most one sample counts
-  static constexpr std::size_t kWindow = 154;  // samples: 2 s
+  static constexpr Duration kWindow = std::chrono::seconds(2);
 
  private:
   void sample();
@@ -36,7 +37,10 @@ class LagMonitor {
   Loop& loop_;
   Loop::TimerId timer_ = 0;
   TimePoint due_{0};
-  std::deque<double> lateMs_;  // the last kWindow samples
+  // the samples of the last kWindow (when, how late): a held loop samples less often, so the
+  // window is one of time, not of a number of samples
+  std::deque<std::pair<TimePoint, double>> lateMs_;
+  TimePoint started_{0};
   bool behind_ = false;
 };
 
