@@ -1,7 +1,6 @@
 #include "engine/core/lag_monitor.hpp"
 
 #include <algorithm>
-#include <numeric>
 
 namespace pitwall {
 
