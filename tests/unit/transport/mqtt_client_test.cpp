@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
@@ -414,4 +415,29 @@ TEST_CASE("mqtt: TLS with a throwaway CA connects, and a server the CA did not s
     CHECK(refused.drops.front().first.find("certificate verify failed") != std::string::npos);
     CHECK(refused.connects == 0);
   }
+}
+
+// The watchdog's stop of a remote car (engine/mqtt/remote.cpp): one publication on a connection
+// of its own, from a thread that is not the loop's. Acknowledged by a real broker; against no
+// broker at all (a refused port) false within its limit, so the watchdog's thread goes on.
+TEST_CASE("mqtt: publishOnce delivers on a connection of its own, and gives up in bounded time") {
+  MosquittoBroker broker;
+  Loop loop(ClockKind::Real);
+  MqttClient client(loop, optionsFor(broker, "watcher"));
+  Probe probe(client);
+  client.subscribe("pitwall/once/#", 1);
+  client.connect();
+  REQUIRE(runUntil(loop, [&] { return probe.connects == 1; }));
+  // until the subscription holds (its SUBACK is not reported), from the test's own thread
+  REQUIRE(runUntil(loop, [&] {
+    CHECK(publishOnce(optionsFor(broker, "ignored"), "pitwall/once/stop", "{\"speed\":0}", 1,
+                      std::chrono::milliseconds(800)));
+    return probe.has("pitwall/once/stop", "{\"speed\":0}");
+  }));
+  MqttOptions nowhere;
+  nowhere.host = "127.0.0.1";
+  nowhere.port = 1;  // nothing listens: refused
+  const auto before = std::chrono::steady_clock::now();
+  CHECK_FALSE(publishOnce(nowhere, "pitwall/once/stop", "{}", 1, std::chrono::milliseconds(300)));
+  CHECK(std::chrono::steady_clock::now() - before < std::chrono::seconds(5));
 }
