@@ -8,6 +8,7 @@
 #include "bindings/lua_args.hpp"
 #include "bindings/pitwall_module.hpp"
 #include "bindings/script_host.hpp"
+#include "engine/core/printable.hpp"
 #include "engine/protocol/anki/advertisement.hpp"
 #include "engine/protocol/anki/limits.hpp"
 #include "engine/sim/grid.hpp"
@@ -85,8 +86,10 @@ int setTrack(lua_State* L) {
   if (!loaded) throw LuaError(loaded.error());
   sim::Noise noise = s.world->noise();
   Loop& loop = s.world->loop();
+  sim::SensorModel sensor = s.world->sensor();
   s.world = std::make_unique<sim::World>(loop, std::move(*loaded), s.seed);
   s.world->setNoise(noise);
+  s.world->setSensor(sensor);
   pushTrack(L, s.world->track());
   return 1;
 }
@@ -265,19 +268,43 @@ int noise(lua_State* L) {
   return 1;
 }
 
+// sim.sensor{model = "real"|"ideal"}: what the cars' sensors report (docs/simulator.md "Sensor
+// model"); returns the current setting.
+int sensor(lua_State* L) {
+  SimSession& s = session(L);
+  if (!lua_isnoneornil(L, 1)) {
+    if (!lua_istable(L, 1))
+      throw LuaError("sim.sensor takes a table {model = \"real\" or \"ideal\"}");
+    static constexpr std::array<const char*, 1> kOptions = {"model"};
+    lua::checkOptions(L, 1, "sim.sensor", kOptions);
+    if (lua_getfield(L, 1, "model") != LUA_TNIL) {
+      std::string name = lua::checkString(L, -1, "sensor model");
+      auto model = sim::sensorModelNamed(name);
+      if (!model)
+        throw LuaError("sensor model '" + printable(name, 40) +
+                       "' is not one the simulator has; use \"real\" (fitted to real cars: "
+                       "positions thin out with speed) or \"ideal\" (every code)");
+      s.world->setSensor(*model);
+    }
+    lua_pop(L, 1);
+  }
+  lua_createtable(L, 0, 1);
+  std::string_view name = sim::sensorModelName(s.world->sensor());
+  lua_pushlstring(L, name.data(), name.size());
+  lua_setfield(L, -2, "model");
+  return 1;
+}
+
 }  // namespace
 
 void openSimModule(ScriptHost& host) {
   lua_State* L = host.state();
-  static const luaL_Reg functions[] = {{"track", lua::guarded<track>},
-                                       {"setTrack", lua::guarded<setTrack>},
-                                       {"layouts", lua::guarded<layouts>},
-                                       {"_addCar", lua::guarded<addCar>},
-                                       {"truth", lua::guarded<truth>},
-                                       {"lift", lua::guarded<lift>},
-                                       {"place", lua::guarded<place>},
-                                       {"noise", lua::guarded<noise>},
-                                       {nullptr, nullptr}};
+  static const luaL_Reg functions[] = {
+      {"track", lua::guarded<track>},     {"setTrack", lua::guarded<setTrack>},
+      {"layouts", lua::guarded<layouts>}, {"_addCar", lua::guarded<addCar>},
+      {"truth", lua::guarded<truth>},     {"lift", lua::guarded<lift>},
+      {"place", lua::guarded<place>},     {"noise", lua::guarded<noise>},
+      {"sensor", lua::guarded<sensor>},   {nullptr, nullptr}};
   lua_getglobal(L, "pitwall");
   luaL_newlib(L, functions);
   openScriptUnderTest(L);

@@ -701,6 +701,9 @@ function Alphabot:stop() end
 ---@field late? number delay probability 0..1
 ---@field lateBy? number the delay's upper bound, s
 
+---@class pitwall.sim.Sensor
+---@field model? "real"|"ideal" real: fitted to real cars, position updates thin out with speed; ideal (the default for now): every code
+
 ---A script under test (sim.script).
 ---@class pitwall.sim.ScriptUnderTest
 ---@field started boolean
@@ -771,6 +774,11 @@ function pitwall.sim.runUntil(cond, timeout, step) end
 ---@param options? pitwall.sim.ScriptOptions
 ---@return pitwall.sim.ScriptUnderTest
 function pitwall.sim.script(pathOrSource, options) end
+
+---What the simulated cars' sensors report (docs/simulator.md "Sensor model"); returns the current setting.
+---@param sensor? pitwall.sim.Sensor
+---@return pitwall.sim.Sensor
+function pitwall.sim.sensor(sensor) end
 
 ---Replaces the track (a layout name, a file or layout text); only before any car is added.
 ---@param track string

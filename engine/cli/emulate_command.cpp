@@ -58,6 +58,7 @@ int emulateCar(const EmulateOptions& options) {
   Loop loop(ClockKind::Real);
   log::setTimeSource([&loop] { return loop.seconds(); });
   sim::World world(loop, std::move(*track), options.seed);
+  world.setSensor(sim::sensorModelNamed(options.sensor).value_or(sim::SensorModel::Ideal));
   sim::CarSpec spec = sim::gridSpec(world.track(), 0);
   spec.name = options.name;
   spec.model_id = options.model;
@@ -182,6 +183,10 @@ Command addEmulateCommand(CLI::App& app) {
       ->check(CLI::Range(1, 255));
   cmd->add_option("--track", emulate->track, "Track layout the car drives on (oval)");
   cmd->add_option("--seed", emulate->seed, "Seed of the simulator");
+  cmd->add_option("--sensor", emulate->sensor,
+                  "What the car's sensor reports: real (as real cars do) or ideal (every code; the "
+                  "default for now)")
+      ->check(CLI::IsMember({"real", "ideal"}));
   cmd->add_option("--duration", emulate->duration, "Stop after this many seconds")
       ->check(CLI::PositiveNumber);
   return {cmd, [emulate] { return cli::emulateCar(*emulate); }};

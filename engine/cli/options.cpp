@@ -17,6 +17,11 @@ CLI::Option* addCarSource(CLI::App* cmd, CarSource& source, const char* when) {
   auto* ble = cmd->add_flag("--ble", source.ble,
                             "Drive real cars over Bluetooth LE (BlueZ) instead of the simulator");
   ble->excludes(cars);  // real cars are the cars there are
+  cmd->add_option("--sensor", source.sensor,
+                  "What the simulated cars' sensors report: real (fitted to real cars: position "
+                  "updates thin out with speed) or ideal (every code; the default for now)")
+      ->check(CLI::IsMember({"real", "ideal"}))
+      ->excludes(ble);
   cmd->add_option("--car", source.carAddresses, "With --ble: only this car (repeatable)")
       ->needs(ble);
   cmd->add_option("--adapter", source.adapters,

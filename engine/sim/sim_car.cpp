@@ -27,6 +27,7 @@ constexpr double kLowBatteryMv = 3600;
 constexpr double kFullBatteryMv = 4200;
 constexpr std::uint8_t kBitsRead = 0x07;  // parsing flags low nibble: 7-bit codes (§4.5.1)
 constexpr std::uint8_t kReverseDriving = 0x20;
+constexpr std::uint8_t kReverseParsing = 0x40;  // the piece's codes read backwards
 
 std::uint16_t clampU16(double v) {
   return static_cast<std::uint16_t>(std::clamp(std::lround(v), 0L, 65535L));
@@ -214,7 +215,11 @@ void Car::plan(double dt) {
     speed_ = std::min(target_, speed_ + accel_ * dt);
   } else if (speed_ > target_) {
     speed_ = std::max(target_, speed_ - accel_ * dt);
+    // Real cars report a collision as they come to a halt from speed (docs/simulator.md).
+    if (speed_ == 0 && on_track_ && sensor::reportsHalt(env_.sensor, peak_))
+      emit(anki::Collision{1, 0});
   }
+  peak_ = speed_ > 0 ? std::max(peak_, speed_) : 0;
 
   // Lateral move toward the target lane: accelerate to the asked lateral speed, and slow down
   // in time to arrive without overshoot. A car steers only while it rolls.
@@ -280,8 +285,8 @@ void Car::move(double lane_mm) {
       for (int k = 0; k < codes; ++k) {
         int idx = dir_ > 0 ? k : codes - 1 - k;
         double f = row.code_at[static_cast<std::size_t>(idx)];
-        if (dir_ > 0 ? (f > u_ && f <= nu) : (f < u_ && f >= nu))
-          sendPosition(row.location[static_cast<std::size_t>(idx)]);
+        if ((dir_ > 0 ? (f > u_ && f <= nu) : (f < u_ && f >= nu)) && reads(p))
+          sendPosition(row.location[static_cast<std::size_t>(idx)], row.reversed != (dir_ < 0));
       }
     }
     // Wheels run on lanes of their own: in a curve the outer wheel travels further.
@@ -297,7 +302,11 @@ void Car::move(double lane_mm) {
 
 void Car::crossBoundary() {
   const bool reporting = on_track_ && !delocalized_;
-  if (reporting) sendTransition();
+  if (reporting) {
+    sendTransition();
+    double phantom = sensor::phantomCollisionChance(env_.sensor, speed_);
+    if (phantom > 0 && uniform() < phantom) emit(anki::Collision{0, 1});
+  }
   std::size_t n = env_.pieces.size();
   std::size_t from = piece_;
   piece_ = dir_ > 0 ? (piece_ + 1) % n : (piece_ + n - 1) % n;
@@ -399,14 +408,26 @@ int Car::rowAt(const PieceInfo& p) const {
                     rows - 1);
 }
 
-void Car::sendPosition(int location_id) {
+bool Car::reads(const PieceInfo& p) {
+  double radius = p.piece.radius() + p.piece.turn * offset_;
+  double chance = sensor::readChance(env_.sensor, p.piece.type, speed_, radius);
+  return chance >= 1 || uniform() < chance;
+}
+
+void Car::sendPosition(int location_id, bool read_backwards) {
   anki::PositionUpdate m;
   m.location_id = static_cast<std::uint8_t>(location_id);
   const PieceInfo& p = here();
   m.piece_id = p.piece.id;
   m.offset_mm = static_cast<float>(believedOffset());
-  m.speed_mm_s = clampU16(speed_);
-  m.parsing_flags = kBitsRead | (dir_ < 0 ? kReverseDriving : 0);
+  double reported = speed_;
+  if (env_.sensor == SensorModel::Real) {
+    double u1 = uniform();
+    reported = sensor::reportedSpeed(env_.sensor, speed_, u1, uniform());
+  }
+  m.speed_mm_s = clampU16(reported);
+  m.parsing_flags = static_cast<std::uint8_t>(kBitsRead | (dir_ < 0 ? kReverseDriving : 0) |
+                                              (read_backwards ? kReverseParsing : 0));
   m.last_recv_lane_change_id = lane_recv_id_;
   m.last_exec_lane_change_id = lane_exec_id_;
   m.last_desired_lane_change_speed_mm_s = lane_speed_asked_;

@@ -12,6 +12,7 @@
 
 #include "engine/core/loop.hpp"
 #include "engine/protocol/anki/messages.hpp"
+#include "engine/sim/sensor.hpp"
 #include "engine/sim/world.hpp"
 
 namespace pitwall::sim {
@@ -26,6 +27,7 @@ struct PieceInfo {
   struct Row {
     std::vector<double> code_at;
     std::vector<int> location;  // the location id of each code, in the same order
+    bool reversed = false;      // its ids run against the layout (a right curve): read backwards
   };
   std::vector<Row> rows;  // left to right in the piece's forward direction
   double row_pitch_mm = 12;
@@ -38,6 +40,7 @@ struct Environment {
   std::vector<PieceInfo> pieces;
   double lap_mm = 0;  // centre-line lap length
   Noise noise;
+  SensorModel sensor = SensorModel::Ideal;  // not yet Real by default: docs/simulator.md
   std::mt19937_64 rng;
   std::function<void()> wake;  // a car has something to do: make sure the world ticks
 };
@@ -91,7 +94,8 @@ class Car final : public SimCar {
   void flushOutbox();
   double uniform();  // [0, 1) from the world's generator, by our own arithmetic
   void sendStatus();
-  void sendPosition(int code_index);
+  bool reads(const PieceInfo& p);  // whether passing a code yields a position (the sensor model)
+  void sendPosition(int location_id, bool read_backwards);
   void sendTransition();
 
   Environment& env_;
@@ -107,6 +111,7 @@ class Car final : public SimCar {
   double bias_ = 0;  // believed − true offset, in the driving frame (set-offset re-bases it)
 
   double speed_ = 0, target_ = 0, accel_ = 0;
+  double peak_ = 0;  // the fastest since the car last stood (a halt from speed reports, Sensor)
   double planned_lane_ = 0, planned_centre_ = 0;
 
   bool lane_active_ = false;

@@ -33,6 +33,7 @@ PieceInfo describe(const Piece& piece) {
   info.row_pitch_mm = g.row_pitch_mm;
   for (const CodeRow& row : codeLayout(piece, g).rows) {
     PieceInfo::Row r;
+    r.reversed = row.reversed;
     for (int k = 0; k < row.sections; ++k) {
       r.code_at.push_back(row.sectionCentre(k) / row.length_mm);
       r.location.push_back(row.locationOf(k));
@@ -46,7 +47,8 @@ PieceInfo describe(const Piece& piece) {
 
 struct World::State {
   State(Loop& loop, Track t, std::uint64_t seed)
-      : track(std::move(t)), env{loop, track, {}, 0, {}, std::mt19937_64(seed), {}} {
+      : track(std::move(t)), env{loop, track, {}, 0, {}, SensorModel::Ideal, std::mt19937_64(seed),
+                                 {}} {
     if (track.size() == 0) throw std::invalid_argument("a simulated world needs a track");
     std::size_t n = track.size();
     env.pieces.resize(n);
@@ -291,6 +293,14 @@ void World::setNoise(Noise noise) {
 
 const Noise& World::noise() const {
   return state_->env.noise;
+}
+
+void World::setSensor(SensorModel model) {
+  state_->env.sensor = model;
+}
+
+SensorModel World::sensor() const {
+  return state_->env.sensor;
 }
 
 }  // namespace pitwall::sim

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "engine/core/loop.hpp"
+#include "engine/sim/sensor.hpp"
 #include "engine/sim/track.hpp"
 
 namespace pitwall::sim {
@@ -93,6 +94,11 @@ class World {
   std::vector<SimCar*> cars();
   void setNoise(Noise noise);
   const Noise& noise() const;
+  // What the cars' sensors report (engine/sim/sensor.hpp): `Real`, fitted to a physical car's
+  // frames, or `Ideal` (every code; the default until everything users see holds under `Real`,
+  // docs/simulator.md "Sensor model").
+  void setSensor(SensorModel model);
+  SensorModel sensor() const;
   // Ticks made up for because the loop ran them late (real time only; docs/simulator.md
   // "Real time"): the cars moved on by the wall clock meanwhile.
   std::uint64_t lateTicks() const;

@@ -47,6 +47,10 @@ FakeBluez::State::State(Loop& loop_, sdbus::IConnection& connection, Options opt
   auto track = sim::loadLayout(options.track);
   if (!track) throw std::invalid_argument(track.error());
   world = std::make_unique<sim::World>(loop, std::move(track.value()), options.seed);
+  auto sensor = sim::sensorModelNamed(options.sensor);
+  if (!sensor)
+    throw std::invalid_argument("sensor model '" + options.sensor + "': use real or ideal");
+  world->setSensor(*sensor);
 
   for (int i = 0; i < options.adapters; ++i) {
     auto a = std::make_unique<Adapter>();

@@ -53,7 +53,8 @@ say "bluetoothd $("$BLUETOOTHD" -v): hci0 $ADDR0 and hci1 $ADDR1 powered"
 # Meanwhile, an adapter BlueZ does not have must give one sentence and status 2.
 "$PITWALL" emulate-car --adapter hci9 >"$LOGS/hci9.out" 2>&1 &
 HCI9_PID=$!
-"$PITWALL" --log-level "${PITWALL_QEMU_LOG:-info}" emulate-car --adapter hci0 --name pitwall \
+# every code and the exact speed: the centrals check speeds and count laps from positions
+"$PITWALL" --log-level "${PITWALL_QEMU_LOG:-info}" emulate-car --sensor ideal --adapter hci0 --name pitwall \
   > >(sed -u 's/^/[car] /') 2>&1 &
 CAR_PID=$!
 say "pitwall emulate-car started (pid $CAR_PID)"

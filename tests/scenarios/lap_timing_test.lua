@@ -4,6 +4,11 @@
 -- the frames are lost: the counts stay exact.
 -- tags: track
 local sim = require "pitwall.sim"
+-- As real cars report: position updates thin out with speed, none on most curves at 1000 mm/s
+-- and up; the laps come from the transitions (docs/simulator.md "Sensor model").
+expect.eq(sim.sensor().model, "ideal", "the default, for now")
+sim.sensor { model = "real" }
+expect.eq(sim.sensor().model, "real")
 local track = require "pitwall.track"
 local laps = require "pitwall.laps"
 

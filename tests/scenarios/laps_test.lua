@@ -2,6 +2,10 @@
 -- at several speeds and lanes, and lap times match lap length / speed.
 -- tags: track
 local sim = require "pitwall.sim"
+-- Every code: this counts laps from the position events themselves, which a real car at speed
+-- does not send on every piece (docs/simulator.md "Sensor model"; pitwall.laps counts
+-- transitions too: tests/scenarios/lap_timing_test.lua).
+sim.sensor { model = "ideal" }
 
 local cases = {
   { speed = 400, lane = 1 },

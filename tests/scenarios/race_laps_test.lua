@@ -2,6 +2,8 @@
 -- stopped at the end; results rows; positions and gaps.
 -- tags: race
 local sim = require "pitwall.sim"
+-- As real cars report (docs/simulator.md "Sensor model"): finish order and laps hold.
+sim.sensor { model = "real" }
 local race = require "pitwall.race"
 local track = require "pitwall.track"
 

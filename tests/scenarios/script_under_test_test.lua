@@ -7,6 +7,8 @@ local sim = require "pitwall.sim"
 
 expect.fails(function() sim.reload("x = 1") end, "no script under test to reload")
 
+-- every code: the scenario counts the position events its handler hears
+sim.sensor { model = "ideal" }
 local car = sim.addCar {}
 local heard = 0
 car.onPosition = function() heard = heard + 1 end

@@ -52,6 +52,9 @@ return {
 ---@field late? number delay probability 0..1
 ---@field lateBy? number the delay's upper bound, s
 
+---@class pitwall.sim.Sensor
+---@field model? "real"|"ideal" real: fitted to real cars, position updates thin out with speed; ideal (the default for now): every code
+
 ---A script under test (sim.script).
 ---@class pitwall.sim.ScriptUnderTest
 ---@field started boolean
@@ -98,6 +101,9 @@ See docs/testing.md and docs/simulator.md.]],
       noise = [[Frame loss and delay; returns the current setting.
 @param noise? pitwall.sim.Noise
 @return pitwall.sim.Noise]],
+      sensor = [[What the simulated cars' sensors report (docs/simulator.md "Sensor model"); returns the current setting.
+@param sensor? pitwall.sim.Sensor
+@return pitwall.sim.Sensor]],
       script = [[Runs a script under test in Lua worlds of its own, as `pitwall run --watch` does.
 @param pathOrSource string
 @param options? pitwall.sim.ScriptOptions

@@ -35,6 +35,8 @@ struct ReloadFixture {
                                        std::to_string(reinterpret_cast<std::uintptr_t>(this)));
     fs::create_directories(dir);
     sim.world = std::make_unique<sim::World>(loop, *sim::loadLayout("oval"), 1);
+    // these tests count the events a script hears across reloads: every code makes one
+    sim.world->setSensor(sim::SensorModel::Ideal);
     for (int i = 0; i < cars; ++i)
       testing::addSimulatedCar(loop, fleet, *sim.world, sim::gridSpec(sim.world->track(), i));
     counting = fleet.frames.connect([this](AnkiCar&, AnkiCar::Direction d,

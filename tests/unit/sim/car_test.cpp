@@ -37,6 +37,8 @@ struct Rig {
                 .value(),
             7),
         car(world.addCar(std::move(spec))) {
+    world.setSensor(
+        SensorModel::Ideal);  // the protocol, code by code (sensor_test.cpp: the real model)
     car.connect(
         [this](std::span<const std::uint8_t> f) {
           auto m = anki::decode(f);

@@ -32,7 +32,11 @@ struct Rig {
   std::vector<Heard> heard;
 
   explicit Rig(std::uint64_t seed = 1, std::string_view layout = "oval")
-      : world(loop, namedLayout(layout).value(), seed) {}
+      : world(loop, namedLayout(layout).value(), seed) {
+    // the world's rules, frame by frame: every code, only real contacts (the real sensor
+    // model has tests of its own, sensor_test.cpp, and the determinism test below)
+    world.setSensor(SensorModel::Ideal);
+  }
   SimCar& add(CarSpec spec) {
     SimCar& car = world.addCar(std::move(spec));
     std::size_t index = cars.size();
@@ -340,6 +344,7 @@ TEST_CASE("the same seed and commands give the same frames at the same times") {
   auto run = [](std::uint64_t seed) {
     Rig rig(seed, "kidney");
     rig.world.setNoise({.drop = 0.05, .late = 0.1, .late_by = 80ms});
+    rig.world.setSensor(SensorModel::Real);  // its draws too
     SimCar& a = rig.add({.name = "a", .piece_index = 0});
     SimCar& b = rig.add({.name = "b", .piece_index = 3, .offset_mm = 23});
     SimCar& c = rig.add({.name = "c", .piece_index = 6, .offset_mm = -68});
