@@ -1,5 +1,6 @@
 #include "engine/view/feed.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "engine/core/log.hpp"
@@ -204,13 +205,18 @@ nlohmann::json Feed::carJson(const AnkiCar& ankiCar, std::size_t laps) const {
     j["bestLap"] = round3(*t.bestLap());
   }
   if (track_ && t.pieceIndex() && !s.delocalized && s.on_track) {
-    Pose p = pointOnTrack(*track_, *t.pieceIndex(), t.fraction(), s.offset_mm);
+    // localized: moved on from the last position or transition by the car's speed (the page
+    // goes on from here between updates)
+    const double at = std::max(now(), t.positionTime());
+    const double fraction = t.fractionAt(at, s.speed_mm_s, s.offset_mm, s.reverse);
+    Pose p = pointOnTrack(*track_, *t.pieceIndex(), fraction, s.offset_mm);
     j["pieceIndex"] = *t.pieceIndex();
-    j["fraction"] = round3(t.fraction());
+    j["fraction"] = round3(fraction);
     j["x"] = round3(p.x);
     j["y"] = round3(p.y);
     j["heading"] = round3(p.heading);
     j["positionTime"] = round3(t.positionTime());
+    j["at"] = round3(at);
   }
   return j;
 }

@@ -93,6 +93,15 @@ void CarTracker::update(const anki::Message& message, const CarState& state, dou
   }
 }
 
+double CarTracker::fractionAt(double now, double speed_mm_s, double offset_mm, bool reverse) const {
+  if (!track_ || !index_ || positionTime_ < 0 || now <= positionTime_ || speed_mm_s <= 0)
+    return fraction_;
+  const double length = track_->pieces()[*index_].length(offset_mm);
+  if (length <= 0) return fraction_;
+  const double moved = speed_mm_s * (now - positionTime_) / length;
+  return reverse ? std::max(0.0, fraction_ - moved) : std::min(1.0, fraction_ + moved);
+}
+
 // The car left the piece it was on: 34 → 33 driving forward is the finish line. Known by the
 // piece it was on (reported, or carried on by the map), or — with no map and no position
 // update on the start piece — by the number of pieces a lap has, once two laps have shown it.

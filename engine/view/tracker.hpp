@@ -26,6 +26,10 @@ class CarTracker {
   std::optional<std::size_t> pieceIndex() const { return index_; }
   double fraction() const { return fraction_; }
   double positionTime() const { return positionTime_; }  // when index/fraction were last set
+  // Where along its piece the car is at `now`: the last known fraction moved on by its speed
+  // along its lane since then, but never past the piece's end — the transition says when it
+  // left (a real car at speed reports no position on most curves: docs/view.md "Cars").
+  double fractionAt(double now, double speed_mm_s, double offset_mm, bool reverse) const;
 
   int laps() const { return static_cast<int>(lapTimes_.size()); }
   const std::vector<double>& lapTimes() const { return lapTimes_; }

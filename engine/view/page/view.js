@@ -212,7 +212,9 @@ function targetOf(car, now) {
   }
   if (car.pieceIndex == null || !t.pieces[car.pieceIndex])
     return { x: car.x, y: car.y, heading: car.heading || 0, moving: false };
-  const dt = Math.min(EXTRAPOLATE_MAX_S, Math.max(0, now - (car.positionTime ?? now)));
+  // from where the feed estimated the car (`at`), else from its last report
+  const from = car.at ?? car.positionTime ?? now;
+  const dt = Math.min(EXTRAPOLATE_MAX_S, Math.max(0, now - from));
   const at = advance(t, car.pieceIndex, car.fraction || 0, car.offset || 0,
                      Math.max(0, car.speed || 0) * dt, !!car.reverse);
   const p = pointOnTrack(t, at.index, at.fraction, car.offset || 0);

@@ -22,7 +22,10 @@ struct Race {
   Fleet fleet{loop};
   std::unique_ptr<view::Feed> feed;
   explicit Race(sim::Track track = sim::namedLayout("oval").value())
-      : world(loop, std::move(track), 1) {}
+      : world(loop, std::move(track), 1) {
+    // as real cars report: no position update on most curves at speed (docs/simulator.md)
+    world.setSensor(sim::SensorModel::Real);
+  }
   void run(double seconds) {
     loop.at(loop.now() + fromSeconds(seconds), [this] { loop.stop(); });
     loop.run();
@@ -93,7 +96,9 @@ TEST_CASE("view feed: cars are placed where the simulator has them, and laps are
       CHECK(state["cars"][k]["lap"].get<int>() == truth.laps - 1);
       CHECK(truth.laps >= 3);
       for (double t : state["cars"][k]["lapTimes"]) CHECK(t > 2.0);
-      CHECK(state["cars"][k]["speedHistory"].size() > 100);
+      // a speed sample a frame, at most ten a second; at 700–1000 mm/s a real car's frames
+      // that carry a speed (position updates) thin out to two or three a second
+      CHECK(state["cars"][k]["speedHistory"].size() > 50);
     }
   }
 }

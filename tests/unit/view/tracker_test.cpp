@@ -97,3 +97,37 @@ TEST_CASE("tracker: without a map and without the start piece's reports no lap i
   });
   CHECK(none.laps() == 0);
 }
+
+TEST_CASE(
+    "tracker: between updates the car moves on by its speed along its lane, never past the "
+    "piece's end") {
+  const sim::Track track = sim::namedLayout("oval").value();
+  view::CarTracker tracker;
+  tracker.setTrack(&track);
+  CarState state;
+  CHECK(tracker.fractionAt(5, 1000, 0, false) == 0);  // not localized: nothing to move on
+  // a report on the start piece (34), then the transitions onto 33 and the straight after it
+  anki::PositionUpdate p;
+  p.piece_id = anki::kFinishBefore;
+  p.location_id = 0;
+  tracker.update(p, state, 1.0);
+  tracker.update(anki::TransitionUpdate{}, state, 1.2);
+  tracker.update(anki::TransitionUpdate{}, state, 1.4);
+  REQUIRE(tracker.pieceIndex());
+  const sim::Piece& straight = track.pieces()[*tracker.pieceIndex()];
+  REQUIRE(straight.type == anki::PieceType::Straight);
+  CHECK(tracker.fraction() == 0);
+  CHECK(tracker.positionTime() == doctest::Approx(1.4));
+  // 0.28 s at 1000 mm/s on a 560 mm straight: half of it
+  CHECK(tracker.fractionAt(1.68, 1000, 23, false) == doctest::Approx(0.5));
+  CHECK(tracker.fractionAt(1.4, 1000, 23, false) == 0);
+  CHECK(tracker.fractionAt(9.0, 1000, 23, false) == 1);  // the transition says when it left
+  CHECK(tracker.fractionAt(9.0, 0, 23, false) == 0);     // standing
+  // onto the curve: on the outer lane of a left curve (+68 mm) it is longer than the centre's
+  tracker.update(anki::TransitionUpdate{}, state, 2.0);
+  const sim::Piece& curve = track.pieces()[*tracker.pieceIndex()];
+  REQUIRE(curve.type == anki::PieceType::Curve);
+  const double outer = curve.length(68);
+  CHECK(outer > curve.length(0));
+  CHECK(tracker.fractionAt(2.0 + 0.25 * outer / 800, 800, 68, false) == doctest::Approx(0.25));
+}
