@@ -70,8 +70,11 @@ void CarTracker::update(const anki::Message& message, const CarState& state, dou
         !crossedSinceStartPiece_)
       crossFinish(now);
     if (p->piece_id == anki::kFinishBefore) crossedSinceStartPiece_ = false;
+    const bool placing = !index_ && currentPieceId() < 0;
     lastPieceId_ = p->piece_id;
     index_ = locate(p->piece_id, reverse);
+    if (placing && index_ && !reverse) placeEarlierTransitions();
+    unplaced_.clear();
     // The piece as the track has it (a custom one's shape), else Anki's stock piece of that id.
     sim::Piece piece{p->piece_id, anki::pieceType(p->piece_id),
                      anki::pieceType(p->piece_id) == anki::PieceType::Curve ? 1 : 0};
@@ -102,10 +105,30 @@ double CarTracker::fractionAt(double now, double speed_mm_s, double offset_mm, b
   return reverse ? std::max(0.0, fraction_ - moved) : std::min(1.0, fraction_ + moved);
 }
 
+// The car has said where it is for the first time, after transitions it made before: walked
+// back along the map, one of them may have been the line (34 → 33), crossed then.
+void CarTracker::placeEarlierTransitions() {
+  const auto& pieces = track_->pieces();
+  const std::size_t n = pieces.size();
+  const std::size_t k = unplaced_.size();
+  for (std::size_t j = 1; j <= k && j < n; ++j) {  // the j-th transition back: into index − j + 1
+    const std::size_t into = (*index_ + n * j - (j - 1)) % n;
+    const std::size_t from = (into + n - 1) % n;
+    if (pieces[from].id == anki::kFinishBefore && pieces[into].id == anki::kFinishAfter) {
+      crossFinish(unplaced_[k - j]);
+      crossedSinceStartPiece_ = pieces[*index_].id != anki::kFinishBefore;
+      return;
+    }
+  }
+}
+
 // The car left the piece it was on: 34 → 33 driving forward is the finish line. Known by the
 // piece it was on (reported, or carried on by the map), or — with no map and no position
 // update on the start piece — by the number of pieces a lap has, once two laps have shown it.
 void CarTracker::transition(bool reverse, double now) {
+  if (track_ && !index_ && currentPieceId() < 0 && !reverse &&
+      unplaced_.size() < 2 * track_->size())
+    unplaced_.push_back(now);
   bool crossed = false;
   if (currentPieceId() == anki::kFinishBefore && !reverse && !crossedSinceStartPiece_) {
     crossed = true;

@@ -38,6 +38,7 @@ class CarTracker {
  private:
   void crossFinish(double now);
   void transition(bool reverse, double now);
+  void placeEarlierTransitions();
   int currentPieceId() const;
   std::optional<std::size_t> locate(int pieceId, bool reverse) const;
   double codeFraction(const sim::Piece& piece, long key, int location);
@@ -50,6 +51,9 @@ class CarTracker {
   double positionTime_ = -1;
   int lastPieceId_ = -1;
   bool crossedSinceStartPiece_ = false;
+  // Times of the transitions a car made before it ever said where it was (a real car pulling
+  // away from the grid fast may report nothing before the line): placed once it reports.
+  std::vector<double> unplaced_;
   std::optional<double> lastCrossing_;
   // Without a map: transitions since the line (none: not known), and the pieces of a lap once
   // two crossings in a row showed it

@@ -217,6 +217,17 @@ function Tracker:_adopt()
   for _, x in ipairs(e.entered) do self:_notify("enter", x[1], x[2], x[3]) end
 end
 
+--- Takes the car to stand on map piece `index` before it has reported where it is (a race
+--- director that drove it to the grid knows): localized there, its place in the piece a guess,
+--- so the next transition is the end of that piece. A real car pulling away from the grid at
+--- speed may send no position update before the line (docs/simulator.md "Sensor model").
+--- Nothing changes for a car already localized.
+function Tracker:assume(index)
+  if self.localized or not self.map.pieces[index] then return end
+  self.hyps, self.entrySeen = nil, false
+  self.index, self.pos, self.anchored, self.localized = index, 0.5, false, true
+end
+
 function Tracker:_onPosition(ev)
   local t = ev.time
   if ev.reverse ~= self.reverse then

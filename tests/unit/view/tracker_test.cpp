@@ -131,3 +131,42 @@ TEST_CASE(
   CHECK(outer > curve.length(0));
   CHECK(tracker.fractionAt(2.0 + 0.25 * outer / 800, 800, 68, false) == doctest::Approx(0.25));
 }
+
+TEST_CASE(
+    "tracker: a car that pulls away from the grid without a report crosses the line on the "
+    "transition it made before its first report") {
+  const sim::Track track = sim::namedLayout("oval").value();
+  CarState state;
+  // off the grid (34) at speed: no report on 34, the line at t = 1, the first report on the
+  // piece after the next one (two transitions back), then reports only on the start piece
+  view::CarTracker tracker;
+  tracker.setTrack(&track);
+  tracker.update(anki::TransitionUpdate{}, state, 1.0);  // 34 → 33: the line
+  tracker.update(anki::TransitionUpdate{}, state, 1.2);  // 33 → straight
+  anki::PositionUpdate p;
+  p.piece_id = track.pieces()[2].id;
+  p.location_id = 1;
+  tracker.update(p, state, 1.3);
+  REQUIRE(tracker.pieceIndex() == 2u);
+  CHECK(tracker.laps() == 0);  // the line crossed starts lap 1
+  // the rest of the lap by transitions alone: the line again at 1.0 + 9 pieces' time
+  double now = 1.2;
+  for (std::size_t i = 2; i < track.size(); ++i)
+    tracker.update(anki::TransitionUpdate{}, state, now += 1);
+  tracker.update(anki::TransitionUpdate{}, state, now += 1);  // 34 → 33
+  CHECK(tracker.laps() == 1);
+  REQUIRE(tracker.lapTimes().size() == 1);
+  CHECK(tracker.lapTimes()[0] == doctest::Approx(now - 1.0));
+
+  // a car whose first report shows it has not reached the line yet: nothing is crossed
+  view::CarTracker before;
+  before.setTrack(&track);
+  before.update(anki::TransitionUpdate{}, state, 1.0);
+  p.piece_id = anki::kFinishBefore;
+  before.update(p, state, 1.1);
+  before.update(anki::TransitionUpdate{}, state, 1.5);  // now the line
+  before.update(anki::TransitionUpdate{}, state, 2.5);
+  for (int k = 1; k <= 8; ++k) before.update(anki::TransitionUpdate{}, state, 2.5 + k);
+  CHECK(before.laps() == 1);
+  CHECK(before.lapTimes()[0] == doctest::Approx(9.0));
+}
