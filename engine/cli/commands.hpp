@@ -28,8 +28,8 @@ struct CarSource {
   std::uint64_t seed = 1;  // the simulator's noise and the script's math.random
   int cars = 4;            // simulated cars on the grid
   std::string track = "oval";
-  std::string sensor = "ideal";  // --sensor real|ideal: the simulated cars' (docs/simulator.md)
-  bool trackGiven = false;  // --track was on the command line (else: an oval that holds `cars`)
+  std::string sensor = "real";  // --sensor real|ideal: the simulated cars' (docs/simulator.md)
+  bool trackGiven = false;      // --track was on the command line (else: an oval that holds `cars`)
   bool ble = false;
   std::vector<std::string> carAddresses;  // --car ADDR (repeatable): only these; empty: all found
   std::vector<std::string> adapters;      // --adapter hciN (repeatable); empty: every adapter
@@ -125,7 +125,7 @@ struct EmulateOptions {
   std::uint8_t model = 8;  // Groundshock
   std::string track = "oval";
   std::uint64_t seed = 1;
-  std::string sensor = "ideal";    // --sensor real|ideal (docs/simulator.md "Sensor model")
+  std::string sensor = "real";     // --sensor real|ideal (docs/simulator.md "Sensor model")
   std::optional<double> duration;  // seconds; none: until SIGINT/SIGTERM
 };
 int emulateCar(const EmulateOptions& options);

@@ -58,7 +58,7 @@ int emulateCar(const EmulateOptions& options) {
   Loop loop(ClockKind::Real);
   log::setTimeSource([&loop] { return loop.seconds(); });
   sim::World world(loop, std::move(*track), options.seed);
-  world.setSensor(sim::sensorModelNamed(options.sensor).value_or(sim::SensorModel::Ideal));
+  world.setSensor(sim::sensorModelNamed(options.sensor).value_or(sim::SensorModel::Real));
   sim::CarSpec spec = sim::gridSpec(world.track(), 0);
   spec.name = options.name;
   spec.model_id = options.model;
@@ -184,8 +184,8 @@ Command addEmulateCommand(CLI::App& app) {
   cmd->add_option("--track", emulate->track, "Track layout the car drives on (oval)");
   cmd->add_option("--seed", emulate->seed, "Seed of the simulator");
   cmd->add_option("--sensor", emulate->sensor,
-                  "What the car's sensor reports: real (as real cars do) or ideal (every code; the "
-                  "default for now)")
+                  "What the car's sensor reports: real (as real cars do; the default) or ideal "
+                  "(every code)")
       ->check(CLI::IsMember({"real", "ideal"}));
   cmd->add_option("--duration", emulate->duration, "Stop after this many seconds")
       ->check(CLI::PositiveNumber);

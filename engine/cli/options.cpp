@@ -19,7 +19,7 @@ CLI::Option* addCarSource(CLI::App* cmd, CarSource& source, const char* when) {
   ble->excludes(cars);  // real cars are the cars there are
   cmd->add_option("--sensor", source.sensor,
                   "What the simulated cars' sensors report: real (fitted to real cars: position "
-                  "updates thin out with speed) or ideal (every code; the default for now)")
+                  "updates thin out with speed; the default) or ideal (every code)")
       ->check(CLI::IsMember({"real", "ideal"}))
       ->excludes(ble);
   cmd->add_option("--car", source.carAddresses, "With --ble: only this car (repeatable)")

@@ -93,7 +93,7 @@ std::unique_ptr<Session> Session::open(const CarSource& source, bool fast, const
     session = std::make_unique<Session>(fast ? ClockKind::Virtual : ClockKind::Real,
                                         std::move(*track), source.seed);
     session->sim().world->setSensor(
-        sim::sensorModelNamed(source.sensor).value_or(sim::SensorModel::Ideal));
+        sim::sensorModelNamed(source.sensor).value_or(sim::SensorModel::Real));
   } else {
     // Real cars on printed pieces: the layout tells the scripts the custom pieces' shapes.
     std::optional<sim::Track> design;

@@ -40,7 +40,7 @@ struct Environment {
   std::vector<PieceInfo> pieces;
   double lap_mm = 0;  // centre-line lap length
   Noise noise;
-  SensorModel sensor = SensorModel::Ideal;  // not yet Real by default: docs/simulator.md
+  SensorModel sensor = SensorModel::Real;
   std::mt19937_64 rng;
   std::function<void()> wake;  // a car has something to do: make sure the world ticks
 };

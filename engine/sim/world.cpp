@@ -47,7 +47,7 @@ PieceInfo describe(const Piece& piece) {
 
 struct World::State {
   State(Loop& loop, Track t, std::uint64_t seed)
-      : track(std::move(t)), env{loop, track, {}, 0, {}, SensorModel::Ideal, std::mt19937_64(seed),
+      : track(std::move(t)), env{loop, track, {}, 0, {}, SensorModel::Real, std::mt19937_64(seed),
                                  {}} {
     if (track.size() == 0) throw std::invalid_argument("a simulated world needs a track");
     std::size_t n = track.size();

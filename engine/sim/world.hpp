@@ -94,9 +94,8 @@ class World {
   std::vector<SimCar*> cars();
   void setNoise(Noise noise);
   const Noise& noise() const;
-  // What the cars' sensors report (engine/sim/sensor.hpp): `Real`, fitted to a physical car's
-  // frames, or `Ideal` (every code; the default until everything users see holds under `Real`,
-  // docs/simulator.md "Sensor model").
+  // What the cars' sensors report (engine/sim/sensor.hpp): `Real` (the default), fitted to a
+  // physical car's frames, or `Ideal`: every code (docs/simulator.md "Sensor model").
   void setSensor(SensorModel model);
   SensorModel sensor() const;
   // Ticks made up for because the loop ran them late (real time only; docs/simulator.md

@@ -217,15 +217,15 @@ function Tracker:_adopt()
   for _, x in ipairs(e.entered) do self:_notify("enter", x[1], x[2], x[3]) end
 end
 
---- Takes the car to stand on map piece `index` before it has reported where it is (a race
---- director that drove it to the grid knows): localized there, its place in the piece a guess,
---- so the next transition is the end of that piece. A real car pulling away from the grid at
---- speed may send no position update before the line (docs/simulator.md "Sensor model").
---- Nothing changes for a car already localized.
+--- Takes it that the car stands on map piece `index` though it has not reported where it is (a
+--- race director that drove it to the grid knows): if its next event is a transition, that is
+--- the end of this piece, and the car is localized on the next one from there. A real car
+--- pulling away from the grid at speed may send no position update before the line
+--- (docs/simulator.md "Sensor model"). Until then it stays not localized; a position update
+--- first drops the hint. Nothing changes for a car already localized.
 function Tracker:assume(index)
   if self.localized or not self.map.pieces[index] then return end
-  self.hyps, self.entrySeen = nil, false
-  self.index, self.pos, self.anchored, self.localized = index, 0.5, false, true
+  self.grid = index
 end
 
 function Tracker:_onPosition(ev)
@@ -238,6 +238,7 @@ function Tracker:_onPosition(ev)
     self.carry, self.modelSpeed, self.modelTime = 0, 0, t
   end
   local m = self:_travel(t)
+  self.grid = nil
   if self.index then
     if not self:_step(self, m, ev.piece, self.time, t) then
       self:_lose(t, "its piece ids stopped fitting the map")
@@ -260,6 +261,13 @@ function Tracker:_onTransition(ev)
   local m = self:_travel(t)
   if self.index then
     self:_step(self, m, nil, self.time, t)
+  elseif self.grid then
+    -- the end of the piece it was taken to stand on (Tracker:assume)
+    local from = self.grid
+    local i = self.map:next(from, self:_dir())
+    self.grid, self.hyps = nil, nil
+    self.index, self.pos, self.anchored, self.localized = i, 0, true, true
+    self:_notify("enter", i, from, t)
   elseif self.hyps then
     self:_stepAll(m, nil, t)
     if self.hyps and #self.hyps == 1 then self:_adopt() end

@@ -30,7 +30,7 @@ struct FakeBluezOptions {
   int cars = 1;                        // car i sits on adapter i % adapters
   std::string track = "oval";          // a layout name or file (sim::loadLayout)
   std::uint64_t seed = 1;              // the world's seed, and the RSSI jitter's
-  std::string sensor = "ideal";        // the cars' sensor model (engine/sim/sensor.hpp)
+  std::string sensor = "real";         // the cars' sensor model (engine/sim/sensor.hpp)
   std::vector<std::string> addresses;  // car i's address; default E0:00:00:00:00:<i+1>
   std::vector<std::string> names;      // car i's user name; default from the grid
   bool noAcquire = false;  // AcquireNotify/AcquireWrite → org.bluez.Error.NotSupported

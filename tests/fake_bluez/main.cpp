@@ -55,7 +55,7 @@ int main(int argc, char** argv) {
   app.add_option("--track", options.track, "Track layout: a name (oval, …) or a layout file");
   app.add_option("--seed", options.seed, "Seed of the simulator and the RSSI jitter (default 1)");
   app.add_option("--sensor", options.sensor,
-                 "The cars' sensor model: real or ideal (every code; the default)");
+                 "The cars' sensor model: real (the default) or ideal (every code)");
   app.add_option("--address", options.addresses,
                  "Address of car 1, 2, … in order (repeatable; default E0:00:00:00:00:01, …)");
   app.add_option("--name", options.names, "User name of car 1, 2, … in order (repeatable)");

@@ -51,7 +51,9 @@ check "time trial rows" 4 "$(wc -l < "$TMP/tt.csv" | tr -d ' ')"
 
 # A run cut short mid-race (--duration): the race says where it stood, once — the final table
 # titled "stopped", the results file with every car unfinished — and the run exits 0 as asked.
-out=$(LAPS=5 $PITWALL run "$SRC/examples/grand_prix.lua" --fast --cars 4 --duration 40 \
+# (the scan lap from the inner lane takes about 32 s under the real sensor model, the race
+# goes green at about 40 s and lasts about 20)
+out=$(LAPS=5 $PITWALL run "$SRC/examples/grand_prix.lua" --fast --cars 4 --duration 50 \
   --results "$TMP/cut.csv" 2>"$TMP/cut.err"); rc=$?
 check "cut short: exit status" 0 "$rc"
 check "cut short: the final table once" 1 "$(echo "$out" | grep -c 'Grand prix, 5 laps   stopped')"

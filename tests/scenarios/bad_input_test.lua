@@ -35,7 +35,7 @@ expect.fails(function() sim.sensor { model = string.rep("\xff", 100000) } end, "
 expect.fails(function() sim.sensor { modle = "real" } end, "modle")
 expect.fails(function() sim.sensor { model = 1e308 } end, "sensor model")
 expect.fails(function() sim.sensor("real") end, "sim.sensor takes a table")
-expect.eq(sim.sensor().model, "ideal", "a refused sensor setting changes nothing")
+expect.eq(sim.sensor().model, "real", "a refused sensor setting changes nothing")
 expect.fails(function() sim.truth("car") end, "expected a car")
 expect.eq(pitwall.car("nobody"), nil)
 expect.eq(pitwall.car(7), nil)

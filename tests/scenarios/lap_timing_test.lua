@@ -6,7 +6,7 @@
 local sim = require "pitwall.sim"
 -- As real cars report: position updates thin out with speed, none on most curves at 1000 mm/s
 -- and up; the laps come from the transitions (docs/simulator.md "Sensor model").
-expect.eq(sim.sensor().model, "ideal", "the default, for now")
+expect.eq(sim.sensor().model, "real", "the default")
 sim.sensor { model = "real" }
 expect.eq(sim.sensor().model, "real")
 local track = require "pitwall.track"
