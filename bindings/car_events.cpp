@@ -248,8 +248,9 @@ void CarBinding::dispatchOther(Proxy& p, const Message& m) {
           [&](const SpeedUpdate& sp) {
             deliver(p, CarEvent::Speed, [&](EventTable& t) {
               t.integer(kDesired, sp.desired_mm_s);
-              t.integer(kAccel, sp.accel_mm_s2);
-              t.integer(kActual, sp.actual_mm_s);
+              // firmware 0x266e's short form says the desired speed only: the others are nil
+              if (sp.accel_mm_s2) t.integer(kAccel, *sp.accel_mm_s2);
+              if (sp.actual_mm_s) t.integer(kActual, *sp.actual_mm_s);
             });
           },
           [&](const LaneChangeUpdate& lc) {

@@ -115,7 +115,7 @@ void checkOnRoad(double offset_mm) {
                    std::to_string(static_cast<int>(kOffsetMax)) + " mm)");
 }
 
-// sim._addCar{name=, model=, piece=, distance=, lane= | offset=, battery=, version=}
+// sim._addCar{name=, model=, piece=, distance=, lane= | offset=, battery=, firmware=}
 int addCar(lua_State* L) {
   ScriptHost& host = ScriptHost::from(L);
   SimSession& s = *host.sim();
@@ -126,7 +126,7 @@ int addCar(lua_State* L) {
     lua_newtable(L);
   }
   static constexpr std::array<const char*, 8> kOptions = {"name", "model",  "piece",   "distance",
-                                                          "lane", "offset", "battery", "version"};
+                                                          "lane", "offset", "battery", "firmware"};
   lua::checkOptions(L, 1, "sim.addCar", kOptions);
   const sim::Track& track = s.world->track();
   int index = static_cast<int>(s.world->cars().size());
@@ -171,9 +171,11 @@ int addCar(lua_State* L) {
     spec.battery_mv = static_cast<std::uint16_t>(mv);
   }
   lua_pop(L, 1);
-  if (lua_getfield(L, 1, "version") != LUA_TNIL) {
-    auto v = lua::checkInteger(L, -1, "version");
-    lua::requireRange("version", static_cast<double>(v), 0, 0xffff);
+  // docs/simulator.md "Firmware families": 0x266e sends the older layouts
+  if (lua_getfield(L, 1, "firmware") != LUA_TNIL) {
+    auto v = lua::checkInteger(L, -1, "firmware (a version, e.g. 0x266e)");
+    lua::requireRange("firmware", static_cast<double>(v), 1, 0xffff, {},
+                      "a version as `pitwall scan` shows it, e.g. 0x266e or 0x2b70");
     spec.version = static_cast<std::uint16_t>(v);
   }
   lua_pop(L, 1);

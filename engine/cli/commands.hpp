@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "engine/print/commands.hpp"
+#include "engine/protocol/anki/firmware.hpp"
 
 namespace pitwall::cli {
 
@@ -29,7 +30,8 @@ struct CarSource {
   int cars = 4;            // simulated cars on the grid
   std::string track = "oval";
   std::string sensor = "real";  // --sensor real|ideal: the simulated cars' (docs/simulator.md)
-  bool trackGiven = false;      // --track was on the command line (else: an oval that holds `cars`)
+  std::uint16_t firmware = anki::kFirmwareDefault;  // --firmware: the simulated cars' version
+  bool trackGiven = false;  // --track was on the command line (else: an oval that holds `cars`)
   bool ble = false;
   std::vector<std::string> carAddresses;  // --car ADDR (repeatable): only these; empty: all found
   std::vector<std::string> adapters;      // --adapter hciN (repeatable); empty: every adapter
@@ -125,8 +127,9 @@ struct EmulateOptions {
   std::uint8_t model = 8;  // Groundshock
   std::string track = "oval";
   std::uint64_t seed = 1;
-  std::string sensor = "real";     // --sensor real|ideal (docs/simulator.md "Sensor model")
-  std::optional<double> duration;  // seconds; none: until SIGINT/SIGTERM
+  std::string sensor = "real";  // --sensor real|ideal (docs/simulator.md "Sensor model")
+  std::uint16_t firmware = anki::kFirmwareDefault;  // --firmware (docs/simulator.md)
+  std::optional<double> duration;                   // seconds; none: until SIGINT/SIGTERM
 };
 int emulateCar(const EmulateOptions& options);
 

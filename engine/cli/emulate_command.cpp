@@ -65,6 +65,7 @@ int emulateCar(const EmulateOptions& options) {
   // Fully charged, as a car just taken off its charger: its name's state byte is 0x10 "full
   // battery". A battery neither full nor low is state 0, a NUL the text name cannot hold.
   spec.battery_mv = kFullBatteryMv;
+  spec.version = options.firmware;
   sim::SimCar& car = world.addCar(spec);
 
   PeripheralSpec peripheralSpec;
@@ -186,7 +187,8 @@ Command addEmulateCommand(CLI::App& app) {
   cmd->add_option("--sensor", emulate->sensor,
                   "What the car's sensor reports: real (as real cars do; the default) or ideal "
                   "(every code)")
-      ->check(CLI::IsMember({"real", "ideal"}));
+      ->check(CLI::IsMember({"real", "ideal", "transitions"}));
+  addFirmware(cmd, emulate->firmware, "the car");
   cmd->add_option("--duration", emulate->duration, "Stop after this many seconds")
       ->check(CLI::PositiveNumber);
   return {cmd, [emulate] { return cli::emulateCar(*emulate); }};

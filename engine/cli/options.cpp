@@ -3,6 +3,8 @@
 #include <cctype>
 #include <list>
 
+#include "engine/protocol/anki/firmware.hpp"
+
 namespace pitwall::cli {
 
 CLI::Option* addCarSource(CLI::App* cmd, CarSource& source, const char* when) {
@@ -19,9 +21,11 @@ CLI::Option* addCarSource(CLI::App* cmd, CarSource& source, const char* when) {
   ble->excludes(cars);  // real cars are the cars there are
   cmd->add_option("--sensor", source.sensor,
                   "What the simulated cars' sensors report: real (fitted to real cars: position "
-                  "updates thin out with speed; the default) or ideal (every code)")
-      ->check(CLI::IsMember({"real", "ideal"}))
+                  "updates thin out with speed; the default), ideal (every code) or transitions "
+                  "(no position update at all: the worst case)")
+      ->check(CLI::IsMember({"real", "ideal", "transitions"}))
       ->excludes(ble);
+  addFirmware(cmd, source.firmware, "the simulated cars")->excludes(ble);
   cmd->add_option("--car", source.carAddresses, "With --ble: only this car (repeatable)")
       ->needs(ble);
   cmd->add_option("--adapter", source.adapters,
@@ -47,6 +51,21 @@ CLI::Option* addCarSource(CLI::App* cmd, CarSource& source, const char* when) {
                   "(default 10)")
       ->check(CLI::PositiveNumber);
   return ble;
+}
+
+CLI::Option* addFirmware(CLI::App* cmd, std::uint16_t& firmware, const char* whose) {
+  return cmd
+      ->add_option_function<std::string>(
+          "--firmware",
+          [&firmware](const std::string& text) {
+            auto version = anki::parseFirmware(text);
+            if (!version) throw CLI::ValidationError("--firmware", version.error());
+            firmware = *version;
+          },
+          std::string("The firmware version ") + whose +
+              " answer, in hex: 0x2b70 (the default) or one before 0x2b6e, e.g. 0x266e, whose "
+              "frames have the older layouts (docs/simulator.md \"Firmware families\")")
+      ->type_name("VERSION");
 }
 
 CLI::Option* addMqtt(CLI::App* cmd, MqttSettings& mqtt, double& timeout, const char* what) {

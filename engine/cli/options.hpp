@@ -37,6 +37,9 @@ Command addCompletionCommand(CLI::App& app);  // `completion bash|zsh`
 // --seed, --cars, --track, --ble and its companions, --budget, --lua-memory (run, repl, bridge);
 // `when` ends the help of --scan-timeout. Returns the --ble flag.
 CLI::Option* addCarSource(CLI::App* cmd, CarSource& source, const char* when);
+// --firmware VERSION (hex): the version simulated cars answer, and so the layouts they send
+// (docs/simulator.md "Firmware families"); `whose` names the cars in the help.
+CLI::Option* addFirmware(CLI::App* cmd, std::uint16_t& firmware, const char* whose);
 // --mqtt URL and how to log in; `what` says what the broker is for. Returns --mqtt.
 CLI::Option* addMqtt(CLI::App* cmd, MqttSettings& mqtt, double& timeout, const char* what);
 // --mqtt for run and repl: the cars bridged by other hosts, and --remote-cars.

@@ -499,6 +499,7 @@ bool Session::addGridCars(int count) {
   for (int i = 0; i < count; ++i) {
     sim::CarSpec spec = sim::gridSpec(sim_.world->track(), i);
     spec.name = anki::uniqueCarName(spec.model_id, names);
+    spec.version = source_.firmware;
     names.push_back(spec.name);
     sim::SimCar& simCar = sim_.world->addCar(spec);
     auto link = std::make_unique<SimLink>(loop_, simCar);

@@ -126,7 +126,9 @@ std::vector<Publication> fromMessage(std::string_view car, const anki::Message& 
                                   kEventQos, false});
                  },
                  [&](const anki::OffsetUpdate& m) { st("Lane/Actual", mm(m.offset_mm)); },
-                 [&](const anki::SpeedUpdate& m) { st("Speed/Actual", m.actual_mm_s); },
+                 [&](const anki::SpeedUpdate& m) {
+                   if (m.actual_mm_s) st("Speed/Actual", *m.actual_mm_s);  // not in 0x266e's
+                 },
                  [&](const anki::PingResponse&) {
                    // round-trip time in ms (µs precision); null when no ping of ours was waiting.
                    // S/PingResp is where the seed's controller's clients read it; S/PingResponse

@@ -148,8 +148,12 @@ void Car::receive(std::span<const std::uint8_t> frame) {
             if (m.speed_mm_s <= 0) ++stop_commands_;
             target_ = std::clamp<double>(m.speed_mm_s, 0, kMaxSpeed);
             accel_ = m.accel_mm_s2 > 0 ? m.accel_mm_s2 : kMaxAccel;
-            emit(anki::SpeedUpdate{static_cast<std::int16_t>(target_), m.accel_mm_s2,
-                                   static_cast<std::int16_t>(std::lround(speed_))});
+            anki::SpeedUpdate ack{.desired_mm_s = static_cast<std::int16_t>(target_)};
+            if (!olderFirmware()) {  // the older firmware's says the desired speed only
+              ack.accel_mm_s2 = m.accel_mm_s2;
+              ack.actual_mm_s = static_cast<std::int16_t>(std::lround(speed_));
+            }
+            emit(ack);
             if (target_ > 0) env_.wake();
           },
           [&](const anki::ChangeLane& m) {
@@ -440,6 +444,9 @@ void Car::sendTransition() {
   m.piece_idx = 0;  // always 0 on real cars (anki-overdrive.md, firmware variants)
   m.prev_piece_idx = 0;
   m.offset_mm = static_cast<float>(believedOffset());
+  // The older firmware's 19-byte layout: 0 forward, as IBM's captured frame (an assumption for
+  // reversed: 1)
+  if (olderFirmware()) m.driving_direction = static_cast<std::uint8_t>(dir_ < 0 ? 1 : 0);
   m.last_recv_lane_change_id = lane_recv_id_;
   m.last_exec_lane_change_id = lane_exec_id_;
   m.last_desired_lane_change_speed_mm_s = lane_speed_asked_;

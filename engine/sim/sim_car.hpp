@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "engine/core/loop.hpp"
+#include "engine/protocol/anki/firmware.hpp"
 #include "engine/protocol/anki/messages.hpp"
 #include "engine/sim/sensor.hpp"
 #include "engine/sim/world.hpp"
@@ -97,6 +98,8 @@ class Car final : public SimCar {
   bool reads(const PieceInfo& p);  // whether passing a code yields a position (the sensor model)
   void sendPosition(int location_id, bool read_backwards);
   void sendTransition();
+  // Firmware before 0x2b6e: the older layouts (docs/simulator.md "Firmware families").
+  bool olderFirmware() const { return anki::olderLayouts(spec_.version); }
 
   Environment& env_;
   CarSpec spec_;

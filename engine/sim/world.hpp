@@ -12,19 +12,20 @@
 #include <vector>
 
 #include "engine/core/loop.hpp"
+#include "engine/protocol/anki/firmware.hpp"
 #include "engine/sim/sensor.hpp"
 #include "engine/sim/track.hpp"
 
 namespace pitwall::sim {
 
 struct CarSpec {
-  std::string name;              // user name in the advertisement
-  std::uint8_t model_id = 8;     // Groundshock
-  std::uint32_t identifier = 0;  // 0: the world assigns one
-  std::size_t piece_index = 0;   // index into track.pieces() where the car starts
-  double distance_mm = 0;        // how far into that piece (along its lane)
-  double offset_mm = 0;          // lateral offset from road centre, mm (+ right)
-  std::uint16_t version = 0x2b70;
+  std::string name;                                // user name in the advertisement
+  std::uint8_t model_id = 8;                       // Groundshock
+  std::uint32_t identifier = 0;                    // 0: the world assigns one
+  std::size_t piece_index = 0;                     // index into track.pieces() where the car starts
+  double distance_mm = 0;                          // how far into that piece (along its lane)
+  double offset_mm = 0;                            // lateral offset from road centre, mm (+ right)
+  std::uint16_t version = anki::kFirmwareDefault;  // docs/simulator.md "Firmware families"
   std::uint16_t battery_mv = 4100;
 };
 

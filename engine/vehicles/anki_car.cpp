@@ -241,8 +241,8 @@ void AnkiCar::apply(const Message& message) {
     state_.lane_change_target_mm.reset();  // the car gave up whatever it was doing
   } else if (std::holds_alternative<AutoRecoverySucceeded>(message)) {
     state_.delocalized = false;
-  } else if (auto* s = std::get_if<SpeedUpdate>(&message)) {
-    state_.speed_mm_s = s->actual_mm_s;
+  } else if (auto* s = std::get_if<SpeedUpdate>(&message); s && s->actual_mm_s) {
+    state_.speed_mm_s = *s->actual_mm_s;  // firmware 0x266e's short form does not say it
     speedReportedAt_ = loop_.seconds();
   } else if (auto* b = std::get_if<BatteryResponse>(&message)) {
     state_.battery_mv = b->millivolts;

@@ -281,8 +281,12 @@ end
 function Tracker:_onSpeed(ev)
   -- The reckoning so far is kept; from now on the car heads for the asked speed.
   local t = ev.time
+  local v = ev.actual or speedAfter(self.modelSpeed, self.target, self.accel, t - self.modelTime)
   self.carry = self:_travel(t)
-  self.modelTime, self.modelSpeed = t, ev.actual
+  self.modelTime, self.modelSpeed = t, v
+  -- Firmware 0x266e's short form says neither the acceleration nor the actual speed: the
+  -- reckoning goes on as for a car that sends no speed update (by the commanded speed).
+  if not ev.accel then return end
   self.target = ev.desired
   self.accel = ev.accel > 0 and ev.accel or MAX_ACCEL
 end

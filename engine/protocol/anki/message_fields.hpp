@@ -264,10 +264,13 @@ struct Spec<OffsetUpdate> {
       Field{"lane_change_id", &M::lane_change_id},
   };
 };
+// Newer firmware: desired, acceleration, actual (size 7). Firmware 0x266e sends two payload bytes
+// (IBM's example `03 36 00 00`, ../shared/realdata): read as the desired speed, the first field
+// of the newer layout (an assumption, docs/simulator.md "Firmware families").
 template <>
 struct Spec<SpeedUpdate> {
   using M = SpeedUpdate;
-  static constexpr Layout layout{id::kSpeedUpdate, "speed-update", {7, 7}};
+  static constexpr Layout layout{id::kSpeedUpdate, "speed-update", {3, 7}};
   static constexpr std::tuple fields{
       Field{"desired_mm_s", &M::desired_mm_s},
       Field{"accel_mm_s2", &M::accel_mm_s2},

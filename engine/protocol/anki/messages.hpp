@@ -179,8 +179,8 @@ struct OffsetUpdate {
 };
 struct SpeedUpdate {
   std::int16_t desired_mm_s = 0;
-  std::int16_t accel_mm_s2 = 0;
-  std::int16_t actual_mm_s = 0;
+  std::optional<std::int16_t> accel_mm_s2;  // not in firmware 0x266e's short form (size byte 3)
+  std::optional<std::int16_t> actual_mm_s;  // not in firmware 0x266e's short form (size byte 3)
   bool operator==(const SpeedUpdate&) const = default;
 };
 struct CarStatus {

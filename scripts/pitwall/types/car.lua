@@ -60,8 +60,8 @@ return {
 
 ---@class pitwall.SpeedEvent: pitwall.Event
 ---@field desired integer mm/s
----@field accel integer mm/s²
----@field actual integer mm/s
+---@field accel? integer mm/s² (nil from firmware before 0x2b6e: its speed update says the desired speed only)
+---@field actual? integer mm/s (nil from firmware before 0x2b6e)
 
 ---@class pitwall.LaneChangeEvent: pitwall.Event
 ---@field current number mm

@@ -12,7 +12,7 @@ return {
 ---@field lane? integer 1..4 = −68, −23, +23, +68 mm
 ---@field offset? number −70..70 mm
 ---@field battery? integer 3000..4300 mV
----@field version? integer firmware version
+---@field firmware? integer firmware version, e.g. 0x266e (the older layouts) or 0x2b70 (the default)
 
 ---@class pitwall.sim.Piece
 ---@field id integer road piece id

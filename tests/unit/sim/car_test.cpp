@@ -20,6 +20,7 @@ namespace {
 struct Heard {
   double t;
   anki::Message m;
+  std::size_t size = 0;  // bytes on the air
 };
 
 // One car on a track, its frames decoded and logged with their time.
@@ -43,7 +44,7 @@ struct Rig {
         [this](std::span<const std::uint8_t> f) {
           auto m = anki::decode(f);
           REQUIRE(m.ok());
-          heard.push_back({loop.seconds(), *m});
+          heard.push_back({loop.seconds(), *m, f.size()});
         },
         [this] { dropped = true; });
   }
@@ -74,6 +75,41 @@ TEST_CASE("a car answers ping, version and battery requests without SDK mode") {
   CHECK(std::holds_alternative<anki::PingResponse>(rig.heard[0].m));
   CHECK(std::get<anki::VersionResponse>(rig.heard[1].m).version == 0x2b70);
   CHECK(std::get<anki::BatteryResponse>(rig.heard[2].m).millivolts == 3950);
+}
+
+// docs/simulator.md "Firmware families": the layouts follow the version the car answers.
+TEST_CASE("a car of firmware before 0x2b6e sends the older layouts, a newer one the newer") {
+  for (std::uint16_t version : {std::uint16_t{0x266e}, anki::kFirmwareDefault}) {
+    const bool older = version == 0x266e;
+    INFO("firmware " << version);
+    Rig rig(CarSpec{.name = "car", .version = version});
+    rig.sdk();
+    rig.send(anki::SetSpeed{600, 1000});
+    rig.runUntil(4);
+    rig.send(anki::Turn{anki::TurnType::UTurn, anki::TurnTrigger::Immediate});
+    rig.runUntil(8);
+    std::vector<int> sizes, directions;
+    for (const auto& h : rig.heard)
+      if (auto* t = std::get_if<anki::TransitionUpdate>(&h.m)) {
+        sizes.push_back(static_cast<int>(h.size));
+        directions.push_back(t->driving_direction ? *t->driving_direction : -1);
+      }
+    REQUIRE(sizes.size() >= 4);
+    CHECK(std::ranges::all_of(sizes, [&](int n) { return n == (older ? 19 : 18); }));
+    if (older) {
+      CHECK(directions.front() == 0);  // forward, as IBM's captured frame
+      CHECK(directions.back() == 1);   // after the U-turn
+    } else {
+      CHECK(std::ranges::all_of(directions, [](int d) { return d == -1; }));
+    }
+    auto speed = rig.all<anki::SpeedUpdate>();
+    REQUIRE(speed.size() == 1);
+    CHECK(speed[0].second.desired_mm_s == 600);
+    CHECK(speed[0].second.actual_mm_s.has_value() == !older);
+    CHECK(speed[0].second.accel_mm_s2.has_value() == !older);
+    rig.send(anki::VersionRequest{});
+    CHECK(std::get<anki::VersionResponse>(rig.heard.back().m).version == version);
+  }
 }
 
 TEST_CASE("a car reports its status when connected and when SDK mode goes on") {

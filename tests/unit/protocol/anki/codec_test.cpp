@@ -134,6 +134,8 @@ const std::vector<Golden>& goldens() {
       {OffsetUpdate{.offset_mm = 20.0f, .lane_change_id = 5}, "06 2d 00 00 a0 41 05"},
       {SpeedUpdate{.desired_mm_s = 600, .accel_mm_s2 = 1000, .actual_mm_s = -3},
        "07 36 58 02 e8 03 fd ff"},
+      {SpeedUpdate{.desired_mm_s = 250, .accel_mm_s2 = {}, .actual_mm_s = {}},
+       "03 36 fa 00"},  // before firmware 0x2b6e (IBM's 0x266e car, ../shared/realdata)
       {CarStatus{.on_track = true, .on_charger = false, .low_battery = {}, .fully_charged = {}},
        "03 3f 01 00"},
       {CarStatus{.on_track = true, .on_charger = true, .low_battery = false, .fully_charged = true},
@@ -250,6 +252,22 @@ TEST_CASE("an old-firmware intersection update has no distance since the last co
   const auto& i = std::get<IntersectionUpdate>(*r);
   CHECK_FALSE(i.mm_since_last_intersection_code.has_value());
   CHECK(i.mm_since_last_transition_bar == 120);
+}
+
+TEST_CASE("firmware 0x266e's speed update has one field: the others are absent, not zero") {
+  const auto r = decode(bytes("03 36 00 00"));  // IBM's captured frame (../shared/realdata)
+  REQUIRE(r.ok());
+  const auto& s = std::get<SpeedUpdate>(*r);
+  CHECK(s.desired_mm_s == 0);
+  CHECK_FALSE(s.accel_mm_s2.has_value());
+  CHECK_FALSE(s.actual_mm_s.has_value());
+  CHECK(hex(encode(*r).span()) == "03 36 00 00");
+  // written long as soon as one newer field is set; the other goes out as zero
+  CHECK(hex(encode(SpeedUpdate{.desired_mm_s = 1, .accel_mm_s2 = {}, .actual_mm_s = 2}).span()) ==
+        "07 36 01 00 00 00 02 00");
+  const auto cut = errorOf("05 36 fa 00 d4 30");
+  CHECK(cut.kind == DecodeError::Kind::TooShort);
+  CHECK(cut.expected == 8);
 }
 
 TEST_CASE("a version response with 4 payload bytes reads the first u16 and is written short") {
