@@ -55,8 +55,8 @@ std::span<const std::uint8_t> bytesOf(const std::string& s) {
   return {reinterpret_cast<const std::uint8_t*>(s.data()), s.size()};
 }
 
-// What BlueZ's Name keeps of an Anki local name: the bytes before the first reserved zero — a
-// non-zero state byte and at most the two version bytes.
+// What BlueZ's Name keeps of an Anki local name whose reserved bytes are zero (drive-sdk's
+// description; the captured real cars' are not): a non-zero state byte and at most the version.
 bool cutAnkiName(const std::string& name) {
   return !name.empty() && name.size() <= 3 && name[0] != 0 &&
          stateByte(static_cast<unsigned char>(name[0]));
@@ -70,8 +70,8 @@ anki::LocalName Device::localName() const {
     n.user_name = std::string(rawName->begin(), std::find(rawName->begin(), rawName->end(), 0));
     return n;
   }
-  // A whole Anki-shaped name in Name: an emulated car's (pitwall emulate-car puts control
-  // characters where a real car's zeros would cut the string; anki::localNameText).
+  // A whole Anki-shaped name in Name: a real car's whose reserved bytes are not zero (the captured
+  // ones, cut at the zero after the user name) and an emulated car's (anki::localNameText).
   if (anki::isAnkiLocalName(bytesOf(name))) return anki::parseLocalName(bytesOf(name));
   if (cutAnkiName(name)) {
     auto n = anki::parseLocalName(bytesOf(name));

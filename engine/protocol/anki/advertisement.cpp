@@ -123,7 +123,10 @@ LocalName parseLocalName(std::span<const std::uint8_t> raw) {
 
 bool isAnkiLocalName(std::span<const std::uint8_t> raw) {
   if (raw.size() < 8 || (raw[0] & ~0x70u) != 0) return false;
-  return std::all_of(raw.begin() + 3, raw.begin() + 8, [](std::uint8_t b) { return b < 0x20; });
+  // Real cars' reserved bytes are not all zero, as drive-sdk says: both captured names
+  // (tests/realdata/advertisements) have 01 and then spaces and letters (01 20 20 5a 39,
+  // 01 20 20 20 20). Their first is a control character, which no text name has.
+  return raw[3] < 0x20;
 }
 
 std::string userNameProblem(std::string_view name) {

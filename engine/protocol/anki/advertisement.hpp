@@ -37,9 +37,10 @@ struct LocalName {
 LocalName parseLocalName(std::span<const std::uint8_t> raw);
 
 // Whether bytes have the shape of an Anki local name rather than a plain text name: at least 8
-// bytes, a state byte with no bits but 0x10/0x20/0x40, and the five reserved bytes 3..7 control
-// characters — zero on a real car, kNameFiller from an emulated one (localNameText). A text
-// name has letters there.
+// bytes, a state byte with no bits but 0x10/0x20/0x40, and the first reserved byte (3) a control
+// character — 0x01 on the real cars captured (their other reserved bytes are spaces and
+// letters), zero in drive-sdk's description, kNameFiller from an emulated one (localNameText).
+// A text name has a printable character there.
 bool isAnkiLocalName(std::span<const std::uint8_t> raw);
 
 // What an emulated car puts in the reserved bytes, which a real car leaves zero: a stack that

@@ -172,6 +172,28 @@ TEST_CASE("an Anki-shaped local name is told from a text name by its state and r
   CHECK_FALSE(isAnkiLocalName("pitwall emulated"_b));  // 'p' is a state byte, but letters follow
   CHECK_FALSE(isAnkiLocalName("\x10\x70\x2b\x00\x00"_b));               // too short
   CHECK_FALSE(isAnkiLocalName("\x11\x70\x2b\x00\x00\x00\x00\x00x"_b));  // bit 0x01 is no state
+  CHECK_FALSE(isAnkiLocalName("Pa\x21 \x01\x01\x01\x01x"_b));  // a text name: byte 3 printable
+}
+
+// tests/realdata/advertisements: a real car's reserved bytes are 01 and then printable ones.
+TEST_CASE("the local names real cars sent are read as Anki names: state, version, user name") {
+  const auto drive =
+      "\x50\x20\x21\x01\x20\x20\x5a\x39"
+      "AA3 TOMMY\x00"_b;  // drive-sdk's
+  REQUIRE(isAnkiLocalName(drive));
+  const auto a = parseLocalName(drive);
+  CHECK(a.full_battery);
+  CHECK(a.on_charger);
+  CHECK(a.version == 0x2120);
+  CHECK(a.user_name == "AA3 TOMMY");
+  const auto dynamo =
+      "\x10\x60\x30\x01\x20\x20\x20\x20"
+      "Drive\x00"_b;  // ble_monitor #1256
+  REQUIRE(isAnkiLocalName(dynamo));
+  const auto b = parseLocalName(dynamo);
+  CHECK(b.full_battery);
+  CHECK(b.version == 0x3060);
+  CHECK(b.user_name == "Drive");
 }
 
 TEST_CASE("model ids name the car, unknown ones print as model-n") {
