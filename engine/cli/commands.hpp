@@ -146,6 +146,8 @@ struct ReplayOptions {
   std::optional<std::string> track;
   std::string script;      // --script S.lua: the recorded events reach its handlers
   std::uint64_t seed = 1;  // the script's math.random
+  // --interval S: a capture without times has a frame every S seconds (else they are inferred)
+  std::optional<double> interval;
 };
 int replay(const ReplayOptions& options);
 

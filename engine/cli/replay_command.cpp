@@ -10,12 +10,14 @@
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "bindings/script_file.hpp"
 #include "engine/cli/commands.hpp"
 #include "engine/cli/options.hpp"
 #include "engine/cli/session.hpp"
 #include "engine/core/log.hpp"
+#include "engine/record/capture.hpp"
 #include "engine/record/record_player.hpp"
 #include "engine/record/record_reader.hpp"
 
@@ -119,11 +121,33 @@ int replay(const ReplayOptions& options) {
                  "file: save it to a file first\n";
     return 2;
   }
-  std::ifstream in(file, std::ios::binary);
-  if (!in) {
+  std::ifstream file_in(file, std::ios::binary);
+  if (!file_in) {
     std::cerr << "pitwall replay: cannot read " << file << ": " << std::strerror(errno) << "\n";
     return 2;
   }
+  // A capture without times (docs/cli.md "Captures without times") is read whole and given
+  // times; a record is played from its file.
+  std::istream* source = &file_in;
+  std::istringstream captured;
+  std::optional<BadLines> captureBad;
+  if (RecordKind kind = recordKind(file_in); kind != RecordKind::Timed) {
+    auto timed = timeCapture(file_in, kind, CaptureTiming{options.interval});
+    if (!timed) {
+      std::cerr << "pitwall replay: " << file << ": " << timed.error() << "\n";
+      return 2;
+    }
+    log::info("replay", file + " is a capture without times: " + timed->how);
+    captured.str(std::move(timed->record));
+    captureBad = std::move(timed->bad);
+    source = &captured;
+  } else if (options.interval) {
+    std::cerr << "pitwall replay: --interval states the time between the frames of a capture "
+                 "without times, and "
+              << file << " has its times (\"t\"): leave it out\n";
+    return 2;
+  }
+  std::istream& in = *source;
   // One pass to count and check; the frames are read again as they are played (RecordPlayer):
   // neither pass keeps more than a line, a frame and the first bad lines.
   RecordSummary record = scanRecord(in);
@@ -131,6 +155,7 @@ int replay(const ReplayOptions& options) {
     std::cerr << "pitwall replay: cannot read " << file << ": " << std::strerror(errno) << "\n";
     return 2;
   }
+  if (captureBad) record.bad = std::move(*captureBad);  // the capture's lines, not ours
   const auto& bad = record.bad;
   for (std::size_t i = 0; i < bad.first.size() && i < kBadLinesShown; ++i)
     std::cerr << file << ":" << bad.first[i].line << ": " << bad.first[i].why << "\n";
@@ -286,7 +311,14 @@ Command addReplayCommand(CLI::App& app) {
       "replay",
       "Play a --record file back through the codec and the car model: a summary per car, the "
       "race view, or a script's handlers (docs/view.md)");
-  cmd->add_option("file", replay->file, "The record: JSON lines written by --record")->required();
+  cmd->add_option("file", replay->file,
+                  "The record: JSON lines written by --record, or a capture without times "
+                  "(INDEX CAR HEX… lines, or JSON lines without \"t\")")
+      ->required();
+  cmd->add_option("--interval", replay->interval,
+                  "For a capture without times: seconds between its frames (default: inferred "
+                  "from the cars' speeds and wheel distances)")
+      ->check(CLI::Range(0.0001, 60.0));
   cmd->add_flag("--summary", replay->summary,
                 "Print a table per car: laps, best and last lap, frames in and out, "
                 "malformed frames (the default without --view and --script)");

@@ -81,10 +81,43 @@ std::variant<std::vector<std::uint8_t>, std::string> hexBytes(const std::string&
 
 }  // namespace
 
-std::variant<RecordedFrame, std::string> parseRecordLine(std::string_view line, double lastTime) {
-  if (line.size() > kMaxLineBytes)
-    return "a line of " + std::to_string(line.size()) + " bytes, longer than " +
-           std::to_string(kMaxLineBytes) + ": not a frame of a record";
+std::string lineTooLong(std::size_t length) {
+  return "a line of " + std::to_string(length) + " bytes, longer than " +
+         std::to_string(kMaxLineBytes) + ": not a frame of a record";
+}
+
+LineReader::LineReader(std::istream& in) : in_(in), buffer_(kMaxLineBytes + 1, '\0') {}
+
+void LineReader::restart() {
+  number_ = 0;
+  end_ = !in_;
+}
+
+LineReader::Got LineReader::next(std::string_view& line, std::size_t& tooLong) {
+  if (end_) return Got::End;
+  ++number_;
+  in_.getline(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
+  const auto got = static_cast<std::size_t>(in_.gcount());
+  if ((in_.eof() && got == 0) || in_.bad()) {
+    end_ = true;
+    return Got::End;
+  }
+  if (in_.fail() && !in_.eof()) {  // longer than the buffer: skipped unread
+    in_.clear();
+    in_.ignore(std::numeric_limits<std::streamsize>::max(), '\n');
+    tooLong = got + static_cast<std::size_t>(in_.gcount()) - (in_.eof() ? 0 : 1);
+    end_ = in_.eof();
+    return Got::TooLong;
+  }
+  end_ = in_.eof();
+  line = std::string_view(buffer_.data(), got - (in_.eof() ? 0 : 1));  // without the newline
+  if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+  return Got::Line;
+}
+
+std::variant<RecordedFrame, std::string> parseRecordLine(std::string_view line, double lastTime,
+                                                         bool timed) {
+  if (line.size() > kMaxLineBytes) return lineTooLong(line.size());
   Check check;
   if (!json::sax_parse(line, &check) || !check.error.empty())
     return check.error.empty() ? std::string("not JSON") : check.error;
@@ -98,6 +131,7 @@ std::variant<RecordedFrame, std::string> parseRecordLine(std::string_view line, 
 
   RecordedFrame frame;
   auto t = j.find("t");
+  if (t == j.end() && !timed) t = j.emplace("t", 0).first;  // its time is worked out later
   if (t == j.end()) return std::string("no \"t\" (the frame's time in seconds)");
   if (!t->is_number()) return "\"t\" is not a number: " + shown(*t);
   frame.t = t->get<double>();
@@ -168,15 +202,14 @@ void BadLines::add(BadLine bad) {
   if (first.size() > keep) first.pop_back();
 }
 
-RecordStream::RecordStream(std::istream& in, std::size_t keepBad)
-    : in_(in), buffer_(kMaxLineBytes + 1, '\0') {
+RecordStream::RecordStream(std::istream& in, std::size_t keepBad) : in_(in), lines_(in) {
   bad_.keep = keepBad;
 }
 
 bool RecordStream::rewind() {
   in_.clear();
   in_.seekg(0);
-  number_ = 0;
+  lines_.restart();
   end_ = !in_;
   lastTime_ = before_ = 0;
   pending_.reset();
@@ -187,34 +220,25 @@ bool RecordStream::rewind() {
 }
 
 std::optional<RecordedFrame> RecordStream::parseNext(std::size_t& lines) {
-  std::istream& in = in_;
   while (!end_) {
     if (lines == 0) return std::nullopt;  // not the end: more another time
     --lines;
-    const std::size_t number = ++number_;
-    in.getline(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
-    const auto got = static_cast<std::size_t>(in.gcount());
-    if (in.eof() && got == 0) break;
-    if (in.bad()) break;
-    if (in.fail() && !in.eof()) {  // longer than the buffer: skipped unread
-      in.clear();
-      in.ignore(std::numeric_limits<std::streamsize>::max(), '\n');
-      std::size_t length = got + static_cast<std::size_t>(in.gcount()) - (in.eof() ? 0 : 1);
-      bad_.add({number, "a line of " + std::to_string(length) + " bytes, longer than " +
-                            std::to_string(kMaxLineBytes) + ": not a frame of a record"});
-      if (in.eof()) break;
+    std::string_view line;
+    std::size_t length = 0;
+    const LineReader::Got got = lines_.next(line, length);
+    if (got == LineReader::Got::End) break;
+    end_ = lines_.atEnd();
+    if (got == LineReader::Got::TooLong) {
+      bad_.add({lines_.number(), lineTooLong(length)});
       continue;
     }
-    end_ = in.eof();
-    std::string_view line(buffer_.data(), got - (in.eof() ? 0 : 1));  // without the newline
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     if (line.find_first_not_of(" \t") == line.npos) continue;
     auto parsed = parseRecordLine(line, 0);  // the time's order is checked by next()
     if (auto* frame = std::get_if<RecordedFrame>(&parsed)) {
-      frame->line = number;
+      frame->line = lines_.number();
       return std::move(*frame);
     }
-    bad_.add({number, std::move(std::get<std::string>(parsed))});
+    bad_.add({lines_.number(), std::move(std::get<std::string>(parsed))});
   }
   end_ = true;
   return std::nullopt;

@@ -76,7 +76,33 @@ inline constexpr std::size_t kMaxRecordedName = 64;  // bytes of a car's name
 inline constexpr std::size_t kMaxRecordedLayout = 8192;  // bytes of a layout's text
 
 // One line (without its newline) against the time of the last good frame; the frame, or why not.
-std::variant<RecordedFrame, std::string> parseRecordLine(std::string_view line, double lastTime);
+// With `timed` false a line without "t" is a frame at time 0 (a capture without times,
+// engine/record/capture.hpp).
+std::variant<RecordedFrame, std::string> parseRecordLine(std::string_view line, double lastTime,
+                                                         bool timed = true);
+
+// The lines of a stream, each at most kMaxLineBytes: a longer one is skipped unread (its length
+// told), so that no line costs more than the buffer. One buffer, reused.
+class LineReader {
+ public:
+  explicit LineReader(std::istream& in);
+  enum class Got { Line, TooLong, End };
+  // The next line without its newline (nor a '\r' before it), valid until the next call; or
+  // TooLong with its length in `tooLong`; or End (the end of the stream, or a read error).
+  Got next(std::string_view& line, std::size_t& tooLong);
+  std::size_t number() const { return number_; }  // the last line's, from 1
+  bool atEnd() const { return end_; }
+  void restart();  // after the stream was put back to its start
+
+ private:
+  std::istream& in_;
+  std::string buffer_;
+  std::size_t number_ = 0;
+  bool end_ = false;
+};
+
+// "a line of N bytes, longer than 65536: not a frame of a record"
+std::string lineTooLong(std::size_t length);
 
 // The frames of a record one at a time, as they are read: the same frames and bad lines as
 // readRecord gives, in the same order, holding one line and one frame (a frame far ahead of the
@@ -101,8 +127,7 @@ class RecordStream {
   std::optional<RecordedFrame> parseNext(std::size_t& lines);
 
   std::istream& in_;
-  std::string buffer_;
-  std::size_t number_ = 0;  // the last line read
+  LineReader lines_;
   bool end_ = false;
   double lastTime_ = 0;
   double before_ = 0;  // the time of the frame handed on before pending_ (0: none)

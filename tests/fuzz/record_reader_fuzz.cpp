@@ -2,14 +2,18 @@
 // any bytes are a file. Never a crash or an exception; every line is a frame, a bad line with its
 // number and a short reason, valid UTF-8 without control characters, or blank; frames keep the
 // reader's promises (car 1..64, t within range and never going back by more than the slack, a
-// non-empty frame); the parse of one line is the same alone as within the file.
+// non-empty frame); the parse of one line is the same alone as within the file. Read as a capture
+// without times (engine/record/capture.hpp), it is timed or refused with a short sentence, and
+// what timing writes is a record that reads back whole: the same frames, times in order.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <regex>
 #include <sstream>
 #include <string>
 
+#include "engine/record/capture.hpp"
 #include "engine/record/record_reader.hpp"
 #include "tests/fuzz/fuzz_check.hpp"
 
@@ -77,6 +81,29 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const bool odd = !record.bad.empty() && record.bad.front().line == 1 &&
                      std::regex_match(record.bad.front().why, kOdd);
     FUZZ_CHECK(std::holds_alternative<RecordedFrame>(alone) == (frame || odd), first);
+  }
+
+  std::istringstream again(text);
+  const RecordKind kind = recordKind(again);
+  if (kind != RecordKind::Timed) {
+    for (std::optional<double> interval : {std::optional<double>{}, std::optional<double>{0.05}}) {
+      again.clear();
+      again.seekg(0);
+      auto timed = timeCapture(again, kind, CaptureTiming{interval});
+      if (!timed) {
+        FUZZ_CHECK(!timed.error().empty() && timed.error().size() < 400, text);
+        FUZZ_CHECK(printable(timed.error()), timed.error());
+        continue;
+      }
+      std::istringstream written(timed->record);
+      Record back = readRecord(written);
+      FUZZ_CHECK(back.bad.empty(), timed->record);
+      FUZZ_CHECK(back.frames.size() == timed->frames, timed->record);
+      FUZZ_CHECK(timed->frames + timed->bad.count <= lines, text);
+      for (std::size_t i = 1; i < back.frames.size(); ++i)
+        FUZZ_CHECK(back.frames[i].t >= back.frames[i - 1].t, timed->record);
+      for (const auto& b : timed->bad.first) FUZZ_CHECK(printable(b.why), b.why);
+    }
   }
   return 0;
 }
