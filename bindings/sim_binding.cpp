@@ -270,13 +270,14 @@ int noise(lua_State* L) {
   return 1;
 }
 
-// sim.sensor{model = "real"|"ideal"}: what the cars' sensors report (docs/simulator.md "Sensor
+// sim.sensor{model = "real"|"ideal"|"transitions"}: what the cars' sensors report (docs/simulator.md "Sensor
 // model"); returns the current setting.
 int sensor(lua_State* L) {
   SimSession& s = session(L);
   if (!lua_isnoneornil(L, 1)) {
     if (!lua_istable(L, 1))
-      throw LuaError("sim.sensor takes a table {model = \"real\" or \"ideal\"}");
+      throw LuaError(
+          "sim.sensor takes a table {model = \"real\", \"ideal\" or \"transitions\"}");
     static constexpr std::array<const char*, 1> kOptions = {"model"};
     lua::checkOptions(L, 1, "sim.sensor", kOptions);
     if (lua_getfield(L, 1, "model") != LUA_TNIL) {
@@ -285,7 +286,8 @@ int sensor(lua_State* L) {
       if (!model)
         throw LuaError("sensor model '" + printable(name, 40) +
                        "' is not one the simulator has; use \"real\" (fitted to real cars: "
-                       "positions thin out with speed) or \"ideal\" (every code)");
+                       "positions thin out with speed), \"ideal\" (every code) or "
+                       "\"transitions\" (no position update at all: the worst case)");
       s.world->setSensor(*model);
     }
     lua_pop(L, 1);

@@ -36,12 +36,18 @@ constexpr double kHaltFromMmS = 200;
 }  // namespace
 
 std::string_view sensorModelName(SensorModel model) {
-  return model == SensorModel::Ideal ? "ideal" : "real";
+  switch (model) {
+    case SensorModel::Ideal: return "ideal";
+    case SensorModel::Transitions: return "transitions";
+    case SensorModel::Real: break;
+  }
+  return "real";
 }
 
 std::optional<SensorModel> sensorModelNamed(std::string_view name) {
   if (name == "real") return SensorModel::Real;
   if (name == "ideal") return SensorModel::Ideal;
+  if (name == "transitions") return SensorModel::Transitions;
   return std::nullopt;
 }
 
@@ -50,6 +56,7 @@ namespace sensor {
 double readChance(SensorModel model, anki::PieceType type, double speed_mm_s,
                   double lane_radius_mm) {
   if (model == SensorModel::Ideal) return 1;
+  if (model == SensorModel::Transitions) return 0;
   if (type != anki::PieceType::Curve) return logistic(speed_mm_s, kStraightSpeed50, kStraightWidth);
   if (lane_radius_mm <= 0) return 0;
   double p = logistic(speed_mm_s * speed_mm_s / lane_radius_mm, kCurveAccel50, kCurveAccelWidth);
@@ -67,7 +74,7 @@ double phantomCollisionChance(SensorModel model, double speed_mm_s) {
 }
 
 bool reportsHalt(SensorModel model, double speed_mm_s) {
-  return model == SensorModel::Real && speed_mm_s >= kHaltFromMmS;
+  return model != SensorModel::Ideal && speed_mm_s >= kHaltFromMmS;
 }
 
 }  // namespace sensor

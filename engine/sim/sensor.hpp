@@ -3,7 +3,8 @@
 // that passing a code section yields a position update, the speed it reads, and the collision
 // reports it sends with no collision. `Real` is fitted to frames of a physical car
 // (../shared/realdata, docs/simulator.md "Sensor model"); `Ideal` reports every code, the exact
-// speed and only real contacts.
+// speed and only real contacts; `Transitions` is the worst case a script must survive: the real
+// model without a single position update (only the 0x29 at each boundary).
 #include <optional>
 #include <string_view>
 
@@ -11,9 +12,9 @@
 
 namespace pitwall::sim {
 
-enum class SensorModel { Real, Ideal };
+enum class SensorModel { Real, Ideal, Transitions };
 
-std::string_view sensorModelName(SensorModel model);                // "real", "ideal"
+std::string_view sensorModelName(SensorModel model);  // "real", "ideal", "transitions"
 std::optional<SensorModel> sensorModelNamed(std::string_view name);  // nullopt: unknown
 
 namespace sensor {

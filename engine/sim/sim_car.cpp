@@ -425,7 +425,7 @@ void Car::sendPosition(int location_id, bool read_backwards) {
   m.piece_id = p.piece.id;
   m.offset_mm = static_cast<float>(believedOffset());
   double reported = speed_;
-  if (env_.sensor == SensorModel::Real) {
+  if (env_.sensor != SensorModel::Ideal) {
     double u1 = uniform();
     reported = sensor::reportedSpeed(env_.sensor, speed_, u1, uniform());
   }

@@ -49,7 +49,7 @@ FakeBluez::State::State(Loop& loop_, sdbus::IConnection& connection, Options opt
   world = std::make_unique<sim::World>(loop, std::move(track.value()), options.seed);
   auto sensor = sim::sensorModelNamed(options.sensor);
   if (!sensor)
-    throw std::invalid_argument("sensor model '" + options.sensor + "': use real or ideal");
+    throw std::invalid_argument("sensor model '" + options.sensor + "': use real, ideal or transitions");
   world->setSensor(*sensor);
 
   for (int i = 0; i < options.adapters; ++i) {

@@ -53,7 +53,7 @@ return {
 ---@field lateBy? number the delay's upper bound, s
 
 ---@class pitwall.sim.Sensor
----@field model? "real"|"ideal" real (the default): fitted to real cars, position updates thin out with speed; ideal: every code
+---@field model? "real"|"ideal"|"transitions" real (the default): fitted to real cars, position updates thin out with speed; ideal: every code; transitions: no position update at all (the worst case)
 
 ---A script under test (sim.script).
 ---@class pitwall.sim.ScriptUnderTest
