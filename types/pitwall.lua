@@ -333,8 +333,8 @@ function expect.truthy(v, what) end
 
 ---@class pitwall.SpeedEvent: pitwall.Event
 ---@field desired integer mm/s
----@field accel integer mm/s²
----@field actual integer mm/s
+---@field accel? integer mm/s² (nil from firmware before 0x2b6e: its speed update says the desired speed only)
+---@field actual? integer mm/s (nil from firmware before 0x2b6e)
 
 ---@class pitwall.LaneChangeEvent: pitwall.Event
 ---@field current number mm
@@ -661,7 +661,7 @@ function Alphabot:stop() end
 ---@field lane? integer 1..4 = −68, −23, +23, +68 mm
 ---@field offset? number −70..70 mm
 ---@field battery? integer 3000..4300 mV
----@field version? integer firmware version
+---@field firmware? integer firmware version, e.g. 0x266e (the older layouts) or 0x2b70 (the default)
 
 ---@class pitwall.sim.Piece
 ---@field id integer road piece id
@@ -702,7 +702,7 @@ function Alphabot:stop() end
 ---@field lateBy? number the delay's upper bound, s
 
 ---@class pitwall.sim.Sensor
----@field model? "real"|"ideal" real (the default): fitted to real cars, position updates thin out with speed; ideal: every code
+---@field model? "real"|"ideal"|"transitions" real (the default): fitted to real cars, position updates thin out with speed; ideal: every code; transitions: no position update at all (the worst case)
 
 ---A script under test (sim.script).
 ---@class pitwall.sim.ScriptUnderTest
