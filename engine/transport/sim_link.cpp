@@ -9,7 +9,16 @@ SimLink::SimLink(Loop& loop, sim::SimCar& car, Duration latency)
     : loop_(loop),
       car_(car),
       latency_(std::max(latency, Duration::zero())),
-      alive_(std::make_shared<bool>(true)) {}
+      alive_(std::make_shared<bool>(true)) {
+  if (loop.clockKind() == ClockKind::Real) setConnectionInterval(kRealTimeInterval);
+}
+
+void SimLink::setConnectionInterval(Duration interval) {
+  interval_ = std::max(interval, Duration::zero());
+  phase_ = interval_.count() > 0
+               ? Duration(static_cast<Duration::rep>(car_.identifier()) % interval_.count())
+               : Duration::zero();
+}
 
 SimLink::~SimLink() {
   // The controller goes away: the car notices and stops, as on a lost BLE connection. Pending
@@ -53,7 +62,13 @@ std::string SimLink::address() const {
 
 void SimLink::enqueue(std::deque<InFlight>& queue, Loop::TimerId& timer, bool toCar,
                       std::span<const std::uint8_t> frame) {
-  InFlight f{loop_.now() + latency_, {}};
+  TimePoint due = loop_.now() + latency_;
+  if (interval_.count() > 0) {  // the next connection event: later frames never come earlier
+    const auto since = (due - TimePoint{} - phase_).count();
+    const auto events = (since + interval_.count() - 1) / interval_.count();
+    due = TimePoint{} + phase_ + interval_ * std::max<Duration::rep>(events, 0);
+  }
+  InFlight f{due, {}};
   std::copy(frame.begin(), frame.end(), f.frame.bytes.begin());
   f.frame.length = static_cast<std::uint8_t>(frame.size());
   queue.push_back(f);
@@ -62,7 +77,8 @@ void SimLink::enqueue(std::deque<InFlight>& queue, Loop::TimerId& timer, bool to
 
 void SimLink::arm(std::deque<InFlight>& queue, Loop::TimerId& timer, bool toCar) {
   if (timer || queue.empty()) return;
-  // Same latency for every frame keeps the queue sorted by due time: order is preserved.
+  // Due times never fall as frames are queued (a fixed latency, then the next event at or
+  // after it): the queue stays sorted and order is preserved.
   if (toCar)
     timer = loop_.at(queue.front().due, [this] { deliverToCar(); });
   else

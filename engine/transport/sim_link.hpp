@@ -1,7 +1,8 @@
 #pragma once
 // The simulator link: the mock transport. It carries real frames between a controller-side
-// vehicle model and a simulated car, with a fixed one-way latency on the engine loop, the way a
-// BLE connection interval delays them.
+// vehicle model and a simulated car, with a fixed one-way latency on the engine loop and, in real
+// time, a BLE connection interval: a frame waits for the link's next connection event, as it
+// does on a real car's connection (docs/simulator.md "Timing"). Order is kept either way.
 #include <deque>
 #include <memory>
 
@@ -15,8 +16,15 @@ namespace pitwall {
 class SimLink : public Link {
  public:
   static constexpr Duration kDefaultLatency = std::chrono::milliseconds(10);
+  // BlueZ asks a car for a 30–50 ms interval (its default LE connection parameters); real-time
+  // links take the shortest of it. Virtual time keeps frames on the fixed latency alone.
+  static constexpr Duration kRealTimeInterval = std::chrono::milliseconds(30);
 
   SimLink(Loop& loop, sim::SimCar& car, Duration latency = kDefaultLatency);
+  // Connection events every `interval` (zero: none, the fixed latency alone), at a phase of the
+  // link's own taken from the car's identifier, as two cars' connections do not beat together.
+  void setConnectionInterval(Duration interval);
+  Duration connectionInterval() const { return interval_; }
   ~SimLink() override;
 
   // Connects to the simulated car; the state handler reports it on the loop.
@@ -32,6 +40,8 @@ class SimLink : public Link {
   Loop& loop_;
   sim::SimCar& car_;
   Duration latency_;
+  Duration interval_{};
+  Duration phase_{};
   bool connected_ = false;
   std::shared_ptr<bool> alive_;  // guards callbacks queued on the loop after destruction
 

@@ -160,3 +160,44 @@ TEST_CASE("a sim link names the car by its identifier") {
   Rig rig;
   CHECK(rig.link->address() == "sim:00c0ffee");
 }
+
+// docs/simulator.md "Timing": a frame waits for the link's next connection event.
+TEST_CASE("with a connection interval, frames wait for the next event, in order, spread over it") {
+  Rig rig;
+  rig.link->setConnectionInterval(30ms);
+  const Duration phase(0x00c0ffee % 30'000'000);  // the car's identifier, in ns, modulo 30 ms
+  rig.link->connect();
+  rig.runUntil(100ms);
+  rig.frames.clear();
+  // a ping every 7 ms: each reaches the car at its next event after 20 ms, and the answer the
+  // event after 20 ms more
+  std::vector<TimePoint> sent;
+  for (int i = 0; i < 30; ++i)
+    rig.loop.at(100ms + i * 7ms, [&] {
+      sent.push_back(rig.loop.now());
+      rig.send(anki::PingRequest{});
+    });
+  rig.runUntil(600ms);
+  REQUIRE(rig.frames.size() == 30);
+  Duration least = 1s, most{};
+  for (std::size_t i = 0; i < rig.frames.size(); ++i) {
+    const TimePoint at = rig.frames[i].first;
+    CHECK((at - phase).count() % 30'000'000 == 0);    // on a connection event
+    if (i > 0) CHECK(at >= rig.frames[i - 1].first);  // never overtakes
+    const Duration delay = at - sent[i];
+    least = std::min(least, delay);
+    most = std::max(most, delay);
+  }
+  CHECK(least >= 40ms);         // the two latencies at least
+  CHECK(most <= 40ms + 60ms);   // and at most an interval more each way
+  CHECK(most - least >= 20ms);  // spread: tens of ms, as a real connection's
+}
+
+TEST_CASE("a real-time sim link has the connection interval; a virtual-time one has none") {
+  Loop real{ClockKind::Real};
+  World realWorld{real, namedLayout("oval").value(), 3};
+  SimLink realLink(real, realWorld.addCar({.name = "a"}));
+  CHECK(realLink.connectionInterval() == SimLink::kRealTimeInterval);
+  Rig rig;
+  CHECK(rig.link->connectionInterval() == Duration::zero());
+}
