@@ -195,11 +195,14 @@ end
 -- ---- helpers for drivers ----
 
 --- The nearest car ahead whose offset is within `width` mm (default 45) of `lane`, within
---- `range` mm, from ctx:nearby: {car, loc, gap, lane} or nil.
-function drivers.aheadIn(ctx, lane, range, width)
+--- `range` mm, from ctx:nearby: {car, loc, gap, lane} or nil. `skip(o)`, when given, leaves out
+--- the cars it returns true for.
+function drivers.aheadIn(ctx, lane, range, width, skip)
   width = width or 45
   for _, o in ipairs(ctx:nearby(range)) do
-    if o.gap > 0 and o.lane and math.abs(o.lane - lane) < width then return o end
+    if o.gap > 0 and o.lane and math.abs(o.lane - lane) < width and not (skip and skip(o)) then
+      return o
+    end
   end
   return nil
 end

@@ -298,6 +298,11 @@ local function listenTo(self)
     pitwall.listen(car, "onPosition", function(_, ev) self:_onPosition(ev) end),
     pitwall.listen(car, "onTransition", function(_, ev) self:_onTransition(ev) end),
     pitwall.listen(car, "onSpeed", function(_, ev) self:_onSpeed(ev) end),
+    -- A car run into from behind (the front car's report: side 0, "front") knows a car is right
+    -- behind it, whatever that car's reckoning says (drivers.follower uses it).
+    pitwall.listen(car, "onCollision", function(_, ev)
+      if ev.side == 0 and ev.where == "front" then self.hitFromBehind = ev.time end
+    end),
     pitwall.listen(car, "onDelocalized", function(_, ev)
       self:_lose(ev.time, "delocalized")
       self:_rebase(ev.time, 0)

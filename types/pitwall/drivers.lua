@@ -87,13 +87,14 @@ function Handle:stop() end
 ---@class pitwall.drivers
 local drivers = {}
 
----The nearest car ahead within `width` mm (45) of `lane`, within `range` mm, or nil.
+---The nearest car ahead within `width` mm (45) of `lane`, within `range` mm, or nil; `skip(o)` true leaves a car out.
 ---@param ctx pitwall.drivers.Context
 ---@param lane number
 ---@param range number
 ---@param width? number
+---@param skip? fun(o: pitwall.drivers.Other): boolean
 ---@return pitwall.drivers.Other?
-function drivers.aheadIn(ctx, lane, range, width) end
+function drivers.aheadIn(ctx, lane, range, width, skip) end
 
 ---Calls driver[method] if it has one, reporting an error like drivers.run does.
 ---@param driver pitwall.drivers.Driver

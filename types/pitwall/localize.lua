@@ -14,6 +14,7 @@
 ---@field speed? number last reported speed, mm/s
 ---@field reverse boolean driving reversed
 ---@field time? number time of the last event
+---@field hitFromBehind? number time of the last report that another car ran into this one from behind
 local Tracker = {}
 
 ---Centre-line mm from the finish line, the piece index and the fraction of that piece at time t (default now); nil when not localized.

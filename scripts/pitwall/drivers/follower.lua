@@ -10,12 +10,14 @@
 -- car that is a time gap of gap·(1+margin) plus standstill / speed, so the time gap (distance /
 -- own speed) stays above `gap` while it closes, brakes, follows and stops, and it speeds up
 -- again as the gap opens. The car it follows stays its leader while in its lane even when
--- reckoned a little behind (cars in one lane cannot pass each other).
+-- reckoned a little behind, and a car that ran into it from behind stays behind for a while even
+-- when reckoned a little ahead (cars in one lane cannot pass each other: Follower:leader).
 local drivers = require "pitwall.drivers"
 local cruiser = require "pitwall.drivers.cruiser"
 
 local follower = { name = "follower" }
 local STICKY = 500 -- mm: how far behind a followed car in our lane may be reckoned
+local STICKY_FOR = 2 -- s: how long a car that ran into us stays behind us whatever is reckoned
 local Follower = {}
 Follower.__index = Follower
 Follower.__name = "follower" -- (how errors name it: "follower has no method …")
@@ -42,21 +44,47 @@ function follower.new(options)
 end
 
 --- The car this follower keeps its gap to (from ctx:nearby), or nil.
+---
+--- Cars in one lane cannot pass through each other: what the trackers reckon between reports
+--- can say otherwise until the next report puts it right. So the order last known stands for up
+--- to STICKY_FOR s while the reckoning is within STICKY mm of it: the car we followed, reckoned a
+--- little behind us (our own speed update lost, say, so our tracker drives on while we stand), is
+--- still just ahead; and a car known to be behind us — it ran into us from behind — reckoned a
+--- little ahead is still behind. A car held behind us, pushing, is reckoned on at the speed it
+--- was told; taken for a leader, it held the follower, which held it: both crawled for a whole
+--- grand prix (issue 34's jam, drivers_follower_jam_test.lua).
 function Follower:leader(car, ctx)
   local half = ctx.map:lapLength(0) / 2 - 1
   local range = math.min(self.range or math.max(2000, 3 * self.gap * self.cruise.speed), half)
-  local lead = drivers.aheadIn(ctx, car.offset or 0, range)
+  local now, mine = pitwall.now(), car.offset or 0
+  local inLane = function(o) return o.lane and math.abs(o.lane - mine) < 45 end
+  self.behind = self.behind or {}
+  local hit = ctx.loc.hitFromBehind
+  if hit and hit ~= self.hitSeen then
+    -- the car that ran into us: the nearest in our lane, whatever its reckoning says
+    self.hitSeen = hit
+    local nearest
+    for _, o in ipairs(ctx:nearby(STICKY)) do
+      if inLane(o) and (not nearest or math.abs(o.gap) < math.abs(nearest.gap)) then nearest = o end
+    end
+    if nearest then
+      self.behind[nearest.car] = now
+      if self.lastLead == nearest.car then self.lastLead = nil end
+    end
+  end
+  local function knownBehind(o)
+    local t = self.behind[o.car]
+    return t ~= nil and now - t <= STICKY_FOR and o.gap < STICKY
+  end
+  local lead = drivers.aheadIn(ctx, mine, range, nil, knownBehind)
   if drivers.changing(car) and car.targetOffset then
-    local other = drivers.aheadIn(ctx, car.targetOffset, range)
+    local other = drivers.aheadIn(ctx, car.targetOffset, range, nil, knownBehind)
     if other and (not lead or other.gap < lead.gap) then lead = other end
   end
-  -- A car cannot pass through another in the same lane: the car we followed, still in our lane
-  -- and now reckoned a little behind us, is an error of the reckoning (our speed update lost,
-  -- say, so our tracker drives on while we stand): it is still just ahead.
   local last = self.lastLead
   if last and not (lead and lead.car == last) then
     for _, o in ipairs(ctx:nearby(STICKY)) do
-      if o.car == last and o.gap <= 0 and o.lane and math.abs(o.lane - (car.offset or 0)) < 45 then
+      if o.car == last and o.gap <= 0 and inLane(o) then
         lead = { car = o.car, loc = o.loc, gap = 0, lane = o.lane }
       end
     end

@@ -97,6 +97,7 @@ function Map:layout(ids) end
 ---@field speed? number last reported speed, mm/s
 ---@field reverse boolean driving reversed
 ---@field time? number time of the last event
+---@field hitFromBehind? number time of the last report that another car ran into this one from behind
 local Tracker = {}
 
 ---Centre-line mm from the finish line, the piece index and the fraction of that piece at time t (default now); nil when not localized.
@@ -339,11 +340,12 @@ function Handle:stop() end]],
 @param ctx pitwall.drivers.Context
 @param v number
 @return number]],
-      aheadIn = [[The nearest car ahead within `width` mm (45) of `lane`, within `range` mm, or nil.
+      aheadIn = [[The nearest car ahead within `width` mm (45) of `lane`, within `range` mm, or nil; `skip(o)` true leaves a car out.
 @param ctx pitwall.drivers.Context
 @param lane number
 @param range number
 @param width? number
+@param skip? fun(o: pitwall.drivers.Other): boolean
 @return pitwall.drivers.Other?]],
       changing = [[A lane change is under way (unless the reported offset already reached the target).
 @param car pitwall.Car
