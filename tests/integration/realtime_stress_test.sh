@@ -2,14 +2,14 @@
 # cgroup with a small quota, beside one with the machine as it is, each over several seeds, with
 # the simulator's frames as late as a BLE connection makes them (the default in real time). Every
 # car finishes; no car's laps average more than 1.5 times its best (no jam, no car left crawling);
-# the engine never says it fell behind real time in the runs that are not starved.
+# the engine says it fell behind real time in the starved runs, and never in the others.
 #
 # The cgroup is made here and removed at the end: cgroup v2 (cpu.max) or v1 (cpu.cfs_quota_us).
 # Where neither can be made (not root, no cgroup file system) the test is skipped (77); CI runs
-# as root, where it always runs. STRESS_QUOTA (percent of one CPU, default 2), STRESS_SEEDS
+# as root, where it always runs. STRESS_QUOTA (percent of one CPU, default 1), STRESS_SEEDS
 # (default "1 2") and LAPS (default 2) change it.
 source "$(dirname "$0")/lib.sh"
-QUOTA=${STRESS_QUOTA:-2}
+QUOTA=${STRESS_QUOTA:-1}
 SEEDS=${STRESS_SEEDS:-1 2}
 LAPS=${LAPS:-2}
 
@@ -72,11 +72,9 @@ PY
 )
     check "$name: every car finishes, none averaging over 1.5x its best lap" ok "$verdict"
   done
-  # Starved to 2 % of a CPU (the race needs about 3.6 % with its start), the loop runs late
-  # around the warning's threshold (a 10 ms mean over 2 s): it is said or not, so it is shown
-  # here, not checked; integration.lag_test checks that a loop surely late is said to be.
-  echo "note: starved-$seed: the engine said it fell behind real time" \
-    "$(grep -c 'the engine is falling behind real time' "$TMP/starved-$seed.err") time(s)"
+  said=$(grep -c 'the engine is falling behind real time' "$TMP/starved-$seed.err")
+  [ "$said" -ge 1 ] && echo "ok: starved-$seed: the engine says it falls behind real time ($said)" ||
+    fail "starved-$seed: the engine never said it fell behind real time"
   check "free-$seed: and the run with the machine as it is does not" 0 \
     "$(grep -c 'the engine is falling behind real time' "$TMP/free-$seed.err")"
 done
