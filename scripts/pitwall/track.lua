@@ -270,7 +270,7 @@ end
 --- Drives `car` one lap in a fixed lane and returns the map (inside a task only).
 --- options: speed (mm/s, default 350), offset (mm: change to this lane first; default: stay),
 --- timeout (s, default 120), stop (default true: stop the car once the map is complete, just
---- past the finish line; false leaves it driving at the scan speed).
+--- past the finish line, and when the scan fails; false leaves it driving at the scan speed).
 function track.scan(car, options)
   options = options or {}
   if not coroutine.isyieldable() then
@@ -339,9 +339,22 @@ function track.scan(car, options)
   end
 
   local ok, result = pcall(function()
+    -- Pieces crossed and not one position update: the ids the scan learns the pieces by never
+    -- come (`least` pieces at least, so that a car just starting is not blamed).
+    local function unnamed(least)
+      local named = 0
+      for _, s in ipairs(st.segs) do named = named + s.idCount end
+      if #st.segs >= least and named == 0 then
+        pitwall._raise(string.format("track.scan: %s crossed %d pieces and sent no position "
+          .. "update on any of them; the scan learns the pieces from those (a car that sends only "
+          .. "transitions, as the simulator's transitions sensor model does, cannot be scanned "
+          .. "yet: give the race a map, e.g. track.fromSim() or a layout)", tostring(car), #st.segs))
+      end
+    end
     local function waitFor(cond, what)
       local left = st.deadline - pitwall.now()
       if left <= 0 or not pitwall.waitUntil(cond, left) then
+        unnamed(3)
         pitwall._raise(string.format("track.scan: %s within %g s with %s (%d pieces crossed); "
           .. "give a longer timeout, or check that the car drives and the layout has the start "
           .. "pieces 34 and 33", what, timeout, tostring(car), #st.segs))
@@ -378,6 +391,7 @@ function track.scan(car, options)
         car:uturn()
         st.turnedAt = pitwall.now()
       end
+      unnamed(30) -- three laps of a small track and more
       ids, run = findLap(st.segs)
       return ids ~= nil
     end, "no complete clean lap from finish line to finish line")
@@ -411,7 +425,11 @@ function track.scan(car, options)
   end)
   cancel()
   -- (its errors name the script's line already: pitwall._raise, the bindings)
-  if not ok then error(result, 0) end
+  if not ok then
+    -- a scan that failed leaves no car driving at the scan speed (unless told to keep it going)
+    if options.stop ~= false and car.connected then pcall(car.stop, car) end
+    error(result, 0)
+  end
   return result
 end
 
