@@ -6,7 +6,11 @@ namespace pitwall {
 
 std::size_t utf8Length(std::string_view s) {
   auto c = static_cast<unsigned char>(s[0]);
-  std::size_t n = c >= 0xf0 && c <= 0xf4 ? 4 : c >= 0xe0 ? 3 : c >= 0xc2 && c < 0xe0 ? 2 : 0;
+  // lead bytes: C2–DF of 2, E0–EF of 3, F0–F4 of 4; F5–FF and C0, C1 never lead
+  std::size_t n = c >= 0xf0 && c <= 0xf4  ? 4
+                  : c >= 0xe0 && c < 0xf0 ? 3
+                  : c >= 0xc2 && c < 0xe0 ? 2
+                                          : 0;
   if (n == 0 || s.size() < n) return 0;
   for (std::size_t i = 1; i < n; ++i)
     if ((static_cast<unsigned char>(s[i]) & 0xc0) != 0x80) return 0;

@@ -233,8 +233,12 @@ Result<TimedCapture, std::string> timeCapture(std::istream& in, RecordKind kind,
     const RecordedFrame& f = frames[i];
     text += "{\"t\":" + seconds(times[i]) + ",\"car\":" + std::to_string(f.car) + ",\"dir\":\"" +
             (f.tx ? "tx" : "rx") + "\",\"hex\":\"" + toHex(f.bytes) + "\"";
-    if (!f.name.empty()) text += ",\"carName\":" + nlohmann::json(f.name).dump();
-    if (!f.layout.empty()) text += ",\"layout\":" + nlohmann::json(f.layout).dump();
+    // (names and layouts are checked text already; `replace` keeps a slip from throwing)
+    auto json = [](const std::string& s) {
+      return nlohmann::json(s).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+    };
+    if (!f.name.empty()) text += ",\"carName\":" + json(f.name);
+    if (!f.layout.empty()) text += ",\"layout\":" + json(f.layout);
     text += "}\n";
   }
   out.record = std::move(text);

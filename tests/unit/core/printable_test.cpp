@@ -2,6 +2,7 @@
 
 #include <doctest/doctest.h>
 
+#include <cstdio>
 #include <string>
 
 using namespace pitwall;
@@ -27,4 +28,20 @@ TEST_CASE("printable cuts a long text after maxBytes of it, and says so") {
   CHECK(printable("ééé", 5) == "éé…");
   CHECK(utf8Length("é") == 2);
   CHECK(utf8Length("e") == 0);
+}
+
+// Found by the record reader's fuzzer through a capture's bad line: F5–FF followed by two
+// continuation bytes were taken for a 3-byte character and passed through raw.
+TEST_CASE("printable: bytes that never lead a UTF-8 character are escaped, whatever follows") {
+  for (unsigned lead = 0xf5; lead <= 0xff; ++lead) {
+    const std::string bytes = {static_cast<char>(lead), '\x8c', '\x8c', '\x8c'};
+    CHECK(utf8Length(bytes) == 0);
+    char escaped[8];
+    std::snprintf(escaped, sizeof escaped, "\\x%02x", lead);
+    CHECK(printable(bytes) == std::string(escaped) + "\\x8c\\x8c\\x8c");
+  }
+  CHECK(utf8Length("\xc0\x80") == 0);  // overlong forms of NUL
+  CHECK(utf8Length("\xc1\xbf") == 0);
+  CHECK(utf8Length("\xef\xbf\xbf") == 3);      // U+FFFF, the last 3-byte character
+  CHECK(utf8Length("\xf4\x8f\xbf\xbf") == 4);  // U+10FFFF, the last there is
 }
