@@ -137,7 +137,11 @@ int replay(const ReplayOptions& options) {
       std::cerr << "pitwall replay: " << file << ": " << timed.error() << "\n";
       return 2;
     }
-    log::info("replay", file + " is a capture without times: " + timed->how);
+    log::info("replay", file +
+                            (kind == RecordKind::IndexedJson
+                                 ? "'s \"t\" counts its frames (0, 1, 2, …), not seconds: "
+                                 : " is a capture without times: ") +
+                            timed->how);
     captured.str(std::move(timed->record));
     captureBad = std::move(timed->bad);
     source = &captured;

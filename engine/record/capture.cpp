@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -143,6 +144,21 @@ std::string seconds(double t) {
 
 }  // namespace
 
+// Whether the first kIndexFrames frame lines of `lines` (the first of them `first`) have "t"
+// k, k+1, k+2, …
+bool countsFrames(LineReader& lines, std::string_view first) {
+  double expected = -1;
+  std::string_view line = first;
+  for (int k = 0; k < kIndexFrames; ++k) {
+    if (k > 0 && !nextLine(lines, line, nullptr)) return false;
+    auto parsed = parseRecordLine(line, 0, true);
+    auto* frame = std::get_if<RecordedFrame>(&parsed);
+    if (!frame || frame->t != std::floor(frame->t) || (k > 0 && frame->t != expected)) return false;
+    expected = frame->t + 1;
+  }
+  return true;
+}
+
 RecordKind recordKind(std::istream& in) {
   RecordKind kind = RecordKind::Timed;
   LineReader lines(in);
@@ -152,6 +168,8 @@ RecordKind recordKind(std::istream& in) {
       if (std::holds_alternative<RecordedFrame>(parseRecordLine(line, 0, false)) &&
           !std::holds_alternative<RecordedFrame>(parseRecordLine(line, 0, true)))
         kind = RecordKind::UntimedJson;
+      else if (countsFrames(lines, line))
+        kind = RecordKind::IndexedJson;
     } else if (std::holds_alternative<CaptureLine>(parseCaptureLine(line))) {
       kind = RecordKind::CaptureText;
     }

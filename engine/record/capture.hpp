@@ -22,11 +22,15 @@ namespace pitwall {
 enum class RecordKind {
   Timed,        // a --record file: JSON lines with "t"
   UntimedJson,  // JSON lines of frames, none with "t"
+  IndexedJson,  // JSON lines of frames whose "t" counts them (0, 1, 2, …): an index, not seconds
   CaptureText,  // `INDEX CAR HEX…` lines: the index is an order, not a time
 };
 
-// What the first line that is not blank looks like; `in` is read from its start and put back
-// there. A file whose first line is neither is taken for a record (and its bad lines said so).
+// What the first lines that are not blank look like; `in` is read from its start and put back
+// there. A record whose first kIndexFrames frames have "t" k, k+1, k+2, … counts its frames
+// (no run sends a frame a second for that long). A file that is none of these is taken for a
+// record (and its bad lines said so).
+inline constexpr int kIndexFrames = 3;
 RecordKind recordKind(std::istream& in);
 
 inline constexpr std::size_t kMaxCaptureFrames = 500000;
@@ -46,7 +50,8 @@ struct TimedCapture {
   std::string how;           // one sentence: how the times were found
 };
 
-// The capture in `in` (RecordKind UntimedJson or CaptureText) with times. An error is a sentence:
+// The capture in `in` (RecordKind UntimedJson, IndexedJson or CaptureText) with times; an
+// index for a time is left aside. An error is a sentence:
 // too many frames, or too many cars (a capture names them; the first kMaxRecordedCar are
 // numbered in the order they appear).
 Result<TimedCapture, std::string> timeCapture(std::istream& in, RecordKind kind,

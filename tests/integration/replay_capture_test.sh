@@ -21,6 +21,20 @@ out=$($PITWALL replay "$REAL/ibm/messages.txt" --json 2>"$TMP/ibm.err")
 check "IBM's examples: every frame in, none malformed" "13 0" \
   "$(echo "$out" | python3 -c 'import json,sys; r=json.loads(sys.stdin.readline()); print(r["framesIn"], r["malformed"])')"
 
+# a record whose "t" is the frame's index: timed as a capture, and said so
+python3 - "$REAL/okoeth/lane3_speed750.txt" "$TMP/indexed.rec" <<'PY'
+import json, sys
+with open(sys.argv[1]) as f, open(sys.argv[2], "w") as out:
+    for line in f:
+        index, car, *hexes = line.split()
+        out.write(json.dumps({"t": int(index), "car": 1, "dir": "rx", "hex": " ".join(hexes)}) + "\n")
+PY
+out=$($PITWALL replay "$TMP/indexed.rec" --json 2>"$TMP/indexed.err")
+check "an indexed record: every frame in, none malformed" "$(wc -l <"$REAL/okoeth/lane3_speed750.txt") 0" \
+  "$(echo "$out" | python3 -c 'import json,sys; r=json.loads(sys.stdin.readline()); print(r["framesIn"], r["malformed"])')"
+contains "an indexed record: said so" '"t" counts its frames (0, 1, 2, …), not seconds: times inferred' \
+  "$(cat "$TMP/indexed.err")"
+
 # a stated interval
 $PITWALL replay "$REAL/okoeth/lane2_speed750.txt" --interval 0.05 >/dev/null 2>"$TMP/interval.err"
 contains "--interval: said" "times at the stated interval, 0.050000 s a frame" "$(cat "$TMP/interval.err")"

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <initializer_list>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -78,6 +79,27 @@ TEST_CASE("capture: a record, a capture's lines and JSON lines without times are
         std::string("{\"t\":-5,\"car\":1,\"dir\":\"rx\",\"hex\":\"01 17\"}\n"),
         std::string("{\"car\":1}\n"), std::string("12 car zz\n"), std::string("\xff\xfe 1 2\n")})
     CHECK(kindOf(hostile) == RecordKind::Timed);
+}
+
+TEST_CASE("capture: a record whose \"t\" counts its frames is told from one in seconds") {
+  auto lines = [](std::initializer_list<const char*> ts) {
+    std::string text;
+    for (const char* t : ts)
+      text += std::string(R"({"t":)") + t + R"(,"car":1,"dir":"rx","hex":"01 17"})" + "\n";
+    return text;
+  };
+  CHECK(kindOf(lines({"0", "1", "2", "3"})) == RecordKind::IndexedJson);
+  CHECK(kindOf(lines({"5", "6", "7"})) == RecordKind::IndexedJson);
+  CHECK(kindOf(lines({"0.0", "1.0", "2.0"})) == RecordKind::IndexedJson);
+  CHECK(kindOf(lines({"0", "1", "3"})) == RecordKind::Timed);
+  CHECK(kindOf(lines({"0", "0.5", "1"})) == RecordKind::Timed);
+  CHECK(kindOf(lines({"0.01", "0.02", "0.03"})) == RecordKind::Timed);
+  CHECK(kindOf(lines({"0", "1"})) == RecordKind::Timed);  // too little to tell
+  CHECK(kindOf(lines({"0", "1"}) + "garbage\n") == RecordKind::Timed);
+  // timed as a capture: the index is left aside
+  const TimedCapture capture = timed(lines({"0", "1", "2"}));
+  CHECK(capture.frames == 3);
+  CHECK(recordOf(capture).frames[2].t < 1);  // 10 ms apart, not a second
 }
 
 TEST_CASE("capture: the real car's frames timed by its speeds and wheel distances") {
