@@ -2,7 +2,11 @@
 # cgroup with a small quota, beside one with the machine as it is, each over several seeds, with
 # the simulator's frames as late as a BLE connection makes them (the default in real time). Every
 # car finishes; no car's laps average more than 1.5 times its best (no jam, no car left crawling);
-# the engine says it fell behind real time in the starved runs, and never in the others.
+# the engine never says it fell behind real time in the free runs. Whether a starved run falls
+# behind by the engine's measure depends on how fast the machine is (a quick CPU does a race's
+# work within 1 %), so the warning is checked in a third run that is surely late: frozen by the
+# test (SIGSTOP) for 200 ms of every 250 ms for 4 s of its scan lap — a machine too busy to run
+# it — it says so, and its cars still finish.
 #
 # The cgroup is made here and removed at the end: cgroup v2 (cpu.max) or v1 (cpu.cfs_quota_us).
 # Where neither can be made (not root, no cgroup file system) the test fails saying so: it is
@@ -40,24 +44,45 @@ else
 fi
 echo "ok: a cgroup $kind with a quota of $QUOTA % of a CPU"
 
-# race NAME SEED [starved]: a real-time grand prix, its results and its stderr in $TMP/NAME.*
+# freeze NAME: once NAME's race has begun its scan lap, stop the process 200 ms of every 250 ms
+# for 4 s (each freeze shorter than the watchdog's second, so only the lag monitor can see it)
+freeze() {
+  wait_for "$TMP/$1.err" "scan lap with car" 30 || return
+  local pid
+  pid=$(cat "$TMP/$1.pid")
+  for _ in $(seq 16); do
+    kill -STOP "$pid" 2>/dev/null || return
+    sleep 0.2
+    kill -CONT "$pid"
+    sleep 0.05
+  done
+}
+
+# race NAME SEED [starved|frozen]: a real-time grand prix, its results and its stderr in $TMP/NAME.*
 race() {
   local prefix=()
   [ "${3:-}" = starved ] && prefix=(bash -c 'echo $$ >"$0/cgroup.procs" && exec "$@"' "$group")
   LAPS=$LAPS "${prefix[@]}" $PITWALL run "$SRC/examples/grand_prix.lua" --seed "$2" \
-    --results "$TMP/$1.json" >"$TMP/$1.out" 2>"$TMP/$1.err"
+    --results "$TMP/$1.json" >"$TMP/$1.out" 2>"$TMP/$1.err" &
+  local pid=$!
+  echo "$pid" >"$TMP/$1.pid"
+  [ "${3:-}" = frozen ] && freeze "$1"
+  wait "$pid"
   echo $? >"$TMP/$1.rc"
 }
 
-# both at once: the starved run's quota leaves the machine to the other
+# all at once: the starved run's quota leaves the machine to the others (the frozen run is the
+# first seed's only)
+first=${SEEDS%% *}
 for seed in $SEEDS; do
   race "starved-$seed" "$seed" starved &
   race "free-$seed" "$seed" &
+  [ "$seed" = "$first" ] && race frozen "$seed" frozen &
   wait
 done
 
-for seed in $SEEDS; do
-  for name in "starved-$seed" "free-$seed"; do
+verdicts() {
+  for name in "$@"; do
     check "$name: the run ends well" 0 "$(cat "$TMP/$name.rc")"
     verdict=$(python3 - "$TMP/$name.json" "$LAPS" <<'PY'
 import json, sys
@@ -73,12 +98,19 @@ PY
 )
     check "$name: every car finishes, none averaging over 1.5x its best lap" ok "$verdict"
   done
-  said=$(grep -c 'the engine is falling behind real time' "$TMP/starved-$seed.err")
-  [ "$said" -ge 1 ] && echo "ok: starved-$seed: the engine says it falls behind real time ($said)" ||
-    fail "starved-$seed: the engine never said it fell behind real time"
-  check "free-$seed: and the run with the machine as it is does not" 0 \
-    "$(grep -c 'the engine is falling behind real time' "$TMP/free-$seed.err")"
+}
+behind() { grep -c 'the engine is falling behind real time' "$TMP/$1.err"; }
+
+for seed in $SEEDS; do
+  verdicts "starved-$seed" "free-$seed"
+  echo "(starved-$seed: the engine said $(behind "starved-$seed") time(s) it fell behind)"
+  check "free-$seed: the run with the machine as it is never says it falls behind" 0 \
+    "$(behind "free-$seed")"
 done
+verdicts frozen
+said=$(behind frozen)
+[ "$said" -ge 1 ] && echo "ok: frozen: the engine says it falls behind real time ($said)" ||
+  fail "frozen: frozen 200 ms of every 250 ms for 4 s, the engine never said it fell behind"
 [ "$kind" = v1 ] && echo "ok: the starved runs were throttled $(grep nr_throttled "$group/cpu.stat")"
 
 finish
