@@ -148,7 +148,8 @@ void Car::receive(std::span<const std::uint8_t> frame) {
             if (m.speed_mm_s <= 0) ++stop_commands_;
             target_ = std::clamp<double>(m.speed_mm_s, 0, kMaxSpeed);
             accel_ = m.accel_mm_s2 > 0 ? m.accel_mm_s2 : kMaxAccel;
-            anki::SpeedUpdate ack{.desired_mm_s = static_cast<std::int16_t>(target_)};
+            anki::SpeedUpdate ack;
+            ack.desired_mm_s = static_cast<std::int16_t>(target_);
             if (!olderFirmware()) {  // the older firmware's says the desired speed only
               ack.accel_mm_s2 = m.accel_mm_s2;
               ack.actual_mm_s = static_cast<std::int16_t>(std::lround(speed_));
@@ -312,14 +313,12 @@ void Car::crossBoundary() {
     if (phantom > 0 && uniform() < phantom) emit(anki::Collision{0, 1});
   }
   std::size_t n = env_.pieces.size();
-  std::size_t from = piece_;
   piece_ = dir_ > 0 ? (piece_ + 1) % n : (piece_ + n - 1) % n;
   u_ = dir_ > 0 ? 0.0 : 1.0;
   wheel_left_mm_ = wheel_right_mm_ = 0;
-  // The finish line lies between 34 and 33 (anki-overdrive.md "Track").
-  if (reporting && dir_ > 0 && env_.pieces[from].piece.type == anki::PieceType::StartLong &&
-      here().piece.type == anki::PieceType::StartShort)
-    ++laps_;
+  // The finish line lies between 34 and 33 (anki-overdrive.md "Track"); on a track without them,
+  // at the beginning of its first piece (Track::finishIndex).
+  if (reporting && dir_ > 0 && piece_ == env_.track.finishIndex()) ++laps_;
 }
 
 void Car::checkDelocalization() {

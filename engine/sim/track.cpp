@@ -259,7 +259,7 @@ Result<Parsed, std::string> parseTokens(std::string_view text) {
         return fail(named + ": start is always pieces 34 and 33 and takes no piece id or keys");
       if (startAt != 0)
         return fail("a second start" + at + " (the first is at position " +
-                    std::to_string(startAt) + "); a track has exactly one start");
+                    std::to_string(startAt) + "); a track has at most one start");
       startAt = position;
       pieces.push_back({anki::kFinishBefore, anki::PieceType::StartLong, 0});
       pieces.push_back({anki::kFinishAfter, anki::PieceType::StartShort, 0});
@@ -420,9 +420,8 @@ Result<Track, std::string> parseLayout(std::string_view text, std::string name) 
   if (pieces.empty())
     return fail(
         std::string("the layout is empty; list its pieces, for example `start S L L S S L L`"));
-  if (startAt == 0)
-    return fail(std::string(
-        "the layout has no start; add `start` (pieces 34 and 33) where the finish line is"));
+  // No start is a track without the start/finish piece (real tracks need not have one): its
+  // laps are counted at the beginning of its first piece (Track::finishIndex).
 
   Walk walk;
   for (const Piece& p : pieces) walk.advance(p);

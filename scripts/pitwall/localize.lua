@@ -15,7 +15,9 @@
 --
 -- Position updates carry only a piece id: the piece is the one with that id ahead in driving
 -- order whose place fits the reckoning, so pieces that occur several times are told apart by
--- the sequence, and lost frames (a transition, every position on a piece) are bridged. A car
+-- the sequence, and lost frames (a transition, every position on a piece) are bridged. A map
+-- piece whose id a scan never saw (track.scan of a car that sent no position update on it) fits
+-- any id of its kind (Map:fits). A car
 -- that is not localized (at the start, after it left the track or was lifted, or when its ids
 -- stop fitting the map) follows every piece that carries its id as a hypothesis through the
 -- next events, dropping those that stop fitting, until one remains; the pieces it drove
@@ -138,7 +140,7 @@ function Tracker:_step(e, m, id, t0, t)
   else
     local best, bestDist
     for j = 1, MAX_SKIP + 1 do
-      if map.pieces[idx[j]].id == id then
+      if map:fits(idx[j], id) then
         local lo, hi = start[j], start[j] + self:_len(idx[j])
         if j == 1 then
           hi = hi + TWIN_MARGIN
@@ -198,7 +200,7 @@ function Tracker:_identify(id, t, m)
     -- Every piece with this id, at its start or, right after a transition, as far in as the
     -- car has driven since.
     local hyps = {}
-    for _, k in ipairs(self.map:find(id)) do
+    for _, k in ipairs(self.map:candidates(id)) do
       local e = { index = k, pos = 0, anchored = self.entrySeen, entered = { { k, nil, t } } }
       if e.anchored then e.pos = math.min(1, self.sinceEntry / self:_len(k)) end
       hyps[#hyps + 1] = e
@@ -416,8 +418,8 @@ end
 function Tracker:__tostring()
   local d, i = self:locate()
   if not d then return string.format("%s: not localized", tostring(self.car)) end
-  return string.format("%s: piece %d (%d), %.0f of %.0f mm, lane %s", tostring(self.car), i,
-    self.map.pieces[i].id, d, self.map:lapLength(0), tostring(self.lane))
+  return string.format("%s: piece %d (%s), %.0f of %.0f mm, lane %s", tostring(self.car), i,
+    self.map.pieces[i].id or "id unknown", d, self.map:lapLength(0), tostring(self.lane))
 end
 
 return localize

@@ -198,9 +198,11 @@ function Race:_map()
   pitwall.log("info", "race: scan lap with " .. tostring(self.cars[1]))
   self.scanning = true -- (the view shows the phase)
   self:_viewStart()
-  local ok, map = pcall(track.scan, self.cars[1], scanOptions)
+  local ok, map, here = pcall(track.scan, self.cars[1], scanOptions)
   self.scanning = nil
   if not ok then error(map, 0) end
+  -- where the scan left its car: known even on a track or at a speed without position updates
+  self.scanHere = { car = self.cars[1], index = here }
   return map
 end
 
@@ -437,6 +439,7 @@ function Race:_entries()
   for slot, car in ipairs(self:_gridOrder()) do
     local e = { car = car, loc = localize.follow(car, self.map), gridSlot = slot, passes = {},
       started = false }
+    if self.scanHere and self.scanHere.car == car then e.loc:assume(self.scanHere.index) end
     self.entries[car] = e
     self.order[slot] = e
   end

@@ -30,18 +30,28 @@ function Start:_gridProblem(e)
   return where .. ((car.speed or 0) == 0 and ", standing still" or "")
 end
 
--- Drives cars that are known to be elsewhere to the grid (piece 34) and stops them there. Cars
+-- Drives cars that are known to be elsewhere to the grid (the map's last piece, before the line:
+-- 34, or on a track without the start piece the one before the line the map has) and stops
+-- them there. Cars
 -- are given lanes of their own (those already on the grid keep theirs; the others take the
 -- free lane nearest to theirs), so two cars in one lane do not end up one behind the other.
 function Start:_toGrid()
   local n = #self.map.pieces
+  local gridId = self.map.pieces[n].id
   local moving, taken = {}, {}
   for _, e in ipairs(self.order) do
-    local piece = e.loc.index and self.map.pieces[e.loc.index].id or e.car.piece
-    -- a transition after its last position update: it has left that piece (a scan lap ends so,
-    -- just past the line)
-    if not e.loc.index and self.lastKind[e.car] == "transition" then piece = 0 end
-    if piece and piece ~= 34 and e.car.connected then
+    -- elsewhere: localized on another piece; or, not localized, its last position update on a
+    -- piece with another id, or a transition after it (it has left that piece). A car that has
+    -- not reported where it is stands where it was put: on the grid.
+    local elsewhere
+    if e.loc.index then
+      elsewhere = e.loc.index ~= n
+    elseif self.lastKind[e.car] == "transition" then
+      elsewhere = true
+    else
+      elsewhere = e.car.piece ~= nil and e.car.piece ~= gridId
+    end
+    if elsewhere and e.car.connected then
       moving[#moving + 1] = e
     else
       taken[localize.nearestLane(e.car.offset or 0)] = e
@@ -96,9 +106,10 @@ function Start:_toGrid()
         if e.car.connected then pcall(e.car.stop, e.car) end
       end
     end
-    pitwall._raise(string.format("race: %d car(s) did not reach the grid (piece 34) in %g s — %s. "
+    pitwall._raise(string.format("race: %d car(s) did not reach the grid (%s) in %g s — %s. "
       .. "The cars are stopped: check that each is on the track and can drive (a car blocked in "
-      .. "its lane: put it in a lane of its own), or raise gridTimeout", #why, timeout,
+      .. "its lane: put it in a lane of its own), or raise gridTimeout", #why,
+      gridId == 34 and "piece 34" or "map piece " .. n .. ", before the line", timeout,
       table.concat(why, "; ")))
   end
   -- settled: a car still rolling at the first light would be a false start
@@ -159,14 +170,11 @@ function Start:_lights()
     wait(k, 0)
   end
   for _, s in ipairs(subs) do s:cancel() end
-  -- Every car stands on the grid (piece 34): its tracker knows it from here, so the line is
-  -- crossed on its first transition even when it reports no position on the way (a real car
-  -- pulling away fast often does not).
-  local grid = self.map:find(34)[1]
-  if grid then
-    for _, e in ipairs(self.order) do
-      if not e.falseStart then e.loc:assume(grid) end
-    end
+  -- Every car stands on the grid (the map's last piece: 34): its tracker knows it from here, so
+  -- the line is crossed on its first transition even when it reports no position on the way (a
+  -- real car pulling away fast often does not).
+  for _, e in ipairs(self.order) do
+    if not e.falseStart then e.loc:assume(#self.map.pieces) end
   end
   pitwall.log("debug", "race: green")
 end

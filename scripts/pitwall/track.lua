@@ -16,6 +16,14 @@
 -- curve the outer wheel travels further (anki-overdrive.md, 0x29). A scan lap that lost a
 -- transition (two pieces in one, a length that does not add up) is thrown away and the next
 -- lap is scanned; a piece that got no position update takes its id from another good lap.
+--
+-- A track without the start/finish piece, or a car that sends few or no position updates, is
+-- mapped as a loop (pitwall.track_loop): the lap closed by its curves' total turn, the pieces
+-- the car saw no id on kept as pieces of unknown id, of the standard shape of their kind. Laps
+-- are then counted at the beginning of the piece where the scan began, or at the line the
+-- script names (`line = id`, map:withLine(index)).
+local loop = require "pitwall.track_loop"
+
 local track = {}
 
 local Piece = {}
@@ -31,7 +39,7 @@ function Piece:length(offset)
 end
 
 function Piece:__tostring()
-  return string.format("piece %d: %d %s%s", self.index, self.id, self.type,
+  return string.format("piece %d: %s %s%s", self.index, self.id or "id unknown", self.type,
     self.turn and (" " .. self.turn) or "")
 end
 
@@ -61,6 +69,49 @@ function Map:find(id)
   return out
 end
 
+--- Whether a car reporting road piece id `id` can be on piece `i`: the piece has that id, or
+--- its id is unknown (a scan that saw no position update on it) and it is of the id's kind.
+function Map:fits(i, id)
+  local p = self.pieces[i]
+  if p.id ~= nil then return p.id == id end
+  local spec = pitwall.piece(id)
+  return spec ~= nil and spec.type == p.type
+end
+
+--- The indices of every piece a car reporting `id` can be on (Map:fits), in order.
+function Map:candidates(id)
+  local out = {}
+  for i in ipairs(self.pieces) do
+    if self:fits(i, id) then out[#out + 1] = i end
+  end
+  return out
+end
+
+--- The same track with the finish line at the beginning of piece `index`: a new map whose
+--- piece 1 is this one's piece `index` (laps are counted where the last piece meets the first).
+function Map:withLine(index)
+  local n = #self.pieces
+  if math.type(index) ~= "integer" or index < 1 or index > n then
+    pitwall._raise(string.format("map:withLine: %s is not a piece index of this map (1..%d)",
+      tostring(index), n))
+  end
+  local fields = {}
+  for k, v in pairs(self) do
+    if k ~= "pieces" then fields[k] = v end
+  end
+  local rotated = setmetatable(fields, Map)
+  rotated.pieces, rotated.finishIndex = {}, 1
+  local start = 0
+  for k = 1, n do
+    local p = {}
+    for key, v in pairs(self.pieces[(index - 2 + k) % n + 1]) do p[key] = v end
+    p.index, p.start = k, start
+    start = start + p.centre
+    rotated.pieces[k] = setmetatable(p, Piece)
+  end
+  return rotated
+end
+
 local letters = { straight = "S", curve = "?", intersection = "X" }
 
 -- A number as text that reads back as exactly that number (a layout must close as it did).
@@ -73,14 +124,18 @@ end
 --- The map as simulator layout text ("start S L L S S L L"); with `ids`, "S:36 L:17 …" and a
 --- custom piece's shape ("S:60,len=300").
 function Map:layout(ids)
-  local words = { "start" }
   local n = #self.pieces
-  -- 34 (last) and 33 (first) are the start pair; the rest in order.
-  for i = 2, n - 1 do
+  -- 34 (last) and 33 (first) are the start pair; the rest in order. A loop without them (a
+  -- track with no start piece, or its line elsewhere) is every piece in order; a piece whose id
+  -- is unknown has none.
+  local paired = self.pieces[1].id == 33 and self.pieces[n].id == 34
+  local words, from, to = { "start" }, 2, n - 1
+  if not paired then words, from, to = {}, 1, n end
+  for i = from, to do
     local p = self.pieces[i]
     local letter = p.type == "curve" and (p.turn == "left" and "L" or "R") or letters[p.type]
       or ("?" .. p.type)
-    local word = ids and (letter .. ":" .. p.id) or letter
+    local word = (ids and p.id) and (letter .. ":" .. p.id) or letter
     -- a custom piece's shape, as a layout gives it (docs/tracks.md)
     if ids and p.custom then
       if p.radius then
@@ -99,13 +154,21 @@ function Map:__tostring()
     self:lapLength(0))
 end
 
--- Builds a map from {id=, turn=, measured=} entries in driving order, 33 first, 34 last.
+-- The standard shape of a kind of piece, for a piece whose id a scan never saw.
+local SHAPE_OF = { curve = 17, straight = 36 }
+
+-- Builds a map from {id=, turn=, measured=} entries in driving order, 33 first, 34 last (or,
+-- for a loop, from the line; an entry without id has `type`, and the standard shape of it).
 local function build(entries, fields)
   local map = setmetatable(fields or {}, Map)
   map.pieces, map.finishIndex = {}, 1
   local start = 0
   for i, e in ipairs(entries) do
-    local spec = pitwall.piece(e.id)
+    local spec = pitwall.piece(e.id or SHAPE_OF[e.type] or -1)
+    if e.id == nil and spec then
+      spec = { type = e.type, length = spec.length, radius = spec.radius,
+        angle = e.angle or spec.angle }
+    end
     local p = setmetatable({
       index = i,
       id = e.id,
@@ -136,10 +199,10 @@ function track.fromSim()
     entries[#entries + 1] = { id = p.id, turn = p.turn > 0 and "left" or p.turn < 0 and "right" or nil,
       measured = p.length }
   end
-  if entries[1].id ~= 33 or entries[n].id ~= 34 then
-    pitwall._raise("track.fromSim: the simulator's track " .. t.name .. " has no start pair 34 → 33")
-  end
-  return build(entries, { name = t.name, source = "sim" })
+  -- a track without the start piece: its laps from the beginning of its first piece, as the
+  -- simulator counts them
+  local hasStart = entries[1].id == 33 and entries[n].id == 34
+  return build(entries, { name = t.name, source = "sim", hasStart = hasStart })
 end
 
 -- ---- the scan lap ----
@@ -149,14 +212,7 @@ local function newSegment(time, byTransition)
   return { ids = {}, idCount = 0, t0 = time, byTransition = byTransition, reckoned = 0 }
 end
 
--- The one piece id a segment saw, or nil (none, or more than one: a transition was lost).
-local function segmentId(seg)
-  if seg.idCount ~= 1 then return nil end
-  local id = next(seg.ids)
-  return id
-end
-
-local NO_POSITION = "no position update on it"
+local segmentId, NO_POSITION = loop.segmentId, loop.NO_POSITION
 
 -- Why a closed segment cannot be used, or nil when it is good. NO_POSITION is a lesser
 -- problem: the piece is there, only its id is missing (another lap may have it).
@@ -164,8 +220,9 @@ local function segmentProblem(seg)
   if not seg.byTransition then return "it did not start at a transition" end
   if seg.idCount > 1 then return "two pieces in one (a lost transition)" end
   local wheels = (seg.left + seg.right) * 5 -- mean of both wheels, cm → mm
-  -- A lost transition between two pieces with the same id: twice the distance driven.
-  if math.abs(seg.reckoned - wheels) > math.max(0.35 * wheels, 80) then
+  -- A lost transition between two pieces with the same id: twice the distance driven (not
+  -- known while the car's speed is not: no position update yet since the scan set it).
+  if not seg.blind and math.abs(seg.reckoned - wheels) > math.max(0.35 * wheels, 80) then
     return string.format("driven %.0f mm but the wheels say %.0f mm", seg.reckoned, wheels)
   end
   if seg.idCount == 0 then return NO_POSITION end
@@ -267,20 +324,21 @@ function track._adopt(map)
   return map
 end
 
---- Drives `car` one lap in a fixed lane and returns the map (inside a task only).
---- options: speed (mm/s, default 350), offset (mm: change to this lane first; default: stay),
---- timeout (s, default 120), stop (default true: stop the car once the map is complete, just
---- past the finish line, and when the scan fails; false leaves it driving at the scan speed).
-function track.scan(car, options)
+-- track.scan (drive true) and track.learn (drive false: the car is not commanded).
+local function scan(car, options, drive)
+  local name = drive and "track.scan" or "track.learn"
   options = options or {}
   if not coroutine.isyieldable() then
-    pitwall._raise("track.scan drives a lap and waits for it: call it inside a task (the "
-      .. "script's main chunk or pitwall.spawn), not in a handler or timer")
+    pitwall._raise(name .. (drive and " drives a lap" or " watches the car's laps")
+      .. " and waits for it: call it inside a task (the script's main chunk or pitwall.spawn), "
+      .. "not in a handler or timer")
   end
   if type(options) ~= "table" then
-    pitwall._raise("track.scan: options must be a table such as {speed = 350}, got " .. type(options))
+    pitwall._raise(name .. ": options must be a table such as "
+      .. (drive and "{speed = 350}" or "{timeout = 60}") .. ", got " .. type(options))
   end
-  pitwall._checkOptions("track.scan", options, { "speed", "offset", "timeout", "stop" })
+  pitwall._checkOptions(name, options, drive and { "speed", "offset", "timeout", "stop", "line" }
+    or { "timeout", "line" })
   local speed = options.speed or 350
   local timeout = options.timeout or 120
   if type(speed) ~= "number" or speed < 100 or speed > 1000 then
@@ -288,19 +346,25 @@ function track.scan(car, options)
       .. "drives slowly so that no position update is missed; 300–400 is a good choice)")
   end
   if not car.connected then
-    pitwall._raise("track.scan: " .. tostring(car) .. " is not connected")
+    pitwall._raise(name .. ": " .. tostring(car) .. " is not connected")
   end
 
   -- The scan's state is one table, so that a reload of the script takes it up where it was
   -- (pitwall._carry below): the new version's track.scan of the same car goes on with it.
   local now = pitwall.now()
   local st = takeScan(car) or { car = car, speed = speed, phase = "start", segs = {}, cur = nil,
-    lastTime = now, lastSpeed = car.speed or 0, reversed = false, delocalized = false,
+    -- (its speed unknown until it reports one: a scan sets it now, a car watched may be
+    -- driving at any speed)
+    lastTime = now, lastSpeed = nil, reversed = false, delocalized = false,
     uturns = 0, deadline = now + timeout }
   speed = st.speed
   scanning[st] = true
   local function reckon(t)
-    if st.cur then st.cur.reckoned = st.cur.reckoned + st.lastSpeed * (t - st.lastTime) end
+    if st.cur and st.lastSpeed then
+      st.cur.reckoned = st.cur.reckoned + st.lastSpeed * (t - st.lastTime)
+    elseif st.cur then
+      st.cur.blind = true
+    end
     st.lastTime = t
   end
   local subs = {
@@ -338,29 +402,21 @@ function track.scan(car, options)
     scanning[st] = nil
   end
 
-  local ok, result = pcall(function()
-    -- Pieces crossed and not one position update: the ids the scan learns the pieces by never
-    -- come (`least` pieces at least, so that a car just starting is not blamed).
-    local function unnamed(least)
-      local named = 0
-      for _, s in ipairs(st.segs) do named = named + s.idCount end
-      if #st.segs >= least and named == 0 then
-        pitwall._raise(string.format("track.scan: %s crossed %d pieces and sent no position "
-          .. "update on any of them; the scan learns the pieces from those (a car that sends only "
-          .. "transitions, as the simulator's transitions sensor model does, cannot be scanned "
-          .. "yet: give the race a map, e.g. track.fromSim() or a layout)", tostring(car), #st.segs))
-      end
-    end
+  local ok, result, here = pcall(function()
     local function waitFor(cond, what)
       local left = st.deadline - pitwall.now()
       if left <= 0 or not pitwall.waitUntil(cond, left) then
-        unnamed(3)
-        pitwall._raise(string.format("track.scan: %s within %g s with %s (%d pieces crossed); "
-          .. "give a longer timeout, or check that the car drives and the layout has the start "
-          .. "pieces 34 and 33", what, timeout, tostring(car), #st.segs))
+        local named = 0
+        for _, s in ipairs(st.segs) do named = named + s.idCount end
+        pitwall._raise(string.format("%s: %s within %g s with %s (%d pieces crossed%s); "
+          .. "give a longer timeout, or check that the car drives round a closed track", name, what,
+          timeout, tostring(car), #st.segs, named == 0 and #st.segs > 0
+            and ", not one position update among them" or ""))
       end
     end
-    if st.phase == "start" then
+    if st.phase == "start" and not drive then
+      st.phase = "lap"
+    elseif st.phase == "start" then
       car:setSpeed(speed, 1000)
       if options.offset then
         waitFor(function() return (car.speed or 0) > 0 end, "the car did not start moving")
@@ -373,16 +429,16 @@ function track.scan(car, options)
       end
       st.phase = "lap"
     else
-      pitwall.log("info", string.format("track.scan: %s goes on with the scan an earlier version "
-        .. "began (%d pieces crossed)", tostring(car), #st.segs))
+      pitwall.log("info", string.format("%s: %s goes on with the scan an earlier version "
+        .. "began (%d pieces crossed)", name, tostring(car), #st.segs))
     end
-    local ids, run
+    local ids, run, lap
     waitFor(function()
       if st.delocalized then
-        pitwall._raise("track.scan: " .. tostring(car) .. " left the track during the scan; put it "
+        pitwall._raise(name .. ": " .. tostring(car) .. " left the track during the scan; put it "
           .. "back and scan again, slower")
       end
-      if st.reversed and (not st.turnedAt or pitwall.now() - st.turnedAt > 1) then
+      if drive and st.reversed and (not st.turnedAt or pitwall.now() - st.turnedAt > 1) then
         -- It drives reversed: turn it round (once more if that did not take within 1 s).
         st.uturns = st.uturns + 1
         if st.uturns > 3 then
@@ -391,46 +447,103 @@ function track.scan(car, options)
         car:uturn()
         st.turnedAt = pitwall.now()
       end
-      unnamed(30) -- three laps of a small track and more
       ids, run = findLap(st.segs)
-      return ids ~= nil
-    end, "no complete clean lap from finish line to finish line")
+      if ids then return true end
+      -- no finish-to-finish lap yet: a loop closed by its turn (a track without the start
+      -- piece; a car that sends few or no position updates). A scan whose car sends position
+      -- updates at all drives up to five passes for the ids of pieces that had none; learning
+      -- takes what came (a record ends).
+      lap = loop.close(st.segs)
+      return lap ~= nil and (not drive or lap.unknown == 0 or lap.named == 0
+        or lap.seen >= 5 * lap.period)
+    end, "no complete lap (neither one from finish line to finish line nor a loop whose curves "
+      .. "turn 360°)")
 
-    local entries, turns, offsets = {}, 0, 0
-    for k, s in ipairs(run) do
-      local e = { id = ids[k], measured = (s.left + s.right) * 5 }
-      local spec = pitwall.piece(e.id)
-      if spec and spec.type == "curve" then
-        -- The outer wheel travels further: the right wheel in a left curve.
-        e.turn = s.right > s.left and "left" or "right"
-        turns = turns + (e.turn == "left" and 1 or -1) * spec.angle
+    local entries, turns, offsets, first = {}, 0, 0, nil
+    local fields = { source = "scan", scanSpeed = speed, scannedBy = car.name }
+    if ids then
+      for k, s in ipairs(run) do
+        local e = { id = ids[k], measured = (s.left + s.right) * 5 }
+        local spec = pitwall.piece(e.id)
+        if spec and spec.type == "curve" then
+          -- The outer wheel travels further: the right wheel in a left curve.
+          e.turn = s.right > s.left and "left" or "right"
+          turns = turns + (e.turn == "left" and 1 or -1) * spec.angle
+        end
+        offsets = offsets + s.offset
+        entries[#entries + 1] = e
       end
-      offsets = offsets + s.offset
-      entries[#entries + 1] = e
+      for k, s in ipairs(st.segs) do
+        if s == run[1] then first = k break end
+      end
+      fields.scanOffset = offsets / #entries
+    else
+      entries, first = lap.pieces, lap.first
+      for k = first, first + lap.period - 1 do offsets = offsets + st.segs[k].offset end
+      fields.scanOffset = offsets / lap.period
     end
-    local map = build(entries, {
-      source = "scan",
-      scanOffset = offsets / #entries,
-      scanSpeed = speed,
-      scannedBy = car.name,
-    })
+    local map = build(entries, fields)
+    -- a track without the start piece counts laps where the scan began, or at the script's line
+    map.hasStart = map:find(33)[1] ~= nil
     if math.abs((turns + 180) % 360 - 180) > 0.5 then
-      pitwall.log("warn", string.format("track.scan: the curves turn %g° in all; a closed track "
-        .. "turns a multiple of 360°: a curve's direction may be wrong", turns))
+      pitwall.log("warn", string.format("%s: the curves turn %g° in all; a closed track "
+        .. "turns a multiple of 360°: a curve's direction may be wrong", name, turns))
     end
-    if options.stop ~= false then car:stop() end
+    -- the piece the car is on now (its open segment comes after the closed ones)
+    local here = (#st.segs - first + 1) % #map.pieces + 1
+    -- the line: the script's, else the finish line (33 first), else where the scan began
+    local line = 1
+    if options.line ~= nil then
+      line = map:find(options.line)[1]
+      if not line then
+        local seen = {}
+        for _, p in ipairs(map.pieces) do
+          if p.id then seen[#seen + 1] = tostring(p.id) end
+        end
+        pitwall._raise(string.format("%s: line = %s: no piece of the map has that id "
+          .. "(ids seen: %s); name one of them, or leave line out to count laps at the "
+          .. "finish line, or where the scan began on a track without one", name, tostring(options.line),
+          #seen > 0 and table.concat(seen, ", ") or "none"))
+      end
+    elseif not ids then
+      line = map:find(33)[1] or 1
+    end
+    if line ~= 1 then
+      map = map:withLine(line)
+      here = (here - line) % #map.pieces + 1
+    end
+    if drive and options.stop ~= false then car:stop() end
     -- the race view draws what was learnt (a simulator's layout stays: pitwall.view.track)
     if pitwall.view and pitwall.view.active then pcall(pitwall.view.track, map) end
-    return map
+    return map, here
   end)
   cancel()
   -- (its errors name the script's line already: pitwall._raise, the bindings)
   if not ok then
     -- a scan that failed leaves no car driving at the scan speed (unless told to keep it going)
-    if options.stop ~= false and car.connected then pcall(car.stop, car) end
+    if drive and options.stop ~= false and car.connected then pcall(car.stop, car) end
     error(result, 0)
   end
-  return result
+  return result, here
+end
+
+--- Drives `car` one lap in a fixed lane and returns the map, and the index of the map piece
+--- the car is on at its end (inside a task only).
+--- options: speed (mm/s, default 350), offset (mm: change to this lane first; default: stay),
+--- timeout (s, default 120), stop (default true: stop the car once the map is complete, and
+--- when the scan fails; false leaves it driving at the scan speed), line (a piece id: laps are
+--- counted at the beginning of the first piece with it; default the finish line, and where the
+--- scan began on a track without one).
+function track.scan(car, options)
+  return scan(car, options, true)
+end
+
+--- The map of the track `car` drives, learnt from its events as track.scan learns it but
+--- without commanding the car (a car someone else drives; a record replayed with --script),
+--- and the index of the map piece it is on by then (inside a task only).
+--- options: timeout (s, default 120), line (as track.scan's).
+function track.learn(car, options)
+  return scan(car, options, false)
 end
 
 return track

@@ -5,7 +5,7 @@
 ---A piece of a track map, in driving order.
 ---@class pitwall.track.Piece
 ---@field index integer position in the map
----@field id integer road piece id
+---@field id? integer road piece id; nil when a scan never saw it (a loop mapped from transitions: the standard shape of its type)
 ---@field type string "start-short", "straight", "curve", "start-long", "intersection", … ("unknown")
 ---@field turn? "left"|"right" curves only
 ---@field centre number centre-line length, mm
@@ -22,8 +22,9 @@ function Piece:length(offset) end
 
 ---A track map: one lap from the finish line.
 ---@class pitwall.track.Map
----@field pieces pitwall.track.Piece[] from the piece after the finish line (pieces[1] is 33, the last 34)
+---@field pieces pitwall.track.Piece[] from the piece after the finish line (pieces[1] is 33, the last 34; on a track without them, from the line)
 ---@field finishIndex integer 1: the index of the piece after the finish line
+---@field hasStart boolean the track has the start/finish piece (33, 34); false: laps are counted where the scan began or at the script's line
 ---@field source "scan"|"sim"
 ---@field scanOffset? number
 ---@field scanSpeed? number
@@ -46,6 +47,22 @@ function Map:next(i, dir) end
 ---@return integer[]
 function Map:find(id) end
 
+---Whether a car reporting road piece id `id` can be on piece `i`: the piece has that id, or its id is unknown and it is of the id's kind.
+---@param i integer
+---@param id integer
+---@return boolean
+function Map:fits(i, id) end
+
+---The indices of every piece a car reporting `id` can be on (Map:fits), in order.
+---@param id integer
+---@return integer[]
+function Map:candidates(id) end
+
+---The same track with the finish line at the beginning of piece `index`: a new map whose piece 1 is this one's piece `index`.
+---@param index integer
+---@return pitwall.track.Map
+function Map:withLine(index) end
+
 ---The map as simulator layout text ("start S L L S S L L"); with `ids`, "S:36 L:17 …".
 ---@param ids? boolean
 ---@return string
@@ -57,6 +74,12 @@ function Map:layout(ids) end
 ---@field offset? number change to this lane (mm from the centre) first
 ---@field timeout? number s (default 120)
 ---@field stop? boolean stop the car once the map is complete (default true)
+---@field line? integer a piece id: laps counted at the beginning of the first piece with it (default: the finish line, or where the scan began on a track without one)
+
+---Options of track.learn.
+---@class pitwall.track.LearnOptions
+---@field timeout? number s (default 120)
+---@field line? integer as track.scan's
 
 ---Track mapping (require "pitwall.track"; docs/racing.md "Track mapping").
 ---@class pitwall.track
@@ -66,10 +89,18 @@ local track = {}
 ---@return pitwall.track.Map
 function track.fromSim() end
 
----Drives `car` one lap in a fixed lane and returns the map (inside a task only).
+---The map of the track `car` drives, learnt from its events as track.scan learns it but without commanding the car (a car someone else drives; a record replayed with --script), and the index of the map piece it is on by then (inside a task only).
+---@param car pitwall.Car
+---@param options? pitwall.track.LearnOptions
+---@return pitwall.track.Map map
+---@return integer here
+function track.learn(car, options) end
+
+---Drives `car` round the track in a fixed lane until its lap is known and returns the map, and the index of the map piece the car is on by then (inside a task only).
 ---@param car pitwall.Car
 ---@param options? pitwall.track.ScanOptions
----@return pitwall.track.Map
+---@return pitwall.track.Map map
+---@return integer here
 function track.scan(car, options) end
 
 return track
