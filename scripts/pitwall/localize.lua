@@ -232,6 +232,7 @@ end
 
 function Tracker:_onPosition(ev)
   local t = ev.time
+  self.seenAt = t -- the car read the track: it moved
   if ev.reverse ~= self.reverse then
     -- A U-turn somewhere since the last update: about as far forth as back, so stay put.
     self.reverse = ev.reverse
@@ -260,6 +261,7 @@ end
 
 function Tracker:_onTransition(ev)
   local t = ev.time
+  self.seenAt = t
   local m = self:_travel(t)
   if self.index then
     self:_step(self, m, nil, self.time, t)
@@ -303,7 +305,9 @@ local function listenTo(self)
     -- A car run into from behind (the front car's report: side 0, "front") knows a car is right
     -- behind it, whatever that car's reckoning says (drivers.follower uses it).
     pitwall.listen(car, "onCollision", function(_, ev)
+      -- (0x4d: "front", a car ran into this one from behind; "back", this one into a car)
       if ev.side == 0 and ev.where == "front" then self.hitFromBehind = ev.time end
+      if ev.side == 0 and ev.where == "back" then self.ranInto = ev.time end
     end),
     pitwall.listen(car, "onDelocalized", function(_, ev)
       self:_lose(ev.time, "delocalized")

@@ -18,6 +18,8 @@ local cruiser = require "pitwall.drivers.cruiser"
 local follower = { name = "follower" }
 local STICKY = 500 -- mm: how far behind a followed car in our lane may be reckoned
 local STICKY_FOR = 2 -- s: how long a car that ran into us stays behind us whatever is reckoned
+local INTO_LANE = 60 -- mm across: a car this near our offset can run into us (lanes are 45 apart)
+local SILENT = 1 -- s without a position update or transition: a car that is not moving
 local Follower = {}
 Follower.__index = Follower
 Follower.__name = "follower" -- (how errors name it: "follower has no method …")
@@ -60,21 +62,33 @@ function Follower:leader(car, ctx)
   local inLane = function(o) return o.lane and math.abs(o.lane - mine) < 45 end
   self.behind = self.behind or {}
   local hit = ctx.loc.hitFromBehind
-  if hit and hit ~= self.hitSeen then
-    -- the car that ran into us: the nearest in our lane, whatever its reckoning says
-    self.hitSeen = hit
-    local nearest
+  if hit and hit ~= self.hitSeen and now - hit <= STICKY_FOR then
+    -- the car that ran into us, whatever its reckoning says along: the one that reported
+    -- running into a car as we reported being hit; else, of those reckoned within STICKY, the
+    -- nearest across, by the lane it is heading for (one changing into our lane is between
+    -- two). Until we are localized (a hit at the start) it is asked again each update.
+    local nearest, nearestAcross
     for _, o in ipairs(ctx:nearby(STICKY)) do
-      if inLane(o) and (not nearest or math.abs(o.gap) < math.abs(nearest.gap)) then nearest = o end
+      local ran = o.loc.ranInto
+      if ran and math.abs(ran - hit) < 0.05 then nearest, nearestAcross = o, -1 break end
+      local lane = drivers.changing(o.car) and o.car.targetOffset or o.lane
+      local across = lane and math.abs(lane - mine) or math.huge
+      if across < INTO_LANE and (not nearest or across < nearestAcross) then
+        nearest, nearestAcross = o, across
+      end
     end
     if nearest then
-      self.behind[nearest.car] = now
+      self.hitSeen = hit
+      self.behind[nearest.car] = hit
       if self.lastLead == nearest.car then self.lastLead = nil end
     end
   end
+  -- behind: for STICKY_FOR s, and then while it reads nothing of the track for SILENT s (a car
+  -- held behind us, pushing, reports nothing: its reckoning is no news)
   local function knownBehind(o)
     local t = self.behind[o.car]
-    return t ~= nil and now - t <= STICKY_FOR and o.gap < STICKY
+    return t ~= nil and o.gap < STICKY
+      and (now - t <= STICKY_FOR or now - (o.loc.seenAt or -math.huge) > SILENT)
   end
   local lead = drivers.aheadIn(ctx, mine, range, nil, knownBehind)
   if drivers.changing(car) and car.targetOffset then

@@ -127,6 +127,8 @@ function Map:layout(ids) end
 ---@field reverse boolean driving reversed
 ---@field time? number time of the last event
 ---@field hitFromBehind? number time of the last report that another car ran into this one from behind
+---@field ranInto? number time of the last report that this car ran into another
+---@field seenAt? number time of the car's last position update or transition (when it last read the track)
 local Tracker = {}
 
 ---Centre-line mm from the finish line, the piece index and the fraction of that piece at time t (default now); nil when not localized.
