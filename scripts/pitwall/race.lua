@@ -100,8 +100,8 @@ local MODES = { practice = "Free practice", qualifying = "Qualifying", laps = "R
 -- Every option a session takes (docs/racing.md "Options"): any other key is a typo.
 race.options = { "mode", "laps", "minutes", "seconds", "cars", "map", "scan", "drivers", "grid",
   "lights", "lightInterval", "hold", "falseStartPenalty", "safety", "cooldown", "finishTimeout",
-  "period", "gridSpeed", "gridTimeout", "board", "title", "redraw", "results", "onLap",
-  "onFinish", "onPositionChange", "onFalseStart", "onLights", "onEnd" }
+  "period", "gridSpeed", "gridTimeout", "board", "title", "redraw", "results", "marshal", "onLap",
+  "onFinish", "onPositionChange", "onFalseStart", "onLights", "onSlowLap", "onEnd" }
 
 local function report(where, err)
   if pitwall._reportError then pitwall._reportError(where, err)
@@ -220,6 +220,8 @@ end
 for name, fn in pairs(require "pitwall.race_start") do Race[name] = fn end
 -- What the race view shows (race_view.lua).
 for name, fn in pairs(require "pitwall.race_view") do Race[name] = fn end
+-- Slow laps seen and contacts freed (race_marshal.lua).
+for name, fn in pairs(require "pitwall.race_marshal") do Race[name] = fn end
 
 function Race:_start(e)
   e.started = true
@@ -231,6 +233,9 @@ function Race:_finish(e, t)
   self.finishers = self.finishers + 1
   e.finished, e.finishTime, e.finishRank = true, t, self.finishers
   e.progress = e.timer.count
+  -- what the results say: the laps up to the flag (a finished car circles on at the cool-down
+  -- speed while the others finish, and those laps are timed but not raced)
+  e.final = { count = e.timer.count, best = e.timer.best, last = e.timer.last }
   if not self.leaderFinished then self.leaderFinished = t end
   drivers.call(e.driver, "finish", e.car, e.ctx)
   -- A cool-down: on at a low speed (a parked car would block the lane at the line).
@@ -288,7 +293,8 @@ function Race:_gap(e, leader)
     return a and b and a.time - b.time or nil, 0
   end
   if e.finished and leader.finished then
-    return e.finishTime - leader.finishTime, math.max(0, leader.timer.count - e.timer.count)
+    local lf, ef = leader.final or leader.timer, e.final or e.timer
+    return e.finishTime - leader.finishTime, math.max(0, lf.count - ef.count)
   end
   local behind = 0
   if leader.progress and e.progress then
@@ -340,12 +346,14 @@ function Race:_tick()
   end
   self.ticks = self.ticks + 1
   self:_safety(now)
+  self:_marshal(now)
   for _, e in ipairs(self.order) do
     local car = e.car
     if not e.started and now >= e.releaseAt then self:_start(e) end
     if e.started and not e.finished and car.connected then
       if e.ctx then e.ctx.limit = e.limit end
       drivers.call(e.driver, "update", car, e.ctx)
+      self:_applyFloor(e, now)
       if e.limit and (car.targetSpeed or 0) > e.limit then pcall(car.setSpeed, car, e.limit, 2000) end
     elseif e.finished and car.connected and e.limit and (car.targetSpeed or 0) > e.limit then
       pcall(car.setSpeed, car, e.limit, 2000)
@@ -390,7 +398,7 @@ function Race:_rows()
   local rows, leader = {}, self.order[1]
   for k, e in ipairs(self.order) do
     local gap, behind = self:_gap(e, leader)
-    local t = e.timer
+    local t = e.finished and e.final or e.timer
     local lastCross = e.finishTime or (t.last and t.last.finish)
     rows[k] = {
       position = k, car = e.car.name, number = e.car.number,

@@ -63,3 +63,24 @@ for k, row in ipairs(r:results()) do
   expect.truthy(text:find('"car":%s*"' .. row.car .. '"'), "car " .. row.car .. " in the JSON")
 end
 os.remove(csv); os.remove(json); os.remove(base)
+
+-- Laps after the flag are not results (issue 35): a car that never drives keeps the race
+-- waiting (finishTimeout), the finished cars circle at the cool-down speed meanwhile, and the
+-- results still give each finisher the race's 2 laps, its best and last of those.
+local Parked = { name = "parked", update = function() end }
+local waited = race.laps { laps = 2, map = map, board = false, finishTimeout = 20,
+  drivers = function(car, i)
+    if i == 1 then return setmetatable({}, { __index = Parked }) end
+    return race.Steady.new { speed = speeds[i] }
+  end }
+local finishers = 0
+for _, row in ipairs(waited:results()) do
+  if row.finished and row.laps > 0 then
+    finishers = finishers + 1
+    expect.eq(row.laps, 2, row.car .. ": the race's laps, not those circled after the flag")
+    local e = waited:entry(pitwall.car(row.car))
+    expect.gt(e.timer.count, 2, row.car .. " did circle on after the flag")
+    expect.eq(row.lastLap, e.timer.history[2].time, row.car .. ": its last lap is its second")
+  end
+end
+expect.eq(finishers, 2, "two cars finished")

@@ -1,0 +1,115 @@
+-- The race's marshal (docs/racing.md "What a session does"): a car whose lap is taking far
+-- longer than it should is seen, said in the log (and so in the view's event log) and, when it
+-- is stuck in a contact, freed. Methods of a session (pitwall.race); no state of its own.
+--
+-- Slow: a lap under way for more than SLOW times the reference and SLOW_MIN s more — the reference
+-- is the car's best lap, else the field's, else a lap at 400 mm/s. Seen once per SLOW·reference
+-- while it lasts.
+--
+-- Stuck in a contact: the car reported a collision during that lap (it ran into a car, or one ran
+-- into it). Two AI drivers can hold each other so: a car held behind another, pushing, reports
+-- nothing and is reckoned on ahead, and the car in front stands for it (the jam of issue 34). So a
+-- stuck car is driven at NUDGE_SPEED at least for NUDGE_FOR s whatever its driver says (the car in
+-- front moves, the one behind reads the track again), and one that ran into a car is sent to the
+-- nearest lane no other car is reckoned in within FREE mm. A human's car is never driven for its
+-- driver: it is only reported. A car slow with no contact (its driver stands it, it is lost) is
+-- only reported, with its speed.
+local Marshal = {}
+
+local SLOW = 2.5          -- a lap this many times the reference is slow …
+local SLOW_MIN = 3        -- … and at least this many seconds more than it
+local NUDGE_SPEED = 300   -- mm/s
+local NUDGE_FOR = 2       -- s
+local FREE = 600          -- mm either side: a lane with no car reckoned this near is free
+local LANES = { -68, -23, 23, 68 }
+
+-- The lap time a car's laps are measured against.
+function Marshal:_reference(e)
+  if e.timer.best then return e.timer.best.time end
+  local best
+  for _, o in ipairs(self.order) do
+    local b = o.timer.best and o.timer.best.time
+    if b and (not best or b < best) then best = b end
+  end
+  return best or self.map:lapLength(0) / 400
+end
+
+-- The free lane nearest to the car's, or nil.
+function Marshal:_freeLane(e)
+  local mine = e.car.offset or 0
+  local L = self.map:lapLength(0)
+  local d = e.loc:distance()
+  local best
+  for _, lane in ipairs(LANES) do
+    if math.abs(lane - mine) > 20 then
+      local free = true
+      for _, o in ipairs(self.order) do
+        local od = o ~= e and o.loc:distance()
+        if od and d and math.abs(((od - d + L / 2) % L) - L / 2) < FREE
+            and math.abs((o.car.offset or 0) - lane) < 35 then
+          free = false
+        end
+      end
+      if free and (not best or math.abs(lane - mine) < math.abs(best - mine)) then best = lane end
+    end
+  end
+  return best
+end
+
+-- Sees slow cars and frees those stuck in a contact. Called every tick while racing.
+function Marshal:_marshal(now)
+  if self.state ~= "racing" or self.options.marshal == false then return end
+  for _, e in ipairs(self.order) do
+    local start = e.timer.start
+    if e.started and not e.finished and e.car.connected and start then
+      local ref = self:_reference(e)
+      local took = now - start
+      if took > SLOW * ref and took > ref + SLOW_MIN
+          and (not e.slowAt or now - e.slowAt > SLOW * ref) then
+        e.slowAt = now
+        self:_slow(e, took, ref, now)
+      end
+    end
+  end
+end
+
+function Marshal:_slow(e, took, ref, now)
+  local car, loc = e.car, e.loc
+  local lap = e.timer.count + 1
+  local contact = (loc.hitFromBehind and loc.hitFromBehind >= e.timer.start)
+    or (loc.ranInto and loc.ranInto >= e.timer.start)
+  local human = e.driver and e.driver.name == "human"
+  local what
+  if contact and not human then
+    e.floor, e.floorUntil = NUDGE_SPEED, now + NUDGE_FOR
+    what = string.format("stuck in a contact: driven at %d mm/s for %g s", NUDGE_SPEED, NUDGE_FOR)
+    if loc.ranInto and loc.ranInto >= e.timer.start then
+      local lane = self:_freeLane(e)
+      if lane then
+        pcall(car.changeLane, car, lane)
+        what = what .. string.format(", and to lane %+d", lane)
+      end
+    end
+  elseif contact then
+    what = "stuck in a contact (a human drives it: left to its driver)"
+  else
+    what = string.format("no contact: its driver asks %d mm/s%s", car.targetSpeed or 0,
+      loc.localized and "" or ", and it is not found on the track")
+  end
+  local text = string.format("race: %s is slow: lap %d has taken %.1f s, %.1f times %.3f s; %s",
+    tostring(car), lap, took, took / ref, ref, what)
+  pitwall.log("warn", text)
+  self:_emit("onSlowLap", car, { lap = lap, took = took, reference = ref, action = what }, self)
+end
+
+-- After its driver's update: a car being freed drives at least the nudge speed (the safety
+-- limit still wins).
+function Marshal:_applyFloor(e, now)
+  if not e.floorUntil then return end
+  if now >= e.floorUntil then e.floor, e.floorUntil = nil, nil return end
+  local v = e.floor
+  if e.limit then v = math.min(v, e.limit) end
+  if (e.car.targetSpeed or 0) < v then pcall(e.car.setSpeed, e.car, v, 1000) end
+end
+
+return Marshal
