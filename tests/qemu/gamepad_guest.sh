@@ -51,7 +51,7 @@ say "trigger pulled: car 1 drives"
 
 m=$(mark "$RUN")
 echo "key 304 1" >&3  # BTN_SOUTH: brake
-wait_new "$RUN" "$m" 'throttle=0.00 .* moving=no' 20 || fail "BTN_SOUTH did not stop car 1"
+wait_new "$RUN" "$m" 'throttle=0.00 .* truth=0$' 20 || fail "BTN_SOUTH did not stop car 1"
 echo "key 304 0" >&3  # let go of the brake: the trigger, still pulled, counts again
 wait_new "$RUN" "$m" 'throttle=1.00 .* moving=yes' 20 || fail "car 1 did not drive after the brake"
 say "BTN_SOUTH braked car 1 to a stop, and it drove on when let go"
@@ -60,7 +60,7 @@ m=$(mark "$RUN")
 echo "unplug" >&3  # the trigger still pulled: the car must stop all the same
 exec 3>&-
 wait_new "$RUN" "$m" 'the gamepad was unplugged' 10 || fail "pitwall did not see pad A unplugged"
-wait_new "$RUN" "$m" 'holder=nil throttle=0.00 .* moving=no' 20 ||
+wait_new "$RUN" "$m" 'holder=nil throttle=0.00 .* truth=0$' 20 ||
   fail "car 1 did not slow to a stop after pad A was unplugged"
 say "pad A unplugged with its trigger held: seat 1 free, car 1 stopped"
 
@@ -77,7 +77,8 @@ m=$(mark "$RUN")
 echo "axis 5 0" >&4
 echo "unplug" >&4
 exec 4>&-
-wait_new "$RUN" "$m" 'holder=nil throttle=0.00 .* moving=no' 20 || fail "car 1 did not stop after pad B"
+# at rest by the simulator's own speed: `moving` says no while a car rolls without reporting
+wait_new "$RUN" "$m" 'holder=nil throttle=0.00 .* truth=0$' 20 || fail "car 1 did not stop after pad B"
 m=$(mark "$RUN")
 plug 5 "Pad C" 128
 wait_new "$RUN" "$m" 'seat 1: holder=gamepad' 20 || fail "pad C took no seat"
@@ -87,7 +88,7 @@ echo "key 304 1" >&5  # A pressed and let go: the brake lets go to 0, not to the
 echo "key 304 0" >&5
 echo "axis 5 200" >&5  # the right stick moved about, never to its minimum
 sleep 2
-tail -n +"$((m + 1))" "$RUN" | grep -qE 'seat 1: holder=gamepad throttle=0\.[1-9]|moving=yes' &&
+tail -n +"$((m + 1))" "$RUN" | grep -qE 'seat 1: holder=gamepad throttle=0\.[1-9]|truth=[1-9]' &&
   fail "pad C's resting ABS_RZ drove car 1"
 m=$(mark "$RUN")
 echo "key 313 1" >&5  # BTN_TR2 drives meanwhile
