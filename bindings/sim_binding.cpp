@@ -217,6 +217,7 @@ int truth(lua_State* L) {
   lua::setBoolean(L, "connected", t.connected);
   lua::setInteger(L, "battery", t.battery_mv);
   lua::setInteger(L, "collisions", t.collisions);
+  lua::setInteger(L, "slides", t.slides);
   lua::setInteger(L, "speedCommands", t.speed_commands);
   lua::setInteger(L, "stopCommands", t.stop_commands);
   return 1;
@@ -270,14 +271,13 @@ int noise(lua_State* L) {
   return 1;
 }
 
-// sim.sensor{model = "real"|"ideal"|"transitions"}: what the cars' sensors report (docs/simulator.md "Sensor
-// model"); returns the current setting.
+// sim.sensor{model = "real"|"ideal"|"transitions"}: what the cars' sensors report
+// (docs/simulator.md "Sensor model"); returns the current setting.
 int sensor(lua_State* L) {
   SimSession& s = session(L);
   if (!lua_isnoneornil(L, 1)) {
     if (!lua_istable(L, 1))
-      throw LuaError(
-          "sim.sensor takes a table {model = \"real\", \"ideal\" or \"transitions\"}");
+      throw LuaError("sim.sensor takes a table {model = \"real\", \"ideal\" or \"transitions\"}");
     static constexpr std::array<const char*, 1> kOptions = {"model"};
     lua::checkOptions(L, 1, "sim.sensor", kOptions);
     if (lua_getfield(L, 1, "model") != LUA_TNIL) {

@@ -20,8 +20,15 @@ constexpr double kDefaultLaneAccel = 1000;  // mm/s²
 constexpr double kStopDecel = 5000;         // mm/s²: a dropped connection stops the car
 constexpr double kCoastDecel = 6000;        // mm/s²: a delocalized car coasts ≈190 mm from 1500
 constexpr double kMaxLateralAccel = 9000;   // mm/s²: v²/r above this throws the car off a curve
-constexpr double kOffRoadMm = 100;          // |offset| beyond this is off the road
-constexpr double kHalfTrackMm = 20;         // wheel distance from the car's centre line
+// A car thrown by less than kSlideLimit times that slides outward by kSlideMm and, still on the
+// road, loses the code for kFindMm of driving at kSlideSpeedFactor of its speed: then it reads the
+// track again. Thrown harder, or slid off the road, it flies off (docs/simulator.md).
+constexpr double kSlideLimit = 1.15;
+constexpr double kSlideMm = 30;
+constexpr double kFindMm = 200;
+constexpr double kSlideSpeedFactor = 0.6;
+constexpr double kOffRoadMm = 100;   // |offset| beyond this is off the road
+constexpr double kHalfTrackMm = 20;  // wheel distance from the car's centre line
 constexpr double kDrainMvPerMm = 500.0 / (20 * 60 * kMaxSpeed);  // 500 mV per 20 min flat out
 constexpr double kLowBatteryMv = 3600;
 constexpr double kFullBatteryMv = 4200;
@@ -214,7 +221,7 @@ void Car::refuse(std::span<const std::uint8_t> frame, const std::string& why) co
 // ---- physics ----
 
 void Car::plan(double dt) {
-  if (delocalized_) {
+  if (delocalized_ && !sliding()) {
     speed_ = std::max(0.0, speed_ - kCoastDecel * dt);
   } else if (speed_ < target_) {
     speed_ = std::min(target_, speed_ + accel_ * dt);
@@ -264,6 +271,10 @@ void Car::collided(bool rear) {
 void Car::commit() {
   if (planned_lane_ <= 0) return;
   move(planned_lane_);
+  if (sliding()) {
+    find_left_mm_ -= planned_lane_;
+    if (find_left_mm_ <= 0) delocalized_ = false;  // it reads the track again
+  }
   if (!delocalized_) {
     battery_mv_ -= kDrainMvPerMm * planned_lane_;
     if (!low_battery_ && battery_mv_ < kLowBatteryMv) {
@@ -326,11 +337,29 @@ void Car::checkDelocalization() {
   bool off = std::abs(offset_) > kOffRoadMm;
   bool thrown = false;
   const Piece& p = here().piece;
+  double excess = 0;
   if (p.type == anki::PieceType::Curve && speed_ > 0) {
     double r = p.radius() + p.turn * offset_;
-    thrown = r <= 0 || speed_ * speed_ / r > kMaxLateralAccel;
+    excess = r <= 0 ? 1e9 : speed_ * speed_ / r / kMaxLateralAccel;
+    thrown = excess > 1;
+  }
+  if (thrown && !off && excess < kSlideLimit) {
+    // outward: a left curve (turn +1) has its outside at larger offsets (r = radius + offset)
+    double slid = offset_ + p.turn * kSlideMm;
+    if (std::abs(slid) <= kOffRoadMm) return slide(slid);
   }
   if (off || thrown) delocalize();
+}
+
+void Car::slide(double offset) {
+  ++slides_;
+  offset_ = offset;
+  speed_ *= kSlideSpeedFactor;
+  find_left_mm_ = kFindMm;
+  delocalized_ = true;  // on the road, the code lost: nothing reported until it is found again
+  lane_active_ = false;
+  lane_vel_ = 0;
+  emit(anki::Delocalized{});
 }
 
 void Car::delocalize() {
@@ -343,7 +372,7 @@ void Car::delocalize() {
 }
 
 bool Car::active() const {
-  return speed_ > 0 || (target_ > 0 && on_track_ && !delocalized_);
+  return speed_ > 0 || (target_ > 0 && on_track_);  // (on the track and delocalized: sliding)
 }
 
 double Car::lapPosition() const {
@@ -392,6 +421,7 @@ Truth Car::truth() const {
   t.connected = static_cast<bool>(sink_);
   t.battery_mv = clampU16(battery_mv_);
   t.collisions = collisions_;
+  t.slides = slides_;
   t.speed_commands = speed_commands_;
   t.stop_commands = stop_commands_;
   return t;

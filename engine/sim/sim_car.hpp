@@ -87,6 +87,8 @@ class Car final : public SimCar {
   void crossBoundary();
   void checkDelocalization();
   void delocalize();
+  void slide(double offset);  // thrown a little: slid outward to `offset`, the code lost a while
+  bool sliding() const { return delocalized_ && on_track_; }
   void stop();
   void drop(bool notify);
 
@@ -125,7 +127,8 @@ class Car final : public SimCar {
 
   bool on_track_ = true, delocalized_ = false, sdk_ = false, low_battery_ = false;
   double battery_mv_ = 0;
-  int laps_ = 0, collisions_ = 0;
+  int laps_ = 0, collisions_ = 0, slides_ = 0;
+  double find_left_mm_ = 0;  // sliding: mm to drive until it reads the track again
   int speed_commands_ = 0, stop_commands_ = 0;  // Truth::speed_commands, stop_commands
   double wheel_left_mm_ = 0, wheel_right_mm_ = 0;
 

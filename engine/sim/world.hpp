@@ -51,6 +51,7 @@ struct Truth {
   bool connected = false;
   std::uint16_t battery_mv = 0;
   int collisions = 0;
+  int slides = 0;          // times thrown off a curve and slid on, still on the road
   int speed_commands = 0;  // set-speed frames received in SDK mode
   int stop_commands = 0;   // those of them that asked for 0 mm/s
 };

@@ -15,6 +15,8 @@
 -- ctx (drivers.context; a race director builds the same):
 --   ctx.car, ctx.map (pitwall.track map), ctx.loc (this car's pitwall.localize tracker),
 --   ctx.period (s), ctx.limit (speed cap, mm/s, nil = none: every driver respects it),
+--   ctx.pieceLimits (map index → mm/s, or nil: curves the race saw the car thrown off; the
+--   cruiser, and so every shipped driver, keeps to them),
 --   ctx:ahead()          → nearest car ahead in driving order on the same map, any lane:
 --                          {car, loc, gap = centre-line mm from us to it,
 --                           time = gap / our speed in s (math.huge when stopped),

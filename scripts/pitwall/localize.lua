@@ -170,9 +170,11 @@ end
 
 function Tracker:_lose(t, why)
   local was = self.index
+  -- where it was reckoned when it was lost (a car thrown off a curve: that curve)
+  local _, at = self:locate(t)
   self.index, self.localized, self.anchored = nil, false, false
   self.hyps, self.entrySeen = nil, false
-  if was then self:_notify("lost", t, why) end
+  if was then self:_notify("lost", t, why, at) end
 end
 
 -- Moves every hypothesis by an event; keeps those it fits, one per piece (two that arrive on
@@ -374,7 +376,8 @@ end
 
 --- Calls handlers.enter(tracker, index, from, time) each time the car is on a new piece
 --- (`from` is the previous index, nil when the car was found anew) and handlers.lost(tracker,
---- time, why) when it is lost. Returns a function that ends the subscription.
+--- time, why, index) when it is lost (`index`: the piece it was reckoned on then). Returns a
+--- function that ends the subscription.
 function Tracker:subscribe(handlers)
   local list = table.move(self.watchers, 1, #self.watchers, 1, {})
   list[#list + 1] = handlers
@@ -406,6 +409,14 @@ function Tracker:locate(t)
   if self.reverse then f = 1 - f end
   local p = self.map.pieces[i]
   return p.start + f * p.centre, i, f
+end
+
+--- The speed the car is reckoned at, at time t (default now): its last reported speed, heading
+--- for the speed it was told at the acceleration it was told (mm/s).
+function Tracker:speedAt(t)
+  t = t or pitwall.now()
+  if t <= self.modelTime then return self.modelSpeed end
+  return speedAfter(self.modelSpeed, self.target, self.accel, t - self.modelTime)
 end
 
 --- Centre-line mm from the finish line at time t (default now), or nil.

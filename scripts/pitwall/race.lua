@@ -100,8 +100,9 @@ local MODES = { practice = "Free practice", qualifying = "Qualifying", laps = "R
 -- Every option a session takes (docs/racing.md "Options"): any other key is a typo.
 race.options = { "mode", "laps", "minutes", "seconds", "cars", "map", "scan", "drivers", "grid",
   "lights", "lightInterval", "hold", "falseStartPenalty", "safety", "cooldown", "finishTimeout",
-  "period", "gridSpeed", "gridTimeout", "board", "title", "redraw", "results", "marshal", "onLap",
-  "onFinish", "onPositionChange", "onFalseStart", "onLights", "onSlowLap", "onEnd" }
+  "period", "gridSpeed", "gridTimeout", "board", "title", "redraw", "results", "marshal",
+  "searchSpeed", "onLap", "onFinish", "onPositionChange", "onFalseStart", "onLights", "onSlowLap",
+  "onThrown", "onEnd" }
 
 local function report(where, err)
   if pitwall._reportError then pitwall._reportError(where, err)
@@ -337,7 +338,7 @@ function Race:_tick()
   local old = {}
   for k, e in ipairs(self.order) do old[e] = k end
   for _, e in ipairs(self.order) do
-    if e.lost and e.loc.localized then e.lost = false end
+    if e.lost and e.loc.localized then self:_found(e) end
   end
   self:_standings(now)
   for k, e in ipairs(self.order) do
@@ -351,7 +352,7 @@ function Race:_tick()
     local car = e.car
     if not e.started and now >= e.releaseAt then self:_start(e) end
     if e.started and not e.finished and car.connected then
-      if e.ctx then e.ctx.limit = e.limit end
+      if e.ctx then e.ctx.limit, e.ctx.pieceLimits = e.limit, e.pieceLimits end
       drivers.call(e.driver, "update", car, e.ctx)
       self:_applyFloor(e, now)
       if e.limit and (car.targetSpeed or 0) > e.limit then pcall(car.setSpeed, car, e.limit, 2000) end
@@ -498,9 +499,11 @@ function Race:_timing(adopted)
         local key = (e.timer.start and e.timer.count or -1) * n + i
         if not e.key or key > e.key then e.key, e.passes[key] = key, t end
       end,
-      lost = function()
+      lost = function(_, t, why, index)
         if self.state == "racing" and e.distance then
-          e.lost, e.lostDistance = true, e.distance
+          e.lost, e.lostDistance, e.lostWhy, e.lostAt = true, e.distance, why, t
+          e.lostIndex = index
+          e.lostSpeed = math.max(e.loc:speedAt(t), e.car.speed or 0)
         end
       end,
     }

@@ -14,6 +14,13 @@
 -- nearest lane no other car is reckoned in within FREE mm. A human's car is never driven for its
 -- driver: it is only reported. A car slow with no contact (its driver stands it, it is lost) is
 -- only reported, with its speed.
+--
+-- Thrown off a curve: a car that delocalized on a curve and is still on the track (no status
+-- "off the track": it slid, as a real car does when it takes a curve a little too fast) is driven
+-- on at searchSpeed at most until it is found again, and that curve's limit for it
+-- (ctx.pieceLimits, which the shipped drivers keep to) is set to 85 % of the speed it was thrown
+-- at, lower each time it is thrown there again. A car off the track (lifted, flown off) is left
+-- to the safety caps and to whoever puts it back.
 local Marshal = {}
 
 local SLOW = 2.5          -- a lap this many times the reference is slow …
@@ -22,6 +29,8 @@ local NUDGE_SPEED = 300   -- mm/s
 local NUDGE_FOR = 2       -- s
 local FREE = 600          -- mm either side: a lane with no car reckoned this near is free
 local LANES = { -68, -23, 23, 68 }
+local SEARCH = 400        -- mm/s: a thrown car is driven at most this fast until it is found
+local LOWER = 0.85        -- a curve's limit after a throw: this share of the speed it happened at
 
 -- The lap time a car's laps are measured against.
 function Marshal:_reference(e)
@@ -56,9 +65,59 @@ function Marshal:_freeLane(e)
   return best
 end
 
--- Sees slow cars and frees those stuck in a contact. Called every tick while racing.
+-- The map index of the piece at centre-line distance d from the line.
+function Marshal:_pieceAt(d)
+  for i, p in ipairs(self.map.pieces) do
+    if d >= p.start and d < p.start + p.centre then return i end
+  end
+  return #self.map.pieces
+end
+
+-- A car lost on a curve while still on the track: thrown off it. Once per loss.
+function Marshal:_thrown(e)
+  e.thrownSeen = e.lostAt
+  local i = e.lostIndex or self:_pieceAt(e.lostDistance)
+  local p = self.map.pieces[i]
+  if p.type ~= "curve" then return end
+  local speed = math.floor((e.lostSpeed or 0) + 0.5)
+  local limit = math.floor(LOWER * speed)
+  e.pieceLimits = e.pieceLimits or {}
+  if e.pieceLimits[i] then limit = math.min(limit, math.floor(LOWER * e.pieceLimits[i])) end
+  e.pieceLimits[i] = limit
+  e.searching = true
+  local search = self.options.searchSpeed or SEARCH
+  local what = string.format("driven at %d mm/s at most until it is found again; it takes "
+    .. "that curve at %d mm/s at most from now", search, limit)
+  pitwall.log("warn", string.format("race: %s was thrown off piece %d (%s) at %d mm/s: %s",
+    tostring(e.car), i, tostring(p), speed, what))
+  self:_emit("onThrown", e.car, { piece = i, speed = speed, limit = limit, action = what }, self)
+end
+
+-- A lost car is localized again.
+function Marshal:_found(e)
+  e.lost = false
+  if e.searching then
+    e.searching = false
+    local _, i = e.loc:locate()
+    pitwall.log("info", string.format("race: %s found again on piece %s", tostring(e.car),
+      tostring(i)))
+  end
+end
+
+-- Sees slow cars and frees those stuck in a contact; drives thrown cars on slowly. Called every
+-- tick while racing, after the safety caps.
 function Marshal:_marshal(now)
   if self.state ~= "racing" or self.options.marshal == false then return end
+  local search = self.options.searchSpeed or SEARCH
+  for _, e in ipairs(self.order) do
+    if e.lost and e.lostWhy == "delocalized" and not e.offTrack and e.started and not e.finished
+        and e.thrownSeen ~= e.lostAt then
+      self:_thrown(e)
+    end
+    if e.searching and e.lost and not e.offTrack then
+      e.limit = math.min(e.limit or search, search)
+    end
+  end
   for _, e in ipairs(self.order) do
     local start = e.timer.start
     if e.started and not e.finished and e.car.connected and start then

@@ -30,12 +30,14 @@
 ---@field title? string the board's title (default: the mode's name)
 ---@field redraw? number s between redraws (default 0.25)
 ---@field results? string|false the results file (default pitwall.resultsFile)
----@field marshal? boolean see slow laps and free cars stuck in a contact (default true)
+---@field marshal? boolean see slow laps, free cars stuck in a contact, drive thrown cars on slowly (default true)
+---@field searchSpeed? number mm/s: the most a car thrown off a curve is driven until it is found again (default 400)
 ---@field onLap? fun(car: pitwall.Car, lap: pitwall.laps.Lap, session: pitwall.race.Session)
 ---@field onFinish? fun(car: pitwall.Car, rank: integer, session: pitwall.race.Session)
 ---@field onPositionChange? fun(car: pitwall.Car, position: integer, old: integer, session: pitwall.race.Session)
 ---@field onFalseStart? fun(car: pitwall.Car, session: pitwall.race.Session)
 ---@field onLights? fun(k: integer, session: pitwall.race.Session)
+---@field onThrown? fun(car: pitwall.Car, info: {piece: integer, speed: number, limit: number, action: string}, session: pitwall.race.Session)
 ---@field onSlowLap? fun(car: pitwall.Car, info: {lap: integer, took: number, reference: number, action: string}, session: pitwall.race.Session)
 ---@field onEnd? fun(session: pitwall.race.Session)
 
@@ -113,6 +115,7 @@ function Session:abort() end
 ---@field onLap? fun(car: pitwall.Car, lap: pitwall.laps.Lap, session: pitwall.race.Session) every session's laps, after the session's own
 ---@field onPositionChange? fun(car: pitwall.Car, position: integer, old: integer, session: pitwall.race.Session)
 ---@field onSlowLap? fun(car: pitwall.Car, info: {lap: integer, took: number, reference: number, action: string}, session: pitwall.race.Session)
+---@field onThrown? fun(car: pitwall.Car, info: {piece: integer, speed: number, limit: number, action: string}, session: pitwall.race.Session)
 local race = {}
 
 ---A race of `laps` laps: lights; ranked by laps, then time.

@@ -4,8 +4,9 @@
 --
 -- On straights it drives `speed`; in a curve at most √(lateral · r), r the curve's radius in
 -- the car's lane (the simulator delocalizes a car above v²/r = 9000 mm/s²), and before a curve it
--- brakes at `decel` in time to enter at that speed. ctx.limit caps everything. Other drivers use
--- it for their speed: cruiser:target(car, ctx) → the speed it would drive now.
+-- brakes at `decel` in time to enter at that speed; a curve in ctx.pieceLimits (map index →
+-- mm/s: where the race saw the car thrown off) at most that. ctx.limit caps everything. Other
+-- drivers use it for their speed: cruiser:target(car, ctx) → the speed it would drive now.
 local drivers = require "pitwall.drivers"
 
 local cruiser = { name = "cruiser" }
@@ -60,6 +61,9 @@ function Cruiser:target(car, ctx)
     end
     if p.type == "curve" and p.radius then
       local vc = math.sqrt(self.lateral * laneRadius(p, car))
+      -- a piece the car was thrown off has a limit of its own (ctx.pieceLimits, the race's)
+      local own = ctx.pieceLimits and ctx.pieceLimits[p.index]
+      if own and own < vc then vc = own end
       if dist <= 0 then
         if vc < v then v, braking = vc, true end
       else

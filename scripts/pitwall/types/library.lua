@@ -639,12 +639,14 @@ function Human:waiting(car, ctx) end]],
 ---@field title? string the board's title (default: the mode's name)
 ---@field redraw? number s between redraws (default 0.25)
 ---@field results? string|false the results file (default pitwall.resultsFile)
----@field marshal? boolean see slow laps and free cars stuck in a contact (default true)
+---@field marshal? boolean see slow laps, free cars stuck in a contact, drive thrown cars on slowly (default true)
+---@field searchSpeed? number mm/s: the most a car thrown off a curve is driven until it is found again (default 400)
 ---@field onLap? fun(car: pitwall.Car, lap: pitwall.laps.Lap, session: pitwall.race.Session)
 ---@field onFinish? fun(car: pitwall.Car, rank: integer, session: pitwall.race.Session)
 ---@field onPositionChange? fun(car: pitwall.Car, position: integer, old: integer, session: pitwall.race.Session)
 ---@field onFalseStart? fun(car: pitwall.Car, session: pitwall.race.Session)
 ---@field onLights? fun(k: integer, session: pitwall.race.Session)
+---@field onThrown? fun(car: pitwall.Car, info: {piece: integer, speed: number, limit: number, action: string}, session: pitwall.race.Session)
 ---@field onSlowLap? fun(car: pitwall.Car, info: {lap: integer, took: number, reference: number, action: string}, session: pitwall.race.Session)
 ---@field onEnd? fun(session: pitwall.race.Session)
 
@@ -731,6 +733,7 @@ runs a whole session inside a task and returns it when every car has stopped.]],
       onPositionChange = {
         "fun(car: pitwall.Car, position: integer, old: integer, session: pitwall.race.Session)", "" },
       onFalseStart = { "fun(car: pitwall.Car, session: pitwall.race.Session)", "" },
+      onThrown = { "fun(car: pitwall.Car, info: {piece: integer, speed: number, limit: number, action: string}, session: pitwall.race.Session)", "" },
       onSlowLap = { "fun(car: pitwall.Car, info: {lap: integer, took: number, reference: number, action: string}, session: pitwall.race.Session)", "" },
     },
     functions = {
