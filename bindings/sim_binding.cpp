@@ -228,6 +228,14 @@ int lift(lua_State* L) {
   return 0;
 }
 
+int reboot(lua_State* L) {
+  double seconds = lua::optNumber(L, 2, "seconds (the car is away)", 3);
+  lua::requireRange("seconds", seconds, 0, 600);
+  simCarOf(L, 1).reboot(
+      std::chrono::duration_cast<Duration>(std::chrono::duration<double>(seconds)));
+  return 0;
+}
+
 int place(lua_State* L) {
   sim::SimCar& car = simCarOf(L, 1);
   const sim::Track& track = session(L).world->track();
@@ -303,12 +311,17 @@ int sensor(lua_State* L) {
 
 void openSimModule(ScriptHost& host) {
   lua_State* L = host.state();
-  static const luaL_Reg functions[] = {
-      {"track", lua::guarded<track>},     {"setTrack", lua::guarded<setTrack>},
-      {"layouts", lua::guarded<layouts>}, {"_addCar", lua::guarded<addCar>},
-      {"truth", lua::guarded<truth>},     {"lift", lua::guarded<lift>},
-      {"place", lua::guarded<place>},     {"noise", lua::guarded<noise>},
-      {"sensor", lua::guarded<sensor>},   {nullptr, nullptr}};
+  static const luaL_Reg functions[] = {{"track", lua::guarded<track>},
+                                       {"setTrack", lua::guarded<setTrack>},
+                                       {"layouts", lua::guarded<layouts>},
+                                       {"_addCar", lua::guarded<addCar>},
+                                       {"truth", lua::guarded<truth>},
+                                       {"lift", lua::guarded<lift>},
+                                       {"reboot", lua::guarded<reboot>},
+                                       {"place", lua::guarded<place>},
+                                       {"noise", lua::guarded<noise>},
+                                       {"sensor", lua::guarded<sensor>},
+                                       {nullptr, nullptr}};
   lua_getglobal(L, "pitwall");
   luaL_newlib(L, functions);
   openScriptUnderTest(L);

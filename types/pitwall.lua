@@ -693,6 +693,7 @@ function Alphabot:stop() end
 ---@field connected boolean
 ---@field battery integer mV
 ---@field collisions integer
+---@field slides integer times thrown off a curve and slid on, still on the road
 ---@field speedCommands integer set-speed frames it received
 ---@field stopCommands integer those asking for 0 mm/s
 
@@ -752,6 +753,11 @@ function pitwall.sim.openSeats(n) end
 ---@param piece integer
 ---@param offset? number −70..70 (default 0)
 function pitwall.sim.place(car, piece, offset) end
+
+---The car resets (a tired cell): its connection drops, it stands with everything forgotten, and it can be connected again `seconds` later; the link connects it again then.
+---@param car pitwall.Car
+---@param seconds? number 0..600 (default 3)
+function pitwall.sim.reboot(car, seconds) end
 
 ---Replaces the script under test with a new version at engine time `at` (default: at once).
 ---@param pathOrSource string

@@ -381,6 +381,20 @@ double Car::lapPosition() const {
 
 // ---- test hooks ----
 
+void Car::reboot(Duration down) {
+  drop(true);
+  speed_ = target_ = 0;
+  sdk_ = false;
+  lane_active_ = false;
+  lane_vel_ = 0;
+  bias_ = 0;
+  boot_until_ = env_.loop.now() + down;
+}
+
+bool Car::connectable() const {
+  return env_.loop.now() >= boot_until_;
+}
+
 void Car::lift() {
   speed_ = 0;
   if (!on_track_) {

@@ -62,6 +62,9 @@ class Car final : public SimCar {
   Truth truth() const override;
   double believedOffset() const override { return offset_ * dir_ + bias_; }
   void lift() override;
+  void reboot(Duration down) override;
+  bool connectable() const override;
+  std::weak_ptr<const void> lifetime() const override { return life_; }
   void place(std::size_t piece_index, double offset_mm) override;
 
   // The world's tick, in three phases over all cars in a fixed order:
@@ -129,6 +132,8 @@ class Car final : public SimCar {
   double battery_mv_ = 0;
   int laps_ = 0, collisions_ = 0, slides_ = 0;
   double find_left_mm_ = 0;  // sliding: mm to drive until it reads the track again
+  TimePoint boot_until_{};   // rebooting: not connectable before this
+  std::shared_ptr<const int> life_ = std::make_shared<const int>(0);
   int speed_commands_ = 0, stop_commands_ = 0;  // Truth::speed_commands, stop_commands
   double wheel_left_mm_ = 0, wheel_right_mm_ = 0;
 

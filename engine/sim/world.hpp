@@ -79,6 +79,13 @@ class SimCar {
   // Test hooks: lift the car off the track (it delocalizes and stops reporting) and put it back.
   virtual void lift() = 0;
   virtual void place(std::size_t piece_index, double offset_mm) = 0;
+  // Test hook: the car resets, as on a tired cell under hard acceleration: its connection drops,
+  // it stands where it is with everything forgotten (SDK mode off, speed 0, no lane change, its
+  // believed offset its true one), and it can be connected again `down` later.
+  virtual void reboot(Duration down) = 0;
+  virtual bool connectable() const = 0;  // not booting
+  // Expires with the car (its world destroyed): a link that looks again later checks it first.
+  virtual std::weak_ptr<const void> lifetime() const = 0;
 };
 
 class World {

@@ -9,7 +9,8 @@ SimLink::SimLink(Loop& loop, sim::SimCar& car, Duration latency)
     : loop_(loop),
       car_(car),
       latency_(std::max(latency, Duration::zero())),
-      alive_(std::make_shared<bool>(true)) {
+      alive_(std::make_shared<bool>(true)),
+      carLife_(car.lifetime()) {
   if (loop.clockKind() == ClockKind::Real) setConnectionInterval(kRealTimeInterval);
 }
 
@@ -25,6 +26,7 @@ SimLink::~SimLink() {
   // timers die with us; posted state reports see alive_ expire and do nothing.
   if (toCarTimer_) loop_.cancel(toCarTimer_);
   if (toControllerTimer_) loop_.cancel(toControllerTimer_);
+  if (retryTimer_) loop_.cancel(retryTimer_);
   if (connected_) {
     connected_ = false;
     car_.disconnect();
@@ -39,7 +41,22 @@ void SimLink::connect() {
       [this](std::span<const std::uint8_t> frame) {
         if (connected_) enqueue(toController_, toControllerTimer_, false, frame);
       },
-      [this] { lost("the car disconnected"); });
+      [this] {
+        lost("the car disconnected");
+        retryLater();
+      });
+}
+
+void SimLink::retryLater() {
+  if (retryTimer_) return;
+  retryTimer_ = loop_.after(kRetry, [this] {
+    retryTimer_ = 0;
+    if (connected_ || carLife_.expired()) return;
+    if (car_.connectable())
+      connect();
+    else
+      retryLater();
+  });
 }
 
 bool SimLink::send(std::span<const std::uint8_t> frame) {
@@ -49,6 +66,8 @@ bool SimLink::send(std::span<const std::uint8_t> frame) {
 }
 
 void SimLink::disconnect() {
+  if (retryTimer_) loop_.cancel(retryTimer_);  // the controller's own: it stays down
+  retryTimer_ = 0;
   if (!connected_) return;
   lost("disconnected by the controller");
   car_.disconnect();

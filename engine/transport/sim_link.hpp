@@ -19,6 +19,7 @@ class SimLink : public Link {
   // BlueZ asks a car for a 30–50 ms interval (its default LE connection parameters); real-time
   // links take the shortest of it. Virtual time keeps frames on the fixed latency alone.
   static constexpr Duration kRealTimeInterval = std::chrono::milliseconds(30);
+  static constexpr Duration kRetry = std::chrono::milliseconds(500);
 
   SimLink(Loop& loop, sim::SimCar& car, Duration latency = kDefaultLatency);
   // Connection events every `interval` (zero: none, the fixed latency alone), at a phase of the
@@ -57,6 +58,11 @@ class SimLink : public Link {
   void deliverToCar();
   void deliverToController();
   void lost(const std::string& reason);  // the connection is gone: clear, report
+  // The car dropped the connection (it reset, it was told to): connect again once it can be
+  // connected, looking every kRetry, as a BLE link reconnects a car that dropped.
+  void retryLater();
+  Loop::TimerId retryTimer_ = 0;
+  std::weak_ptr<const void> carLife_;  // the car's world may go first
   void reportState(bool up, std::string reason);
   std::deque<InFlight> toCar_, toController_;
   Loop::TimerId toCarTimer_ = 0, toControllerTimer_ = 0;

@@ -271,7 +271,10 @@ void AnkiCar::linkStateChanged(bool up, const std::string& reason) {
     requestVersion();
     requestBattery();
   } else {
+    // A car whose connection dropped stops (a real car, the simulator's): told nothing since, it
+    // is told to stand, so a driver that drives it again after a reconnection sends its speed.
     state_.speed_mm_s = 0;
+    state_.target_speed_mm_s = 0;
     state_.lane_change_target_mm.reset();
     pingSentAt_.reset();
   }

@@ -44,6 +44,7 @@ return {
 ---@field connected boolean
 ---@field battery integer mV
 ---@field collisions integer
+---@field slides integer times thrown off a curve and slid on, still on the road
 ---@field speedCommands integer set-speed frames it received
 ---@field stopCommands integer those asking for 0 mm/s
 
@@ -94,6 +95,9 @@ See docs/testing.md and docs/simulator.md.]],
 @return pitwall.sim.Truth]],
       lift = [[Takes the car off the track (it delocalizes).
 @param car pitwall.Car]],
+      reboot = [[The car resets (a tired cell): its connection drops, it stands with everything forgotten, and it can be connected again `seconds` later; the link connects it again then.
+@param car pitwall.Car
+@param seconds? number 0..600 (default 3)]],
       place = [[Puts the car back on piece `piece` (1-based index) at `offset` mm.
 @param car pitwall.Car
 @param piece integer

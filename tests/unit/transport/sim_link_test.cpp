@@ -127,6 +127,31 @@ TEST_CASE("a disconnect frame makes the car drop the sim link") {
   CHECK(std::holds_alternative<anki::PingResponse>(rig.frames.back().second));
 }
 
+TEST_CASE("a car that resets drops the sim link and is connected again once it can be") {
+  Rig rig;
+  rig.link->connect();
+  rig.send(anki::SdkMode{true, 1});
+  rig.send(anki::SetSpeed{600, 1000});
+  rig.runUntil(1s);
+  CHECK(rig.car.truth().sdk_mode);
+  rig.car.reboot(3s);  // at 1 s: back from 4 s
+  CHECK(rig.car.truth().speed_mm_s == 0);
+  CHECK_FALSE(rig.car.truth().sdk_mode);
+  rig.runUntil(3900ms);
+  CHECK_FALSE(rig.link->connected());  // looked every 0.5 s: not yet
+  rig.runUntil(5s);
+  CHECK(rig.link->connected());
+  REQUIRE(rig.states.size() == 3);
+  CHECK(rig.states[1].second == "down: the car disconnected");
+  CHECK(rig.states[2].second == "up: connected");
+  CHECK(rig.states[2].first >= 4s);
+  CHECK(rig.states[2].first <= 4500ms);
+  // The controller's own disconnect stays down.
+  rig.link->disconnect();
+  rig.runUntil(8s);
+  CHECK_FALSE(rig.link->connected());
+}
+
 TEST_CASE("destroying a sim link makes its pending callbacks no-ops and stops the car") {
   Rig rig;
   bool called = false;
