@@ -7,7 +7,8 @@
 --   map:lapLength(offset)                       -- mm of one lap in that lane
 --
 -- Pieces are in driving order starting with the piece after the finish line (33), so
--- `map.finishIndex` is always 1 and the last piece is 34. A piece's `start` is the centre-line
+-- `map.finishIndex` is always 1 and the last piece is 34 (on a track without them, from the
+-- line: `map.hasStart` is false). A piece's `start` is the centre-line
 -- distance from the finish line to its beginning. Offsets given to a map are in the map's
 -- frame: right of the scan's driving direction (a car that drives reversed sees them mirrored).
 --
