@@ -6,6 +6,7 @@
 --   build/pitwall run examples/grand_prix.lua --ble                  -- the same, real cars
 --
 -- On a terminal the leaderboard redraws in place; elsewhere only the final table is printed.
+-- With --view the results stay on the view for SHOW seconds (default 30) before the run ends.
 local race = require "pitwall.race"
 local drivers = require "pitwall.drivers"
 
@@ -32,7 +33,11 @@ local gp = race.laps {
   drivers = driverFor,
   title = string.format("Grand prix, %d laps", LAPS),
 }
-local winner = gp:results()[1]
-print(string.format("Winner: %s, %d laps in %s", winner.car, winner.laps, race.time(winner.totalTime)))
+print(race.winner(gp) or "No winner: nobody finished")
 if gp.resultsPath then print("Results written to " .. gp.resultsPath) end
+if pitwall.view.active then -- the podium stays up on the view for a while
+  local show = tonumber(os.getenv("SHOW")) or 30
+  print(string.format("The results stay on the view for %d s (Ctrl-C ends sooner)", show))
+  pitwall.sleep(show)
+end
 pitwall.stop()

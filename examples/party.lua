@@ -101,9 +101,7 @@ local party = race.laps {
     if not session:entry(car).finished then itemFor(car, session) end
   end,
 }
-local winner = party:results()[1]
-print(string.format("Winner: %s, %d laps in %s", winner.car, winner.laps,
-  race.time(winner.totalTime)))
+print(race.winner(party) or "No winner: nobody finished")
 if pitwall.view.active then -- the results stay up on the view and the phones for a while
   local show = tonumber(os.getenv("SHOW")) or 60
   print(string.format("The results stay on the view for %d s (Ctrl-C ends sooner)", show))

@@ -31,6 +31,16 @@ function Board.time(seconds)
   return string.format("%.3f", seconds)
 end
 
+--- A duration with its unit: "9.215 s", "1 min 2.345 s"; "-" for nil.
+function Board.duration(seconds)
+  if seconds == nil or seconds ~= seconds or seconds == math.huge then return "-" end
+  if seconds >= 60 then
+    local minutes = math.floor(seconds / 60)
+    return string.format("%d min %.3f s", minutes, seconds - 60 * minutes)
+  end
+  return string.format("%.3f s", seconds)
+end
+
 --- The gap to the leader: "+1.234" (seconds) or "+1 lap" / "+2 laps" when laps behind;
 --- "" for the leader itself (gap 0 and no laps).
 function Board.gap(seconds, laps)

@@ -24,8 +24,8 @@ local race = {}
 --- race.onPositionChange(car, position, old, session), race.onFalseStart(car, session).
 race.onLap, race.onFinish, race.onPositionChange, race.onFalseStart = nil, nil, nil, nil
 
-race.columns = { "position", "car", "number", "laps", "totalTime", "bestLap", "lastLap",
-  "finished", "falseStart" }
+race.columns = { "position", "car", "number", "driver", "player", "laps", "totalTime", "bestLap",
+  "lastLap", "status", "finished", "falseStart" }
 
 -- A driver that holds one speed (under ctx.limit): the default when no driver is given and
 -- pitwall.drivers has no "cruiser".
@@ -44,6 +44,19 @@ race.Steady = Steady
 
 --- "1:02.345" from seconds (Board.time).
 race.time = Board.time
+--- "9.215 s", "1 min 2.345 s" from seconds (Board.duration).
+race.duration = Board.duration
+
+--- The sentence that names a session's winner: "Winner: nuke (overtaker), 5 laps in 21.470 s";
+--- nil when nobody finished.
+function race.winner(session)
+  local w = session:results()[1]
+  if not w or w.status ~= "finished" then return nil end
+  local who = w.player and w.player .. " in " .. w.car or w.car
+  if w.driver and not w.player then who = who .. " (" .. w.driver .. ")" end
+  return string.format("Winner: %s, %d lap%s in %s", who, w.laps, w.laps == 1 and "" or "s",
+    Board.duration(w.totalTime))
+end
 
 local Race = {}
 Race.__index = Race
@@ -237,7 +250,7 @@ function Race:_finish(e, t)
   -- what the results say: the laps up to the flag (a finished car circles on at the cool-down
   -- speed while the others finish, and those laps are timed but not raced)
   e.final = { count = e.timer.count, best = e.timer.best, last = e.timer.last }
-  if not self.leaderFinished then self.leaderFinished = t end
+  if not self.leaderFinished or t < self.leaderFinished then self.leaderFinished = t end
   drivers.call(e.driver, "finish", e.car, e.ctx)
   -- A cool-down: on at a low speed (a parked car would block the lane at the line).
   if e.car.connected then pcall(e.car.setSpeed, e.car, self.options.cooldown or 300, 1000) end
@@ -251,7 +264,8 @@ function Race:_onLap(e, lap)
   local mode, now = self.mode, lap.finish
   local timeUp = self.seconds and now >= self.green + self.seconds
   if mode == "laps" then
-    if e.timer.count >= self.laps or self.leaderFinished then self:_finish(e, now) end
+    local flag = self.leaderFinished and now >= self.leaderFinished
+    if e.timer.count >= self.laps or flag then self:_finish(e, now) end
   elseif mode == "timed" then
     if self.leaderFinished then self:_finish(e, now)
     elseif timeUp then
@@ -279,11 +293,29 @@ function Race:_standings(now)
     else
       -- classified by laps (a finisher's laps are frozen at the line), then finishing time
       local pa, pb = a.progress or -math.huge, b.progress or -math.huge
+      -- (by the time each crossed the line: a lap recovered late is timed when it was driven)
+      if a.finished and b.finished and pa == pb and a.finishTime ~= b.finishTime then
+        return a.finishTime < b.finishTime
+      end
       if a.finished and b.finished and pa == pb then return a.finishRank < b.finishRank end
       if pa ~= pb then return pa > pb end
     end
     return a.gridSlot < b.gridSlot
   end)
+end
+
+-- The time `e` was at `progress` (laps), from its trace; nil before its trace begins.
+local function traceTime(e, progress)
+  local T, P = e.traceT, e.traceP
+  local n = T and #T or 0
+  if n == 0 or progress < P[1] then return nil end
+  if progress >= P[n] then return T[n] end
+  local lo, hi = 1, n -- P[lo] <= progress < P[hi]
+  while hi - lo > 1 do
+    local mid = (lo + hi) // 2
+    if P[mid] <= progress then lo = mid else hi = mid end
+  end
+  return T[lo] + (T[hi] - T[lo]) * (progress - P[lo]) / (P[hi] - P[lo])
 end
 
 -- Gap to the leader: seconds and laps behind.
@@ -297,13 +329,28 @@ function Race:_gap(e, leader)
     local lf, ef = leader.final or leader.timer, e.final or e.timer
     return e.finishTime - leader.finishTime, math.max(0, lf.count - ef.count)
   end
-  local behind = 0
-  if leader.progress and e.progress then
-    behind = math.max(0, math.floor(leader.progress - e.progress))
+  if not (leader.progress and e.progress) then return nil, 0 end
+  local behind = math.max(0, math.floor(leader.progress - e.progress))
+  -- How long ago the leader was where this car is now: a car further back has a larger gap,
+  -- always (the leader's progress only grows), so the table reads down in order.
+  local at = traceTime(leader, e.progress)
+  return at and math.max(0, (e.finishTime or pitwall.now()) - at), behind
+end
+
+-- Each car's progress over time while it races, for the gaps (two arrays of numbers: 16 bytes a
+-- sample, ten samples a second).
+function Race:_trace(now)
+  for _, e in ipairs(self.order) do
+    local p = e.progress
+    if p and not e.finished then
+      if not e.traceP then e.traceT, e.traceP = {}, {} end
+      local P = e.traceP
+      if #P == 0 or p > P[#P] then
+        P[#P + 1] = p
+        e.traceT[#e.traceT + 1] = now
+      end
+    end
   end
-  local mine = e.key and e.passes[e.key]
-  local theirs = e.key and leader.passes[e.key]
-  return mine and theirs and mine - theirs or nil, behind
 end
 
 function Race:_safety(now)
@@ -336,11 +383,12 @@ end
 function Race:_tick()
   local now = pitwall.now()
   local old = {}
-  for k, e in ipairs(self.order) do old[e] = k end
+  for k, e in ipairs(self.order) do old[e] = e.position or k end
   for _, e in ipairs(self.order) do
     if e.lost and e.loc.localized then self:_found(e) end
   end
   self:_standings(now)
+  self:_trace(now)
   for k, e in ipairs(self.order) do
     e.position = k
     if old[e] ~= k and self.ticks > 0 then self:_emit("onPositionChange", e.car, k, old[e], self) end
@@ -394,8 +442,37 @@ function Race:_status(now)
   return ""
 end
 
+-- A driver's name: its own `name`, else its class's.
+local function driverName(driver)
+  if type(driver) ~= "table" then return nil end
+  local name = rawget(driver, "name")
+  local class = getmetatable(driver)
+  if name == nil and type(class) == "table" then
+    name = rawget(class, "name")
+    if name == nil and type(class.__index) == "table" then name = rawget(class.__index, "name") end
+  end
+  return type(name) == "string" and name or nil
+end
+
+-- Who drives a human's seat: a phone's player name, the gamepad's, …
+local function playerOf(driver)
+  local seat = type(driver) == "table" and rawget(driver, "seat")
+  if type(seat) ~= "userdata" then return nil end
+  local ok, player = pcall(function() return seat.player or seat.holder end)
+  return ok and player or nil
+end
+
+-- "finished", "running" (racing, or the run ended first), "DNF" or "DNF (disconnected)".
+function Race:_statusOf(e)
+  if e.finished then return "finished" end
+  if self.state ~= "done" or self.cut then return "running" end
+  return e.car.connected and "DNF" or "DNF (disconnected)"
+end
+
 -- Rows of the live board / results.
 function Race:_rows()
+  -- (in order as of now: a lap's event between two ticks may have changed it)
+  if self.state == "racing" then self:_standings(pitwall.now()) end
   local rows, leader = {}, self.order[1]
   for k, e in ipairs(self.order) do
     local gap, behind = self:_gap(e, leader)
@@ -403,6 +480,7 @@ function Race:_rows()
     local lastCross = e.finishTime or (t.last and t.last.finish)
     rows[k] = {
       position = k, car = e.car.name, number = e.car.number,
+      driver = driverName(e.driver), player = playerOf(e.driver), status = self:_statusOf(e),
       laps = t.count,
       lap = e.finished and t.count or (t.start and math.min(t.count + 1, self.laps or math.huge) or 0),
       totalTime = lastCross and self.green and lastCross - self.green or nil,
@@ -446,7 +524,7 @@ end
 -- The entries: one per car, in grid order, each followed on the map.
 function Race:_entries()
   for slot, car in ipairs(self:_gridOrder()) do
-    local e = { car = car, loc = localize.follow(car, self.map), gridSlot = slot, passes = {},
+    local e = { car = car, loc = localize.follow(car, self.map), gridSlot = slot,
       started = false }
     if self.scanHere and self.scanHere.car == car then e.loc:assume(self.scanHere.index) end
     self.entries[car] = e
@@ -486,7 +564,6 @@ end
 
 -- Lap timers (from the grid on) and what the director follows of each car.
 function Race:_timing(adopted)
-  local n = #self.map.pieces
   for _, e in ipairs(self.order) do
     local onLap = function(_, lap) self:_onLap(e, lap) end
     if adopted and e.timer then
@@ -495,10 +572,6 @@ function Race:_timing(adopted)
       e.timer = laps.timer(e.car, self.map, { onLap = onLap })
     end
     e.unsubscribe = e.loc:subscribe {
-      enter = function(_, i, _, t)
-        local key = (e.timer.start and e.timer.count or -1) * n + i
-        if not e.key or key > e.key then e.key, e.passes[key] = key, t end
-      end,
       lost = function(_, t, why, index)
         if self.state == "racing" and e.distance then
           e.lost, e.lostDistance, e.lostWhy, e.lostAt = true, e.distance, why, t
@@ -530,18 +603,23 @@ function Race:_board()
     columns = {
       { key = "position", title = "POS", align = "right" },
       { key = "car", title = "CAR" },
+      { key = "driver", title = "DRIVER",
+        format = function(v, row) return row.player and row.player .. " (" .. (v or "?") .. ")" or v end },
       { key = "lap", title = "LAP", align = "right" },
       { key = "lastLap", title = "LAST", align = "right", format = Board.time },
       { key = "bestLap", title = "BEST", align = "right", format = Board.time },
       { key = "gap", title = "GAP", align = "right",
-        format = function(v, row) return Board.gap(v, row.lapsBehind) end },
+        format = function(v, row)
+          if row.status ~= "finished" and row.status ~= "running" then return row.status end
+          return Board.gap(v, row.lapsBehind)
+        end },
     },
   }
 end
 
 -- The run ended while the session raced: the standings as they were, once.
 function Race:_cut()
-  self.phase, self.state = "done", "done"
+  self.phase, self.state, self.cut = "done", "done", true
   self:_standings(pitwall.now())
   pitwall.log("warn", string.format("race: the run ended before the %s did: the standings when "
     .. "it ended are its results", self.title))

@@ -11,19 +11,6 @@ local publishers = setmetatable({}, { __mode = "k" })
 local VIEW_PHASES = { new = "grid", grid = "grid", lights = "lights", racing = "racing",
   ending = "ending", done = "done" }
 
-local function driverName(driver)
-  if type(driver) ~= "table" then return nil end
-  local name = rawget(driver, "name")
-  if name == nil then
-    local class = getmetatable(driver)
-    name = type(class) == "table" and rawget(class, "name") or nil
-    if name == nil and type(class) == "table" and type(class.__index) == "table" then
-      name = rawget(class.__index, "name")
-    end
-  end
-  return type(name) == "string" and name or nil
-end
-
 --- The session as plain data for pitwall.view.race.
 function View:_viewState()
   local phase = VIEW_PHASES[self.phase or "new"] or tostring(self.phase)
@@ -33,6 +20,9 @@ function View:_viewState()
     seconds = self.seconds, green = self.green, rows = {}, lapTimes = {},
   }
   if phase == "lights" then state.light, state.lights = self.light or 0, self.options.lights or 5 end
+  -- seconds a jump start is held after green (the phone says it during the lights and to whoever
+  -- jumped)
+  state.penalty = self.penalty
   if self.order and #self.order > 0 and self.order[1].timer then
     if self.green then
       local ok, status = pcall(self._status, self, pitwall.now())
@@ -43,18 +33,16 @@ function View:_viewState()
       for k, row in ipairs(rows) do
         local e = self.order[k]
         local car = e.car
-        row.driver = driverName(e.driver)
-        -- a human's seat: who drives (a phone's player name, the gamepad's)
-        local seat = type(e.driver) == "table" and rawget(e.driver, "seat")
-        if type(seat) == "userdata" then
-          local ok, player = pcall(function() return seat.player or seat.holder end)
-          if ok then row.player = player end
-        end
         row.speed = car.speed
         row.lane = car.offset
         row.connected = car.connected
         local times = {}
-        for i, lap in ipairs(e.timer.history or {}) do times[i] = lap.time end
+        -- (the laps up to the flag: a finished car's cool-down laps are no race laps)
+        local upTo = e.final and e.final.count or math.huge
+        for i, lap in ipairs(e.timer.history or {}) do
+          if i > upTo then break end
+          times[i] = lap.time
+        end
         state.lapTimes[tostring(car.number)] = times
         state.rows[k] = row
       end

@@ -16,6 +16,5 @@ for _, x in ipairs(r:results()) do
   print(string.format("result %d %s laps=%d finished=%s time=%.2f", x.position, x.car, x.laps,
     tostring(x.finished), x.totalTime or -1))
 end
-local winner = r:results()[1]
-print(string.format("Winner: %s, %d laps in %s", winner.car, winner.laps, race.time(winner.totalTime)))
+print(race.winner(r) or "No winner: nobody finished")
 pitwall.stop()

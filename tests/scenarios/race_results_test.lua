@@ -84,3 +84,15 @@ for _, row in ipairs(waited:results()) do
   end
 end
 expect.eq(finishers, 2, "two cars finished")
+local rows = waited:results()
+expect.eq(rows[3].car, cars[1].name, "the car that never drove is last")
+expect.eq(rows[3].status, "DNF", "and did not finish")
+expect.eq(rows[3].driver, "parked", "its driver named")
+expect.eq(rows[1].status, "finished", "the winner finished")
+expect.eq(rows[1].driver, "steady", "the winner's driver named")
+for k = 2, #rows do
+  expect.ge(rows[k].gap or math.huge, rows[k - 1].gap or 0, "gaps down the table")
+end
+expect.eq(race.winner(waited), string.format("Winner: %s (steady), 2 laps in %s", rows[1].car,
+  race.duration(rows[1].totalTime)), "the winner's sentence")
+expect.truthy(race.winner(waited):find(" s$"), "a time with its unit")

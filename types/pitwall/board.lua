@@ -20,6 +20,11 @@
 ---@class pitwall.Board
 local Board = {}
 
+---A duration with its unit: "9.215 s", "1 min 2.345 s"; "-" for nil.
+---@param seconds number?
+---@return string
+function Board.duration(seconds) end
+
 ---The gap to the leader: "+1.234", or "+1 lap" / "+2 laps"; "" for the leader.
 ---@param seconds number?
 ---@param laps? integer laps behind

@@ -46,13 +46,16 @@
 ---@field position integer
 ---@field car string the car's name
 ---@field number integer
+---@field driver? string the driver's name ("cruiser", "human")
+---@field player? string who drives a human's seat (a phone's player name, the gamepad's)
 ---@field laps integer
 ---@field totalTime? number green to its last counted crossing, s
 ---@field bestLap? number s
 ---@field lastLap? number s
+---@field status "finished"|"running"|"DNF"|"DNF (disconnected)" running: the session, or the run, ended first
 ---@field finished boolean
 ---@field falseStart boolean
----@field gap? number s
+---@field gap? number s how long ago the leader was where this car is (a finisher: behind the winner's finish)
 ---@field lapsBehind? integer
 
 ---The director's record of a car (session:entry).
@@ -118,6 +121,11 @@ function Session:abort() end
 ---@field onThrown? fun(car: pitwall.Car, info: {piece: integer, speed: number, limit: number, action: string}, session: pitwall.race.Session)
 local race = {}
 
+---"9.215 s", "1 min 2.345 s" from seconds (Board.duration).
+---@param seconds number?
+---@return string
+function race.duration(seconds) end
+
 ---A race of `laps` laps: lights; ranked by laps, then time.
 ---@param options pitwall.race.Options
 ---@return pitwall.race.Session
@@ -147,5 +155,10 @@ function race.time(seconds) end
 ---@param options pitwall.race.Options
 ---@return pitwall.race.Session
 function race.timed(options) end
+
+---The sentence naming a session's winner: "Winner: nuke (overtaker), 5 laps in 21.470 s"; nil when nobody finished.
+---@param session pitwall.race.Session
+---@return string?
+function race.winner(session) end
 
 return race

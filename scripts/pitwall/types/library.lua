@@ -592,6 +592,9 @@ function Human:waiting(car, ctx) end]],
       time = [["1:02.345" from seconds (minutes only from a minute on: "4.125"); "-" for nil.
 @param seconds number?
 @return string]],
+      duration = [[A duration with its unit: "9.215 s", "1 min 2.345 s"; "-" for nil.
+@param seconds number?
+@return string]],
       gap = [[The gap to the leader: "+1.234", or "+1 lap" / "+2 laps"; "" for the leader.
 @param seconds number?
 @param laps? integer laps behind
@@ -655,13 +658,16 @@ function Human:waiting(car, ctx) end]],
 ---@field position integer
 ---@field car string the car's name
 ---@field number integer
+---@field driver? string the driver's name ("cruiser", "human")
+---@field player? string who drives a human's seat (a phone's player name, the gamepad's)
 ---@field laps integer
 ---@field totalTime? number green to its last counted crossing, s
 ---@field bestLap? number s
 ---@field lastLap? number s
+---@field status "finished"|"running"|"DNF"|"DNF (disconnected)" running: the session, or the run, ended first
 ---@field finished boolean
 ---@field falseStart boolean
----@field gap? number s
+---@field gap? number s how long ago the leader was where this car is (a finisher: behind the winner's finish)
 ---@field lapsBehind? integer
 
 ---The director's record of a car (session:entry).
@@ -755,6 +761,12 @@ runs a whole session inside a task and returns it when every car has stopped.]],
       time = [["1:02.345" from seconds (Board.time).
 @param seconds number?
 @return string]],
+      duration = [["9.215 s", "1 min 2.345 s" from seconds (Board.duration).
+@param seconds number?
+@return string]],
+      winner = [[The sentence naming a session's winner: "Winner: nuke (overtaker), 5 laps in 21.470 s"; nil when nobody finished.
+@param session pitwall.race.Session
+@return string?]],
     },
   },
   -- pitwall.repl ----------------------------------------------------------------------------
