@@ -24,8 +24,8 @@ local race = {}
 --- race.onPositionChange(car, position, old, session), race.onFalseStart(car, session).
 race.onLap, race.onFinish, race.onPositionChange, race.onFalseStart = nil, nil, nil, nil
 
-race.columns = { "position", "car", "number", "driver", "player", "laps", "totalTime", "bestLap",
-  "lastLap", "status", "finished", "falseStart" }
+race.columns = { "position", "car", "number", "laps", "totalTime", "bestLap", "lastLap",
+  "finished", "falseStart", "driver", "player", "status" }
 
 -- A driver that holds one speed (under ctx.limit): the default when no driver is given and
 -- pitwall.drivers has no "cruiser".
