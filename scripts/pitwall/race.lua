@@ -582,6 +582,7 @@ function Race:_timing(adopted)
     }
     -- A car put back on the track (a status "on track" after it left) stands still: it is sent
     -- its last commanded speed again, so that its driver resumes.
+    e.contactSub = pitwall.listen(e.car, "onCollision", function(_, ev) self:_contact(e, ev) end)
     e.statusSub = pitwall.listen(e.car, "onStatus", function(car, ev)
       if not ev.onTrack then e.offTrack = true
       elseif e.offTrack then
@@ -693,7 +694,9 @@ function Race:_race()
   -- (car.speed is the last reported one: a stopped car reports nothing.) A version that took
   -- the session up here waits out what is left of the half second, no more.
   pitwall.sleep(math.max(0, (self.endAt or pitwall.now() + 0.5) - pitwall.now()))
-  for _, e in ipairs(self.order) do e.unsubscribe(); e.timer:cancel(); e.statusSub:cancel() end
+  for _, e in ipairs(self.order) do
+    e.unsubscribe(); e.timer:cancel(); e.statusSub:cancel(); e.contactSub:cancel()
+  end
   if self.board then
     self.board.title = self.title .. "   results"
     self.board:final(self:_rows())

@@ -163,6 +163,45 @@ end
 
 -- After its driver's update: a car being freed drives at least the nudge speed (the safety
 -- limit still wins).
+-- A car that reports a contact (0x4d, side 0) while racing with a car reckoned within
+-- CONTACT_NEAR mm: said in the log and the view's event log — "skull ran into nuke" when nuke
+-- is ahead, else "contact: skull and nuke" — once per pair within CONTACT_QUIET s (both cars
+-- report the same contact). A report with no car near is none: real cars at speed send one at
+-- many piece boundaries (docs/simulator.md), and so does the simulator's real sensor model.
+local CONTACT_NEAR = 300  -- mm
+local CONTACT_QUIET = 3   -- s
+function Marshal:_contact(e, ev)
+  if self.state ~= "racing" or ev.side ~= 0 then return end
+  local L = self.map:lapLength(0)
+  local mine = e.loc:distance()
+  local other, ahead, best
+  if mine then
+    for _, o in ipairs(self.order) do
+      local d = o ~= e and o.loc:distance()
+      if d then
+        local gap = (d - mine) % L
+        local near = math.min(gap, L - gap)
+        if near <= CONTACT_NEAR and (not best or near < best) then
+          other, ahead, best = o, gap <= L / 2, near
+        end
+      end
+    end
+  end
+  -- (none near: a report at a boundary with no car there, which real cars send at speed)
+  if not other then return end
+  local a, b = e.car, other.car
+  local key = a.number < b.number and a.number .. ":" .. b.number or b.number .. ":" .. a.number
+  self.contacts = self.contacts or {}
+  local now = pitwall.now()
+  if self.contacts[key] and now - self.contacts[key] < CONTACT_QUIET then return end
+  self.contacts[key] = now
+  local text
+  if ahead and ev.where == "back" then text = a.name .. " ran into " .. b.name
+  else text = a.name .. " and " .. b.name end
+  pitwall.log("info", "race: contact: " .. text)
+  pcall(pitwall.view.event, "contact: " .. text)
+end
+
 function Marshal:_applyFloor(e, now)
   if not e.floorUntil then return end
   if now >= e.floorUntil then e.floor, e.floorUntil = nil, nil return end

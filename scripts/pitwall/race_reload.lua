@@ -11,7 +11,8 @@ return function(Race, shared)
   -- and what its driver hands over; not the options, drivers, handlers or board, which the next
   -- version brings.
   local LEFT_BEHIND = { options = true, board = true, lastKind = true }
-  local LEFT_BEHIND_ENTRY = { driver = true, ctx = true, unsubscribe = true, statusSub = true }
+  local LEFT_BEHIND_ENTRY = { driver = true, ctx = true, unsubscribe = true, statusSub = true,
+    contactSub = true }
   function Race:_carry()
     local c = {}
     for k, v in pairs(self) do
