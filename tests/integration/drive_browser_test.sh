@@ -4,8 +4,10 @@
 # (tests/view/drive_race.lua) drives cars 1 and 2 with human drivers; two headless Chromium pages
 # on /drive (tests/view/drive_check.mjs, puppeteer-core pinned by tests/view/package-lock.json):
 # seats taken and refused, the throttle moves car 1 and only car 1, letting go and closing the page
-# stop it; then the party (examples/party.lua) to its end. Screenshots in
-# ./view_test_artifacts/drive-*.png.
+# stop it; then the party (examples/party.lua) to its end, one phone upright (390×844) and one on
+# its side (844×390): the lights and the countdown, GO, the place and lap, "Finished — P<n>" and
+# the result with no throttle, every state fitting the screen without scrolling. Screenshots of
+# each state in ./view_test_artifacts/drive-*.png.
 source "$(dirname "$0")/lib.sh"
 source "$(dirname "$0")/browser_lib.sh"
 

@@ -168,11 +168,17 @@ TEST_CASE("race library → view: phases in order, the table with drivers, the s
   ScriptHost host(loop, fleet, &sim, options);
   std::vector<std::string> phases;
   nlohmann::json last;
+  int maxLight = 0;         // the most lights seen on (the phone's countdown reads them)
+  nlohmann::json lightsOf;  // the lights' count and the jump start's penalty, as in the lights
   std::function<void()> watch = [&] {
     auto race = feed.state()["race"];
     if (race.is_object()) {
       std::string phase = race["phase"];
       if (phases.empty() || phases.back() != phase) phases.push_back(phase);
+      if (phase == "lights") {
+        maxLight = std::max(maxLight, race.value("light", 0));
+        lightsOf = {{"lights", race.value("lights", 0)}, {"penalty", race.value("penalty", 0.0)}};
+      }
       last = race;
     }
     loop.after(std::chrono::milliseconds(50), watch);
@@ -199,6 +205,9 @@ TEST_CASE("race library → view: phases in order, the table with drivers, the s
   for (const auto& p : phases) got += p + " ";
   CAPTURE(got);
   CHECK(phases == expected);
+  CHECK(maxLight == 5);
+  CHECK(lightsOf == nlohmann::json{{"lights", 5}, {"penalty", 5.0}});
+  CHECK(last["penalty"] == 5);
   REQUIRE(last["rows"].size() == 3);
   std::vector<std::string> seen;
   for (const auto& row : last["rows"]) {
