@@ -157,6 +157,8 @@ struct TrackShowOptions {
   std::string svg;  // empty: none; "-": stdout
 };
 int trackShow(const TrackShowOptions& options);
+// pitwall track list: the named layouts and Anki's stock pieces, on stdout.
+int trackList();
 
 // pitwall track print / track verify (docs/cli.md): run by the print module, loaded for them
 // alone (engine/print/commands.hpp, engine/cli/print_module.hpp).

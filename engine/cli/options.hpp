@@ -28,7 +28,7 @@ Command addEmulateCommand(CLI::App& app);
 Command addSimRobotCommand(CLI::App& app);
 Command addTestCommand(CLI::App& app);
 Command addReplayCommand(CLI::App& app);
-Command addTrackCommand(CLI::App& app);  // `track show`, `track print`, `track verify`
+Command addTrackCommand(CLI::App& app);  // `track show`, `list`, `print`, `verify`
 Command addDecodeCommand(CLI::App& app);
 Command addEncodeCommand(CLI::App& app);
 Command addTypesCommand(CLI::App& app);       // `types [DIR]`: LuaLS definitions (docs/editor.md)

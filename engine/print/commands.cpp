@@ -146,7 +146,7 @@ int verifyPiece(const VerifyRequest& options) {
     std::cerr << ", code " << changed;
   std::cerr << "\n";
   const auto result = readBack(raster, *piece, *code, model);
-  std::cout << report(result, *piece, options.file);
+  std::cout << report(result, *piece, options.file, options.verbose);
   return result.ok() ? 0 : 1;
 }
 

@@ -22,7 +22,7 @@ struct PrintRequest {
 int printPieces(const PrintRequest& request);
 
 // pitwall track verify FILE.svg [--dpi N] [--blur MM] [--misalign MM] [--code NAME=VALUE]…
-// [--draw-mb N] [--draw-seconds N]:
+// [--draw-mb N] [--draw-seconds N] [--verbose]:
 // reads a printed piece back with the code dimensions its metadata gives (or --code's) as a
 // car's sensor would; 0 all as designed, 1 not, 2 bad input.
 struct VerifyRequest {
@@ -33,6 +33,7 @@ struct VerifyRequest {
   std::vector<std::string> code;  // over the file's own dimensions
   int draw_mb = 512;              // what librsvg may spend drawing it (raster.hpp DrawLimits)
   int draw_seconds = 20;
+  bool verbose = false;  // a line for every row and direction, not only for those that fail
 };
 int verifyPiece(const VerifyRequest& request);
 
@@ -40,7 +41,7 @@ int verifyPiece(const VerifyRequest& request);
 // pitwall, with other requests, is refused, never called. A version counted by hand (raise it
 // when a field changes) and the structs' sizes.
 inline constexpr unsigned long kRequestAbi =
-    1'000'000'000UL + sizeof(PrintRequest) * 10'000 + sizeof(VerifyRequest);
+    2'000'000'000UL + sizeof(PrintRequest) * 10'000 + sizeof(VerifyRequest);
 
 }  // namespace pitwall::print
 

@@ -182,6 +182,13 @@ Result<std::vector<sim::Piece>, std::string> piecesOf(std::string_view arg) {
     if (!track) return Unexpected<std::string>(track.error());
     return printed(track->pieces());
   }
+  // A number alone is a stock piece by its id, as `pitwall track list` lists them.
+  if (!arg.empty() && arg.size() <= 9 &&
+      std::all_of(arg.begin(), arg.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+    auto stock = sim::stockPiece(std::stoi(std::string(arg)));
+    if (!stock) return Unexpected<std::string>(stock.error());
+    return printed({*stock});
+  }
   auto piece = sim::parsePiece(arg);
   if (piece) return printed(*piece);
   if (auto named = sim::namedLayout(arg)) return printed(named->pieces());

@@ -35,7 +35,8 @@ Tiling tiling(double width_mm, double height_mm, const Paper& paper);
 
 // The pieces `arg` names, as printed (a right curve as its left curve: the same piece, laid the
 // other way round): a layout file (each piece in order), a piece token ("S", "L:17",
-// "S:60,len=300", "start" = pieces 34 and 33) or a layout name.
+// "S:60,len=300", "start" = pieces 34 and 33), one of Anki's stock pieces by its id alone ("40"
+// is S:40, "34" the start pair's first piece) or a layout name.
 Result<std::vector<sim::Piece>, std::string> piecesOf(std::string_view arg);
 
 // Writes every piece onto tiled pages of one PDF; the number of pages.

@@ -407,7 +407,8 @@ ReadBack readBack(const Raster& raster, const sim::Piece& piece, const sim::Code
   return out;
 }
 
-std::string report(const ReadBack& result, const sim::Piece& piece, std::string_view name) {
+std::string report(const ReadBack& result, const sim::Piece& piece, std::string_view name,
+                   bool verbose) {
   std::string out;
   int sections = 0, failed = 0;
   for (const RowPass& p : result.passes) {
@@ -415,8 +416,9 @@ std::string report(const ReadBack& result, const sim::Piece& piece, std::string_
     std::string head = std::string(name) + ": row " + std::to_string(p.row + 1) +
                        (p.reversed ? " backward: " : " forward:  ");
     if (p.problems.empty()) {
-      out += head + "OK, " + std::to_string(p.sections_read) +
-             (p.sections_read == 1 ? " section\n" : " sections\n");
+      if (verbose)
+        out += head + "OK, " + std::to_string(p.sections_read) +
+               (p.sections_read == 1 ? " section\n" : " sections\n");
       continue;
     }
     ++failed;

@@ -46,7 +46,9 @@ struct ReadBack {
 ReadBack readBack(const Raster& raster, const sim::Piece& piece, const sim::CodeGeometry& g = {},
                   const SensorModel& model = {});
 
-// The report `track verify` prints: one line per row and direction, then the verdict.
-std::string report(const ReadBack& result, const sim::Piece& piece, std::string_view name);
+// The report `track verify` prints: a line for each row and direction that does not read as
+// designed (every one, OK or not, when `verbose`), then the verdict.
+std::string report(const ReadBack& result, const sim::Piece& piece, std::string_view name,
+                   bool verbose = false);
 
 }  // namespace pitwall::print

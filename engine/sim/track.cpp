@@ -162,6 +162,35 @@ std::string pieceToken(const Piece& p) {
   return out;
 }
 
+std::vector<Piece> stockPieces() {
+  std::vector<Piece> out{{anki::kFinishBefore, anki::PieceType::StartLong, 0},
+                         {anki::kFinishAfter, anki::PieceType::StartShort, 0}};
+  for (std::uint8_t id : kStraightIds) out.push_back({id, anki::PieceType::Straight, 0});
+  for (std::uint8_t id : kCurveIds) out.push_back({id, anki::PieceType::Curve, 1});
+  return out;
+}
+
+Result<Piece, std::string> stockPiece(int id) {
+  for (const Piece& p : stockPieces())
+    if (p.id == id) return p;
+  const std::string number = std::to_string(id);
+  if (id >= 0 && id <= 255 &&
+      anki::pieceType(static_cast<std::uint8_t>(id)) != anki::PieceType::Unknown)
+    return fail("piece " + number + " is Anki's " +
+                std::string(anki::pieceTypeName(anki::pieceType(static_cast<std::uint8_t>(id)))) +
+                ", which pitwall has no shape for: it lays out, draws and prints the start pair "
+                "(34, 33), straights (" +
+                idList(kStraightIds) + ") and curves (" + idList(kCurveIds) + ")");
+  // A custom piece is a shape with an id of its own: suggest this id when the code can carry it.
+  const std::string own = id >= 0 && id <= int(anki::optical::kMaxId) ? number : "60";
+  return fail(number +
+              " is not one of Anki's stock pieces: they are the start pair (34, 33), "
+              "straights (" +
+              idList(kStraightIds) + ") and curves (" + idList(kCurveIds) +
+              "); a piece of your own needs its shape, such as S:" + own + ",len=300 or L:" + own +
+              ",r=400,deg=45");
+}
+
 double Track::lapLength(double offset_mm) const {
   double sum = 0;
   for (const Piece& p : pieces_) sum += p.length(offset_mm);

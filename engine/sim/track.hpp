@@ -83,6 +83,14 @@ Result<std::vector<Piece>, std::string> parsePiece(std::string_view token);
 std::string layoutText(const Track& track);
 // One piece as a layout token: "S:36", "L:61,r=400,deg=45"; "start" for either start piece.
 std::string pieceToken(const Piece& piece);
+// Anki's stock pieces with their stock shape, as a layout lays them (docs/tracks.md "Ids"): 34
+// and 33 (the start pair), the straights 36, 39, 40, 48, 51 and the curves 17, 18, 20, 23, 24,
+// 27 (as left curves; a right one is the same piece laid the other way round).
+std::vector<Piece> stockPieces();
+// One of them by its id (`track print 40` is S:40, `17` is L:17, `34` the start pair's first
+// piece), or a sentence: for an id of Anki's that pitwall has no shape for (10, the
+// intersection; 57, 58, 63) and for an id that is no stock piece.
+Result<Piece, std::string> stockPiece(int id);
 // Named layouts: "oval" (the default: start S L L S S L L, ≈4.0 m), and others listed by
 // layoutNames(). loadLayout takes a name or a path to a layout file.
 Result<Track, std::string> namedLayout(std::string_view name);

@@ -90,7 +90,7 @@ check "bash: script files (*.lua) and folders" "grand.lua races/" "$(ask pitwall
 check "bash: after an option's value, the script" "grand.lua" "$(ask pitwall run --seed 3 gr)"
 check "bash: log levels" "warn" "$(ask pitwall --log-level w)"
 check "bash: the protocol of decode" "anki" "$(ask pitwall decode an)"
-check "bash: subcommands" "print show verify" "$(ask pitwall track "")"
+check "bash: subcommands" "list print show verify" "$(ask pitwall track "")"
 check "bash: the paper of track print" "a3 a4" "$(ask pitwall track print S --paper "")"
 check "bash: folders only for types" "races/" "$(ask pitwall types "")"
 mkdir -p "$TMP/proj/my races" && touch "$TMP/proj/my file.lua"

@@ -72,11 +72,20 @@ fi
 out=$($PITWALL track print S:60,len=300 --out piece.svg 2>&1); rc=$?
 check "print an SVG: exit status" 0 "$rc"
 contains "an SVG in mm" 'width="324mm" height="208mm" viewBox="0 0 324 208"' "$(head -c 400 piece.svg)"
-out=$($PITWALL track verify piece.svg 2>&1); rc=$?
+out=$($PITWALL track verify piece.svg 2>verify.err); rc=$?
 check "verify the SVG: exit status" 0 "$rc"
-contains "verify: every row forward" "piece.svg: row 16 forward:  OK, 2 sections" "$out"
-contains "verify: every row backward" "piece.svg: row 1 backward: OK, 2 sections" "$out"
-contains "verify: the verdict" "piece.svg: OK: S:60,len=300 (piece 60), 64 section readings" "$out"
+# a good piece: the verdict alone on stdout, what was read under which conditions on stderr
+check "verify: the verdict, one line" \
+  "piece.svg: OK: S:60,len=300 (piece 60), 64 section readings on 16 rows in both directions all decode to the design" "$out"
+check "verify: how it read, one line" \
+  "reading piece.svg at 300 dpi: S:60,len=300 (piece 60), blur 0.25 mm, misalignment up to 0.5 mm" "$(cat verify.err)"
+for flag in --verbose -v; do
+  out=$($PITWALL track verify piece.svg "$flag" 2>/dev/null); rc=$?
+  check "verify $flag: exit status" 0 "$rc"
+  contains "verify $flag: every row forward" "piece.svg: row 16 forward:  OK, 2 sections" "$out"
+  contains "verify $flag: every row backward" "piece.svg: row 1 backward: OK, 2 sections" "$out"
+  check "verify $flag: a line per row and direction, then the verdict" 33 "$(printf '%s\n' "$out" | wc -l)"
+done
 # a curve, and the start pair (two files)
 # a right curve is its left curve's piece laid the other way round: the same sheet
 $PITWALL track print L:17 --out left.svg 2>/dev/null
@@ -89,6 +98,19 @@ out=$($PITWALL track print start --out start.svg 2>&1)
 contains "several pieces: a file each" "wrote start-2.svg: start (piece 33)" "$out"
 $PITWALL track verify start-1.svg >/dev/null 2>&1
 check "verify start piece 34" 0 "$?"
+
+# a stock piece by its id alone, as `track list` lists it: 40 is S:40, 17 L:17, 34 the start's first
+out=$($PITWALL track print 40 --out s40.svg 2>&1); rc=$?
+check "print a stock piece by its id: exit status" 0 "$rc"
+check "print 40: the stock straight" "wrote s40.svg: S:40 (piece 40)" "$out"
+$PITWALL track print S:40 --out s40-token.svg 2>/dev/null
+check "print 40 is print S:40" yes "$(cmp -s s40.svg s40-token.svg && echo yes)"
+check "print 17: the stock curve" "wrote c17.svg: L:17 (piece 17)" "$($PITWALL track print 17 --out c17.svg 2>&1)"
+check "print 34: the start's first piece" "wrote s34.svg: start (piece 34)" "$($PITWALL track print 34 --out s34.svg 2>&1)"
+$PITWALL track verify s34.svg >/dev/null 2>&1
+check "verify a start piece printed by its id" 0 "$?"
+out=$($PITWALL track print 40 --out s40.pdf 2>&1)
+contains "print 40 to a PDF" "wrote s40.pdf: 1 piece on" "$out"
 
 # 4. tampered: one stroke gone (the first stroke of row 1, piece side), or printed 3 % larger
 python3 - piece.svg nostroke.svg <<'EOF'
@@ -106,6 +128,9 @@ check "a stroke removed: exit status" 1 "$rc"
 contains "a stroke removed: names row and section" "nostroke.svg: row 1 forward:  section 1 (piece 60, location 0)" "$out"
 contains "a stroke removed: backward too" "nostroke.svg: row 1 backward: section 1 (piece 60, location 0)" "$out"
 contains "a stroke removed: the verdict" "nostroke.svg: FAILED" "$out"
+# only the rows that fail (row 1, both ways), the stderr line and the verdict
+check "a stroke removed: the failing rows alone" 4 "$(printf '%s\n' "$out" | wc -l)"
+case "$out" in *"OK, 2 sections"*) fail "a good row listed without --verbose: $out" ;; *) echo "ok: no good row listed" ;; esac
 sed 's/width="324mm" height="208mm"/width="333.72mm" height="214.24mm"/' piece.svg >big.svg
 out=$($PITWALL track verify big.svg 2>&1); rc=$?
 check "scaled by 3 %: exit status" 1 "$rc"
@@ -143,6 +168,11 @@ check "verify an absurd sheet: exit status" 2 "$rc"
 bad "verify --dpi 0" "--dpi" verify piece.svg --dpi 0
 bad "verify --blur nan" "--blur nan is not a number" verify piece.svg --blur nan
 bad "print a bad token" "Q:9" print Q:9 --out q.pdf
+bad "print a stock id pitwall has no shape for" \
+  "piece 10 is Anki's intersection, which pitwall has no shape for: it lays out, draws and prints the start pair (34, 33), straights (36, 39, 40, 48, 51) and curves (17, 18, 20, 23, 24, 27)" print 10 --out i.svg
+bad "print an id that is no stock piece" \
+  "60 is not one of Anki's stock pieces: they are the start pair (34, 33), straights (36, 39, 40, 48, 51) and curves (17, 18, 20, 23, 24, 27); a piece of your own needs its shape, such as S:60,len=300 or L:60,r=400,deg=45" print 60 --out c.svg
+bad "print an id beyond the code's 7 bits" "such as S:60,len=300" print 200 --out c.svg
 bad "print onto unknown paper" "unknown paper 'letter': use a4 or a3" print S --paper letter --out s.pdf
 bad "print to neither PDF nor SVG" "--out 's.png' names neither a .pdf nor a .svg file" print S --out s.png
 bad "print into a missing folder" "cannot write no/such/s.svg" print S --out no/such/s.svg

@@ -83,6 +83,22 @@ TEST_CASE("print: a piece token, start, a layout name or a layout file name thei
   REQUIRE_MESSAGE(file.ok(), (file.ok() ? "" : file.error()));
   CHECK(file->size() == 9);
 
+  // a stock piece by its id alone: 40 is S:40, 17 L:17, 34 the start's first piece alone
+  auto straight = print::piecesOf("40");
+  REQUIRE(straight.ok());
+  REQUIRE(straight->size() == 1);
+  CHECK(straight->front().id == 40);
+  CHECK(straight->front().type == anki::PieceType::Straight);
+  auto curve = print::piecesOf("17");
+  REQUIRE(curve.ok());
+  CHECK(curve->front().turn == 1);
+  auto first = print::piecesOf("34");
+  REQUIRE(first.ok());
+  REQUIRE(first->size() == 1);
+  CHECK(first->front().type == anki::PieceType::StartLong);
+  CHECK(print::piecesOf("10").error().find("intersection") != std::string::npos);
+  CHECK(print::piecesOf("60").error().find("not one of Anki's stock pieces") != std::string::npos);
+
   auto bad = print::piecesOf("Q:9");
   REQUIRE_FALSE(bad.ok());
   CHECK(bad.error().find("Q:9") != std::string::npos);

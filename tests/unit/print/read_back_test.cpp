@@ -2,6 +2,7 @@
 // decodes to the ids the design gives it; a missing stroke or a scaled page does not.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <string>
 
 #include "engine/print/raster.hpp"
@@ -164,4 +165,31 @@ TEST_CASE("print: a blank page reads nothing and says the line was lost") {
     CHECK(mentions(pass, "lost the line"));
     CHECK(mentions(pass, "found 0 sections where the design has"));
   }
+}
+
+TEST_CASE("print: the report of a good piece is its verdict; every row only when verbose") {
+  const sim::Piece piece = onePiece("S:36");
+  const print::ReadBack result = print::readBack(print::renderPiece(piece, kPxPerMm), piece);
+  REQUIRE(result.ok());
+  const std::string brief = print::report(result, piece, "p.svg");
+  CHECK(brief ==
+        "p.svg: OK: S:36 (piece 36), 96 section readings on 16 rows in both directions all "
+        "decode to the design\n");
+  const std::string verbose = print::report(result, piece, "p.svg", true);
+  CHECK(std::count(verbose.begin(), verbose.end(), '\n') == 33);
+  CHECK(verbose.find("p.svg: row 16 backward: OK, 3 sections\n") != std::string::npos);
+  CHECK(verbose.ends_with(brief));
+}
+
+TEST_CASE("print: the report of a bad piece names the rows that fail, and no good one") {
+  const sim::Piece piece = onePiece("S:36");
+  print::DrawOptions options;
+  options.omit = print::StrokeRef{15, 0, 0, false};  // row 16's first boundary, wide side
+  const print::ReadBack result =
+      print::readBack(print::renderPiece(piece, kPxPerMm, {}, options), piece);
+  REQUIRE_FALSE(result.ok());
+  const std::string text = print::report(result, piece, "p.svg");
+  CHECK(text.find("p.svg: row 16 forward:  section 1") != std::string::npos);
+  CHECK(text.find("OK, ") == std::string::npos);
+  CHECK(text.find("p.svg: FAILED: S:36 (piece 36), 2 of 32 row readings") != std::string::npos);
 }

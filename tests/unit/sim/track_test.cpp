@@ -2,6 +2,7 @@
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -312,4 +313,38 @@ TEST_CASE("a layout file larger than 1 MB is refused unread") {
   std::filesystem::remove(path);
   REQUIRE_FALSE(r.ok());
   CHECK(contains(r.error(), " is 1048597 bytes, more than the 1048576 a layout file may be"));
+}
+
+TEST_CASE("stock pieces by id: the start pair, straights and curves with their stock shape") {
+  const auto stock = stockPieces();
+  REQUIRE(stock.size() == 13);
+  for (const Piece& p : stock) {
+    CAPTURE(int(p.id));
+    CHECK(anki::pieceType(p.id) == p.type);
+    CHECK_FALSE(p.custom());
+    auto same = stockPiece(p.id);
+    REQUIRE(same.ok());
+    CHECK(same->id == p.id);
+    // what a layout token makes of it: the same piece
+    auto parsed = parsePiece(pieceToken(p));
+    REQUIRE(parsed.ok());
+    CHECK(std::count_if(parsed->begin(), parsed->end(), [&](const Piece& q) {
+            return q.id == p.id && q.type == p.type && q.turn == p.turn;
+          }) == 1);
+  }
+  CHECK(stockPiece(40)->type == anki::PieceType::Straight);
+  CHECK(stockPiece(40)->length(0) == 560);
+  CHECK(stockPiece(17)->turn == 1);
+  CHECK(stockPiece(17)->angle() == 90);
+  CHECK(stockPiece(34)->type == anki::PieceType::StartLong);
+  CHECK(stockPiece(33)->type == anki::PieceType::StartShort);
+  // Anki's pieces without a shape here, and ids that are no stock piece: a sentence
+  CHECK(
+      stockPiece(10).error().starts_with("piece 10 is Anki's intersection, which pitwall has "
+                                         "no shape for"));
+  CHECK(stockPiece(58).error().find("jump-ramp") != std::string::npos);
+  CHECK(stockPiece(60).error().starts_with("60 is not one of Anki's stock pieces"));
+  CHECK(contains(stockPiece(60).error(), "such as S:60,len=300 or L:60,r=400,deg=45"));
+  CHECK(contains(stockPiece(300).error(), "such as S:60,len=300"));
+  CHECK(contains(stockPiece(-1).error(), "-1 is not one of Anki's stock pieces"));
 }
