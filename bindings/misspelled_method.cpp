@@ -4,6 +4,7 @@
 #include <string_view>
 #include <vector>
 
+#include "bindings/car_lists.hpp"
 #include "engine/core/suggest.hpp"
 
 namespace pitwall::lua {
@@ -11,6 +12,7 @@ namespace pitwall::lua {
 namespace {
 
 constexpr std::string_view kLuaSays = "attempt to call a nil value (method '";
+constexpr std::string_view kLuaSaysField = "attempt to call a nil value (field '";
 
 struct Kind {
   std::string name;                  // "car"
@@ -69,7 +71,183 @@ std::optional<Kind> kindOf(lua_State* L) {
   return kind;
 }
 
+// The first Lua function from `level` of `thread`: the one whose call failed (a failed call may
+// leave a frame of the called value above it, "[C]: in method 'x'").
+bool failedFunction(lua_State* thread, int level, lua_Debug& ar) {
+  for (;; ++level) {
+    if (!lua_getstack(thread, level, &ar)) return false;
+    if (!lua_getinfo(thread, "S", &ar)) return false;
+    if (ar.what[0] != 'C') return true;
+    if (level > 8) return false;
+  }
+}
+
+// A library table: where it is on the stack and how it is named.
+struct Library {
+  int index;
+  std::string name;   // as the failing function sees it ("pitwall", "race", "pitwall.sim")
+  bool seen = false;  // the failing function can see it (a local, an upvalue, a global, a field)
+};
+
+// The library's tables, pushed on `L` (raw reads of package.loaded and the pitwall table):
+// "pitwall", every "pitwall.X" module (named X, as `local X = require "pitwall.X"` names it)
+// and the tables in pitwall (pitwall.sim, pitwall.view; not persist, which holds the script's
+// own data).
+std::vector<Library> libraries(lua_State* L) {
+  std::vector<Library> out;
+  auto known = [&](int idx) {
+    for (const Library& l : out)
+      if (lua_rawequal(L, l.index, idx)) return true;
+    return false;
+  };
+  luaL_getsubtable(L, LUA_REGISTRYINDEX, LUA_LOADED_TABLE);  // never made: the host opened it
+  const int loaded = lua_gettop(L);
+  if (rawField(L, loaded, "pitwall") == LUA_TTABLE) {
+    const int pitwall = lua_gettop(L);
+    out.push_back({pitwall, "pitwall"});
+    lua_pushnil(L);
+    while (lua_next(L, pitwall) != 0 && lua_checkstack(L, 4) && out.size() < 64) {
+      if (lua_type(L, -2) == LUA_TSTRING && lua_istable(L, -1) && !known(-1) &&
+          std::string_view(lua_tostring(L, -2)) != "persist") {
+        const std::string key = lua_tostring(L, -2);
+        lua_insert(L, -2);  // the table stays on the stack, under the key lua_next goes on with
+        out.push_back({lua_gettop(L) - 1, "pitwall." + key});
+        continue;
+      }
+      lua_pop(L, 1);
+    }
+  } else {
+    lua_pop(L, 1);
+  }
+  lua_pushnil(L);
+  while (lua_next(L, loaded) != 0 && lua_checkstack(L, 4) && out.size() < 64) {
+    if (lua_type(L, -2) == LUA_TSTRING && lua_istable(L, -1) && !known(-1)) {
+      const std::string_view key = lua_tostring(L, -2);
+      if (key.starts_with("pitwall.")) {
+        const std::string name(key.substr(8));
+        lua_insert(L, -2);
+        out.push_back({lua_gettop(L) - 1, name});
+        continue;
+      }
+    }
+    lua_pop(L, 1);
+  }
+  return out;
+}
+
 }  // namespace
+
+std::optional<std::string> explainMissingFunction(lua_State* thread, int level,
+                                                  const std::string& message) {
+  const auto at = message.find(kLuaSaysField);
+  if (at == std::string::npos) return std::nullopt;
+  const auto nameStart = at + kLuaSaysField.size();
+  const auto nameEnd = message.find("')", nameStart);
+  if (nameEnd == std::string::npos) return std::nullopt;
+  const std::string field = message.substr(nameStart, nameEnd - nameStart);
+  lua_Debug ar;
+  if (!failedFunction(thread, level, ar) || !lua_checkstack(thread, 80)) return std::nullopt;
+  const int base = lua_gettop(thread);
+  std::vector<Library> libs = libraries(thread);
+
+  // Which of them the failing function can see, and by what name: its locals, its upvalues, the
+  // globals of its _ENV; then the tables in those (pitwall.sim as `pitwall.sim`).
+  auto see = [&](int idx, const std::string& name) {
+    for (Library& l : libs)
+      if (!l.seen && lua_rawequal(thread, l.index, idx)) {
+        l.name = name;
+        l.seen = true;
+      }
+  };
+  // The globals of a table (an _ENV): the names of the library tables in it.
+  auto seeGlobals = [&](int table) {
+    lua_pushnil(thread);
+    for (int read = 0; lua_next(thread, table) != 0; ++read) {
+      if (lua_type(thread, -2) == LUA_TSTRING && lua_istable(thread, -1))
+        see(lua_gettop(thread), lua_tostring(thread, -2));
+      lua_pop(thread, 1);
+      if (read == 100'000) {  // a script's huge global table: enough
+        lua_pop(thread, 1);
+        break;
+      }
+    }
+  };
+  for (int n = 1;; ++n) {
+    const char* name = lua_getlocal(thread, &ar, n);
+    if (!name) break;
+    if (name[0] != '(' && lua_istable(thread, -1)) see(lua_gettop(thread), name);
+    lua_pop(thread, 1);
+  }
+  if (lua_getinfo(thread, "f", &ar)) {
+    const int fn = lua_gettop(thread);
+    for (int n = 1;; ++n) {
+      const char* name = lua_getupvalue(thread, fn, n);
+      if (!name) break;
+      const int up = lua_gettop(thread);
+      if (lua_istable(thread, up)) {
+        if (std::string_view(name) == "_ENV") {
+          seeGlobals(up);
+          // an _ENV of its own (the REPL's prompt) reads the world's globals through its
+          // __index, a function the handler does not call: the globals themselves then
+          lua_rawgeti(thread, LUA_REGISTRYINDEX, LUA_RIDX_GLOBALS);
+          if (!lua_rawequal(thread, -1, up)) seeGlobals(lua_gettop(thread));
+          lua_pop(thread, 1);
+        } else {
+          see(up, name);
+        }
+      }
+      lua_pop(thread, 1);
+    }
+    lua_pop(thread, 1);
+  }
+  for (std::size_t i = 0; i < libs.size(); ++i) {
+    if (!libs[i].seen) continue;
+    lua_pushnil(thread);
+    while (lua_next(thread, libs[i].index) != 0) {
+      if (lua_type(thread, -2) == LUA_TSTRING && lua_istable(thread, -1))
+        see(lua_gettop(thread), libs[i].name + "." + lua_tostring(thread, -2));
+      lua_pop(thread, 1);
+    }
+  }
+
+  // Those that lack the name and have a function near it.
+  std::vector<std::string> tables, suggestions;
+  for (const Library& l : libs) {
+    if (!l.seen) continue;
+    if (rawField(thread, l.index, field.c_str()) != LUA_TNIL) {
+      lua_pop(thread, 1);
+      continue;
+    }
+    lua_pop(thread, 1);
+    std::vector<std::string> functions;
+    addFunctionKeys(thread, l.index, functions);
+    if (auto near = nearest(field, functions)) {
+      tables.push_back(l.name);
+      suggestions.push_back(l.name + "." + *near);
+    }
+  }
+  lua_settop(thread, base);
+  if (tables.empty()) return std::nullopt;
+  auto either = [](const std::vector<std::string>& words, const char* joint) {
+    std::string out;
+    for (std::size_t i = 0; i < words.size(); ++i)
+      out += (i == 0 ? "" : i + 1 == words.size() ? joint : ", ") + words[i];
+    return out;
+  };
+  const std::string sentence =
+      tables.size() == 1
+          ? tables[0] + " has no function " + field + "; did you mean " + suggestions[0] + "?"
+          : "neither " + either(tables, " nor ") + " has a function " + field + "; did you mean " +
+                either(suggestions, " or ") + "?";
+  return message.substr(0, at) + sentence + message.substr(nameEnd + 2);
+}
+
+std::optional<std::string> explainMissingName(lua_State* thread, int level,
+                                              const std::string& message) {
+  if (auto explained = explainMissingMethod(thread, level, message)) return explained;
+  if (auto explained = explainMissingFunction(thread, level, message)) return explained;
+  return explainMissingCar(thread, level, message);
+}
 
 std::optional<std::string> explainMissingMethod(lua_State* thread, int level,
                                                 const std::string& message) {

@@ -8,10 +8,13 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "bindings/car_binding.hpp"
+#include "bindings/car_lists.hpp"
 #include "bindings/copy_budget.hpp"
 #include "bindings/lua_args.hpp"
 #include "bindings/lua_object.hpp"
@@ -20,6 +23,7 @@
 #include "bindings/script_host.hpp"
 #include "engine/core/console.hpp"
 #include "engine/core/log.hpp"
+#include "engine/core/printable.hpp"
 #include "engine/core/suggest.hpp"
 #include "engine/protocol/anki/pieces.hpp"
 #include "engine/sim/track.hpp"
@@ -51,22 +55,41 @@ int cars(lua_State* L) {
     host.cars().push(L, *car);
     lua_rawseti(L, -2, ++i);
   }
+  lua::makeCarList(L, -1);  // cars[9]:setSpeed(…) is an error naming the cars (car_lists.hpp)
   return 1;
 }
 
+// The car with that number or name; a car that is not there is an error naming those that are
+// (docs/lua-api.md "Cars that are not there").
 int car(lua_State* L) {
   ScriptHost& host = ScriptHost::from(L);
   AnkiCar* found = nullptr;
+  std::string asked, name;
+  std::vector<std::pair<long long, std::string>> cars;
+  std::vector<std::string> names;
+  for (AnkiCar* c : host.fleet().cars()) {
+    cars.emplace_back(c->identity().number, c->identity().name);
+    names.push_back(c->identity().name);
+  }
   if (lua_type(L, 1) == LUA_TNUMBER) {
-    found = host.fleet().find(static_cast<int>(lua::checkInteger(L, 1, "car number")));
+    const long long number = lua::checkInteger(L, 1, "car number");
+    if (number >= 1 && number <= std::numeric_limits<int>::max())
+      found = host.fleet().find(static_cast<int>(number));
+    asked = "no car " + std::to_string(number);
   } else {
-    std::string name = lua::checkString(L, 1, "car name or number");
+    name = lua::checkString(L, 1, "car name or number");
     for (AnkiCar* c : host.fleet().cars())
       if (c->identity().name == name) found = c;
+    asked = "no car named '" + printable(name, 40) + "'";
   }
   if (!found) {
-    lua_pushnil(L);
-    return 1;
+    std::string there = lua::carsThereAre(cars);
+    if (auto near = name.empty() ? std::nullopt : nearest(name, names)) {
+      there[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(there[0])));
+      throw LuaError("pitwall.car: " + asked + "; did you mean " + printable(*near, 40) + "? " +
+                     there);
+    }
+    throw LuaError("pitwall.car: " + asked + "; " + there);
   }
   host.cars().push(L, *found);
   return 1;

@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "bindings/car_binding.hpp"
+#include "bindings/car_lists.hpp"
 #include "bindings/lua_args.hpp"
 #include "engine/core/log.hpp"
 
@@ -76,7 +77,9 @@ class Copier {
     lua_newtable(to_);
     lua_pushvalue(to_, -1);
     lua_rawsetp(to_, memo_, key);
-    if (lua_getmetatable(from_, idx)) {
+    if (lua::isCarList(from_, idx)) {
+      lua::makeCarList(to_, -1);  // a list of cars (pitwall.cars()) stays one
+    } else if (lua_getmetatable(from_, idx)) {
       lua_pop(from_, 1);
       if (!quiet_) dropped_.push_back(path + "'s metatable");
     }

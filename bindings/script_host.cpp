@@ -70,7 +70,7 @@ int traceback(lua_State* L) {
   if (!msg) {
     if (luaL_callmeta(L, 1, "__tostring") && lua_type(L, -1) == LUA_TSTRING) return 1;
     msg = lua_pushfstring(L, "(error object is a %s value)", luaL_typename(L, 1));
-  } else if (auto explained = explainMissingMethod(L, 1, msg)) {
+  } else if (auto explained = explainMissingName(L, 1, msg)) {
     msg = lua_pushlstring(L, explained->data(), explained->size());
   }
   pushTraceback(L, L, msg, 1);

@@ -164,7 +164,7 @@ void Tasks::resume(lua_State* co, int nargs) {
       msg = lua_tostring(co, -1);
     }
     std::optional<std::string> explained;
-    explained = lua::explainMissingMethod(co, 0, msg);  // car:setSped → a suggestion
+    explained = lua::explainMissingName(co, 0, msg);  // car:setSped → a suggestion
     if (explained) msg = explained->c_str();
     lua::pushTraceback(L, co, msg, 0);
     error = lua_tostring(L, -1);

@@ -84,9 +84,9 @@ function pitwall.alphabot(options) end
 ---@return boolean cancelled
 function pitwall.cancel(timer) end
 
----The car with that number or name, or nil.
+---The car with that number or name; one that is not there is an error naming the cars.
 ---@param which integer|string a car number or name
----@return pitwall.Car?
+---@return pitwall.Car
 function pitwall.car(which) end
 
 ---A new list of every car of the run, in join order (cars[1] is car number 1).

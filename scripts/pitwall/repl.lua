@@ -401,7 +401,9 @@ local boundKeys = {}  -- the keys it set there last time (the user's own keys ar
 function M.bindCars()
   local current = rawget(_G, "cars")
   if current ~= nil and not rawequal(current, bound) then return nil end
-  bound = bound or {}
+  -- a list from pitwall.cars(), refilled below: using cars[9] or cars.groundshok (nil) is an
+  -- error that names the cars there are (bindings/car_lists.hpp)
+  bound = bound or pitwall.cars()
   for key in next, boundKeys do rawset(bound, key, nil) end
   boundKeys = {}
   for n, car in ipairs(pitwall.cars()) do

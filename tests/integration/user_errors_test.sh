@@ -56,4 +56,32 @@ check "a misspelled method: exit status" 1 "$rc"
 contains "a misspelled method: the line and the suggestion" \
   "typo.lua:2: car has no method setSped; did you mean setSpeed?" "$err"
 
+# The other typos (issue 35), as a run and the REPL report them: a sentence naming what exists.
+cars="1 groundshock, 2 skull, 3 thermo, 4 nuke"
+printf 'local car = pitwall.car("groundshok")\ncar:setSpeed(500)\n' > "$TMP/car.lua"
+err=$(cd "$TMP" && "$PITWALL" run car.lua --fast 2>&1 >/dev/null); rc=$?
+check "a misspelled car: exit status" 1 "$rc"
+contains "a misspelled car: the cars and the nearest" \
+  "car.lua:1: pitwall.car: no car named 'groundshok'; did you mean groundshock? The cars are $cars" "$err"
+printf 'pitwall.car(9):setSpeed(500)\n' > "$TMP/nine.lua"
+err=$(cd "$TMP" && "$PITWALL" run nine.lua --fast 2>&1 >/dev/null)
+contains "a car number that is not there: the cars" "nine.lua:1: pitwall.car: no car 9; the cars are $cars" "$err"
+printf 'pitwall.spwan(function() end)\n' > "$TMP/spwan.lua"
+err=$(cd "$TMP" && "$PITWALL" run spwan.lua --fast 2>&1 >/dev/null); rc=$?
+check "a misspelled library function: exit status" 1 "$rc"
+contains "a misspelled library function: the nearest" \
+  "spwan.lua:1: pitwall has no function spwan; did you mean pitwall.spawn?" "$err"
+printf 'local cars = pitwall.cars()\ncars[9]:setSpeed(500)\n' > "$TMP/list.lua"
+err=$(cd "$TMP" && "$PITWALL" run list.lua --fast 2>&1 >/dev/null); rc=$?
+check "a car past the end of a list: exit status" 1 "$rc"
+contains "a car past the end of a list: what it holds" \
+  "list.lua:2: this list of cars has no [9]; it holds $cars" "$err"
+# at the REPL, its `cars` by number and by name
+out=$(printf 'cars[9]:setSpeed(500)\ncars.groundshok:setSpeed(500)\npitwall.spwan(print)\n' |
+  (cd "$TMP" && timeout 30 "$PITWALL" repl 2>&1))
+contains "REPL: cars[9]" "stdin:1: cars[9] is nil: there is no car 9; the cars are $cars" "$out"
+contains "REPL: cars.groundshok" \
+  "stdin:1: cars.groundshok is nil: there is no car groundshok; did you mean cars.groundshock? The cars are $cars" "$out"
+contains "REPL: pitwall.spwan" "stdin:1: pitwall has no function spwan; did you mean pitwall.spawn?" "$out"
+
 finish

@@ -37,8 +37,9 @@ expect.fails(function() sim.sensor { model = 1e308 } end, "sensor model")
 expect.fails(function() sim.sensor("real") end, "sim.sensor takes a table")
 expect.eq(sim.sensor().model, "real", "a refused sensor setting changes nothing")
 expect.fails(function() sim.truth("car") end, "expected a car")
-expect.eq(pitwall.car("nobody"), nil)
-expect.eq(pitwall.car(7), nil)
+expect.fails(function() pitwall.car("nobody") end, "pitwall.car: no car named 'nobody'; the ")
+expect.fails(function() pitwall.car(7) end, "pitwall.car: no car 7; the ")
+expect.fails(function() pitwall.car(2 ^ 32 + 1) end, "pitwall.car: no car 4294967297; the ")
 
 -- Car commands: types and ranges, and nothing sent.
 local frames = car.frames

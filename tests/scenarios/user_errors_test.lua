@@ -160,3 +160,79 @@ expect.falsy(message:find("did you mean", 1, true), "no suggestion for a name ne
 expect.eq(car.someOwnField, nil, "a missing own field reads nil")
 expect.eq(car.setSped, nil, "a misspelled method read as a field is nil, as in plain Lua")
 if car.someOwnField then expect.truthy(false, "a missing field is not truthy") end
+
+-- Typos of other names (issue 35) get a sentence naming what exists and the nearest: a library
+-- function, named as the script names its table; a car by name or number; a car of a list.
+local spwanLine = debug.getinfo(1, "l").currentline + 1
+local spwan = function() pitwall.spwan(print) end
+expectReported(reported(function() pitwall.spawn(spwan) end), spwanLine,
+  "pitwall has no function spwan; did you mean pitwall.spawn?")
+local lapzLine = debug.getinfo(1, "l").currentline + 1
+local lapz = function() race.lapz { laps = 1 } end
+expectReported(reported(function() pitwall.spawn(lapz) end), lapzLine,
+  "race has no function lapz; did you mean race.laps?")
+local addCraLine = debug.getinfo(1, "l").currentline + 1
+local addCra = function() sim.addCra { name = "two" } end
+expectReported(reported(function() pitwall.spawn(addCra) end), addCraLine,
+  "sim has no function addCra; did you mean sim.addCar?")
+local timerSpwanLine = debug.getinfo(1, "l").currentline + 1
+local timerSpwan = function() pitwall.sleeep(1) end
+expectReported(reported(function() pitwall.after(0, timerSpwan); sim.run(0.01) end), timerSpwanLine,
+  "pitwall has no function sleeep; did you mean pitwall.sleep?")
+-- a table of the script's own, or a name near nothing, keeps Lua's words
+local ownLine = debug.getinfo(1, "l").currentline + 1
+local own = function() local t = {} t.frobnicate() end
+message = reported(function() pitwall.spawn(own) end)
+expectReported(message, ownLine, "attempt to call a nil value (field 'frobnicate')")
+local farCallLine = debug.getinfo(1, "l").currentline + 1
+local farCall = function() pitwall.flyToTheMoon() end
+expectReported(reported(function() pitwall.spawn(farCall) end), farCallLine,
+  "attempt to call a nil value (field 'flyToTheMoon')")
+
+-- pitwall.car: a car that is not there is an error naming the cars there are.
+expect.eq(pitwall.car("one"), car)
+expect.eq(pitwall.car(1), car)
+blames(function() pitwall.car("oen") end,
+  "pitwall.car: no car named 'oen'; did you mean one? The only car is 1 one")
+blames(function() pitwall.car(9) end, "pitwall.car: no car 9; the only car is 1 one")
+blames(function() pitwall.car("nobody") end, "pitwall.car: no car named 'nobody'; the only car is 1 one")
+
+-- A list of cars (pitwall.cars(), the REPL's `cars`) used past its end says what it holds.
+local list = pitwall.cars()
+local listLine = debug.getinfo(1, "l").currentline + 1
+local pastEnd = function() list[9]:setSpeed(500) end
+expectReported(reported(function() pitwall.spawn(pastEnd) end), listLine,
+  "this list of cars has no [9]; it holds 1 one")
+expect.eq(repl.bindCars(), cars, "the REPL's cars")
+local nineLine = debug.getinfo(1, "l").currentline + 1
+local nine = function() print(cars[9].speed) end
+expectReported(reported(function() pitwall.spawn(nine) end), nineLine,
+  "cars[9] is nil: there is no car 9; the only car is 1 one")
+local oenLine = debug.getinfo(1, "l").currentline + 1
+local oen = function() cars.oen:setSpeed(500) end
+expectReported(reported(function() pitwall.spawn(oen) end), oenLine,
+  "cars.oen is nil: there is no car oen; did you mean cars.one? The only car is 1 one")
+local indexLine = debug.getinfo(1, "l").currentline + 1
+local byIndex = function() local n = 3; local c = cars[n]; c:stop() end
+expectReported(reported(function() pitwall.spawn(byIndex) end), indexLine,
+  "cars[3] is nil: there is no car 3; the only car is 1 one")
+-- and plain Lua stays plain: ipairs, #, a test for a car that is not there
+local n = 0
+for _, c in ipairs(cars) do n = n + 1; expect.eq(c, car) end
+expect.eq(n, 1)
+expect.eq(#cars, 1)
+expect.eq(cars[2], nil)
+expect.eq(list[9], nil)
+if cars[5] or cars.nobody then expect.truthy(false, "a car that is not there is not truthy") end
+for _, c in ipairs(pitwall.cars()) do expect.eq(c, car) end
+-- a nil of another table, on a line after the miss, keeps Lua's words
+local otherLine = debug.getinfo(1, "l").currentline + 4
+local other = function()
+  local _ = cars[7]
+  local t = {}
+  return t[1].x
+end
+message = reported(function() pitwall.spawn(other) end)
+expectReported(message, otherLine, "attempt to index a nil value (field 'integer index')")
+expect.falsy(message:find("no car", 1, true), "not taken for the car list's miss: " .. message)
+cars = nil

@@ -85,9 +85,9 @@ function Stdout:flush() end
     functions = {
       cars = [[A new list of every car of the run, in join order (cars[1] is car number 1).
 @return pitwall.Car[] ]],
-      car = [[The car with that number or name, or nil.
+      car = [[The car with that number or name; one that is not there is an error naming the cars.
 @param which integer|string a car number or name
-@return pitwall.Car?]],
+@return pitwall.Car]],
       now = [[Engine clock, seconds since the run started.
 @return number seconds]],
       after = [[Calls fn() once after `delay` ≥ 0 seconds.

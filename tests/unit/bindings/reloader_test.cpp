@@ -5,6 +5,7 @@
 
 #include <doctest/doctest.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
@@ -180,6 +181,26 @@ TEST_CASE("persisted state survives: tables, shared and cyclic ones, and cars") 
   for (const auto& l : f.logged) all += l + "\n";
   CHECK(all.find("pitwall.persist.fn (a function) cannot cross") != std::string::npos);
   CHECK(all.find("pitwall.persist.deep.co (a thread) cannot cross") != std::string::npos);
+}
+
+TEST_CASE(
+    "a persisted list of cars crosses as a list of cars, without a word about its metatable") {
+  ReloadFixture f;
+  auto script = f.write("list.lua", "pitwall.persist.grid = pitwall.cars()\n");
+  REQUIRE(f.scripts->start(script));
+  f.write("list.lua", "-- version 2\n");
+  REQUIRE(f.scripts->reload());
+  CHECK(f.text("tostring(pitwall.persist.grid[2] == pitwall.cars()[2])") == "true");
+  std::string all;
+  for (const auto& l : f.logged) all += l + "\n";
+  CHECK(all.find("metatable") == std::string::npos);
+  // still one: used past its end, it names the cars it holds
+  lua_State* L = f.scripts->host().state();
+  const char* code = "local grid = pitwall.persist.grid\nreturn grid[3].speed";
+  REQUIRE(luaL_loadbufferx(L, code, std::strlen(code), "=list", "t") == LUA_OK);
+  std::string error;
+  REQUIRE_FALSE(f.scripts->host().callInteractive(0, 0, error));
+  CHECK(error.rfind("list:2: this list of cars has no [3]; it holds 1 ", 0) == 0);
 }
 
 TEST_CASE("a version that does not compile is refused with file and line; the old one runs on") {

@@ -95,10 +95,52 @@ TEST_CASE_FIXTURE(Host, "at the REPL a misspelled method names the type and the 
   CHECK(repl("local car = pitwall.cars()[1]\nassert(car.setSped == nil and not car.mine)") == "");
 }
 
-TEST_CASE("a message that is not a missing method is left alone") {
+TEST_CASE_FIXTURE(Host, "at the REPL the typos of issue 35 name what exists and the nearest") {
+  // a library function: the table as the chunk names it
+  CHECK(repl("pitwall.spwan(print)")
+            .rfind("stdin:1: pitwall has no function spwan; did you mean pitwall.spawn?\n", 0) ==
+        0);
+  CHECK(repl("local pw = require 'pitwall'\npw.evrey(1, print)")
+            .rfind("stdin:2: pw has no function evrey; did you mean pw.every?", 0) == 0);
+  CHECK(repl("pitwall.view.evnt('x')")
+            .rfind("stdin:1: pitwall.view has no function evnt; did you mean pitwall.view.event?",
+                   0) == 0);
+  // a car by name or number
+  CHECK(repl("pitwall.car('skul'):setSpeed(500)")
+            .rfind("stdin:1: pitwall.car: no car named 'skul'; did you mean skull? The only car "
+                   "is 1 skull\n",
+                   0) == 0);
+  CHECK(repl("pitwall.car(9)")
+            .rfind("stdin:1: pitwall.car: no car 9; the only car is 1 skull\n", 0) == 0);
+  // a car of a list of cars: the REPL's global `cars` by its name, another list as a list
+  CHECK(repl("cars = pitwall.cars()\ncars[9]:setSpeed(500)")
+            .rfind("stdin:2: cars[9] is nil: there is no car 9; the only car is 1 skull\n", 0) ==
+        0);
+  CHECK(repl("local mine = pitwall.cars()\nprint(mine[2].speed)")
+            .rfind("stdin:2: this list of cars has no [2]; it holds 1 skull\n", 0) == 0);
+  // plain Lua stays: a test for a car that is not there, ipairs, and a later nil of another table
+  CHECK(
+      repl("local n = 0\nfor _ in ipairs(cars) do n = n + 1 end\nassert(n == 1 and not cars[2])") ==
+      "");
+  std::string err = repl("local x = cars[5]\nlocal t = {}\nprint(t[1].y)");
+  CHECK(err.rfind("stdin:3: attempt to index a nil value (field '", 0) == 0);
+  // a list whose __index the script replaced answers as the script says; the handler runs none
+  // of it and keeps Lua's words
+  err = repl(
+      "local l = pitwall.cars()\ngetmetatable(l).__index = function() error('mine') end\n"
+      "local ok = pcall(function() return l[9] end)\nassert(not ok)\nprint(l[1]:nosuch())");
+  CHECK(err.find("car has no method nosuch") != std::string::npos);
+}
+
+TEST_CASE("a message that is not a missing name is left alone") {
   lua_State* L = luaL_newstate();
   CHECK_FALSE(lua::explainMissingMethod(L, 0, "x.lua:1: boom"));
   CHECK_FALSE(lua::explainMissingMethod(L, 0, "attempt to call a nil value (method 'go"));
+  CHECK_FALSE(lua::explainMissingName(L, 0, "x.lua:1: boom"));
+  CHECK_FALSE(lua::explainMissingName(L, 0, "attempt to call a nil value (field 'go"));
+  CHECK_FALSE(
+      lua::explainMissingName(L, 0, "attempt to index a nil value (field 'integer index')"));
+  CHECK_FALSE(lua::explainMissingName(L, 0, "attempt to index a nil value (field '?"));
   lua_close(L);
 }
 
