@@ -57,10 +57,20 @@ void hook(lua_State* L, lua_Debug*) {
   // next instruction, until the engine's call returns.
   if (reason == kUser) luaL_error(L, "interrupted");
   if (reason == kMessage) luaL_error(L, "%s", g_message);
+  // A task (the main chunk, a pitwall.spawn) runs in a coroutine; callbacks on the main thread.
+  const bool task = lua_pushthread(L) == 0;
+  lua_pop(L, 1);
+  const int ms = static_cast<int>(g_budgetMs.load(std::memory_order_relaxed));
+  if (task)
+    luaL_error(L,
+               "still running after %d ms without a pause: interrupted (a task must give the "
+               "loop its turn: call pitwall.sleep or pitwall.waitUntil in its loop, or raise "
+               "--budget)",
+               ms);
   luaL_error(L,
              "still running after %d ms: interrupted (a callback must return quickly; run long "
              "work in a task with pitwall.spawn and pitwall.sleep, or raise --budget)",
-             static_cast<int>(g_budgetMs.load(std::memory_order_relaxed)));
+             ms);
 }
 
 constexpr int kHookMask = LUA_MASKCALL | LUA_MASKRET | LUA_MASKLINE | LUA_MASKCOUNT;

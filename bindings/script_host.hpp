@@ -8,6 +8,8 @@
 // failing prints one traceback, then a count line a second (engine/core/error_flood.hpp).
 #include <lua.hpp>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include <functional>
 #include <memory>
 #include <optional>
@@ -57,6 +59,9 @@ struct HostOptions {
   const sim::Track* design = nullptr;
   // --humans: the seats of human drivers (pitwall.seats); none: no seats.
   drive::Seats* seats = nullptr;
+  // --record: the race as pitwall.view.race reports it, into the record (for a replay's view);
+  // unset: not recorded. pitwall.view.recording says whether it is set.
+  std::function<void(const nlohmann::json& race)> recordRace;
 };
 
 class ScriptHost {

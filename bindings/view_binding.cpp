@@ -1,10 +1,12 @@
 // pitwall.view: what a script tells the race view (docs/view.md "race"). The race library
 // reports its sessions and the map a scan learnt; a script may add lines to the event log.
 //   pitwall.view.active          true when the run serves a view (--view)
+//   pitwall.view.recording       true when the run keeps a record (--record): the race's
+//                                state goes into it too, for a replay's view
 //   pitwall.view.race(t | nil)   the race's state: a table of plain data (no functions)
 //   pitwall.view.track(map)      a map of pitwall.track: its pieces are drawn (real cars)
 //   pitwall.view.event(text [, level])
-// Without a view they do nothing, so a script never needs to ask.
+// Without a view (or a record) they do nothing, so a script never needs to ask.
 #include <cmath>
 
 #include "bindings/copy_budget.hpp"
@@ -112,10 +114,12 @@ nlohmann::json toJson(lua_State* L, int idx, int depth, std::size_t& count, lua:
 
 int race(lua_State* L) {
   view::Feed* feed = feedOf(L);
-  if (!feed) return 0;
   ScriptHost& host = ScriptHost::from(L);
+  const auto& record = host.options().recordRace;
+  if (!feed && !record) return 0;
   if (lua_isnoneornil(L, 1)) {
-    feed->setRace(nullptr);
+    if (feed) feed->setRace(nullptr);
+    if (record) record(nullptr);
     host.chargeOutside(0);
     return 0;
   }
@@ -123,7 +127,8 @@ int race(lua_State* L) {
   std::size_t count = 0;
   lua::CopyBudget budget(L, "pitwall.view.race", kMaxBytes, host.memory().outside);
   nlohmann::json race = toJson(L, 1, 0, count, budget, "race");
-  feed->setRace(std::move(race));
+  if (record) record(race);
+  if (feed) feed->setRace(std::move(race));
   host.chargeOutside(budget.bytes());  // the feed keeps it until the next race table
   return 0;
 }
@@ -195,6 +200,8 @@ void openViewModule(ScriptHost& host) {
   luaL_newlib(L, functions);
   lua_pushboolean(L, host.options().view != nullptr);
   lua_setfield(L, -2, "active");
+  lua_pushboolean(L, static_cast<bool>(host.options().recordRace));
+  lua_setfield(L, -2, "recording");
   lua_setfield(L, -2, "view");
   lua_pop(L, 1);
 }

@@ -198,6 +198,7 @@ function Seat:release() end
 ---What the race view shows (docs/view.md); without --view the calls do nothing visible.
 ---@class pitwall.view
 ---@field active boolean true when the run serves the race view (--view)
+---@field recording boolean true when the run keeps a record (--record): pitwall.view.race goes into it too, for a replay's view
 pitwall.view = {}
 
 ---A line in the view's event log.

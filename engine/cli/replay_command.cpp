@@ -17,6 +17,7 @@
 #include "engine/cli/options.hpp"
 #include "engine/cli/session.hpp"
 #include "engine/core/log.hpp"
+#include "engine/core/printable.hpp"
 #include "engine/record/capture.hpp"
 #include "engine/record/record_player.hpp"
 #include "engine/record/record_reader.hpp"
@@ -44,8 +45,8 @@ std::string lapText(const std::vector<double>& laps, bool best) {
 // The summary per car: the laps the view's feed counted, the frames the car model saw.
 void printSummary(const RecordPlayer& player, const view::Feed& feed, bool json) {
   if (!json)
-    std::printf("%-4s %5s %9s %9s %8s %8s %9s\n", "CAR", "LAPS", "BEST", "LAST", "IN", "OUT",
-                "MALFORMED");
+    std::printf("%-4s %-16s %5s %9s %9s %8s %8s %9s\n", "CAR", "NAME", "LAPS", "BEST", "LAST", "IN",
+                "OUT", "MALFORMED");
   for (int number : player.recordedCars()) {
     const AnkiCar* car = player.car(number);
     const view::CarTracker* tracker = feed.tracker(car->identity().number);
@@ -57,6 +58,7 @@ void printSummary(const RecordPlayer& player, const view::Feed& feed, bool json)
       for (double l : laps) times.push_back(micro(l));
       nlohmann::ordered_json row = {
           {"car", number},
+          {"name", car->identity().name},
           {"laps", laps.size()},
           {"bestLap", laps.empty() ? nlohmann::ordered_json(nullptr)
                                    : nlohmann::ordered_json(
@@ -70,7 +72,8 @@ void printSummary(const RecordPlayer& player, const view::Feed& feed, bool json)
       };
       std::cout << row.dump() << "\n";
     } else {
-      std::printf("%-4d %5zu %9s %9s %8llu %8llu %9llu\n", number, laps.size(),
+      std::printf("%-4d %-16s %5zu %9s %9s %8llu %8llu %9llu\n", number,
+                  printable(car->identity().name, 16).c_str(), laps.size(),
                   lapText(laps, true).c_str(), lapText(laps, false).c_str(),
                   static_cast<unsigned long long>(s.frames_in),
                   static_cast<unsigned long long>(player.framesOut(number)),
@@ -241,7 +244,17 @@ int replay(const ReplayOptions& options) {
   } clocks{feed, loop};
   feed->setClock([&player] { return player.position(); });
   log::setTimeSource([&player] { return player.position(); });
-  player.onRewind = [feed] { feed->reset(); };
+  player.onRewind = [feed] {
+    feed->reset();
+    feed->setRace(nullptr);  // the record's race lines come again from its start
+  };
+  // The race as the run's race library reported it (a record made with --record keeps it): the
+  // view shows the title, the phases, the drivers, the gaps and the race's own laps.
+  player.onSent = [feed](AnkiCar& car, const anki::Message& m) { feed->sent(car, m); };
+  player.onRace = [feed](const std::string& race) {
+    nlohmann::json j = nlohmann::json::parse(race, nullptr, false);
+    if (j.is_object() || j.is_null()) feed->setRace(std::move(j));
+  };
 
   const bool summary = options.summary || options.json || (!options.view && options.script.empty());
   if (options.view) {

@@ -57,6 +57,10 @@ int run(const RunOptions& options) {
   auto made = Session::open(options, options.fast, "run");
   if (!made) return 2;
   Session& session = *made;
+  if (options.fast && options.view)  // said, not refused: a script may hold the view up itself
+    log::warn("pitwall",
+              "--view with --fast: the race runs faster than a browser can follow; "
+              "the view shows where it ends (run without --fast to watch it)");
   if (!options.record.empty()) {
     try {
       session.record(options.record);
@@ -108,10 +112,8 @@ int run(const RunOptions& options) {
   bool capped = false;
   if (!options.duration && options.fast) {
     double cap = options.fastCap.value_or(kFastCap);
-    log::info("pitwall",
-              "--fast without --duration: the run lasts until the script ends it; one "
-              "still running after " +
-                  simulatedTime(cap) + " of simulated time is stopped (--fast-cap S)");
+    log::info("pitwall", "--fast: until the script ends, at most " + simulatedTime(cap) +
+                             " simulated (--fast-cap S)");
     loop.after(fromSeconds(cap), [&session, &capped, cap] {
       capped = true;
       log::error("pitwall", "the script was still running after " + simulatedTime(cap) +

@@ -193,10 +193,11 @@ void Session::catchSignals() {
       return;
     }
     interrupted_ = true;
+    // (a spectator — a replay, a view of another host's cars — has no car of its own to stop)
     log::warn("pitwall", std::string(sig == SIGINT   ? "interrupted"
                                      : sig == SIGHUP ? "hung up"
                                                      : "terminated") +
-                             ": stopping the cars");
+                             (spectator_ ? ": the end" : ": stopping the cars"));
     finish();
   };
 }
@@ -478,6 +479,45 @@ void Session::record(const std::string& path) {
   });
 }
 
+// The race into the record, for a replay's view (docs/cli.md "Record format"): every change of
+// phase or title at once, else at most twice a second (a race reports ten times a second); each
+// car's lap times, the latest kRaceLapsRecorded of them (lapTimesFrom numbers the first), so that
+// a line stays short in a race of a thousand laps.
+void Session::recordRace(const nlohmann::json& race) {
+  constexpr double kEvery = 0.5;
+  constexpr std::size_t kRaceLapsRecorded = 100;
+  const double now = loop_.seconds();
+  auto key = [](const nlohmann::json& r) {
+    if (!r.is_object()) return std::string("null");
+    return r.value("phase", nlohmann::json()).dump() + r.value("title", nlohmann::json()).dump();
+  };
+  const std::string k = key(race);
+  if (k == raceKey_ && now - raceWritten_ < kEvery) return;
+  raceKey_ = k;
+  raceWritten_ = now;
+  constexpr auto kReplace = nlohmann::json::error_handler_t::replace;
+  auto laps = race.is_object() ? race.find("lapTimes") : race.end();
+  if (laps == race.end() || !laps->is_object()) {
+    recorder_->writeRace(now, race.dump(-1, ' ', false, kReplace));
+    return;
+  }
+  nlohmann::json shown = race;
+  nlohmann::json from = nlohmann::json::object();
+  for (auto& [car, times] : shown["lapTimes"].items()) {
+    if (!times.is_array() || times.size() <= kRaceLapsRecorded) continue;
+    const std::size_t cut = times.size() - kRaceLapsRecorded;
+    times.erase(times.begin(), times.begin() + static_cast<std::ptrdiff_t>(cut));
+    from[car] = cut + 1;
+  }
+  if (!from.empty()) shown["lapTimesFrom"] = std::move(from);
+  if (!recorder_->writeRace(now, shown.dump(-1, ' ', false, kReplace)) && !raceTooLong_) {
+    raceTooLong_ = true;
+    log::warn("record",
+              "the race's state is longer than a record's line (64 KiB): left out of "
+              "the record from now on; the frames are all there");
+  }
+}
+
 void Session::openRecord() {
   if (recorder_) recorder_->open();
 }
@@ -529,6 +569,7 @@ std::optional<std::string> Session::connectRealCars() {
 
 void Session::startHost(HostOptions options) {
   if (!sim_.world && design_) options.design = &*design_;
+  if (recorder_) options.recordRace = [this](const nlohmann::json& race) { recordRace(race); };
   scripts_ =
       std::make_unique<Reloader>(loop_, fleet_, sim_.world ? &sim_ : nullptr, std::move(options));
   scripts_->onStopRequested = [this] { finish(); };

@@ -5,6 +5,8 @@
 #include <optional>
 #include <string>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "bindings/reloader.hpp"
 #include "engine/cli/commands.hpp"
 #include "engine/core/emergency_stops.hpp"
@@ -66,6 +68,7 @@ class Session {
   // --record: checked now (throws std::runtime_error naming the file), opened by openRecord()
   // once the start can no longer be refused; the frames before it are kept until then.
   void record(const std::string& path);
+  void recordRace(const nlohmann::json& race);
   void openRecord();  // throws std::runtime_error naming the file
   // Puts `count` cars on the starting grid and runs the loop until all are connected.
   bool addGridCars(int count);
@@ -102,7 +105,10 @@ class Session {
   std::optional<sim::Track> design_;  // --ble --track: the layout the real cars are on
   Fleet fleet_;
   std::unique_ptr<Recorder> recorder_;
-  Subscription recording_;                 // the fleet's frames into recorder_ (--record)
+  Subscription recording_;     // the fleet's frames into recorder_ (--record)
+  std::string raceKey_;        // the phase and title of the race last recorded
+  double raceWritten_ = -1e9;  // when (loop seconds)
+  bool raceTooLong_ = false;
   std::unique_ptr<ble::Central> central_;  // real cars; after the fleet: its links live there
   std::unique_ptr<Reloader> scripts_;
   // MQTT (docs/mqtt.md): the client, and either remote cars (--mqtt) or the bridge

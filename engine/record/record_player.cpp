@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 
+#include "engine/protocol/anki/codec.hpp"
+
 namespace pitwall {
 
 namespace {
@@ -159,8 +161,22 @@ void RecordPlayer::deliverNext() {
   const RecordedFrame f = std::move(*next_);
   const double time = nextTime_;
   readNext();
+  if (f.car == 0) {  // the race as it was at that time
+    if (onRace) {
+      delivering_ = time;
+      onRace(f.race);
+      delivering_.reset();
+    }
+    return;
+  }
   auto c = cars_.find(f.car);  // a car the summary did not see: the file changed since
-  if (f.tx || c == cars_.end()) return;
+  if (c == cars_.end()) return;
+  if (f.tx) {  // what the run sent: told, never sent again
+    if (onSent) {
+      if (auto decoded = anki::decode(f.bytes)) onSent(*c->second.car, *decoded);
+    }
+    return;
+  }
   caught_ = time;
   delivering_ = time;
   c->second.link->deliver(f.bytes);

@@ -16,6 +16,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "engine/core/loop.hpp"
@@ -62,6 +63,11 @@ class RecordPlayer {
   std::function<void()> onEnd;
   // Before frames are delivered again from the start: forget what the frames taught.
   std::function<void()> onRewind;
+  // A race line of the record at its time (JSON text of pitwall.view.race's table, or "null").
+  std::function<void(const std::string& race)> onRace;
+  // A frame the run sent to a car, decoded, at its time (the feed learns what the cars were
+  // told: a car told to stop shows 0 once silent).
+  std::function<void(AnkiCar& car, const anki::Message& message)> onSent;
 
  private:
   void deliverUpTo(double position);

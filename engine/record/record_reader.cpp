@@ -141,6 +141,14 @@ std::variant<RecordedFrame, std::string> parseRecordLine(std::string_view line, 
     return "\"t\" " + shown(*t) + " goes back in time (the frame before was at " +
            shown(json(lastTime)) + ")";
 
+  // The race as the race library reported it (pitwall.view.race), for a replay's view: kept as
+  // its text, never read here (the page reads it as it reads a live race's).
+  if (auto race = j.find("race"); race != j.end() && j.find("car") == j.end()) {
+    if (!race->is_object() && !race->is_null()) return "\"race\" is not an object: " + shown(*race);
+    frame.race = race->dump(-1, ' ', false, json::error_handler_t::replace);
+    return frame;
+  }
+
   auto car = j.find("car");
   if (car == j.end()) return std::string("no \"car\" (the car's number)");
   const bool inRange =
@@ -283,6 +291,10 @@ Record readRecord(std::istream& in) {
   Record record;
   RecordStream stream(in, std::numeric_limits<std::size_t>::max());
   while (auto frame = stream.next()) {
+    if (frame->car == 0) {
+      record.races.push_back(std::move(*frame));
+      continue;
+    }
     if (!frame->name.empty()) record.names.emplace(frame->car, frame->name);
     if (record.layout.empty()) record.layout = frame->layout;
     record.frames.push_back(std::move(*frame));
@@ -295,8 +307,12 @@ RecordSummary scanRecord(std::istream& in) {
   RecordSummary summary;
   RecordStream stream(in, summary.bad.keep);
   while (auto frame = stream.next()) {
-    ++summary.frames;
     summary.duration = std::max(summary.duration, frame->t);
+    if (frame->car == 0) {  // a race line: no car's
+      ++summary.raceLines;
+      continue;
+    }
+    ++summary.frames;
     summary.framesOut[frame->car] += frame->tx ? 1 : 0;
     if (!frame->name.empty()) summary.names.emplace(frame->car, frame->name);
     if (summary.layout.empty()) summary.layout = std::move(frame->layout);

@@ -2,6 +2,7 @@
 // Reading a `--record` file back (docs/cli.md "Record format", engine/record/recorder.hpp): one
 // JSON object per line, {"t":…,"car":N,"dir":"rx"|"tx","hex":"…","msg":{…}}. Only t, car, dir
 // and hex are read: the frame is decoded again by whoever replays it, so "msg" is never trusted.
+// A line {"t":…,"race":{…}} is the race as the run's race library reported it, for the view.
 //
 // The file may be cut short (a killed run), edited or hostile: a line that is not a frame is
 // set aside with its number and why, and the rest is read. Nothing in a line can crash the
@@ -21,7 +22,7 @@ namespace pitwall {
 
 struct RecordedFrame {
   double t = 0;  // engine seconds of the recorded run
-  int car = 0;   // the recording's car number, 1..kMaxRecordedCar
+  int car = 0;   // the recording's car number, 1..kMaxRecordedCar; 0: a race line (below)
   bool tx = false;
   std::vector<std::uint8_t> bytes;
   std::size_t line = 0;  // 1-based line number in the file
@@ -29,6 +30,9 @@ struct RecordedFrame {
   // (empty when the line has none, or one that is no string of a sensible length).
   std::string name;
   std::string layout;
+  // A line {"t":…,"race":{…}} (car 0, no bytes): the race as the race library reported it at t
+  // (pitwall.view.race; "null" when it ended), as JSON text for a replay's view.
+  std::string race;
 };
 
 struct BadLine {
@@ -51,6 +55,7 @@ struct BadLines {
 struct Record {
   std::vector<RecordedFrame> frames;  // in file order; times never go backwards by more than
                                       // kBackwardsSlack
+  std::vector<RecordedFrame> races;   // the race lines (car 0), in file order
   std::vector<BadLine> bad;           // every one
   std::map<int, std::string> names;   // the cars' names, where the record keeps them
   std::string layout;                 // the track's layout text; empty: the record keeps none
@@ -60,7 +65,8 @@ struct Record {
 // these (memory does not grow with the record's length).
 struct RecordSummary {
   std::size_t frames = 0;
-  double duration = 0;  // the last frame's time (the latest of all)
+  std::size_t raceLines = 0;  // lines of the race (car 0), not counted in frames
+  double duration = 0;        // the last line's time (the latest of all)
   BadLines bad;
   std::map<int, std::string> names;        // as in Record
   std::map<int, std::uint64_t> framesOut;  // every recorded car's number: its tx frames

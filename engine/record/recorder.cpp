@@ -15,6 +15,7 @@
 #include "engine/core/hex.hpp"
 #include "engine/core/log.hpp"
 #include "engine/protocol/anki/message_json.hpp"
+#include "engine/record/record_reader.hpp"
 
 namespace pitwall {
 
@@ -158,9 +159,24 @@ void Recorder::write(double t, int car, bool tx, std::span<const std::uint8_t> f
   line.append(",\"dir\":\"").append(tx ? "tx" : "rx").append("\",\"hex\":\"");
   line.append(toHex(frame)).append("\",\"msg\":").append(anki::toJson(message).dump());
   line.append(extra).append("}\n");
+  append(line);
+}
+
+bool Recorder::writeRace(double t, std::string_view race) {
+  char stamp[32];
+  std::snprintf(stamp, sizeof stamp, "%.6f", t);
+  std::string line;
+  line.reserve(race.size() + 32);
+  line.append("{\"t\":").append(stamp).append(",\"race\":").append(race).append("}\n");
+  if (line.size() - 1 > kMaxLineBytes) return false;
+  append(line);
+  return true;
+}
+
+void Recorder::append(const std::string& line) {
   ++lines_;
   if (used_ + line.size() > kCapacity) flush();
-  if (line.size() > kCapacity) {  // never: a frame is at most 20 bytes
+  if (line.size() > kCapacity) {  // never: a frame is at most 20 bytes, a race line 64 KiB
     if (fd_ < 0)
       early_.append(line);
     else if (!failed_)

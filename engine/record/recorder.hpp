@@ -37,6 +37,10 @@ class Recorder {
   // "carName", the record's first line the "layout": docs/cli.md "Record format").
   void write(double t, int car, bool tx, std::span<const std::uint8_t> frame,
              const anki::Message& message, std::string_view extra = {});
+  // A race line, {"t":…,"race":RACE} (docs/cli.md "Record format"): `race` is JSON text, an
+  // object or null. One over kMaxLineBytes of a record is not written (a replay could not read
+  // it); false then.
+  bool writeRace(double t, std::string_view race);
   // Everything written so far reaches the file.
   void flush();
   std::size_t lines() const { return lines_; }
@@ -51,6 +55,7 @@ class Recorder {
   std::chrono::steady_clock::time_point lastFlush_;
   bool failed_ = false;
   std::string early_;  // lines kept before open()
+  void append(const std::string& line);
 };
 
 }  // namespace pitwall

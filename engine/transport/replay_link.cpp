@@ -12,7 +12,11 @@ ReplayLink::ReplayLink(std::string label) : label_(std::move(label)) {}
 void ReplayLink::connect() {
   if (connected_) return;
   connected_ = true;
+  // what the controller sends every car it connects (SDK mode, the version and battery asked)
+  // is no news in a replay: said at debug, not once per car before the table
+  handshake_ = true;
   deliverState(true, "");
+  handshake_ = false;
 }
 
 void ReplayLink::disconnect() {
@@ -34,7 +38,8 @@ bool ReplayLink::send(std::span<const std::uint8_t> frame) {
   } else {
     text = "frame " + toHex(frame);
   }
-  log::info(label_, text + " not sent: a replay");
+  log::write(handshake_ ? log::Level::Debug : log::Level::Info, label_,
+             text + " not sent: a replay");
   return true;
 }
 

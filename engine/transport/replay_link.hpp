@@ -2,7 +2,8 @@
 // The link of a replayed car (pitwall replay, docs/view.md "Replays"): its frames come from a
 // record, delivered by the player at their recorded times; what the controller side sends goes
 // nowhere. A command (a script's, the stop at the end of the run) is logged at info as not sent,
-// so a post-mortem run shows what the script would have done.
+// so a post-mortem run shows what the script would have done; the greeting every connected car
+// gets (SDK mode, version and battery asked) at debug.
 #include <string>
 
 #include "engine/transport/link.hpp"
@@ -26,6 +27,7 @@ class ReplayLink : public Link {
  private:
   std::string label_;
   bool connected_ = false;
+  bool handshake_ = false;  // while connect() reports the car: the controller's greeting
 };
 
 }  // namespace pitwall

@@ -26,9 +26,14 @@ double round3(double v) {
 }
 }  // namespace
 
+constexpr double kStandAfter = 0.5;  // s without a speed report after a command of speed 0
+
 struct Feed::Car {
   CarTracker tracker;
   std::deque<std::pair<double, int>> speeds;  // (time, mm/s)
+  int commanded = -1;      // the last speed sent to the car (mm/s); -1: none seen (a replay)
+  double reportedAt = -1;  // feed time of its last report of its speed
+  bool standing = false;   // as settle() last found it
 };
 
 Feed::Feed(Loop& loop, Fleet& fleet, std::string source)
@@ -87,8 +92,12 @@ const CarTracker* Feed::tracker(int number) const {
   return it == cars_.end() ? nullptr : &it->second->tracker;
 }
 
+void Feed::sent(AnkiCar& ankiCar, const anki::Message& m) {
+  if (auto* set = std::get_if<anki::SetSpeed>(&m)) car(ankiCar).commanded = set->speed_mm_s;
+}
+
 void Feed::frame(AnkiCar& ankiCar, AnkiCar::Direction d, const anki::Message& m) {
-  if (d != AnkiCar::Direction::Rx) return;
+  if (d != AnkiCar::Direction::Rx) return sent(ankiCar, m);
   const bool moves = std::holds_alternative<anki::PositionUpdate>(m) ||
                      std::holds_alternative<anki::TransitionUpdate>(m) ||
                      std::holds_alternative<anki::Delocalized>(m) ||
@@ -101,10 +110,28 @@ void Feed::frame(AnkiCar& ankiCar, AnkiCar::Direction d, const anki::Message& m)
                          ? ankiCar.state().last_position_time
                          : this->now();
   c.tracker.update(m, ankiCar.state(), now);
+  if (std::holds_alternative<anki::PositionUpdate>(m) ||
+      std::holds_alternative<anki::SpeedUpdate>(m)) {
+    c.reportedAt = now;
+    c.standing = false;  // it says its speed again (until then a standing car stays at 0)
+  }
   if (c.speeds.empty() || now - c.speeds.back().first >= kHistoryStep) {
     c.speeds.emplace_back(now, ankiCar.state().speed_mm_s);
     while (!c.speeds.empty() && c.speeds.front().first < now - kHistorySeconds)
       c.speeds.pop_front();
+  }
+}
+
+bool Feed::stands(const Car& c) const {
+  return c.commanded == 0 && (c.reportedAt < 0 || now() - c.reportedAt > kStandAfter);
+}
+
+void Feed::settle() {
+  for (auto& [number, c] : cars_) {
+    if (c->standing || !stands(*c)) continue;
+    c->standing = true;
+    ++changes_;
+    c->speeds.emplace_back(now(), 0);  // the speed chart comes down to 0
   }
 }
 
@@ -132,9 +159,15 @@ void Feed::setRace(nlohmann::json race) {
   ++changes_;
   if (!after.empty() && after != before) {
     auto title = race_.find("title");
-    event("info", (title != race_.end() && title->is_string() ? title->get<std::string>()
-                                                              : std::string("race")) +
-                      ": " + after);
+    std::string text = (title != race_.end() && title->is_string() ? title->get<std::string>()
+                                                                   : std::string("race")) +
+                       ": " + after;
+    // a replay that moved back reports the same phases at the same times again: said once
+    const double t = now();
+    const bool said = std::any_of(events_.begin(), events_.end(), [&](const Event& e) {
+      return e.text == text && std::abs(e.t - t) < 1e-6;
+    });
+    if (!said) event("info", text);
   }
 }
 
@@ -191,6 +224,7 @@ nlohmann::json Feed::carJson(const AnkiCar& ankiCar, std::size_t laps) const {
       {"bestLap", nullptr},
   };
   if (!c) return j;
+  if (c->standing) j["speed"] = 0;
   const CarTracker& t = c->tracker;
   j["lap"] = t.laps();
   // the latest `laps` of them: a long session's list does not grow every update

@@ -72,6 +72,13 @@ class Feed {
   // The time the feed stamps and shows, in seconds; unset: the loop's. A replay sets its
   // position in the record, so laps are timed in the record's time at any playback speed.
   void setClock(std::function<double()> seconds) { clock_ = std::move(seconds); }
+  // Cars told to stop fall silent, so their last reported speed would stay on the page: a car
+  // whose last command was speed 0 and that has reported no speed for half a second is shown
+  // at 0 from then on, until it reports its speed again (the rule of AnkiCar::standing). Called
+  // before updates are made; counts a change when a car comes to stand.
+  void settle();
+  // A command to a car the fleet did not send: a replay's recorded one (what the run sent).
+  void sent(AnkiCar& car, const anki::Message& m);
   // Forgets every car's tracker and speed history (a replay moving backwards replays the frames
   // from the start); the track, the race, the events stay.
   void reset();
@@ -84,6 +91,7 @@ class Feed {
   Car& car(AnkiCar& car);
   void frame(AnkiCar& car, AnkiCar::Direction d, const anki::Message& m);
   nlohmann::json carJson(const AnkiCar& car, std::size_t laps) const;
+  bool stands(const Car& c) const;
   nlohmann::json carsJson(bool history) const;
   nlohmann::json seatsJson() const;
 

@@ -133,6 +133,7 @@ struct Server::Impl::Socket : std::enable_shared_from_this<Socket> {
     ws.read_message_max(kMaxIncoming);
     ws.async_accept(request, [self = shared_from_this()](beast::error_code ec) {
       if (ec) return self->close();
+      self->server->feed.settle();
       nlohmann::json state = self->server->feed.state();
       self->cursor = self->server->feed.eventCursor();
       self->trackSeen = self->server->feed.trackVersion();
@@ -186,6 +187,7 @@ struct Server::Impl::Socket : std::enable_shared_from_this<Socket> {
 
   void send() {
     if (auto answer = page.nextAnswer()) return write(std::move(*answer));
+    server->feed.settle();
     const Feed& feed = server->feed;
     bool unchanged = feed.changes() == lastChanges && feed.eventCursor() == cursor &&
                      feed.trackVersion() == trackSeen;
@@ -348,10 +350,12 @@ struct Server::Impl::Http : std::enable_shared_from_this<Http> {
     if (req.method() != http::verb::get && req.method() != http::verb::head)
       return text(req, http::status::method_not_allowed, "text/plain",
                   "only GET: the view is read-only\n");
-    if (target == "/api/state" || target.starts_with("/api/state?"))
+    if (target == "/api/state" || target.starts_with("/api/state?")) {
+      server->feed.settle();
       return text(
           req, http::status::ok, "application/json",
           server->feed.state().dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
+    }
     // the controller page (docs/view.md "The controller page"): a short address for a phone
     if (target == "/drive" || target.starts_with("/drive?")) target = "/drive.html";
     auto path = assetPath(server->options.assets, target);

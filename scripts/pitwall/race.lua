@@ -622,6 +622,7 @@ end
 function Race:_cut()
   self.phase, self.state, self.cut = "done", "done", true
   self:_standings(pitwall.now())
+  self:_viewNow()
   pitwall.log("warn", string.format("race: the run ended before the %s did: the standings when "
     .. "it ended are its results", self.title))
   if self.board then
@@ -706,6 +707,7 @@ function Race:_race()
   if path == nil then path = pitwall.resultsFile end
   if path then self.resultsPath = pitwall.writeResults(self:results(), race.columns, path) end
   self.phase = "done"
+  self:_viewNow()
   self:_emit("onEnd", self)
   return self
 end

@@ -164,12 +164,13 @@ end
 -- After its driver's update: a car being freed drives at least the nudge speed (the safety
 -- limit still wins).
 -- A car that reports a contact (0x4d, side 0) while racing with a car reckoned within
--- CONTACT_NEAR mm: said in the log and the view's event log — "skull ran into nuke" when nuke
+-- CONTACT_NEAR mm in an overlapping lane: said in the log and the view's event log — "skull ran into nuke" when nuke
 -- is ahead, else "contact: skull and nuke" — once per pair within CONTACT_QUIET s (both cars
 -- report the same contact). A report with no car near is none: real cars at speed send one at
 -- many piece boundaries (docs/simulator.md), and so does the simulator's real sensor model.
 local CONTACT_NEAR = 300  -- mm
 local CONTACT_QUIET = 3   -- s
+local CONTACT_LANE = 40   -- mm between two cars' lane offsets at most (the lanes are 45 apart)
 function Marshal:_contact(e, ev)
   if self.state ~= "racing" or ev.side ~= 0 then return end
   local L = self.map:lapLength(0)
@@ -178,7 +179,9 @@ function Marshal:_contact(e, ev)
   if mine then
     for _, o in ipairs(self.order) do
       local d = o ~= e and o.loc:distance()
-      if d then
+      -- (only a car in an overlapping lane: side by side on the grid is no contact)
+      local lane = math.abs((o.car.offset or 0) - (e.car.offset or 0))
+      if d and lane < CONTACT_LANE then
         local gap = (d - mine) % L
         local near = math.min(gap, L - gap)
         if near <= CONTACT_NEAR and (not best or near < best) then

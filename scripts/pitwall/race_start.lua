@@ -63,7 +63,11 @@ function Start:_toGrid()
     if left > 0 then pitwall.sleep(left) end
     return
   end
-  pitwall.log("info", string.format("race: %d car(s) to the grid", #moving))
+  local names = {}
+  for _, e in ipairs(moving) do names[#names + 1] = e.car.name end
+  local waiting = #self.order - #moving
+  pitwall.log("info", string.format("race: to the grid: %s%s", table.concat(names, ", "),
+    waiting > 0 and string.format(" (%d on it already)", waiting) or ""))
   -- A car's lane is known once it reports a position on the way (one that was put somewhere
   -- by hand has not reported where): then it is given the free lane nearest to its own.
   local began = pitwall.now()

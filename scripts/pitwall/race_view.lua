@@ -1,6 +1,8 @@
 -- The race as the race view shows it (docs/view.md "race"): a session reports its phase, its
--- table and every lap to pitwall.view ten times a second while it runs. Without --view,
--- pitwall.view.active is false and nothing is built. Methods mixed into Race (race.lua).
+-- table and every lap to pitwall.view ten times a second while it runs — to the view (--view)
+-- and to the record (--record), which a replay shows as it was. Without either,
+-- pitwall.view.active and pitwall.view.recording are false and nothing is built. Methods mixed
+-- into Race (race.lua).
 local View = {}
 
 -- The publishers of this version's sessions (a timer is no data to carry across a reload: the
@@ -54,7 +56,8 @@ end
 
 --- Starts reporting this session to the view (once per session and version).
 function View:_viewStart()
-  if not (pitwall.view and pitwall.view.active) or publishers[self] then return end
+  local view = pitwall.view
+  if not (view and (view.active or view.recording)) or publishers[self] then return end
   local failed = false
   local function publish()
     local ok, err = pcall(function() pitwall.view.race(self:_viewState()) end)
@@ -70,12 +73,21 @@ function View:_viewStart()
     publish()
     if self.phase == "done" then timer:cancel() end
   end)
-  publishers[self] = timer
+  publishers[self] = { timer = timer, publish = publish }
+end
+
+--- Reports the session now (its end: a run may stop before the next tick).
+function View:_viewNow()
+  local p = publishers[self]
+  if p then
+    p.publish()
+    if self.phase == "done" then p.timer:cancel() end
+  end
 end
 
 --- The map the session races on, drawn by the view (a simulator's layout stays).
 function View:_viewMap()
-  if self.map and pitwall.view and pitwall.view.active then
+  if self.map and pitwall.view and pitwall.view.active then -- (a replay has its --track)
     pcall(pitwall.view.track, self.map)
   end
 end

@@ -20,6 +20,7 @@
 #include "bindings/script_host.hpp"
 #include "engine/fleet/fleet.hpp"
 #include "engine/protocol/anki/codec.hpp"
+#include "tests/bench/cpu_clock.hpp"
 #include "tests/bench/frames.hpp"
 
 namespace {
@@ -271,17 +272,7 @@ void BM_FrameToLuaFloor(benchmark::State& state) {
 }
 BENCHMARK(BM_FrameToLuaFloor);
 
-// This thread's CPU time: blocks timed with it do not count time the thread spent preempted
-// (the benchmark machines are shared; see docs/performance.md).
-struct ThreadCpuClock {
-  using duration = std::chrono::nanoseconds;
-  using time_point = std::chrono::time_point<ThreadCpuClock>;
-  static time_point now() {
-    timespec ts{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return time_point(std::chrono::seconds(ts.tv_sec) + std::chrono::nanoseconds(ts.tv_nsec));
-  }
-};
+using bench::ThreadCpuClock;
 
 // Path and floor interleaved in blocks within one benchmark, so that both see the same machine
 // state (frequency, caches, noisy neighbours), each block timed in thread CPU time. Reports

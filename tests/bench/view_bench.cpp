@@ -24,6 +24,7 @@
 #include "engine/fleet/fleet.hpp"
 #include "engine/sim/track.hpp"
 #include "engine/view/server.hpp"
+#include "tests/bench/cpu_clock.hpp"
 #include "tests/bench/frames.hpp"
 
 namespace {
@@ -162,5 +163,48 @@ void BM_FrameToLuaViewNoBrowser(benchmark::State& state) {
   frameToLua(state, true, 0, 0);
 }
 BENCHMARK(BM_FrameToLuaViewNoBrowser)->MinTime(1.0);
+
+// What --view costs a frame when nobody watches, as a ratio measured in one run: the path with
+// the feed (view_ns) and without it (floor_ns), interleaved in blocks of 512 frames, each timed
+// in this thread's CPU time, so that both see the same machine (issue 35: ≤ 1.2×).
+void BM_FrameToLuaViewRatio(benchmark::State& state) {
+  using Clock = bench::ThreadCpuClock;
+  constexpr int kBlock = 512;
+  Rig view(true, 0, 0);
+  Rig floor(false, 0, 0);
+  if (!view.error.empty() || !floor.error.empty()) {
+    state.SkipWithError(!view.error.empty() ? view.error.c_str() : floor.error.c_str());
+    return;
+  }
+  anki::Frame frame = positionFrame();
+  std::uint8_t location = 0;
+  Clock::duration viewTime{}, floorTime{};
+  for (auto _ : state) {
+    auto t0 = Clock::now();
+    for (int i = 0; i < kBlock; ++i) {
+      frame.bytes[kLocationByte] = location++;
+      view.car.receive(frame.span());
+      if ((location & 63) == 0) view.loop.io().poll();
+    }
+    auto t1 = Clock::now();
+    for (int i = 0; i < kBlock; ++i) {
+      frame.bytes[kLocationByte] = location++;
+      floor.car.receive(frame.span());
+      if ((location & 63) == 0) floor.loop.io().poll();
+    }
+    auto t2 = Clock::now();
+    viewTime += t1 - t0;
+    floorTime += t2 - t1;
+  }
+  if (view.host->errorCount() > 0 || floor.host->errorCount() > 0)
+    state.SkipWithError("the Lua handler raised an error");
+  const double events = static_cast<double>(state.iterations()) * kBlock;
+  const double viewNs = std::chrono::duration<double, std::nano>(viewTime).count() / events;
+  const double floorNs = std::chrono::duration<double, std::nano>(floorTime).count() / events;
+  state.counters["view_ns"] = viewNs;
+  state.counters["floor_ns"] = floorNs;
+  state.counters["ratio"] = viewNs / floorNs;
+}
+BENCHMARK(BM_FrameToLuaViewRatio)->MinTime(2.0);
 
 }  // namespace

@@ -32,6 +32,12 @@ contains "the car still drives" "moving=true" "$out"
 out=$($PITWALL run "$TMP/runaway.lua" --cars 1 --budget 0.4 2>&1)
 contains "--budget sets it" "still running after 400 ms" "$out"
 
+# A main chunk that waits by spinning is a task already: the hint is to pause, not to spawn.
+printf 'local t = pitwall.now()\nwhile pitwall.now() < t + 1 do end\n' > "$TMP/spin.lua"
+err=$($PITWALL run "$TMP/spin.lua" --cars 1 2>&1 >/dev/null)
+contains "a spinning task is told to pause" "without a pause: interrupted (a task must give the loop its turn: call pitwall.sleep or pitwall.waitUntil" "$err"
+case "$err" in *pitwall.spawn*) fail "the hint for a task names pitwall.spawn: [$err]" ;; *) echo "ok: no pitwall.spawn for a task" ;; esac
+
 err=$($PITWALL run "$TMP/runaway.lua" --budget -1 2>&1 >/dev/null); rc=$?
 check "a negative budget is refused" 2 "$rc"
 

@@ -39,7 +39,10 @@ check "the replay's laps agree with the race's" "agree 4" "$agree"
 
 table=$($PITWALL replay "$TMP/r.jsonl" 2>/dev/null)
 check "without options: the table, a row per car" 5 "$(echo "$table" | wc -l | tr -d ' ')"
-contains "the table's header" "CAR   LAPS      BEST      LAST       IN      OUT MALFORMED" "$table"
+contains "the table's header" "CAR  NAME              LAPS      BEST      LAST       IN      OUT MALFORMED" "$table"
+contains "the cars by the names the record keeps" "1    groundshock" "$table"
+check "no \"not sent\" line for the greeting every car gets when it connects" 0 \
+  "$($PITWALL replay "$TMP/r.jsonl" 2>&1 | grep -c 'not sent')"
 
 # A corrupt copy: a garbage line in the middle (line 101), the last line cut in half.
 lines=$(wc -l <"$TMP/r.jsonl")
@@ -112,7 +115,7 @@ check "--script: exit status" 0 "$?"
 # (the car by the name its first line in the record carries)
 first=$($PY -c '
 import json, sys
-lines = [json.loads(l) for l in open(sys.argv[1])]
+lines = [l for l in map(json.loads, open(sys.argv[1])) if "car" in l]  # (frames, not the race)
 names = {}
 for l in lines:
     names.setdefault(l["car"], l.get("carName"))
@@ -155,7 +158,7 @@ $PITWALL replay "$TMP/r.jsonl" --view 127.0.0.1:0 --speed 5 2>"$TMP/view.err" &
 viewer=$!
 if wait_for "$TMP/view.err" "^view: http://127.0.0.1:[0-9]+/"; then
   url=$(grep -oE -m1 'http://127.0.0.1:[0-9]+/' "$TMP/view.err")
-  result=$(timeout 60 $PY - "$url" <<'PY'
+  result=$(timeout 60 $PY - "$url" "$TMP/r.jsonl" <<'PY'
 import json, sys, time, urllib.request
 import websocket  # Debian's python3-websocket
 base = sys.argv[1]
@@ -195,12 +198,44 @@ ws.send(json.dumps({"type": "control", "seek": 30}))
 again = until(lambda m: abs(m["replay"]["position"] - 30) < 1e-3, "seek to 30 again")
 assert [c["lapTimes"] for c in again["cars"]] == [c["lapTimes"] for c in at30["cars"]], "not the same"
 assert [c["framesIn"] for c in again["cars"]] == [c["framesIn"] for c in at30["cars"]]
-ws.send(json.dumps({"type": "control", "pause": False, "speed": 2}))
-until(lambda m: m["replay"]["position"] > 30.01 and m["replay"]["speed"] == 2, "play on")
-print("ok", laps(at2), laps(at30))
+# The race as it was (the record keeps the race library's lines): at the first line of each
+# phase, that phase, the title and the drivers; at the end the race's own laps, 3 per car, not
+# the scan and grid laps the cars' trackers count too.
+races = [j for j in map(json.loads, open(sys.argv[2])) if "race" in j and "car" not in j]
+first = {}
+for line in races:
+    r = line["race"]
+    if r and r.get("phase") not in first:
+        first[r["phase"]] = line["t"]
+assert list(first) == ["scan", "grid", "lights", "racing", "ending", "done"], list(first)
+ws.send(json.dumps({"type": "control", "pause": True}))
+for phase, t in first.items():
+    ws.send(json.dumps({"type": "control", "seek": t + 0.0005}))
+    m = until(lambda m: abs(m["replay"]["position"] - (t + 0.0005)) < 1e-3, "seek to " + phase)
+    r = m["race"]
+    assert r and r["phase"] == phase and r["title"] == "Grand prix, 3 laps", (phase, r and r.get("phase"))
+    if phase in ("racing", "ending", "done"):
+        assert sorted(row["driver"] for row in r["rows"]) == ["cruiser", "follower", "lanekeeper", "overtaker"], r["rows"]
+        gaps = [row["gap"] for row in r["rows"] if row.get("gap") is not None]
+        assert gaps == sorted(gaps), gaps
+assert all(len(times) == 3 for times in r["lapTimes"].values()), r["lapTimes"]
+assert any(c["lap"] > 3 for c in m["cars"]), "the trackers count the scan and grid laps too"
+print("ok", laps(at2), laps(at30), " ".join(first))
 PY
 )
   contains "the view plays, pauses and seeks the record" "ok " "$result"
+  contains "the replay's view shows the race's phases" "scan grid lights racing ending done" "$result"
+  # the page itself at the end, paused there: the podium over the track, its title, the winner
+  # (and a test artefact: ./view_test_artifacts/replay-done.png)
+  chrome=(timeout 60 "${CHROMIUM:-/usr/bin/chromium}" --headless=new --no-sandbox --disable-gpu
+    --window-size=1600,1000 --virtual-time-budget=5000)
+  dom=$("${chrome[@]}" --dump-dom "$url" 2>/dev/null)
+  contains "the replay's page: the race's title" '<div id="race-title" class="race-title">Grand prix, 3 laps</div>' "$dom"
+  contains "the replay's page: the podium" '<li data-position="1"><span class="place">1</span>' "$dom"
+  mkdir -p view_test_artifacts
+  "${chrome[@]}" --screenshot="$PWD/view_test_artifacts/replay-done.png" "$url" >/dev/null 2>&1
+  [ -s view_test_artifacts/replay-done.png ] && echo "ok: screenshot of the replay" ||
+    fail "no screenshot of the replay"
 else
   fail "replay --view printed no URL: $(cat "$TMP/view.err")"
 fi

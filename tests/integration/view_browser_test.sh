@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # The race view in a real browser (docs/view.md): a grand prix with --view on a free port, the page
 # loaded in headless Chromium and in Firefox ESR (tests/view/browser_check.mjs, puppeteer-core pinned by
-# tests/view/package-lock.json): track, 4 moving cars, leaderboard, charts; then Ctrl-C to the
+# tests/view/package-lock.json): track, 4 moving cars, leaderboard, charts; from the page's first
+# moments to 8 s of racing (--race-start) every car drawn and listed through the scan, the grid
+# and the lights, standing cars at 0 mm/s, the gaps in order on every update; then Ctrl-C to the
 # engine and the open page says "engine gone". Screenshots in ./view_test_artifacts/.
 source "$(dirname "$0")/lib.sh"
 source "$(dirname "$0")/browser_lib.sh"
@@ -35,7 +37,7 @@ in_browser() {
   check "/api/state is the whole state" "state track=oval cars=4" "$state"
 
   timeout -k 5 180 node "$CHECK/browser_check.mjs" "$url" "$ART/view-$name.png" \
-    --expect-cars 4 --kill "$pid" --timeout 40 "$option" "$path" \
+    --expect-cars 4 --race-start --kill "$pid" --timeout 40 "$option" "$path" \
     --restart "$(printf '%q ' "$PITWALL" run "$SRC/examples/grand_prix.lua" --view "$addr")"
   check "$name: browser check exit status" 0 "$?"
 

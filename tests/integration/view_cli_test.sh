@@ -205,4 +205,10 @@ check "repl --view: the REPL's cars in the view" 2 "$cars"
 start_view bridge bridge --mqtt mqtt://127.0.0.1:1 --cars 3 --view 127.0.0.1:0
 cars=$(timeout 10 python3 -c 'import json,sys,urllib.request; print(len(json.load(urllib.request.urlopen(sys.argv[1]+"api/state"))["cars"]))' "$URL")
 check "bridge --view: the bridge's cars in the view" 3 "$cars"
+
+# --fast with --view: run, but said (a browser cannot follow a race in virtual time)
+err=$(LAPS=1 SHOW=0 timeout 60 "$PITWALL" run "$SRC/examples/grand_prix.lua" --fast --cars 2 \
+  --view 127.0.0.1:0 2>&1 >/dev/null); rc=$?
+check "--fast --view: runs" 0 "$rc"
+contains "--fast --view: said" "--view with --fast: the race runs faster than a browser can follow" "$err"
 finish

@@ -71,7 +71,8 @@ export async function passWhen(page, name, fn, arg) {
 // Headless Chromium at `chromium`, or Firefox ESR at `firefox` (through WebDriver BiDi), with no
 // network but loopback: no updates, no telemetry, no first-run pages. A browser that does not
 // start is a FAIL and exit status 1.
-export async function launch({ chromium, firefox, viewport }) {
+// `allow`: hosts besides loopback that Chromium may resolve (a LAN address of this machine).
+export async function launch({ chromium, firefox, viewport, allow = [] }) {
   try {
     if (firefox) {
       return await puppeteer.launch({
@@ -96,7 +97,8 @@ export async function launch({ chromium, firefox, viewport }) {
         // pages side by side (two phones in one browser): no page's timers slowed as a background tab's
         "--disable-background-timer-throttling", "--disable-renderer-backgrounding",
         "--disable-backgrounding-occluded-windows",
-        "--host-resolver-rules=MAP * ~NOTFOUND, EXCLUDE localhost, EXCLUDE 127.0.0.1",
+        "--host-resolver-rules=MAP * ~NOTFOUND, EXCLUDE localhost, EXCLUDE 127.0.0.1" +
+          allow.map((h) => `, EXCLUDE ${h}`).join(""),
       ],
       defaultViewport: viewport,
       timeout: settings.timeoutMs,

@@ -17,6 +17,8 @@
 //   #events li                      the event log, newest first
 //   #lap-chart, #speed-chart        the uPlot charts
 //   #replay                         replay controls, shown only when `replay` is non-null
+//   #podium                         the first three over the track once the race is done
+//                                   (li[data-position]), hidden before
 //   #drive-link                     the link to the controller page (/drive), shown only when
 //                                   the state has seats (a run with --humans N)
 //   #join, #join-code, #join-url    the join code and the controller page's address with it,
@@ -32,6 +34,8 @@
 const SVG_NS = "http://www.w3.org/2000/svg";
 const EXTRAPOLATE_MAX_S = 0.5;   // never guess further than this past the last position update
 const SPEED_WINDOW_S = 60;
+const SPEED_GAP_S = 2.5;         // more than this between two samples of a car: a gap (the feed
+                                 // sends an update at least every second)
 const EVENTS_MAX = 200;
 
 // ---------------------------------------------------------------------------------------------
@@ -204,9 +208,34 @@ function markerFor(car) {
   return m;
 }
 
+// A car that has not reported a position yet: connected, on the track as far as it says. Real
+// cars report nothing until they move, and before the race they stand on the grid: the page
+// draws them there (gridSpot), not as lost — also in the moment after green before their first
+// report.
+function waiting(c) {
+  return c.x == null && c.positionTime == null && c.connected !== false && !c.delocalized &&
+    c.onTrack !== false;
+}
+
+// Where a waiting car is drawn: behind the finish line in its lane, one car length and a gap
+// apart in the order of the cars' numbers (the grid of docs/racing.md), so no two overlap.
+function gridSpot(car) {
+  const t = view.track;
+  if (!t || !t.pieces || !t.pieces.length) return null;
+  const queue = [...view.cars.values()].filter(waiting).sort((a, b) => a.number - b.number);
+  const k = Math.max(0, queue.indexOf(car));
+  const line = t.pieces.findIndex((p) => p.id === 34);
+  const from = line >= 0 ? line : t.pieces.length - 1;
+  const at = advance(t, from, 1, car.offset || 0, 100 + 170 * k, true);
+  const p = pointOnTrack(t, at.index, at.fraction, car.offset || 0);
+  p.moving = false;
+  return p;
+}
+
 // Where the car is now: its last position update moved on by speed × time since (≤ 0.5 s).
 function targetOf(car, now) {
   const t = view.track;
+  if (waiting(car)) return gridSpot(car);
   if (!t || !t.pieces || !t.pieces.length || car.x == null || car.delocalized || !car.onTrack) {
     return car.x == null ? null : { x: car.x, y: car.y, heading: car.heading || 0, moving: false };
   }
@@ -254,7 +283,8 @@ function frame(ts) {
       }
     }
     m.placed = placed;
-    m.g.classList.toggle("off-track", !placed);
+    m.g.classList.toggle("off-track", !placed && !waiting(car));
+    m.g.classList.toggle("waiting", waiting(car));
     m.g.classList.toggle("disconnected", car.connected === false);
     m.g.classList.toggle("unseen", m.x == null);
     if (m.x != null) {
@@ -264,7 +294,40 @@ function frame(ts) {
       m.g.dataset.y = m.y.toFixed(1);
     }
   }
+  placeLabels();
   requestAnimationFrame(frame);
+}
+
+// Names of cars close together must not cover each other: each name goes above its marker,
+// else below, else further out, the first place free of the names placed before it.
+const LABEL_PLACES = [-52, 88, -100, 136];   // the name's baseline, mm below the marker's centre
+const LABEL_HEIGHT = 44;
+function placeLabels() {
+  const taken = [];
+  const markers = [...view.markers.values()].filter((m) => m.x != null)
+    .sort((a, b) => b.y - a.y || a.x - b.x);
+  for (const m of markers) {
+    const text = m.g.querySelector("text.car-name");
+    if (m.labelText !== text.textContent) {
+      m.labelText = text.textContent;
+      m.labelWidth = (text.getComputedTextLength && text.getComputedTextLength()) ||
+        23 * m.labelText.length;
+    }
+    const w = m.labelWidth + 12;
+    let chosen = LABEL_PLACES[0];
+    for (const dy of LABEL_PLACES) {
+      const box = { l: m.x - w / 2, r: m.x + w / 2, t: -m.y + dy - LABEL_HEIGHT + 8, b: -m.y + dy + 8 };
+      if (!taken.some((o) => box.l < o.r && o.l < box.r && box.t < o.b && o.t < box.b)) {
+        chosen = dy;
+        break;
+      }
+    }
+    taken.push({ l: m.x - w / 2, r: m.x + w / 2, t: -m.y + chosen - LABEL_HEIGHT + 8, b: -m.y + chosen + 8 });
+    if (m.labelY !== chosen) {
+      m.labelY = chosen;
+      text.setAttribute("y", chosen);
+    }
+  }
 }
 
 function syncMarkers() {
@@ -277,7 +340,7 @@ function syncMarkers() {
     m.g.querySelector("text.car-name").textContent = car.name || `car ${car.number}`;
   }
   const why = (c) => (c.connected === false ? "disconnected" : c.delocalized ? "delocalized"
-    : c.onTrack === false ? "off the track" : c.x == null ? "no position yet" : "");
+    : c.onTrack === false ? "off the track" : c.x == null && !waiting(c) ? "no position yet" : "");
   const off = [...view.cars.values()].filter((c) => why(c));
   const el = $("#off-track");
   el.hidden = off.length === 0;
@@ -301,6 +364,12 @@ function boardRows() {
   }));
 }
 
+// The feed's speed of the car (a car told to stop and silent shows 0 there), else the row's.
+function speedOf(r, car) {
+  const v = car.speed ?? r.speed;
+  return v == null ? "–" : Math.round(v);
+}
+
 function renderBoard() {
   const tbody = $("#leaderboard tbody");
   const rows = boardRows();
@@ -316,7 +385,8 @@ function renderBoard() {
     tr.dataset.number = r.number;
     tr.style.setProperty("--car", car.color || "#888");
     tr.classList.toggle("disconnected", car.connected === false);
-    tr.classList.toggle("off-track", car.x == null || !!car.delocalized || car.onTrack === false);
+    tr.classList.toggle("off-track", (car.x == null && !waiting(car)) || !!car.delocalized ||
+      car.onTrack === false);
     tr.classList.toggle("finished", !!r.finished);
     let gap = "–";
     if (r.lapsBehind > 0) gap = `+${r.lapsBehind} lap${r.lapsBehind > 1 ? "s" : ""}`;
@@ -326,7 +396,7 @@ function renderBoard() {
       `<span class="swatch"></span>${escapeHtml(r.car ?? car.name ?? `car ${r.number}`)}`,
       escapeHtml(r.player ? `${r.player} (${r.driver ?? "human"})` : (r.driver ?? "–")),
       r.lap ?? "–", fmtTime(r.lastLap), fmtTime(r.bestLap), gap,
-      r.speed == null ? "–" : Math.round(r.speed), fmtMm(r.lane),
+      speedOf(r, car), fmtMm(r.lane),
     ];
     cells.forEach((c, k) => {
       const td = tr.cells[k];
@@ -344,8 +414,9 @@ function escapeHtml(s) {
 function renderRace() {
   const r = view.race;
   const phase = $("#race-phase");
-  phase.textContent = r ? r.phase || "" : "no race";
-  phase.className = `phase phase-${r ? r.phase : "none"}`;
+  // (a replay of a record without the race's lines: it is a replay, not "no race")
+  phase.textContent = r ? r.phase || "" : view.replay ? "replay" : "no race";
+  phase.className = `phase phase-${r ? r.phase : view.replay ? "replay" : "none"}`;
   $("#race-title").textContent = r ? r.title || "" : "";
   $("#race-status").textContent = r ? r.status || "" : "";
   const lights = $("#race-lights");
@@ -359,7 +430,23 @@ function renderRace() {
     [...lights.children].forEach((el, i) => el.classList.toggle("on", i < on));
   }
   $("#source").textContent = view.source ? `· ${view.source}` : "";
+  renderPodium(r);
   renderReplay();
+}
+
+// Over the track once a race is over: the first three, each with its driver and time (or DNF).
+function renderPodium(r) {
+  const el = $("#podium");
+  const rows = r && r.phase === "done" && Array.isArray(r.rows) ? r.rows.slice(0, 3) : [];
+  el.hidden = rows.length === 0;
+  if (el.hidden) return;
+  const who = (row) => row.player ? `${row.player} in ${row.car}` : `${row.car}${row.driver ? ` (${row.driver})` : ""}`;
+  const time = (row) => row.status && row.status !== "finished" ? row.status
+    : row.totalTime != null ? `${row.totalTime.toFixed(3)} s` : "";
+  const html = `<h3>${escapeHtml(r.title || "Results")}</h3><ol>` + rows.map((row, i) =>
+    `<li data-position="${i + 1}"><span class="place">${i + 1}</span><span class="who">${escapeHtml(who(row))}</span>` +
+    `<span class="time">${escapeHtml(time(row))}</span></li>`).join("") + "</ol>";
+  if (el.innerHTML !== html) el.innerHTML = html;
 }
 
 function addEvents(list, reset) {
@@ -395,7 +482,15 @@ function renderReplay() {
   if (!seeking) seek.value = r.position || 0;
   $("#replay-time").textContent = `${(r.position || 0).toFixed(1)} / ${(r.duration || 0).toFixed(1)} s`;
   const sel = $("#replay-speed");
-  if (document.activeElement !== sel && r.speed != null) sel.value = String(r.speed);
+  if (document.activeElement !== sel && r.speed != null) {
+    // (a speed the menu does not list, --speed 5: listed, in order)
+    if (![...sel.options].some((o) => Number(o.value) === r.speed)) {
+      const o = new Option(`${r.speed}×`, String(r.speed));
+      const after = [...sel.options].find((x) => Number(x.value) > r.speed);
+      sel.add(o, after || null);
+    }
+    sel.value = [...sel.options].find((o) => Number(o.value) === r.speed).value;
+  }
 }
 
 function control(msg) {
@@ -416,8 +511,10 @@ const chartAxes = (xLabel, yLabel, wholeX) => [
   { stroke: "#9aa4b2", grid: { stroke: "#2a313c" }, ticks: { stroke: "#2a313c" }, label: yLabel, size: 60 },
 ];
 
+// (a quarter of the window's height at most, so that the track keeps the most of a screen)
 function chartSize(el) {
-  return { width: Math.max(200, el.clientWidth), height: Math.max(160, Math.min(260, el.clientWidth * 0.42)) };
+  const tall = Math.min(260, Math.max(150, window.innerHeight * 0.24));
+  return { width: Math.max(200, el.clientWidth), height: Math.max(140, Math.min(tall, el.clientWidth * 0.42)) };
 }
 
 function makeChart(el, cars, xLabel, yLabel, xFmt) {
@@ -425,8 +522,10 @@ function makeChart(el, cars, xLabel, yLabel, xFmt) {
   if (typeof uPlot === "undefined") { el.textContent = "charts unavailable (uPlot not loaded)"; return null; }
   const series = [{ label: xLabel, value: (u, v) => (v == null ? "–" : xFmt(v)) }];
   for (const c of cars) {
+    // (undefined: no sample of this car at that time, joined over; null: a gap — a seek in a
+    // replay, a car silent for seconds — where the line breaks)
     series.push({ label: c.name || `car ${c.number}`, stroke: c.color || "#888", width: 2,
-                  spanGaps: true, points: { size: 5 } });
+                  spanGaps: false, points: { size: 5 } });
   }
   const opts = { ...chartSize(el), series, axes: chartAxes(xLabel, yLabel, xLabel === "lap"),
                  scales: { x: { time: false } }, legend: { live: false }, cursor: { drag: { x: false, y: false } } };
@@ -453,8 +552,9 @@ function renderCharts() {
   // Lap times: x = lap number. The race's table has every lap of its session; a car's own list
   // (no race: a replay, a spectator) holds its latest laps, the first of them lap lapTimesFrom.
   const laps = cars.map((c) => {
+    // (a record keeps each car's latest 100 race laps: lapTimesFrom numbers the first)
     const fromRace = view.race && view.race.lapTimes && view.race.lapTimes[String(c.number)];
-    if (fromRace) return { from: 1, times: fromRace };
+    if (fromRace) return { from: (view.race.lapTimesFrom || {})[String(c.number)] || 1, times: fromRace };
     return { from: c.lapTimesFrom || 1, times: c.lapTimes || [] };
   });
   const first = Math.min(Infinity, ...laps.filter((l) => l.times.length).map((l) => l.from));
@@ -469,7 +569,7 @@ function renderCharts() {
   const times = [...new Set(hist.flatMap((h) => h.map((s) => s[0])))].sort((a, b) => a - b);
   const col = new Map(times.map((t, i) => [t, i]));
   const ys = hist.map((h) => {
-    const y = new Array(times.length).fill(null);
+    const y = new Array(times.length).fill(undefined);
     for (const [t, v] of h) y[col.get(t)] = v;
     return y;
   });
@@ -486,7 +586,11 @@ function recordSpeed(car, t) {
   if (car.speed == null) return;
   let h = view.speeds.get(car.number);
   if (!h) view.speeds.set(car.number, (h = []));
+  // back in time (a replay moved back): what lies after now is forgotten
+  while (h.length && h[h.length - 1][0] > t + 0.5) h.pop();
   if (h.length && t - h[h.length - 1][0] < 0.1) return;  // at most 10 samples a second
+  // a jump ahead (a seek, or no update for seconds): the line breaks there, it does not join
+  if (h.length && t - h[h.length - 1][0] > SPEED_GAP_S) h.push([(h[h.length - 1][0] + t) / 2, null]);
   h.push([t, car.speed]);
   while (h.length && h[0][0] < t - SPEED_WINDOW_S) h.shift();
 }
@@ -510,7 +614,14 @@ function onState(s) {
   view.time = s.time || 0;
   view.receivedAt = performance.now();
   view.speeds = new Map();
-  for (const c of s.cars || []) view.speeds.set(c.number, (c.speedHistory || []).map((p) => [p[0], p[1]]));
+  for (const c of s.cars || []) {
+    const h = [];
+    for (const [t, v] of c.speedHistory || []) {
+      if (h.length && t - h[h.length - 1][0] > SPEED_GAP_S) h.push([(h[h.length - 1][0] + t) / 2, null]);
+      h.push([t, v]);
+    }
+    view.speeds.set(c.number, h);
+  }
   view.lapKey = view.speedKey = "";
   drawTrack();
   syncMarkers();

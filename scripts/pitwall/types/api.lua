@@ -177,6 +177,7 @@ function Stdout:flush() end
     doc = [[What the race view shows (docs/view.md); without --view the calls do nothing visible.]],
     fields = {
       active = { "boolean", "true when the run serves the race view (--view)" },
+      recording = { "boolean", "true when the run keeps a record (--record): pitwall.view.race goes into it too, for a replay's view" },
     },
     functions = {
       race = [[The race's state for the view: a table of plain data (at most 16 deep), or nil for none.

@@ -211,3 +211,28 @@ TEST_CASE("view feed: a long session's updates carry the latest laps, not all of
   CHECK(text.contains("track"));
   CHECK_FALSE(nlohmann::json::parse(r.feed->updateText(cursor, seen)).contains("track"));
 }
+
+TEST_CASE(
+    "view feed: a car told to stop is shown at 0 mm/s once it falls silent, in the chart too") {
+  Race r;
+  auto& car = r.driving(600, 2000);
+  r.run(3);
+  r.feed->settle();
+  CHECK(r.feed->state()["cars"][0]["speed"].get<int>() > 400);
+  REQUIRE(car.setSpeed(0, 3000));
+  r.run(2);  // stopped, and silent since (a real car reports nothing while it stands)
+  CHECK(car.state().speed_mm_s > 0);  // the last report, kept by the model
+  const auto changes = r.feed->changes();
+  r.feed->settle();
+  CHECK(r.feed->changes() > changes);  // an update is due
+  auto stopped = r.feed->state()["cars"][0];
+  CHECK(stopped["speed"] == 0);
+  CHECK(stopped["speedHistory"].back()[1] == 0);
+  std::uint64_t cursor = 0, seen = 0;
+  CHECK(nlohmann::json::parse(r.feed->updateText(cursor, seen))["cars"][0]["speed"] == 0);
+  // driving again: its reported speed
+  REQUIRE(car.setSpeed(700, 2000));
+  r.run(2);
+  r.feed->settle();
+  CHECK(r.feed->state()["cars"][0]["speed"].get<int>() > 400);
+}
