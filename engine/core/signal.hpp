@@ -109,8 +109,11 @@ class Signal {
       }
     } done{*list};
     for (std::size_t i = 0; i < n; ++i) {
-      std::shared_ptr<Entry> entry = list->slots[i];  // lives through its call
-      if (entry->live) entry->fn(args...);
+      // Lives through its call without a count of its own (no atomic pair per slot and emit):
+      // entries are destroyed only by compact(), never while an emit runs, and a slot connected
+      // meanwhile may move the vector of pointers, not the entry.
+      Entry& entry = *list->slots[i];
+      if (entry.live) entry.fn(args...);
     }
   }
 

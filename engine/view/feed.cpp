@@ -74,16 +74,25 @@ void Feed::followLog(bool on) {
 }
 
 Feed::Car& Feed::car(AnkiCar& car) {
-  auto& slot = cars_[car.identity().number];
+  // frames come in runs from one car (cars_ is by number: a car made anew at the same address
+  // with the same number has the same slot)
+  const int number = car.identity().number;
+  if (&car == lastAnki_ && number == lastNumber_) return *lastCar_;
+  auto& slot = cars_[number];
   if (!slot) {
     slot = std::make_unique<Car>();
     slot->tracker.setTrack(track_ ? &*track_ : nullptr);
   }
+  lastAnki_ = &car;
+  lastNumber_ = number;
+  lastCar_ = slot.get();
   return *slot;
 }
 
 void Feed::reset() {
   cars_.clear();
+  lastAnki_ = nullptr;
+  lastCar_ = nullptr;
   ++changes_;
 }
 

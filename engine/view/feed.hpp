@@ -115,6 +115,9 @@ class Feed {
   std::deque<Event> events_;
   std::uint64_t nextEvent_ = 0;
   std::map<int, std::unique_ptr<Car>> cars_;
+  const AnkiCar* lastAnki_ = nullptr;  // the car of the last car() and its Car: one lookup fewer
+  int lastNumber_ = 0;
+  Car* lastCar_ = nullptr;
   Subscription framesSub_, connectionSub_;  // the fleet's events, while the feed lives
   drive::Seats* seats_ = nullptr;
   Subscription seatsSub_, askedSub_;  // the seats' changes, and their holders' asks

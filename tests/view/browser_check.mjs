@@ -189,6 +189,18 @@ try {
   await page.screenshot({ path: screenshot, fullPage: true });
   pass("screenshot written", screenshot);
 
+  // The page on a phone (390×844): the leaderboard fits the screen's width, none of it cut.
+  await page.setViewport({ width: 390, height: 844, deviceScaleFactor: 1 });
+  if (await waitFor(page, "the leaderboard fits a phone's width", () => {
+    const panel = document.querySelector(".board-panel"), table = document.querySelector("#leaderboard");
+    return panel && table && table.getBoundingClientRect().right <= panel.getBoundingClientRect().right + 1 &&
+      document.documentElement.scrollWidth <= window.innerWidth + 1;
+  })) pass("the leaderboard fits a phone's width");
+  const phone = screenshot.replace(/(\.png)?$/i, "-phone.png");
+  await page.screenshot({ path: phone, fullPage: true });
+  pass("screenshot written", phone);
+  await page.setViewport({ width: 1600, height: 1000, deviceScaleFactor: 1 });
+
   if (opts.kill != null) {
     try {
       process.kill(opts.kill, "SIGINT");
