@@ -73,6 +73,21 @@ std::optional<Kind> kindOf(lua_State* L) {
 
 // The first Lua function from `level` of `thread`: the one whose call failed (a failed call may
 // leave a frame of the called value above it, "[C]: in method 'x'").
+// Lua's sentence `says` in `message` ("attempt to call a nil value (field '") and the name it
+// quotes: where the sentence begins, where the quote ends (past "')"), the name.
+struct Quoted {
+  std::size_t at, end;
+  std::string name;
+};
+std::optional<Quoted> luaSays(const std::string& message, std::string_view says) {
+  const auto at = message.find(says);
+  if (at == std::string::npos) return std::nullopt;
+  const auto nameStart = at + says.size();
+  const auto nameEnd = message.find("')", nameStart);
+  if (nameEnd == std::string::npos) return std::nullopt;
+  return Quoted{at, nameEnd + 2, message.substr(nameStart, nameEnd - nameStart)};
+}
+
 bool failedFunction(lua_State* thread, int level, lua_Debug& ar) {
   for (;; ++level) {
     if (!lua_getstack(thread, level, &ar)) return false;
@@ -139,12 +154,10 @@ std::vector<Library> libraries(lua_State* L) {
 
 std::optional<std::string> explainMissingFunction(lua_State* thread, int level,
                                                   const std::string& message) {
-  const auto at = message.find(kLuaSaysField);
-  if (at == std::string::npos) return std::nullopt;
-  const auto nameStart = at + kLuaSaysField.size();
-  const auto nameEnd = message.find("')", nameStart);
-  if (nameEnd == std::string::npos) return std::nullopt;
-  const std::string field = message.substr(nameStart, nameEnd - nameStart);
+  auto said = luaSays(message, kLuaSaysField);
+  if (!said) return std::nullopt;
+  const auto at = said->at;
+  const std::string& field = said->name;
   lua_Debug ar;
   if (!failedFunction(thread, level, ar) || !lua_checkstack(thread, 80)) return std::nullopt;
   const int base = lua_gettop(thread);
@@ -239,7 +252,7 @@ std::optional<std::string> explainMissingFunction(lua_State* thread, int level,
           ? tables[0] + " has no function " + field + "; did you mean " + suggestions[0] + "?"
           : "neither " + either(tables, " nor ") + " has a function " + field + "; did you mean " +
                 either(suggestions, " or ") + "?";
-  return message.substr(0, at) + sentence + message.substr(nameEnd + 2);
+  return message.substr(0, at) + sentence + message.substr(said->end);
 }
 
 std::optional<std::string> explainMissingName(lua_State* thread, int level,
@@ -251,23 +264,15 @@ std::optional<std::string> explainMissingName(lua_State* thread, int level,
 
 std::optional<std::string> explainMissingMethod(lua_State* thread, int level,
                                                 const std::string& message) {
-  const auto at = message.find(kLuaSays);
-  if (at == std::string::npos) return std::nullopt;
-  const auto nameStart = at + kLuaSays.size();
-  const auto nameEnd = message.find("')", nameStart);
-  if (nameEnd == std::string::npos) return std::nullopt;
-  const std::string method = message.substr(nameStart, nameEnd - nameStart);
+  auto said = luaSays(message, kLuaSays);
+  if (!said) return std::nullopt;
+  const auto at = said->at;
+  const std::string& method = said->name;
 
   // The Lua function that made the call: the first Lua frame from `level` (a failed call may
   // leave a frame of the called value above it, "[C]: in method 'x'").
   lua_Debug ar;
-  for (;; ++level) {
-    if (!lua_getstack(thread, level, &ar)) return std::nullopt;
-    if (!lua_getinfo(thread, "S", &ar)) return std::nullopt;
-    if (ar.what[0] != 'C') break;
-    if (level > 8) return std::nullopt;
-  }
-  if (!lua_checkstack(thread, 4)) return std::nullopt;
+  if (!failedFunction(thread, level, ar) || !lua_checkstack(thread, 4)) return std::nullopt;
   // Candidates: a nil temporary (the method's register) followed by an object with methods
   // (its `self`); pending arguments of an outer call may form such pairs too. A type that has the
   // method is never named; of the others, the first whose type has a method near the name wins,
@@ -297,7 +302,7 @@ std::optional<std::string> explainMissingMethod(lua_State* thread, int level,
   if (!chosen) return std::nullopt;
   std::string sentence = chosen->name + " has no method " + method;
   if (suggestion) sentence += "; did you mean " + *suggestion + "?";
-  return message.substr(0, at) + sentence + message.substr(nameEnd + 2);
+  return message.substr(0, at) + sentence + message.substr(said->end);
 }
 
 }  // namespace pitwall::lua

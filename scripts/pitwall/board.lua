@@ -21,23 +21,24 @@ local Board = {}
 Board.__index = Board
 Board.__name = "board" -- (how errors name it: "board has no method …")
 
+-- (nil, NaN and infinity are no time; whole minutes and the seconds left)
+local function noTime(seconds) return seconds == nil or seconds ~= seconds or seconds == math.huge end
+local function minutes(seconds)
+  local m = math.floor(seconds / 60)
+  return m, seconds - 60 * m
+end
+
 --- "1:02.345" from seconds (minutes only from a minute on: "4.125"); "-" for nil.
 function Board.time(seconds)
-  if seconds == nil or seconds ~= seconds or seconds == math.huge then return "-" end
-  if seconds >= 60 then
-    local minutes = math.floor(seconds / 60)
-    return string.format("%d:%06.3f", minutes, seconds - 60 * minutes)
-  end
+  if noTime(seconds) then return "-" end
+  if seconds >= 60 then return string.format("%d:%06.3f", minutes(seconds)) end
   return string.format("%.3f", seconds)
 end
 
 --- A duration with its unit: "9.215 s", "1 min 2.345 s"; "-" for nil.
 function Board.duration(seconds)
-  if seconds == nil or seconds ~= seconds or seconds == math.huge then return "-" end
-  if seconds >= 60 then
-    local minutes = math.floor(seconds / 60)
-    return string.format("%d min %.3f s", minutes, seconds - 60 * minutes)
-  end
+  if noTime(seconds) then return "-" end
+  if seconds >= 60 then return string.format("%d min %.3f s", minutes(seconds)) end
   return string.format("%.3f s", seconds)
 end
 

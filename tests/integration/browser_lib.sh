@@ -66,6 +66,14 @@ await_view() {
   echo "ok: view at $url${2:+ ($2)}"
 }
 
+# await_code STDERR: until a run on 0.0.0.0 prints its join code ("view: join code 123456: …", at
+# most 20 s); then $code is the code and $port the view's port. False when it never came.
+await_code() {
+  wait_for "$1" '^view: join code [0-9]{6}: ' 20 || return 1
+  code=$(grep -oE '^view: join code [0-9]{6}' "$1" | head -1 | grep -oE '[0-9]{6}$')
+  port=$(grep -oE '^view: http://0\.0\.0\.0:[0-9]+/' "$1" | head -1 | grep -oE '[0-9]+/$' | tr -d /)
+}
+
 # await_end NAME SECONDS STATUS: until $pid ends (at most SECONDS), then checks its exit status is
 # STATUS and forgets $pid; a FAIL when it still runs.
 await_end() {

@@ -43,9 +43,7 @@ show_if_failed "pitwall's stderr" "$TMP/err"
 "$PITWALL" run "$SRC/tests/view/drive_race.lua" --view 0.0.0.0:0 --humans 2 --cars 2 \
   --duration 300 > "$TMP/pair.out" 2> "$TMP/pair.err" &
 pid=$!
-if wait_for "$TMP/pair.err" '^view: join code [0-9]{6}: ' 20; then
-  code=$(grep -oE '^view: join code [0-9]{6}' "$TMP/pair.err" | head -1 | grep -oE '[0-9]{6}$')
-  port=$(grep -oE '^view: http://0\.0\.0\.0:[0-9]+/' "$TMP/pair.err" | head -1 | grep -oE '[0-9]+/$' | tr -d /)
+if await_code "$TMP/pair.err"; then
   contains "the drive line carries the code" "/drive?code=$code (cars 1..2" "$(cat "$TMP/pair.err")"
   timeout -k 5 240 node "$CHECK/drive_check.mjs" "http://127.0.0.1:$port/" --code "$code" \
     --timeout 30 --chromium "$CHROMIUM" --artifacts "$ART"

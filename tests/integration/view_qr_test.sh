@@ -14,9 +14,7 @@ artifacts 'qr*.png'
 "$PITWALL" run "$SRC/tests/view/drive_race.lua" --view 0.0.0.0:0 --humans 2 --cars 2 \
   --duration 300 > "$TMP/out" 2> "$TMP/err" &
 pid=$!
-if wait_for "$TMP/err" '^view: join code [0-9]{6}: ' 20; then
-  code=$(grep -oE '^view: join code [0-9]{6}' "$TMP/err" | head -1 | grep -oE '[0-9]{6}$')
-  port=$(grep -oE '^view: http://0\.0\.0\.0:[0-9]+/' "$TMP/err" | head -1 | grep -oE '[0-9]+/$' | tr -d /)
+if await_code "$TMP/err"; then
   lan=$(grep -oE "phones open http://[^ ]+/drive\?code=$code" "$TMP/err" | head -1 | sed 's/^phones open //')
   case "$lan" in
     http://127.*|http://localhost*|http://0.0.0.0*|"") fail "the terminal's address for phones is no LAN address: [$lan]" ;;
