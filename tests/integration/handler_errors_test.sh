@@ -21,7 +21,7 @@ after_stop() {
 import json, sys
 frames = [json.loads(l) for l in open(sys.argv[1])]
 tx = [(f["car"], f["msg"].get("speed_mm_s")) for f in frames
-      if f["dir"] == "tx" and f["msg"]["name"] == "set-speed"]
+      if f.get("dir") == "tx" and f["msg"]["name"] == "set-speed"]
 stop = next(i for i, (car, speed) in enumerate(tx) if car == 2 and speed == 0)
 later = tx[stop + 1:]
 print("car 2 sent a speed above 0 after its stop:", any(c == 2 and s > 0 for c, s in later))

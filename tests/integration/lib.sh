@@ -42,7 +42,7 @@ import json, sys
 last = {}
 for line in open(sys.argv[1]):
     r = json.loads(line)
-    if r["dir"] == "tx":
+    if r.get("dir") == "tx":  # (a race's own lines in a record have no "dir")
         last[r["car"]] = r["msg"]
 for car in sorted(last):
     m = last[car]

@@ -23,6 +23,9 @@ seen = set()
 with open(src) as f, open(dst, "w") as out:
     for line in f:
         frame = json.loads(line)
+        if "hex" not in frame:  # the race's own lines (docs/cli.md "Record format"): kept
+            out.write(line)
+            continue
         if not keep_layout:
             frame.pop("layout", None)
         b = bytes.fromhex(frame["hex"])
