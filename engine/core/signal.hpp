@@ -74,6 +74,11 @@ class Signal {
   using Slot = std::function<void(Args...)>;
 
   Signal() = default;
+  // Destroyed by one of its own slots during an emit: the list lives on until that emit (the
+  // outermost) returns, so the emit needs no count of its own on the list.
+  ~Signal() {
+    if (list_->emitting > 0) list_->self = list_;
+  }
   Signal(const Signal&) = delete;
   Signal& operator=(const Signal&) = delete;
 
@@ -99,13 +104,17 @@ class Signal {
 
  private:
   [[gnu::noinline]] void emitToSlots(Args... args) const {
-    std::shared_ptr<List> list = list_;  // a slot may destroy the signal
+    // A slot may destroy the signal: then the list keeps itself (~Signal) until this emit ends,
+    // and no atomic count pair is paid on every emit to guard against it.
+    List* list = list_.get();
     const std::size_t n = list->slots.size();
     ++list->emitting;
     struct Done {
       List& list;
       ~Done() {
-        if (--list.emitting == 0 && list.dirty) list.compact();
+        if (--list.emitting > 0) return;
+        if (list.dirty) list.compact();
+        if (list.self) auto last = std::move(list.self);  // the signal is gone: so is the list
       }
     } done{*list};
     for (std::size_t i = 0; i < n; ++i) {
@@ -128,6 +137,7 @@ class Signal {
     std::uint64_t nextId = 1;
     int emitting = 0;
     bool dirty = false;
+    std::shared_ptr<List> self;  // set by ~Signal during an emit, released when it ends
 
     void drop(std::uint64_t id) override {
       for (auto it = slots.begin(); it != slots.end(); ++it) {

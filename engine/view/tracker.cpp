@@ -70,20 +70,24 @@ void CarTracker::update(const anki::Message& message, const CarState& state, dou
         !crossedSinceStartPiece_)
       crossFinish(now);
     if (p->piece_id == anki::kFinishBefore) crossedSinceStartPiece_ = false;
-    const bool placing = !index_ && currentPieceId() < 0;
-    lastPieceId_ = p->piece_id;
-    index_ = locate(p->piece_id, reverse);
-    if (placing && index_ && !reverse) placeEarlierTransitions();
-    unplaced_.clear();
-    // The piece as the track has it (a custom one's shape), else Anki's stock piece of that id.
-    sim::Piece piece{p->piece_id, anki::pieceType(p->piece_id),
-                     anki::pieceType(p->piece_id) == anki::PieceType::Curve ? 1 : 0};
-    long key = 1000000L + p->piece_id;  // (a stock piece: its id; a curve is a left one here)
-    if (track_ && index_) {
-      piece = track_->pieces()[*index_];
-      key = static_cast<long>(*index_);
+    // most reports are from the piece the map has the car on already: no search
+    if (!(track_ && index_ && track_->pieces()[*index_].id == p->piece_id)) {
+      const bool placing = !index_ && currentPieceId() < 0;
+      index_ = locate(p->piece_id, reverse);
+      if (placing && index_ && !reverse) placeEarlierTransitions();
+      unplaced_.clear();
     }
-    fraction_ = codeFraction(piece, key, p->location_id);
+    lastPieceId_ = p->piece_id;
+    // The piece as the track has it (a custom one's shape), else Anki's stock piece of that id.
+    if (track_ && index_) {
+      fraction_ =
+          codeFraction(track_->pieces()[*index_], static_cast<long>(*index_), p->location_id);
+    } else {
+      const anki::PieceType type = anki::pieceType(p->piece_id);
+      const sim::Piece stock{p->piece_id, type, type == anki::PieceType::Curve ? 1 : 0};
+      // (a stock piece's key: its id; a curve is a left one here)
+      fraction_ = codeFraction(stock, 1000000L + p->piece_id, p->location_id);
+    }
     positionTime_ = now;
     // on the start piece: the next transition is the line, whatever the count said
     if (p->piece_id == anki::kFinishBefore && !reverse && lapPieces_ && sinceLine_)

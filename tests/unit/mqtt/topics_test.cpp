@@ -256,7 +256,7 @@ TEST_CASE("mqtt topics: the reading side splits topics and reads status payloads
   CHECK_FALSE(splitTopic("Anki/Boat/x/S"));
   CHECK_FALSE(splitTopic("pitwall/sync/1"));
 
-  CarInfo info{kCar, "E8:5A:0F:11:22:33", 0x12345678, 9, 0xBEEF, "skull"};
+  CarInfo info{kCar, "E8:5A:0F:11:22:33", 0x12345678, 9, 0xBEEF, "skull", false, ""};
   auto joined = carJoined(info, CarState{}, kNow);
   auto read = readInformation(kCar, joined[0].payload);
   REQUIRE(read);
