@@ -142,6 +142,16 @@ Central::Central(Loop& loop, Fleet& fleet, CentralOptions options)
           if (error) log::warn("ble", *error);
         });
   };
+  // a controller unplugged and plugged back (or powered off and on): its cars that vanished with
+  // it are looked for on it again
+  bluez_->onAdapterReady = [this](const std::string& path) {
+    auto it = queues_.find(path);
+    if (it == queues_.end() || it->second.discoverers == 0 || shuttingDown_) return;
+    log::info("ble", path.substr(path.rfind('/') + 1) + " is back: looking for its cars");
+    bluez_->startDiscovery(path, [](std::optional<std::string> error) {
+      if (error) log::warn("ble", *error);
+    });
+  };
   bluez_->onValue = [this](const std::string& charPath, const std::vector<std::uint8_t>& v) {
     for (auto& c : cars_)
       if (c->link->notifyPath() == charPath) return c->link->value(v);

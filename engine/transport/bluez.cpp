@@ -214,6 +214,7 @@ Bluez::Bluez(Loop& loop) : loop_(loop), alive_(std::make_shared<bool>(true)) {
             if (iface != kDeviceIface) Tree::apply(*this, path, iface, props, {}, true);
           if (auto it = ifaces.find(kDeviceIface); it != ifaces.end())
             Tree::apply(*this, path, it->first, it->second, {}, true);
+          if (ifaces.count(kAdapterIface) && onAdapterReady) onAdapterReady(path);
         } else if (msg.getMemberName() == "InterfacesRemoved") {
           std::vector<std::string> ifaces;
           msg >> ifaces;
@@ -229,6 +230,9 @@ Bluez::Bluez(Loop& loop) : loop_(loop), alive_(std::make_shared<bool>(true)) {
         std::vector<std::string> invalidated;
         msg >> iface >> changed >> invalidated;
         Tree::apply(*this, msg.getPath(), iface, changed, invalidated, true);
+        if (iface == kAdapterIface && onAdapterReady)
+          if (auto it = changed.find("Powered"); it != changed.end())
+            if (auto on = take<bool>(it->second); on && *on) onAdapterReady(msg.getPath());
       });
   signals_->owner = connection_->addMatch(
       "type='signal',sender='org.freedesktop.DBus',interface='org.freedesktop.DBus',"

@@ -112,6 +112,8 @@ class Bluez {
   // org.bluez is back on the bus (bluetoothd restarted) and its tree has been read again. When
   // it left, every device was reported removed through onDeviceRemoved.
   std::function<void()> onBluezBack;
+  // A controller that can scan again: plugged in (its Adapter1 object added) or powered on.
+  std::function<void(const std::string& adapterPath)> onAdapterReady;
 
  private:
   struct Signals;      // the signal subscriptions (sdbus slots and the proxy of "/")

@@ -113,9 +113,9 @@ local MODES = { practice = "Free practice", qualifying = "Qualifying", laps = "R
 -- Every option a session takes (docs/racing.md "Options"): any other key is a typo.
 race.options = { "mode", "laps", "minutes", "seconds", "cars", "map", "scan", "drivers", "grid",
   "lights", "lightInterval", "hold", "falseStartPenalty", "safety", "cooldown", "finishTimeout",
-  "period", "gridSpeed", "gridTimeout", "board", "title", "redraw", "results", "marshal",
-  "searchSpeed", "onLap", "onFinish", "onPositionChange", "onFalseStart", "onLights", "onSlowLap",
-  "onThrown", "onEnd" }
+  "reconnectTimeout", "period", "gridSpeed", "gridTimeout", "board", "title", "redraw", "results",
+  "marshal", "searchSpeed", "onLap", "onFinish", "onPositionChange", "onFalseStart", "onLights",
+  "onSlowLap", "onThrown", "onEnd" }
 
 local function report(where, err)
   if pitwall._reportError then pitwall._reportError(where, err)
@@ -419,8 +419,18 @@ function Race:_tick()
     self.board.title = status ~= "" and self.title .. "   " .. status or self.title
     self.board:show(self:_rows())
   end
+  -- Over when every car finished, or is away longer than reconnectTimeout (a link that drops,
+  -- even every car's at once as when bluetoothd restarts, comes back: docs/bluetooth.md)
   local all = true
-  for _, e in ipairs(self.order) do if not e.finished and e.car.connected then all = false end end
+  local away = self.options.reconnectTimeout or 30
+  for _, e in ipairs(self.order) do
+    if e.car.connected then
+      e.awaySince = nil
+    else
+      e.awaySince = e.awaySince or now
+    end
+    if not e.finished and (e.car.connected or now - e.awaySince < away) then all = false end
+  end
   local grace = self.options.finishTimeout or 60
   local since = self.leaderFinished or self.timeUp
   if all or (since and now - since > grace) then self.done = true end

@@ -370,6 +370,7 @@ local function scan(car, options, drive)
   end
   local subs = {
     pitwall.listen(car, "onPosition", function(_, ev)
+      st.finding = nil
       reckon(ev.time)
       st.lastSpeed = ev.speed
       st.reversed = ev.reverse
@@ -396,7 +397,20 @@ local function scan(car, options, drive)
       end
       st.cur = newSegment(ev.time, true)
     end),
-    pitwall.listen(car, "onDelocalized", function() st.delocalized = true end),
+    pitwall.listen(car, "onDelocalized", function()
+      if not st.finding then st.delocalized = true end
+    end),
+    -- A car stops when its link drops (a real car does, and so does the simulator's): the scan
+    -- goes on where it was once the car is back, and a driving scan sets its speed again (a car
+    -- that rebooted comes back delocalized: it finds the track as it drives).
+    pitwall.listen(car, "onDisconnect", function()
+      reckon(pitwall.now())
+      st.lastSpeed = 0
+    end),
+    pitwall.listen(car, "onConnect", function()
+      st.finding = true -- until its first position: a car that rebooted is not on the map yet
+      if drive and st.phase == "lap" then pcall(car.setSpeed, car, speed, 1000) end
+    end),
   }
   local function cancel()
     for _, s in ipairs(subs) do s:cancel() end

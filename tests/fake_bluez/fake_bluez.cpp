@@ -49,7 +49,8 @@ FakeBluez::State::State(Loop& loop_, sdbus::IConnection& connection, Options opt
   world = std::make_unique<sim::World>(loop, std::move(track.value()), options.seed);
   auto sensor = sim::sensorModelNamed(options.sensor);
   if (!sensor)
-    throw std::invalid_argument("sensor model '" + options.sensor + "': use real, ideal or transitions");
+    throw std::invalid_argument("sensor model '" + options.sensor +
+                                "': use real, ideal or transitions");
   world->setSensor(*sensor);
 
   for (int i = 0; i < options.adapters; ++i) {
@@ -417,6 +418,7 @@ void FakeBluez::State::advertise(Device& d) {
   Adapter& a = *d.adapter;
   // A connected car does not advertise; a vanished one never again.
   if (!a.discovering || !a.powered || d.vanished || d.connected) return;
+  if (d.car && !d.car->connectable()) return;  // rebooting
   std::uniform_int_distribution<int> jitter(-12, 12);
   auto rssi = static_cast<std::int16_t>(d.baseRssi + jitter(rng));
   auto manufacturer = d.car ? d.car->manufacturerData() : std::vector<std::uint8_t>{};
@@ -610,31 +612,120 @@ bool FakeBluez::State::inject(Device& d, std::span<const std::uint8_t> bytes) {
   return toClient(d, bytes);
 }
 
-void FakeBluez::State::arm(Device& d, Fault fault, Duration delay) {
-  Duration wait = std::max(Duration::zero(), *d.firstConnect + delay - loop.now());
+void FakeBluez::State::arm(Device& d, const Device::Scheduled& f) {
+  Duration wait = std::max(Duration::zero(), *d.firstConnect + f.after - loop.now());
   Device* dp = &d;
-  after(wait, [this, dp, fault] {
-    switch (fault) {
+  // A fault that lasts: its flag is set now and cleared after `lasting`.
+  auto window = [this, dp, f](bool Device::*flag, const char* what) {
+    dp->*flag = true;
+    log::debug(kComponent, dp->address + ": " + what + " for " +
+                               std::to_string(toSeconds(f.lasting)) + " s (fault)");
+    after(f.lasting, [this, dp, flag] {
+      dp->*flag = false;
+      // a write socket that was not read: read what waits in it now
+      if (flag == &Device::writesHang && dp->writeChar && dp->writeChar->writeIo)
+        watchWriteIo(*dp, *dp->writeChar);
+    });
+  };
+  after(wait, [this, dp, f, window] {
+    switch (f.fault) {
       case Fault::Drop:
         drop(*dp);
         break;
+      case Fault::Burst:
+        drop(*dp);
+        for (int k = 1; k <= 2; ++k) after(k * 1500ms, [this, dp] { drop(*dp); });
+        break;
       case Fault::Vanish:
         vanish(*dp);
+        break;
+      case Fault::Reboot:
+        if (!dp->car) {
+          drop(*dp);
+          break;
+        }
+        log::debug(kComponent, dp->address + ": reboots (fault)");
+        if (dp->connecting) failConnect(*dp, kConnectionAborted);
+        dp->car->reboot(f.lasting);  // the car drops the link itself (linkUp's onDropped)
+        break;
+      case Fault::Mute:
+        window(&Device::muted, "notifications lost");
+        break;
+      case Fault::WriteFail:
+        window(&Device::writesFail, "writes fail");
+        if (dp->writeChar) closeWriteIo(*dp->writeChar);
+        break;
+      case Fault::WriteHang:
+        window(&Device::writesHang, "writes hang");
         break;
       case Fault::Garbage:
         if (dp->robot) {
           // Malformed SENSOR answers: degree 511, and 1 byte of 5.
           auto* sensor =
               dp->robotChars[static_cast<std::size_t>(alphabot::ble::Characteristic::Sensor)].get();
-          for (const auto& f :
+          for (const auto& frame :
                std::vector<std::vector<std::uint8_t>>{{0x81, 0xff, 0, 0, 0}, {0x81}})
-            if (dp->connected) notify(*dp, sensor, f);
+            if (dp->connected) notify(*dp, sensor, frame);
           break;
         }
-        for (const auto& f : FakeBluez::garbageFrames()) inject(*dp, f);
+        for (const auto& frame : FakeBluez::garbageFrames()) inject(*dp, frame);
         break;
     }
   });
+}
+
+// The controller leaves: its links end (the cars stop), its devices and itself leave the bus.
+void FakeBluez::State::unplug(Adapter& a) {
+  if (!a.plugged) return;
+  log::debug(kComponent, a.path + ": unplugged (fault)");
+  for (auto& d : devices) {
+    if (d->adapter != &a) continue;
+    if (d->connecting) failConnect(*d, kConnectionAborted);
+    linkDown(*d, true);
+    unexportDevice(*d);
+  }
+  if (a.discovering) stopScan(a);
+  a.clients.clear();
+  a.plugged = false;
+  if (a.object) a.object->emitInterfacesRemovedSignal();
+  a.object.reset();
+}
+
+void FakeBluez::State::plugBack(Adapter& a) {
+  if (a.plugged || !running) return;
+  log::debug(kComponent, a.path + ": plugged back (fault)");
+  a.plugged = true;
+  exportAdapter(a);
+  a.object->emitInterfacesAddedSignal();
+}
+
+// bluetoothd stops: its connections end with it and its objects go with its name.
+void FakeBluez::State::stopBluez() {
+  if (!running) return;
+  log::debug(kComponent, "bluetoothd stops (fault)");
+  for (auto& d : devices) {
+    if (d->connecting) failConnect(*d, kConnectionAborted);
+    linkDown(*d, true);
+    d->object.reset();  // no signal: the process that owned it is gone
+    d->alias.clear();
+    d->trusted = d->blocked = false;
+  }
+  for (auto& a : adapters) {
+    if (a->discovering) stopScan(*a);
+    a->clients.clear();
+    a->object.reset();
+  }
+  running = false;
+  conn.releaseName("org.bluez");
+}
+
+void FakeBluez::State::startBluez() {
+  if (running) return;
+  log::debug(kComponent, "bluetoothd starts again (fault)");
+  running = true;
+  for (auto& a : adapters)
+    if (a->plugged) exportAdapter(*a);
+  conn.requestName("org.bluez");  // a client reads the tree when it sees the name come back
 }
 
 // ---- FakeBluez ----
@@ -713,10 +804,23 @@ void FakeBluez::inject(std::string_view address, alphabot::ble::Characteristic c
   auto& ch = d.robotChars[static_cast<std::size_t>(characteristic)];
   if (state_->notify(d, ch.get(), bytes)) state_->pump.kick();
 }
-void FakeBluez::schedule(Fault fault, std::string_view address, Duration after) {
+void FakeBluez::schedule(Fault fault, std::string_view address, Duration after, Duration lasting) {
   Device& d = state_->device(address);
-  d.scheduled.emplace_back(fault, after);
-  if (d.firstConnect) state_->arm(d, fault, after);
+  d.scheduled.push_back({fault, after, lasting});
+  if (d.firstConnect) state_->arm(d, d.scheduled.back());
+}
+void FakeBluez::unplug(int adapter, Duration after, Duration lasting) {
+  Adapter* a = state_->adapters.at(static_cast<std::size_t>(adapter)).get();
+  state_->after(after, [this, a, lasting] {
+    state_->unplug(*a);
+    state_->after(lasting, [this, a] { state_->plugBack(*a); });
+  });
+}
+void FakeBluez::restart(Duration after, Duration lasting) {
+  state_->after(after, [this, lasting] {
+    state_->stopBluez();
+    state_->after(lasting, [this] { state_->startBluez(); });
+  });
 }
 
 std::vector<std::vector<std::uint8_t>> FakeBluez::garbageFrames() {

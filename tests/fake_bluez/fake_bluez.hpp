@@ -54,7 +54,17 @@ class FakeBluez {
  public:
   using Options = FakeBluezOptions;
   using Counters = FakeBluezCounters;
-  enum class Fault { Drop, Vanish, Garbage };
+  // A device's faults (a time after its first connection, and for how long where it lasts):
+  //   Drop       the link drops; the device stays known (and connectable)
+  //   Burst      three drops, 1.5 s apart
+  //   Vanish     the link drops and the device is gone for good
+  //   Garbage    malformed frames (garbageFrames)
+  //   Reboot     the car resets (sim::World::Vehicle::reboot): the link drops, the car stops,
+  //              leaves SDK mode and its place on the map, and is not connectable for `lasting`
+  //   Mute       its notifications are lost for `lasting` (the link stays up)
+  //   WriteFail  the write socket closes, and writes (WriteValue, AcquireWrite) fail for `lasting`
+  //   WriteHang  the write socket is not read for `lasting` (what was written arrives late)
+  enum class Fault { Drop, Burst, Vanish, Garbage, Reboot, Mute, WriteFail, WriteHang };
 
   // Exports the adapters, then requests the name org.bluez on `connection` (unless the
   // connection already owns it). Throws std::invalid_argument for bad options (unknown track,
@@ -87,7 +97,14 @@ class FakeBluez {
               std::span<const std::uint8_t> bytes);
   // A fault `after` the device's first successful Connect (at once if that time has passed).
   // Garbage sends garbageFrames().
-  void schedule(Fault fault, std::string_view address, Duration after);
+  void schedule(Fault fault, std::string_view address, Duration after, Duration lasting = {});
+  // The controller hciN is unplugged: its connections end and its objects leave the bus; it is
+  // plugged back after `lasting` (a new object, found by InterfacesAdded). `after`: since now.
+  void unplug(int adapter, Duration after, Duration lasting);
+  // bluetoothd restarts: every connection ends, org.bluez leaves the bus with every object, and
+  // is back after `lasting` with the adapters (devices reappear as they advertise). `after`: since
+  // now.
+  void restart(Duration after, Duration lasting);
   // Malformed Anki frames: a size byte larger than the frame, a 1-byte frame, an unknown id.
   static std::vector<std::vector<std::uint8_t>> garbageFrames();
 

@@ -209,6 +209,7 @@ void FakeBluez::State::writeValue(Device& d, Characteristic& ch,
   if (request && !ch.writeRequest)
     throw notPermitted("Write not permitted");  // the car's ATT error
   if (!request && value.size() > kMtu - 3u) throw failed("Failed to initiate write");
+  if (d.writesFail) throw failed("Failed to initiate write");
   toDevice(d, ch, value);
 }
 
@@ -220,6 +221,7 @@ std::tuple<sdbus::UnixFd, std::uint16_t> FakeBluez::State::acquire(Device& d, Ch
   if (write) {
     if (ch.writeIo) throw notPermitted("Write acquired");
     if (!ch.writeCommand) throw notSupported();
+    if (d.writesFail) throw failed("Failed to acquire write");
   } else {
     if (ch.notifyIo) throw notPermitted("Notify acquired");
     if (!ch.notifySessions.empty()) throw inProgress();
@@ -230,6 +232,7 @@ std::tuple<sdbus::UnixFd, std::uint16_t> FakeBluez::State::acquire(Device& d, Ch
     throw failed(std::strerror(errno));
   if (write) {
     ch.writeIo = std::make_unique<Io>(loop.io(), fds[0]);
+    ch.writeWatched = false;  // (a wait on a closed socket before never ran to its end)
     watchWriteIo(d, ch);
     emit(ch.object.get(), api::kGattCharacteristic, {"WriteAcquired"});
   } else {
@@ -267,9 +270,13 @@ void FakeBluez::State::watchWriteIo(Device& d, Characteristic& ch) {
   std::weak_ptr<int> token = ch.writeIo->token;
   Device* dp = &d;
   Characteristic* cp = &ch;
+  if (ch.writeWatched) return;
+  ch.writeWatched = true;
   ch.writeIo->fd.async_wait(boost::asio::posix::stream_descriptor::wait_read,
                             [this, dp, cp, token](const boost::system::error_code& ec) {
                               if (token.expired() || ec) return;
+                              cp->writeWatched = false;
+                              if (dp->writesHang) return;  // read again when the hang ends
                               std::uint8_t buf[512];
                               for (;;) {
                                 ssize_t n = ::recv(cp->writeIo->fd.native_handle(), buf, sizeof buf,
@@ -343,6 +350,10 @@ void FakeBluez::State::finishConnect(Device& d) {
     log::debug(kComponent, d.address + ": connection refused (fault)");
     return failConnect(d, kConnectionAborted);
   }
+  if (d.car && !d.car->connectable()) {
+    log::debug(kComponent, d.address + ": not answering (it reboots)");
+    return failConnect(d, kConnectionAborted);
+  }
   linkUp(d);
 }
 
@@ -402,7 +413,7 @@ void FakeBluez::State::linkUp(Device& d) {
 
   if (!d.firstConnect) {
     d.firstConnect = loop.now();
-    for (const auto& [fault, delay] : d.scheduled) arm(d, fault, delay);
+    for (const auto& f : d.scheduled) arm(d, f);
   }
 }
 
@@ -438,7 +449,7 @@ bool FakeBluez::State::toClient(Device& d, std::span<const std::uint8_t> frame) 
 }
 
 bool FakeBluez::State::notify(Device& d, Characteristic* ch, std::span<const std::uint8_t> frame) {
-  if (!ch) {
+  if (!ch || d.muted) {
     ++d.counters.framesDropped;
     return false;
   }

@@ -4,8 +4,10 @@
 // and one per Alphabot: `ADDR connected=… speed=… writes=… connects=… disconnects=…`.
 #include <CLI/CLI.hpp>
 #include <boost/asio/signal_set.hpp>
+#include <cmath>
 #include <csignal>
 #include <iostream>
+#include <map>
 
 #include <sdbus-c++/sdbus-c++.h>
 
@@ -40,13 +42,59 @@ Timed parseTimed(const std::string& flag, const std::string& text) {
   return t;
 }
 
+// --fault KIND:TARGET@SECONDS[+LASTING] (see --help)
+void scheduleFault(pitwall::testing::FakeBluez& fake, const std::string& text) {
+  using pitwall::fromSeconds;
+  using Fault = pitwall::testing::FakeBluez::Fault;
+  static const std::map<std::string, Fault> kinds{
+      {"drop", Fault::Drop},           {"burst", Fault::Burst},        {"vanish", Fault::Vanish},
+      {"garbage", Fault::Garbage},     {"reboot", Fault::Reboot},      {"mute", Fault::Mute},
+      {"writefail", Fault::WriteFail}, {"writehang", Fault::WriteHang}};
+  auto bad = [&] {
+    return std::invalid_argument(
+        "--fault '" + text +
+        "': write KIND:ADDRESS@SECONDS[+LASTING] (e.g. reboot:E0:00:00:00:00:01@30+4), "
+        "unplug:hci1@60+5 or restart@90+3");
+  };
+  const auto at = text.rfind('@');
+  if (at == std::string::npos) throw bad();
+  std::string head = text.substr(0, at), when = text.substr(at + 1);
+  double seconds = 0, lasting = 0;
+  try {
+    std::size_t used = 0;
+    seconds = std::stod(when, &used);
+    if (used < when.size()) {
+      if (when[used] != '+') throw bad();
+      std::string rest = when.substr(used + 1);
+      std::size_t more = 0;
+      lasting = std::stod(rest, &more);
+      if (more != rest.size()) throw bad();
+    }
+  } catch (const std::logic_error&) {
+    throw bad();
+  }
+  if (seconds < 0 || lasting < 0 || !std::isfinite(seconds) || !std::isfinite(lasting)) throw bad();
+  if (head == "restart") return fake.restart(fromSeconds(seconds), fromSeconds(lasting));
+  const auto colon = head.find(':');
+  if (colon == std::string::npos) throw bad();
+  std::string kind = head.substr(0, colon), target = head.substr(colon + 1);
+  if (kind == "unplug") {
+    if (target.rfind("hci", 0) != 0) throw bad();
+    int index = std::stoi(target.substr(3));
+    return fake.unplug(index, fromSeconds(seconds), fromSeconds(lasting));
+  }
+  auto it = kinds.find(kind);
+  if (it == kinds.end()) throw bad();
+  fake.schedule(it->second, target, fromSeconds(seconds), fromSeconds(lasting));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   using namespace pitwall;
   CLI::App app{"fake_bluez — a fake org.bluez (BlueZ 5.66 D-Bus API) with simulated Anki cars"};
   testing::FakeBluezOptions options;
-  std::vector<std::string> refuse, drop, vanish, garbage;
+  std::vector<std::string> refuse, drop, vanish, garbage, faults;
   std::string logLevel = "info";
   app.add_option("--adapters", options.adapters, "Number of controllers, hci0… (default 1)")
       ->check(CLI::Range(0, 16));
@@ -63,6 +111,11 @@ int main(int argc, char** argv) {
   app.add_option("--drop", drop, "ADDR@SECONDS: the link drops, the car stays known (repeatable)");
   app.add_option("--vanish", vanish, "ADDR@SECONDS: the car disconnects and is gone for good");
   app.add_option("--garbage", garbage, "ADDR@SECONDS: the car sends malformed frames");
+  app.add_option("--fault", faults,
+                 "KIND:ADDR@SECONDS[+LASTING]: KIND drop, burst, vanish, garbage, reboot, mute, "
+                 "writefail or writehang, seconds after that car's first connection; "
+                 "unplug:hciN@SECONDS+LASTING and restart@SECONDS+LASTING, seconds from now "
+                 "(repeatable)");
   app.add_option("--alphabots", options.alphabots,
                  "Number of Alphabot robots (BLE GATT service of alphabot.md §2; default 0)")
       ->check(CLI::Range(0, 64));
@@ -96,6 +149,7 @@ int main(int argc, char** argv) {
     schedule(drop, "--drop", FakeBluez::Fault::Drop);
     schedule(vanish, "--vanish", FakeBluez::Fault::Vanish);
     schedule(garbage, "--garbage", FakeBluez::Fault::Garbage);
+    for (const auto& text : faults) scheduleFault(fake, text);
 
     boost::asio::signal_set signals(loop.io(), SIGINT, SIGTERM);
     signals.async_wait([&](const boost::system::error_code& ec, int) {

@@ -213,6 +213,7 @@ struct Characteristic {
   std::set<std::string> notifySessions;  // senders that called StartNotify
   std::unique_ptr<Io> notifyIo;          // our end of AcquireNotify's socket
   std::unique_ptr<Io> writeIo;           // our end of AcquireWrite's socket
+  bool writeWatched = false;             // a wait on writeIo is pending
 };
 
 struct Device {
@@ -257,7 +258,14 @@ struct Device {
   bool refused = false;
   bool vanished = false;
   std::optional<TimePoint> firstConnect;
-  std::vector<std::pair<FakeBluez::Fault, Duration>> scheduled;
+  struct Scheduled {
+    FakeBluez::Fault fault;
+    Duration after, lasting;
+  };
+  std::vector<Scheduled> scheduled;
+  bool muted = false;       // Mute: notifications are lost
+  bool writesFail = false;  // WriteFail: writes fail
+  bool writesHang = false;  // WriteHang: the write socket is not read
 
   FakeBluezCounters counters;
 
@@ -282,6 +290,7 @@ struct Adapter {
   std::string name;
   std::string alias;
   bool powered = true;
+  bool plugged = true;  // false: unplugged (FakeBluez::unplug), its object off the bus
   bool discoverable = false;
   bool pairable = true;
   std::unique_ptr<sdbus::IObject> object;
@@ -381,7 +390,12 @@ struct FakeBluez::State {
   void drop(Device& d);
   void vanish(Device& d);
   bool inject(Device& d, std::span<const std::uint8_t> bytes);
-  void arm(Device& d, Fault fault, Duration after);
+  void arm(Device& d, const Device::Scheduled& fault);
+  void unplug(Adapter& a);
+  void plugBack(Adapter& a);
+  void stopBluez();
+  void startBluez();
+  bool running = true;  // org.bluez is on the bus (FakeBluez::restart)
 };
 
 }  // namespace pitwall::testing

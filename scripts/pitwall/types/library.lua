@@ -635,6 +635,7 @@ function Human:waiting(car, ctx) end]],
 ---@field safety? {distance?: number, speed?: number}|false cap cars behind one that left the track (default {distance = 1000, speed = 300})
 ---@field cooldown? number mm/s a finished car drives on at (default 300)
 ---@field finishTimeout? number s after the winner finished until the session ends (default 60)
+---@field reconnectTimeout? number s a car whose link is down is waited for before the session may end without it (default 30)
 ---@field period? number s between driver updates (default 0.1)
 ---@field gridSpeed? number mm/s to the grid (default 500)
 ---@field gridTimeout? number s to reach the grid (default 90)

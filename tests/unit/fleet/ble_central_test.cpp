@@ -346,3 +346,30 @@ TEST_CASE("ble: bluetoothd restarting: the cars go down, then are found and conn
   CHECK(waitFor([&] { return fake->car(kCar1).truth().sdk_mode; }));
   fake.reset();
 }
+
+TEST_CASE("ble: a controller unplugged and plugged back: its cars are found and connected again") {
+  Rig rig(cars(2, 2));  // car 1 on hci0, car 2 on hci1
+  REQUIRE(rig.start() == std::nullopt);
+  REQUIRE(rig.waitFor([&] { return rig.fleet.connectedCount() == 2; }));
+  AnkiCar* second = rig.car(kCar2);
+  REQUIRE(second);
+  rig.fake.unplug(1, 0ms, 300ms);
+  REQUIRE(rig.waitFor([&] { return !second->state().connected; }));
+  CHECK(rig.car(kCar1)->state().connected);  // the other controller's car stays
+  // plugged back: found by a discovery on it (nothing else looks there), connected, SDK mode
+  CHECK(rig.waitFor([&] { return second->state().connected; }));
+  CHECK(rig.waitFor([&] { return rig.fake.car(kCar2).truth().sdk_mode; }));
+  CHECK(rig.fake.counters(kCar2).connects == 2);
+}
+
+TEST_CASE("ble: a car that reboots is connected again once it answers, back in SDK mode") {
+  Rig rig(cars(1, 1));
+  REQUIRE(rig.start() == std::nullopt);
+  REQUIRE(rig.waitFor([&] { return rig.fleet.connectedCount() == 1; }));
+  rig.fake.schedule(FakeBluez::Fault::Reboot, kCar1, 0ms, 300ms);
+  REQUIRE(rig.waitFor([&] { return rig.fleet.connectedCount() == 0; }));
+  CHECK_FALSE(rig.fake.car(kCar1).truth().sdk_mode);  // the reset forgot it
+  CHECK(rig.waitFor([&] { return rig.fleet.connectedCount() == 1; }));
+  CHECK(rig.waitFor([&] { return rig.fake.car(kCar1).truth().sdk_mode; }));
+  CHECK(rig.central->attempts()[kCar1] >= 3);  // it did not answer while it rebooted
+}
