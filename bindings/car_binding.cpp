@@ -295,13 +295,13 @@ bool pushField(lua_State* L, const AnkiCar& car, std::string_view key) {
   return false;
 }
 
-constexpr std::array<const char*, 28> kFieldNames = {
+constexpr std::array<const char*, 29> kFieldNames = {
     "speed",       "piece",       "location",     "offset",       "name",
     "number",      "model",       "modelId",      "identifier",   "address",
     "connected",   "onTrack",     "onCharger",    "delocalized",  "reverse",
     "targetSpeed", "prevPiece",   "laneChanging", "targetOffset", "batteryLevel",
     "batteryLow",  "batteryFull", "firmware",     "lastPing",     "lastPositionTime",
-    "frames",      "malformed",   "extraBytes"};
+    "frames",      "malformed",   "extraBytes",   "link"};
 
 int index(lua_State* L) {
   // 1: car, 2: key. Methods first, then state, then the car's own fields.
@@ -314,6 +314,17 @@ int index(lua_State* L) {
     }
     if (key == "malformed") {
       lua_pushinteger(L, static_cast<lua_Integer>(s.malformed));
+      return true;
+    }
+    if (key == "link") {  // {connects = 2, drops = 1, lastDrop = "…", rssi = -60, …}, fresh
+      const LinkHealth h = p.car->link().health();
+      lua_createtable(L, 0, 6);
+      lua::setInteger(L, "connects", s.connects);
+      lua::setInteger(L, "drops", s.drops);
+      if (!s.last_drop.empty()) lua::setString(L, "lastDrop", s.last_drop);
+      lua::setInteger(L, "writeFailures", h.writeFailures);
+      lua::setInteger(L, "stalls", h.stalls);
+      if (h.rssi) lua::setInteger(L, "rssi", *h.rssi);
       return true;
     }
     if (key == "extraBytes") {  // {["position-update"] = {frames = 3, last = "aa"}, …}, fresh

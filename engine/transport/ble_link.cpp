@@ -93,6 +93,8 @@ void BleLink::up() {
 }
 
 void BleLink::closeChannels() {
+  stalledSince_.reset();
+  failing_ = 0;
   notify_.close();
   closeWrite();
   emergency::removeStopper(std::exchange(emergencyStopper_, 0));
@@ -127,13 +129,50 @@ void BleLink::value(const std::vector<std::uint8_t>& frame) {
   if (gatt_.up()) deliverFrame(frame);
 }
 
+void BleLink::reconnect(const std::string& reason) {
+  if (!gatt_.up()) return;
+  gatt_.drop(reason);
+}
+
+LinkHealth BleLink::health() const {
+  LinkHealth h = health_;
+  if (const Device* d = gatt_.bluez().device(gatt_.devicePath()))
+    if (d->rssi) h.rssi = *d->rssi;
+  return h;
+}
+
+std::string BleLink::refusal() const {
+  return stalledSince_ ? "the car's link takes no writes (BlueZ reads none); it is dropped, "
+                         "which stops the car, once that has lasted " +
+                             std::to_string(static_cast<int>(kWriteStall * 1000)) + " ms"
+                       : std::string();
+}
+
 bool BleLink::send(std::span<const std::uint8_t> frame) {
   if (!gatt_.up()) return false;
   if (writeFd_.is_open()) {
     ssize_t n =
         ::send(writeFd_.native_handle(), frame.data(), frame.size(), MSG_DONTWAIT | MSG_NOSIGNAL);
-    if (n == static_cast<ssize_t>(frame.size())) return true;
-    if (n < 0 && errno != EAGAIN && errno != EWOULDBLOCK) {
+    if (n == static_cast<ssize_t>(frame.size())) {
+      stalledSince_.reset();
+      return true;
+    }
+    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
+      // The socket is full: BlueZ takes nothing from it (the controller is stuck, the link is
+      // dying). A car whose commands cannot reach it cannot be stopped either, except by its
+      // link going: after kWriteStall, the link is dropped (the car stops) and made again.
+      const double now = gatt_.bluez().loop().seconds();
+      if (!stalledSince_) stalledSince_ = now;
+      if (now - *stalledSince_ >= kWriteStall) {
+        stalledSince_.reset();
+        ++health_.stalls;
+        reconnect(gatt_.address() + " took no write for " +
+                  std::to_string(static_cast<int>(kWriteStall * 1000)) +
+                  " ms: its link is dropped, which stops the car, and made again");
+      }
+      return false;
+    }
+    if (n < 0) {
       log::debug(address(), std::string("write socket failed (") + std::strerror(errno) +
                                 "): writes through WriteValue");
       closeWrite();
@@ -155,8 +194,17 @@ void BleLink::writeValue(std::span<const std::uint8_t> frame) {
       .withTimeout(gatt_.timeouts().subscribe)
       .withArguments(std::vector<std::uint8_t>(frame.begin(), frame.end()), options)
       .uponReplyInvoke([this, alive](const sdbus::Error* error) {
-        if (alive.expired() || !error) return;
-        log::warn(address(), describe(*error, "writing a frame"));
+        if (alive.expired()) return;
+        // One line when writes start failing, one when they go through again: not one a frame
+        if (!error) {
+          if (failing_ > 0)
+            log::info(address(), "writes go through again (" + std::to_string(failing_) +
+                                     " failed meanwhile)");
+          failing_ = 0;
+          return;
+        }
+        ++health_.writeFailures;
+        if (failing_++ == 0) log::warn(address(), describe(*error, "writing a frame"));
       });
   gatt_.bluez().pump().kick();
 }

@@ -32,6 +32,9 @@ class BleLink : public Link {
   void connect(Done done);
 
   bool send(std::span<const std::uint8_t> frame) override;
+  // Drops the link (Device1.Disconnect) with `reason`; the Central connects it again.
+  void reconnect(const std::string& reason) override;
+  std::string refusal() const override;
   bool connected() const override { return gatt_.up(); }
   void disconnect() override { disconnect(nullptr); }
   // Asks BlueZ to disconnect; done() when it has (or after the disconnect timeout).
@@ -54,6 +57,11 @@ class BleLink : public Link {
   // A loss the controller did not ask for: the Central reconnects.
   std::function<void(const std::string& reason)> onDropped;
 
+  // A write socket that takes nothing for this long has its link dropped (send()).
+  static constexpr double kWriteStall = 1.0;
+  // What went wrong on this link so far, and the car's RSSI as BlueZ last reported it.
+  LinkHealth health() const override;
+
  private:
   void resolved();
   void subscribe();
@@ -72,6 +80,9 @@ class BleLink : public Link {
   std::vector<std::uint8_t> emergencyStop_;
   int emergencySlot_ = -1;
   int emergencyStopper_ = 0;
+  std::optional<double> stalledSince_;  // since when the write socket is full
+  int failing_ = 0;                     // WriteValue errors since the last write that went through
+  LinkHealth health_;                   // writeFailures, stalls
   std::shared_ptr<bool> alive_;
 };
 

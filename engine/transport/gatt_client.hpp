@@ -45,6 +45,11 @@ class GattClient {
   void fail(const std::string& reason);
   // The link was up and went down (e.g. a notification socket closed).
   void lost(const std::string& reason);
+  // The profile gives the link up (it takes no writes): Device1.Disconnect, and lost(reason).
+  void drop(const std::string& reason) {
+    disconnectQuietly();
+    lost(reason);
+  }
   // Asks BlueZ to disconnect; done() when it has (or after the disconnect timeout).
   void disconnect(std::function<void()> done);
 
@@ -59,6 +64,7 @@ class GattClient {
   const std::string& address() const { return address_; }  // AA:BB:…
   std::string label() const { return "ble:" + address_; }  // for the log
   Bluez& bluez() { return bluez_; }
+  const Bluez& bluez() const { return bluez_; }
   const LinkTimeouts& timeouts() const { return timeouts_; }
 
   // For the profile's own asynchronous steps: the attempt a reply belongs to.

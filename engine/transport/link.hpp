@@ -9,6 +9,14 @@
 
 namespace pitwall {
 
+// What a link knows of its own health beyond up and down (car.link, docs/lua-api.md); a link
+// that knows nothing of it leaves the defaults.
+struct LinkHealth {
+  int writeFailures = 0;    // writes the transport refused
+  int stalls = 0;           // times the link was dropped because it took no write
+  std::optional<int> rssi;  // dBm, where the transport tells it (BlueZ: while discovering)
+};
+
 class Link {
  public:
   using FrameHandler = std::function<void(std::span<const std::uint8_t>)>;
@@ -34,6 +42,7 @@ class Link {
   // Why the last send() returned false, when the link knows more than "not connected": one
   // sentence naming what to do, or empty.
   virtual std::string refusal() const { return {}; }
+  virtual LinkHealth health() const { return {}; }
   // Where the device stands across the road (mm from the centre, as it believes it) before it
   // has reported it, when the link knows: a simulated car, where it was put. A real car tells
   // its offset only in its localization updates, which come once it drives: nullopt.

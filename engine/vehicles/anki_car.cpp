@@ -261,6 +261,12 @@ void AnkiCar::apply(const Message& message) {
 
 void AnkiCar::linkStateChanged(bool up, const std::string& reason) {
   state_.connected = up;
+  if (up) {
+    ++state_.connects;
+  } else {
+    ++state_.drops;
+    state_.last_drop = reason;
+  }
   // Before its first position update the offset is where the link knows the car stands (a
   // simulated car placed since it joined), or what it was.
   if (up && state_.last_position_time < 0)

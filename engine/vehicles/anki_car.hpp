@@ -56,6 +56,10 @@ struct CarState {
   double last_position_time = -1;
   std::uint64_t frames_in = 0, frames_out = 0, malformed = 0;
   std::map<std::string, ExtraBytes, std::less<>> extra_bytes;  // by message name
+  // The link's story (car.link, docs/lua-api.md): connections made, drops, the last drop's reason
+  int connects = 0;
+  int drops = 0;
+  std::string last_drop;
 };
 
 // Why a lane change to a car that stands is refused, and what to do (docs/lua-api.md).
@@ -82,6 +86,7 @@ class AnkiCar {
   const CarIdentity& identity() const { return identity_; }
   const CarState& state() const { return state_; }
   Link& link() { return link_; }
+  const Link& link() const { return link_; }
   std::string label() const;  // "car 2 (groundshock)"
 
   // Commands: validated; an invalid or undeliverable one is refused with a sentence.

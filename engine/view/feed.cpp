@@ -197,6 +197,18 @@ void Feed::event(const std::string& level, const std::string& text) {
   while (events_.size() > kEventsKept) events_.pop_front();
 }
 
+// The link's health, as car.link has it (docs/view.md "State")
+static nlohmann::json linkJson(const AnkiCar& car) {
+  const CarState& s = car.state();
+  const LinkHealth h = car.link().health();
+  return {{"connects", s.connects},
+          {"drops", s.drops},
+          {"lastDrop", s.last_drop.empty() ? nlohmann::json(nullptr) : nlohmann::json(s.last_drop)},
+          {"writeFailures", h.writeFailures},
+          {"stalls", h.stalls},
+          {"rssi", h.rssi ? nlohmann::json(*h.rssi) : nlohmann::json(nullptr)}};
+}
+
 nlohmann::json Feed::carJson(const AnkiCar& ankiCar, std::size_t laps) const {
   const CarState& s = ankiCar.state();
   const int number = ankiCar.identity().number;
@@ -219,6 +231,7 @@ nlohmann::json Feed::carJson(const AnkiCar& ankiCar, std::size_t laps) const {
       {"framesIn", s.frames_in},
       {"framesOut", s.frames_out},
       {"malformed", s.malformed},
+      {"link", linkJson(ankiCar)},
       {"pieceIndex", nullptr},
       {"fraction", nullptr},
       {"x", nullptr},

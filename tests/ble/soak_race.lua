@@ -22,7 +22,9 @@ local gp = race.timed {
 print(race.winner(gp) or "No winner: nobody finished")
 for _, row in ipairs(gp:results()) do
   local car = pitwall.car(row.number)
-  print(string.format("car %d status=%s laps=%d connected=%s", row.number, row.status, row.laps,
-    tostring(car.connected)))
+  local link = car.link
+  print(string.format("car %d status=%s laps=%d connected=%s drops=%d connects=%d "
+    .. "writeFailures=%d stalls=%d", row.number, row.status, row.laps, tostring(car.connected),
+    link.drops, link.connects, link.writeFailures, link.stalls))
 end
 pitwall.stop()

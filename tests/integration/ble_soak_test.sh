@@ -62,6 +62,12 @@ for n in $(seq 1 $((N - 1))); do
 done
 contains "soak: car $N is out, disconnected" "car $N status=DNF (disconnected)" "$out"
 contains "soak: the log says why car $N is out" "$(car "$N") vanished" "$(cat "$TMP/run.err")"
+# car.link counted what the fake did: car 1 dropped (its own drop, bluetoothd's restart)
+line=$(echo "$out" | grep "^car 1 ")
+d=$(echo "$line" | sed -n 's/.* drops=\([0-9]*\).*/\1/p')
+[ "${d:-0}" -ge 2 ] && echo "ok: soak: car.link counted car 1's drops ($d)" ||
+  fail "soak: car.link of car 1: ${d:-none} drops: $line"
+contains "soak: car.link: connected again after each drop" "connects=$((d + 1))" "$line"
 # The results file has every car
 check "soak: a result row per car" "$N" "$(tail -n +2 "$TMP/soak.csv" | wc -l)"
 # The faults happened (the fake's own count of connections): every car went down and came back

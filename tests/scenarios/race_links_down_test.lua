@@ -37,6 +37,13 @@ for _, row in ipairs(r:results()) do
   expect.eq(row.status, "finished", row.car .. " finished")
   expect.eq(row.laps, 4, row.car .. " drove its 4 laps")
 end
+-- car.link tells the story: the scan car dropped twice, the others once, each came back
+for k, c in ipairs(cars) do
+  local link = c.link
+  expect.eq(link.drops, k == 1 and 2 or 1, c.name .. ": its drops in car.link")
+  expect.eq(link.connects, link.drops + 1, c.name .. ": connected again after each")
+  expect.truthy(type(link.lastDrop) == "string" and #link.lastDrop > 0, c.name .. ": why")
+end
 
 -- A car that stays away longer than reconnectTimeout is out; the others finish
 local out = cars[3]

@@ -7,6 +7,7 @@
 
 #include <sdbus-c++/sdbus-c++.h>
 
+#include "engine/core/log.hpp"
 #include "tests/fake_bluez/fake_bluez.hpp"
 #include "tests/support/private_bus.hpp"
 #include "tests/support/run_until.hpp"
@@ -372,4 +373,66 @@ TEST_CASE("ble: a car that reboots is connected again once it answers, back in S
   CHECK(rig.waitFor([&] { return rig.fleet.connectedCount() == 1; }));
   CHECK(rig.waitFor([&] { return rig.fake.car(kCar1).truth().sdk_mode; }));
   CHECK(rig.central->attempts()[kCar1] >= 3);  // it did not answer while it rebooted
+}
+
+TEST_CASE(
+    "ble: a link whose writes stall is dropped after 1 s, which stops the car, and made again") {
+  Rig rig(cars(1, 1));
+  REQUIRE(rig.start() == std::nullopt);
+  REQUIRE(rig.waitFor([&] { return rig.fleet.connectedCount() == 1; }));
+  AnkiCar* car = rig.car(kCar1);
+  auto& link = dynamic_cast<ble::BleLink&>(car->link());
+  REQUIRE(link.writeAcquired());
+  REQUIRE(car->setSpeed(600));
+  REQUIRE(rig.waitFor([&] { return rig.fake.car(kCar1).truth().target_speed_mm_s == 600; }));
+  // BlueZ stops taking writes (a stuck controller): a script keeps commanding
+  rig.fake.schedule(FakeBluez::Fault::WriteHang, kCar1, 0ms, 10s);
+  int refused = 0;
+  bool dropped = rig.waitFor(
+      [&] {
+        if (!car->setSpeed(700)) ++refused;
+        return rig.fake.counters(kCar1).disconnects >= 1;
+      },
+      10s);
+  REQUIRE(dropped);
+  CHECK(refused > 0);  // the full socket's writes were refused, not reported sent
+  CHECK(link.health().stalls == 1);
+  CHECK(car->state().drops == 1);
+  CHECK(car->state().last_drop.find("took no write") != std::string::npos);
+  CHECK(rig.fake.car(kCar1).truth().target_speed_mm_s == 0);  // the drop stopped the car
+  // and it is connected again
+  CHECK(rig.waitFor([&] { return rig.fake.counters(kCar1).connects == 2; }));
+}
+
+TEST_CASE("ble: writes that fail are counted and logged once; they go through again after") {
+  Rig rig(cars(1, 1));
+  REQUIRE(rig.start() == std::nullopt);
+  REQUIRE(rig.waitFor([&] { return rig.fleet.connectedCount() == 1; }));
+  AnkiCar* car = rig.car(kCar1);
+  auto& link = dynamic_cast<ble::BleLink&>(car->link());
+  rig.fake.schedule(FakeBluez::Fault::WriteFail, kCar1, 0ms, 400ms);
+  std::vector<std::string> warnings;
+  auto tap = log::addTap([&](log::Level level, std::string_view, std::string_view message) {
+    if (level == log::Level::Warn) warnings.emplace_back(message);
+  });
+  // a script that keeps commanding through the window
+  int speed = 300;
+  Loop::TimerId ticker = 0;
+  std::function<void()> command = [&] {
+    (void)car->setSpeed(speed += 10);
+    ticker = rig.loop.after(20ms, command);
+  };
+  command();
+  CHECK(rig.waitFor([&] { return link.health().writeFailures >= 3; }));
+  rig.loop.cancel(ticker);
+  CHECK_FALSE(link.writeAcquired());  // the socket closed: writes go through WriteValue
+  // after the window a command reaches the car again
+  testing::runFor(rig.loop, 500ms);
+  REQUIRE(car->setSpeed(777));
+  CHECK(rig.waitFor([&] { return rig.fake.car(kCar1).truth().target_speed_mm_s == 777; }));
+  log::removeTap(tap);
+  int failedLines = 0;
+  for (const auto& w : warnings) failedLines += w.find("writing a frame") != std::string::npos;
+  CHECK(failedLines == 1);        // one line for the whole burst, not one a frame
+  CHECK(car->state().connected);  // failing writes alone do not drop the link
 }

@@ -124,6 +124,12 @@ TEST_CASE("view feed: connections and log lines join the event log; others' hook
   CHECK(std::find(texts.begin(), texts.end(), "car 1 (skull) connected") != texts.end());
   CHECK(std::find(texts.begin(), texts.end(), "race: something to see") != texts.end());
   CHECK(std::find(texts.begin(), texts.end(), "quiet: not for the view") == texts.end());
+  // the car's link as car.link has it: one connection, no drop yet
+  auto link = state["cars"][0]["link"];
+  CHECK(link["connects"] == 1);
+  CHECK(link["drops"] == 0);
+  CHECK(link["lastDrop"].is_null());
+  CHECK(link["rssi"].is_null());  // the simulator's link tells none
   // updates carry only new events
   std::uint64_t cursor = 0, track = 0;
   CHECK(r.feed->update(cursor, track)["events"].size() == texts.size());
