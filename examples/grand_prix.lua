@@ -29,7 +29,9 @@ local cars = pitwall.cars()
 print(string.format("Grand prix: %d cars, %d laps", #cars, LAPS))
 local gp = race.laps {
   laps = LAPS,
-  scan = true,                         -- the first car drives a scan lap (also on real cars)
+  -- the first car drives a scan lap (also on real cars); a grid has 4 lanes, and with more cars
+  -- the second row would be in its way: the simulator's layout is the map then
+  scan = #cars <= 4,
   drivers = driverFor,
   title = string.format("Grand prix, %d laps", LAPS),
 }

@@ -208,6 +208,14 @@ function Race:_map()
     pitwall.log("info", "race: the track map of the session before is used (no new scan lap)")
     return lastMap
   end
+  -- A grid has 4 lanes: a fifth car stands in a second row behind the line, in the scan car's
+  -- lane or another, and a scan lap (from the line round to the line) runs into it.
+  if #self.cars > 4 then
+    pitwall._raise(string.format("race: %d cars and a scan lap: a grid has 4 lanes, so cars 5 "
+      .. "and on stand in a second row behind the line, where the scan car would run into them; "
+      .. "race at most 4 cars with a scan lap (in the simulator, leave scan out: the layout is "
+      .. "the map)", #self.cars))
+  end
   local scanOptions = type(o.scan) == "table" and o.scan or {}
   pitwall.log("info", "race: scan lap with " .. tostring(self.cars[1]))
   self.scanning = true -- (the view shows the phase)
