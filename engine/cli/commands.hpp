@@ -36,8 +36,9 @@ struct CarSource {
   std::vector<std::string> carAddresses;  // --car ADDR (repeatable): only these; empty: all found
   std::vector<std::string> adapters;      // --adapter hciN (repeatable); empty: every adapter
   double scanTimeout = 5;                 // seconds to look for cars before the script starts
-  double budget = 0.1;  // --budget SECONDS a callback may run before it is interrupted; 0: off
-  int luaMemory = 512;  // --lua-memory MB a script's Lua world may hold; 0: no limit
+  int carsPerAdapter = 6;  // --cars-per-adapter: cars one Bluetooth controller is given at most
+  double budget = 0.1;     // --budget SECONDS a callback may run before it is interrupted; 0: off
+  int luaMemory = 512;     // --lua-memory MB a script's Lua world may hold; 0: no limit
   // --handler-errors N, --handler-errors-window SECONDS: a car whose handler fails N times within
   // the window is stopped (bindings/car_binding.hpp); 0: never
   int handlerErrors = 5;

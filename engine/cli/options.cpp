@@ -31,6 +31,11 @@ CLI::Option* addCarSource(CLI::App* cmd, CarSource& source, const char* when) {
   cmd->add_option("--adapter", source.adapters,
                   "With --ble: use this controller, hci0, … (repeatable; default: all)")
       ->needs(ble);
+  cmd->add_option("--cars-per-adapter", source.carsPerAdapter,
+                  "With --ble: cars one controller is given at most (default 6; a car that does "
+                  "not fit is left out with a sentence: add an --adapter)")
+      ->check(CLI::Range(1, 64))
+      ->needs(ble);
   cmd->add_option("--scan-timeout", source.scanTimeout,
                   std::string("With --ble: seconds to look for cars ") + when + " (default 5)")
       ->check(CLI::PositiveNumber)

@@ -109,6 +109,7 @@ std::unique_ptr<Session> Session::open(const CarSource& source, bool fast, const
     central.adapters = source.adapters;
     central.cars = source.carAddresses;
     central.scan = fromSeconds(source.scanTimeout);
+    central.carsPerAdapter = source.carsPerAdapter;
     try {
       session = std::make_unique<Session>(std::move(central));
       session->design_ = std::move(design);

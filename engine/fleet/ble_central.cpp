@@ -16,6 +16,10 @@ std::string upper(std::string s) {
   return s;
 }
 
+std::string lastName(const std::string& path) {
+  return path.substr(path.rfind('/') + 1);
+}
+
 std::string names(const std::vector<const Adapter*>& adapters) {
   std::string out;
   for (const auto* a : adapters) out += (out.empty() ? "" : ", ") + a->name;
@@ -181,6 +185,14 @@ void Central::start(std::function<void(std::optional<std::string> error)> done) 
       return done(std::string(e.what()));
     }
     for (const auto* a : adapters) queues_[a->path];
+    // Other devices connected through a racing adapter (a phone, a gamepad) share its airtime
+    for (const auto& [path, d] : bluez_->devices()) {
+      if (!d.connected || d.isAnki() || !queues_.count(d.adapter)) continue;
+      log::warn("ble", lastName(d.adapter) + " also holds " +
+                           (d.name.empty() ? d.address : d.name + " (" + d.address + ")") +
+                           ", which is not a car: it shares the controller's airtime with the "
+                           "cars; give it another adapter, or give the cars their own (--adapter)");
+    }
     log::info("ble", "looking for Anki cars on " + names(adapters) + " for up to " +
                          secondsText(options_.scan));
     std::string where = names(adapters);
@@ -205,13 +217,27 @@ void Central::start(std::function<void(std::optional<std::string> error)> done) 
 
 void Central::addCars(const std::vector<Sighting>& sightings) {
   std::map<std::string, int> load;
+  for (const auto& c : cars_) ++load[c->adapter];
   std::vector<std::string> taken;
   for (const auto* c : fleet_.cars()) taken.push_back(c->identity().name);
   for (const auto& s : sightings) {
-    // The least loaded adapter that saw the car
+    // The least loaded adapter that saw the car, among those with room for it
     std::string adapter, path;
     for (const auto& [a, p] : s.paths)
-      if (adapter.empty() || load[a] < load[adapter]) adapter = a, path = p;
+      if (load[a] < options_.carsPerAdapter && (adapter.empty() || load[a] < load[adapter]))
+        adapter = a, path = p;
+    if (adapter.empty()) {
+      std::string full;
+      for (const auto& [a, p] : s.paths) full += (full.empty() ? "" : ", ") + lastName(a);
+      log::warn("ble", "the car at " + s.address + " is left out: " + full +
+                           (s.paths.size() > 1 ? " hold " : " holds ") +
+                           std::to_string(options_.carsPerAdapter) +
+                           " cars already (--cars-per-adapter " +
+                           std::to_string(options_.carsPerAdapter) +
+                           "); plug in another adapter and name it with --adapter, or raise "
+                           "--cars-per-adapter if the controller holds more (docs/bluetooth.md)");
+      continue;
+    }
     ++load[adapter];
     auto car = std::make_unique<Car>();
     car->address = s.address;

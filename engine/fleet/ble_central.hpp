@@ -3,7 +3,8 @@
 // them connected.
 //
 //  - Scan: discovery on every chosen adapter for the scan time (shorter when every car asked for
-//    with --car is found). A car seen by several adapters goes to the one holding fewest cars.
+//    with --car is found). A car seen by several adapters goes to the one holding fewest cars,
+//    and none is given more than carsPerAdapter.
 //  - Connect: one car at a time per adapter (controllers handle concurrent LE connection setup
 //    badly), in a queue.
 //  - Keep: a car that drops is reconnected with backoff (0.5 s doubling to 8 s); a car that
@@ -28,6 +29,9 @@ struct CentralOptions {
   std::vector<std::string> adapters;  // names (hci0) or addresses; empty: every adapter
   std::vector<std::string> cars;      // addresses; empty: every Anki car found
   Duration scan = std::chrono::seconds(5);
+  // Cars one controller is given at most (docs/bluetooth.md "Adapters"): a car seen only by
+  // adapters that hold as many is left out, with a sentence.
+  int carsPerAdapter = 6;
   Duration backoffMin = std::chrono::milliseconds(500);
   Duration backoffMax = std::chrono::seconds(8);
   LinkTimeouts timeouts;

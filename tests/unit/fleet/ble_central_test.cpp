@@ -436,3 +436,24 @@ TEST_CASE("ble: writes that fail are counted and logged once; they go through ag
   CHECK(failedLines == 1);        // one line for the whole burst, not one a frame
   CHECK(car->state().connected);  // failing writes alone do not drop the link
 }
+
+TEST_CASE("ble: cars per adapter: spread by the budget, a car that does not fit is left out") {
+  ble::CentralOptions o = Rig::quick();
+  o.carsPerAdapter = 2;
+  Rig rig(cars(1, 3), o);  // three cars, one adapter that is given two
+  std::vector<std::string> warnings;
+  auto tap = log::addTap([&](log::Level level, std::string_view, std::string_view message) {
+    if (level == log::Level::Warn) warnings.emplace_back(message);
+  });
+  REQUIRE(rig.start() == std::nullopt);
+  log::removeTap(tap);
+  CHECK(rig.fleet.cars().size() == 2);
+  CHECK(rig.waitFor([&] { return rig.fleet.connectedCount() == 2; }));
+  CHECK_FALSE(rig.fake.connected("E0:00:00:00:00:03"));
+  bool said = false;
+  for (const auto& w : warnings)
+    said = said || (w.find("E0:00:00:00:00:03 is left out: hci0 holds 2 cars already") !=
+                        std::string::npos &&
+                    w.find("--adapter") != std::string::npos);
+  CHECK(said);
+}
