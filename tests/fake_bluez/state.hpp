@@ -1,7 +1,8 @@
 #pragma once
-// The fake BlueZ's model, shared by its two halves: fake_bluez.cpp (adapters, discovery, devices,
-// faults, the public API) and fake_gatt.cpp (GATT objects, notification and write channels, the
-// link to the simulated car). Private to tests/fake_bluez.
+// The fake BlueZ's model, shared by its three parts: fake_bluez.cpp (adapters, discovery,
+// devices, the public API), fake_gatt.cpp (GATT objects, notification and write channels, the
+// link to the simulated car) and fake_faults.cpp (the faults it injects). Private to
+// tests/fake_bluez.
 
 #include <sys/socket.h>
 #include <unistd.h>
