@@ -120,9 +120,41 @@ FakeBluez::State::State(Loop& loop_, sdbus::IConnection& connection, Options opt
     devices.push_back(std::move(d));
   }
 
+  // Bystanders last: connected to their adapter by someone else before the fake starts.
+  for (std::size_t i = 0; i < options.bystanders.size(); ++i) {
+    std::string spec = options.bystanders[i];
+    auto d = std::make_unique<Device>();
+    d->index = static_cast<int>(i);
+    d->bystander = true;
+    std::size_t at = spec.rfind("@hci");
+    std::size_t adapter = 0;
+    if (at != std::string::npos) {
+      std::string index = spec.substr(at + 4);
+      if (index.empty() || index.find_first_not_of("0123456789") != std::string::npos ||
+          std::stoul(index) >= adapters.size())
+        throw std::invalid_argument("bystander '" + spec + "': the adapter is hci0…hci" +
+                                    std::to_string(adapters.size() - 1));
+      adapter = std::stoul(index);
+      spec.resize(at);
+    }
+    if (adapters.empty()) throw std::invalid_argument("a bystander needs an adapter");
+    char buf[18];
+    std::snprintf(buf, sizeof buf, "BB:00:00:00:00:%02X", static_cast<unsigned>(i + 1) & 0xff);
+    d->address = buf;
+    d->adapter = adapters[adapter].get();
+    std::string tail = d->address;
+    std::replace(tail.begin(), tail.end(), ':', '_');
+    d->path = d->adapter->path + "/dev_" + tail;
+    d->name = spec;
+    d->connected = d->resolved = true;
+    devices.push_back(std::move(d));
+  }
+
   root = sdbus::createObject(conn, "/");
   root->addObjectManager();
   for (auto& a : adapters) exportAdapter(*a);
+  for (auto& d : devices)
+    if (d->bystander) exportDevice(*d);
 
   // Discovery and notify sessions belong to the bus connection that started them.
   nameWatch = conn.addMatch(
@@ -417,7 +449,7 @@ bool FakeBluez::State::wanted(const Adapter& a, const Device& d, std::int16_t rs
 void FakeBluez::State::advertise(Device& d) {
   Adapter& a = *d.adapter;
   // A connected car does not advertise; a vanished one never again.
-  if (!a.discovering || !a.powered || d.vanished || d.connected) return;
+  if (!a.discovering || !a.powered || d.vanished || d.connected || d.bystander) return;
   if (d.car && !d.car->connectable()) return;  // rebooting
   std::uniform_int_distribution<int> jitter(-12, 12);
   auto rssi = static_cast<std::int16_t>(d.baseRssi + jitter(rng));

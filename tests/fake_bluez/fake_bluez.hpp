@@ -38,6 +38,9 @@ struct FakeBluezOptions {
   // adapter (cars + i) % adapters; its address is alphabotAddresses[i], else AB:00:00:00:00:<i+1>.
   int alphabots = 0;
   std::vector<std::string> alphabotAddresses;
+  // Devices that are not cars, already connected when the fake starts (a gamepad, a phone):
+  // "NAME" on hci0 or "NAME@hciN"; addresses BB:00:00:00:00:<i+1>, the HID service's UUID.
+  std::vector<std::string> bystanders;
 };
 
 // What happened to one device, for tests to check.

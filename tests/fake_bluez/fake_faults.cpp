@@ -20,6 +20,7 @@ void FakeBluez::State::vanish(Device& d) {
 }
 
 std::string FakeBluez::State::serviceUuid(const Device& d) const {
+  if (d.bystander) return "00001812-0000-1000-8000-00805f9b34fb";  // Human Interface Device
   return d.robot ? FakeAlphabot::kServiceUuid : std::string(anki::kServiceUuid);
 }
 

@@ -121,6 +121,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 64));
   app.add_option("--alphabot-address", options.alphabotAddresses,
                  "Address of Alphabot 1, 2, … in order (repeatable; default AB:00:00:00:00:01, …)");
+  app.add_option("--bystander", options.bystanders,
+                 "NAME[@hciN]: a device that is not a car (a gamepad, a phone), connected to "
+                 "hci0 (or hciN) from the start (repeatable)");
   app.add_flag("--no-acquire", options.noAcquire,
                "AcquireNotify/AcquireWrite answer org.bluez.Error.NotSupported");
   app.add_option("--log-level", logLevel, "debug, info, warn, error or off (default info)");

@@ -254,6 +254,9 @@ struct Device {
   // by alphabot::ble::Characteristic.
   std::unique_ptr<FakeAlphabot> robot;
   std::array<std::unique_ptr<Characteristic>, 8> robotChars;
+  // Neither a car nor a robot: a device connected to the adapter by someone else (car and robot
+  // are then null), known to BlueZ from the start (FakeBluezOptions::bystanders).
+  bool bystander = false;
 
   // Faults.
   bool refused = false;

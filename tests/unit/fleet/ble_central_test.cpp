@@ -457,3 +457,30 @@ TEST_CASE("ble: cars per adapter: spread by the budget, a car that does not fit 
                     w.find("--adapter") != std::string::npos);
   CHECK(said);
 }
+
+TEST_CASE("ble: a device that is not a car on a racing adapter is named in a warning") {
+  // A gamepad already connected through hci0 shares its airtime with the cars; one on hci1,
+  // which does not race, is nobody's business.
+  FakeBluez::Options fake = cars(2, 2);
+  fake.bystanders = {"Xbox Wireless Controller", "Pixel 7@hci1"};
+  ble::CentralOptions o = Rig::quick();
+  o.adapters = {"hci0"};
+  Rig rig(fake, o);
+  std::vector<std::string> warnings;
+  auto tap = log::addTap([&](log::Level level, std::string_view, std::string_view message) {
+    if (level == log::Level::Warn) warnings.emplace_back(message);
+  });
+  REQUIRE(rig.start() == std::nullopt);
+  log::removeTap(tap);
+  int gamepad = 0, phone = 0;
+  for (const auto& w : warnings) {
+    gamepad += w.find(
+                   "hci0 also holds Xbox Wireless Controller (BB:00:00:00:00:01), which is "
+                   "not a car") != std::string::npos &&
+               w.find("another adapter") != std::string::npos;
+    phone += w.find("Pixel 7") != std::string::npos;
+  }
+  CHECK(gamepad == 1);
+  CHECK(phone == 0);
+  CHECK(rig.waitFor([&] { return rig.fleet.connectedCount() == 1; }));  // hci0's car races
+}
