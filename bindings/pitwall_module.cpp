@@ -21,6 +21,7 @@
 #include "bindings/metatables.hpp"
 #include "bindings/results.hpp"
 #include "bindings/script_host.hpp"
+#include "bindings/track_table.hpp"
 #include "engine/core/console.hpp"
 #include "engine/core/data_dir.hpp"
 #include "engine/core/log.hpp"
@@ -295,6 +296,22 @@ int checkOptionsOf(lua_State* L) {
   return 0;
 }
 
+// The layout the cars are on: the simulator's track, or --ble --track's; none known: null.
+const sim::Track* knownLayout(ScriptHost& host) {
+  return host.sim() && host.sim()->world ? &host.sim()->world->track() : host.options().design;
+}
+
+// pitwall.layout(): that layout as sim.track() gives it, or nil (real cars without --track).
+int layout(lua_State* L) {
+  const sim::Track* known = knownLayout(ScriptHost::from(L));
+  if (!known) {
+    lua_pushnil(L);
+    return 1;
+  }
+  pushTrackTable(L, *known);
+  return 1;
+}
+
 // pitwall.piece(id): what a road piece is (docs/lua-api.md "Track pieces"), nil when unknown:
 // Anki's stock pieces, and the custom pieces of the simulator's track or of --ble --track's
 // layout (docs/tracks.md).
@@ -307,8 +324,7 @@ int piece(lua_State* L) {
   sim::Piece found{static_cast<std::uint8_t>(id), anki::pieceType(static_cast<std::uint8_t>(id))};
   bool known = found.type != anki::PieceType::Unknown;
   ScriptHost& host = ScriptHost::from(L);
-  const sim::Track* layout =
-      host.sim() && host.sim()->world ? &host.sim()->world->track() : host.options().design;
+  const sim::Track* layout = knownLayout(host);
   if (!known && layout)
     for (const sim::Piece& p : layout->pieces())
       if (p.id == id) {  // a custom id: its shape is the layout's
@@ -436,6 +452,7 @@ void openPitwallModule(ScriptHost& host) {
                                        {"stop", stop},
                                        {"log", lua::guarded<logBody>},
                                        {"piece", lua::guarded<piece>},
+                                       {"layout", lua::guarded<layout>},
                                        {"writeResults", lua::guarded<writeResults>},
                                        {"terminal", terminal},
                                        {"_setHub", lua::guarded<&lua::setHub>},

@@ -8,6 +8,7 @@
 #include "bindings/lua_args.hpp"
 #include "bindings/pitwall_module.hpp"
 #include "bindings/script_host.hpp"
+#include "bindings/track_table.hpp"
 #include "engine/core/printable.hpp"
 #include "engine/protocol/anki/advertisement.hpp"
 #include "engine/protocol/anki/limits.hpp"
@@ -48,30 +49,8 @@ std::uint8_t modelFromLua(lua_State* L, int idx) {
   return static_cast<std::uint8_t>(id);
 }
 
-void pushTrack(lua_State* L, const sim::Track& track) {
-  lua_createtable(L, 0, 4);
-  lua::setString(L, "name", track.name());
-  lua::setNumber(L, "lapLength", track.lapLength(0));
-  lua::setInteger(L, "finishIndex", static_cast<lua_Integer>(track.finishIndex()) + 1);
-  lua_createtable(L, static_cast<int>(track.size()), 0);
-  for (std::size_t i = 0; i < track.size(); ++i) {
-    const sim::Piece& p = track.piece(i);
-    lua_createtable(L, 0, 6);
-    lua::setInteger(L, "id", p.id);
-    lua::setString(L, "type", anki::pieceTypeName(p.type));
-    lua::setInteger(L, "turn", p.turn);
-    lua::setNumber(L, "length", p.length(0));
-    if (p.turn != 0) {
-      lua::setNumber(L, "radius", p.radius());
-      lua::setNumber(L, "angle", p.angle());
-    }
-    lua_rawseti(L, -2, static_cast<lua_Integer>(i) + 1);
-  }
-  lua_setfield(L, -2, "pieces");
-}
-
 int track(lua_State* L) {
-  pushTrack(L, session(L).world->track());
+  pushTrackTable(L, session(L).world->track());
   return 1;
 }
 
@@ -90,7 +69,7 @@ int setTrack(lua_State* L) {
   s.world = std::make_unique<sim::World>(loop, std::move(*loaded), s.seed);
   s.world->setNoise(noise);
   s.world->setSensor(sensor);
-  pushTrack(L, s.world->track());
+  pushTrackTable(L, s.world->track());
   return 1;
 }
 

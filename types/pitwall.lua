@@ -105,6 +105,10 @@ function pitwall.copy(t) end
 ---@return pitwall.Timer
 function pitwall.every(period, fn) end
 
+---The layout the cars are on, as sim.track() gives it: the simulator's track, or with --ble the layout given with --track; nil when none is known.
+---@return pitwall.sim.Track?
+function pitwall.layout() end
+
 ---Calls fn(object, ev) on every `event` of a car or robot, before its own handler. Not "onMessage".
 ---@param object pitwall.Car|pitwall.Mindroad|pitwall.Alphabot
 ---@param event string an event name: "onPosition", …

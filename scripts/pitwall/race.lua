@@ -203,7 +203,17 @@ end
 function Race:_map()
   local o = self.options
   if o.map then return o.map end
-  if pitwall.sim and not o.scan then return track.fromSim() end
+  -- a known layout (the simulator's, or --ble --track's) is the map unless a scan is asked for
+  if not o.scan then
+    local layout = track.fromLayout()
+    if layout then
+      if not pitwall.sim then
+        pitwall.log("info", "race: the map is the layout " .. tostring(layout.name)
+          .. " (--track; no scan lap)")
+      end
+      return layout
+    end
+  end
   if lastMap and lastMap.source == "scan" then
     pitwall.log("info", "race: the track map of the session before is used (no new scan lap)")
     return lastMap
@@ -213,8 +223,8 @@ function Race:_map()
   if #self.cars > 4 then
     pitwall._raise(string.format("race: %d cars and a scan lap: a grid has 4 lanes, so cars 5 "
       .. "and on stand in a second row behind the line, where the scan car would run into them; "
-      .. "race at most 4 cars with a scan lap (in the simulator, leave scan out: the layout is "
-      .. "the map)", #self.cars))
+      .. "race at most 4 cars with a scan lap, or leave scan out and give the layout the cars "
+      .. "are on (--track LAYOUT; in the simulator its layout is the map)", #self.cars))
   end
   local scanOptions = type(o.scan) == "table" and o.scan or {}
   pitwall.log("info", "race: scan lap with " .. tostring(self.cars[1]))

@@ -188,11 +188,8 @@ local function build(entries, fields)
   return map
 end
 
---- The map of the simulator's track, without driving (simulator runs only: a test's or a
---- script's shortcut; on real cars use track.scan).
-function track.fromSim()
-  local sim = require "pitwall.sim"
-  local t = sim.track()
+-- The map of a layout table (sim.track(), pitwall.layout()): its pieces from the line on.
+local function fromTable(t, source)
   local n = #t.pieces
   local entries = {}
   for k = 0, n - 1 do
@@ -203,7 +200,23 @@ function track.fromSim()
   -- a track without the start piece: its laps from the beginning of its first piece, as the
   -- simulator counts them
   local hasStart = entries[1].id == 33 and entries[n].id == 34
-  return build(entries, { name = t.name, source = "sim", hasStart = hasStart })
+  return build(entries, { name = t.name, source = source, hasStart = hasStart })
+end
+
+--- The map of the simulator's track, without driving (simulator runs only: a test's or a
+--- script's shortcut; on real cars use track.scan).
+function track.fromSim()
+  local sim = require "pitwall.sim"
+  return fromTable(sim.track(), "sim")
+end
+
+--- The map of the layout the cars are on, without driving: the simulator's track, or on real
+--- cars the layout given with --track (the pieces as built: nominal lengths). nil when no layout
+--- is known (real cars without --track: scan the track).
+function track.fromLayout()
+  local t = pitwall.layout()
+  if not t then return nil end
+  return fromTable(t, pitwall.sim and "sim" or "layout")
 end
 
 -- ---- the scan lap ----

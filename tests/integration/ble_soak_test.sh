@@ -1,5 +1,6 @@
 # A race that survives a real evening's links (issue 36; docs/bluetooth.md "What survives what"):
-# a timed grand prix of SOAK_CARS cars (default 4) on two adapters over the fake BlueZ, in real time, SOAK_SECONDS
+# a timed grand prix of SOAK_CARS cars (default 8: two rows on the grid, so the race's map is
+# the layout given with --track, not a scan lap; 4 or fewer scan) on two adapters over the fake BlueZ, in real time, SOAK_SECONDS
 # long (default 300; more with `SOAK_SECONDS=3600 ctest -R ble_soak`), while the fake injects
 # every link fault on a schedule spread over the race: a drop, a burst of drops, reboots (the car
 # comes back out of SDK mode, delocalized, at speed 0), lost notifications, failing and hanging
@@ -9,7 +10,7 @@
 source "$(dirname "$0")/ble_lib.sh"
 start_bus
 S=${SOAK_SECONDS:-300}
-N=${SOAK_CARS:-4}
+N=${SOAK_CARS:-8}
 at() { awk "BEGIN { printf \"%.1f\", $1 * $S }"; }  # a fraction of the race, in seconds
 car() { printf 'E0:00:00:00:00:%02X' "$1"; }
 # the faults go round cars 1 … N-1; car N vanishes for good
@@ -35,7 +36,7 @@ faults=(
 FAKE_PID=$!
 wait_for "$TMP/fake.out" '^ready$' 10 || { echo "the fake BlueZ did not start: $(cat "$TMP/fake.err")"; exit 1; }
 
-SECONDS_LONG=$S "$PITWALL" run "$SRC/tests/ble/soak_race.lua" --ble --scan-timeout 2 \
+SECONDS_LONG=$S "$PITWALL" run "$SRC/tests/ble/soak_race.lua" --ble --scan-timeout 2 --track oval \
   --record "$TMP/soak.jsonl" --results "$TMP/soak.csv" >"$TMP/run.out" 2>"$TMP/run.err" &
 RUN_PID=$!
 # Memory: the resident size a quarter into the race and at its end (sampled each second)

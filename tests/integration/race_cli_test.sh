@@ -104,6 +104,18 @@ out=$($PITWALL run "$TMP/piece.lua" --ble --scan-timeout 1 --track "$SRC/example
 check "--ble --track: pitwall.piece knows a custom piece" "curve r=400 deg=45" "$out"
 out=$($PITWALL run "$TMP/piece.lua" --ble --scan-timeout 1 2>/dev/null)
 check "--ble without --track: a custom id is unknown" "nil" "$out"
+# …and the layout is the race's map without a scan lap (track.fromLayout): nothing without --track
+cat >"$TMP/layout.lua" <<'LUA'
+local track = require "pitwall.track"
+local l, m = pitwall.layout(), track.fromLayout()
+print(l and string.format("%d pieces, map %s %d pieces", #l.pieces, m.source, #m.pieces) or "none")
+pitwall.stop()
+LUA
+out=$($PITWALL run "$TMP/layout.lua" --ble --scan-timeout 1 --track "$SRC/examples/tracks/hairpin.layout" 2>/dev/null)
+n=$($PITWALL track show "$SRC/examples/tracks/hairpin.layout" 2>/dev/null | grep -cE '^ *[0-9]+ +id ')
+check "--ble --track: pitwall.layout() and track.fromLayout() are the layout" "$n pieces, map layout $n pieces" "$out"
+out=$($PITWALL run "$TMP/layout.lua" --ble --scan-timeout 1 2>/dev/null)
+check "--ble without --track: no layout" "none" "$out"
 stop_fake
 start_fake --adapters 1 --cars 4
 human_race "over --ble" --ble --scan-timeout 1

@@ -85,6 +85,10 @@ function Map:layout(ids) end
 ---@class pitwall.track
 local track = {}
 
+---The map of the layout the cars are on, without driving: the simulator's track, or on real cars --track's layout; nil when none is known (scan the track).
+---@return pitwall.track.Map?
+function track.fromLayout() end
+
 ---The map of the simulator's track, without driving (simulator runs only).
 ---@return pitwall.track.Map
 function track.fromSim() end

@@ -131,6 +131,8 @@ function Stdout:flush() end
       piece = [[What a road piece is, or nil for an unknown id.
 @param id integer road piece id
 @return pitwall.PieceInfo?]],
+      layout = [[The layout the cars are on, as sim.track() gives it: the simulator's track, or with --ble the layout given with --track; nil when none is known.
+@return pitwall.sim.Track?]],
       writeResults = [[Writes rows (tables) with the fields named in `columns` as JSON or CSV (by the extension) to `path` or --results FILE.
 @param rows table[]
 @param columns string[]

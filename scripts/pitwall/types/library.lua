@@ -108,6 +108,8 @@ function Map:layout(ids) end
 @return integer here]],
       fromSim = [[The map of the simulator's track, without driving (simulator runs only).
 @return pitwall.track.Map]],
+      fromLayout = [[The map of the layout the cars are on, without driving: the simulator's track, or on real cars --track's layout; nil when none is known (scan the track).
+@return pitwall.track.Map?]],
     },
   },
   -- pitwall.localize ------------------------------------------------------------------------
