@@ -45,8 +45,8 @@ std::string lapText(const std::vector<double>& laps, bool best) {
 // The summary per car: the laps the view's feed counted, the frames the car model saw.
 void printSummary(const RecordPlayer& player, const view::Feed& feed, bool json) {
   if (!json)
-    std::printf("%-4s %-16s %5s %9s %9s %8s %8s %9s\n", "CAR", "NAME", "LAPS", "BEST", "LAST", "IN",
-                "OUT", "MALFORMED");
+    std::printf("%-4s %-16s %5s %9s %9s %8s %8s %9s %5s\n", "CAR", "NAME", "LAPS", "BEST", "LAST",
+                "IN", "OUT", "MALFORMED", "DROPS");
   for (int number : player.recordedCars()) {
     const AnkiCar* car = player.car(number);
     const view::CarTracker* tracker = feed.tracker(car->identity().number);
@@ -69,15 +69,18 @@ void printSummary(const RecordPlayer& player, const view::Feed& feed, bool json)
           {"framesIn", s.frames_in},
           {"framesOut", player.framesOut(number)},
           {"malformed", s.malformed},
+          {"drops", s.drops},  // the record's link lines that say the link went down
+          {"lastDrop", s.last_drop.empty() ? nlohmann::ordered_json(nullptr)
+                                           : nlohmann::ordered_json(s.last_drop)},
       };
       std::cout << row.dump() << "\n";
     } else {
-      std::printf("%-4d %-16s %5zu %9s %9s %8llu %8llu %9llu\n", number,
+      std::printf("%-4d %-16s %5zu %9s %9s %8llu %8llu %9llu %5d\n", number,
                   printable(car->identity().name, 16).c_str(), laps.size(),
                   lapText(laps, true).c_str(), lapText(laps, false).c_str(),
                   static_cast<unsigned long long>(s.frames_in),
                   static_cast<unsigned long long>(player.framesOut(number)),
-                  static_cast<unsigned long long>(s.malformed));
+                  static_cast<unsigned long long>(s.malformed), s.drops);
     }
   }
   std::cout.flush();

@@ -105,9 +105,10 @@ class Session {
   std::optional<sim::Track> design_;  // --ble --track: the layout the real cars are on
   Fleet fleet_;
   std::unique_ptr<Recorder> recorder_;
-  Subscription recording_;     // the fleet's frames into recorder_ (--record)
-  std::string raceKey_;        // the phase and title of the race last recorded
-  double raceWritten_ = -1e9;  // when (loop seconds)
+  Subscription recording_;      // the fleet's frames into recorder_ (--record)
+  Subscription linkRecording_;  // the cars' links going up and down into recorder_
+  std::string raceKey_;         // the phase and title of the race last recorded
+  double raceWritten_ = -1e9;   // when (loop seconds)
   bool raceTooLong_ = false;
   std::unique_ptr<ble::Central> central_;  // real cars; after the fleet: its links live there
   std::unique_ptr<Reloader> scripts_;

@@ -209,6 +209,7 @@ Result<TimedCapture, std::string> timeCapture(std::istream& in, RecordKind kind,
         continue;
       }
       frame = std::move(std::get<RecordedFrame>(parsed));
+      if (frame.car == 0 || frame.link) continue;  // a race's or a link's line: no frame
     }
     frame.line = lines.number();
     if (frames.size() == kMaxCaptureFrames)

@@ -90,7 +90,10 @@ void RecordPlayer::seek(double seconds) {
   double target = std::clamp(seconds, 0.0, duration());
   if (target < position()) {
     if (onRewind) onRewind();
-    for (auto& [number, c] : cars_) c.car->rewind();
+    for (auto& [number, c] : cars_) {
+      c.link->rewind();
+      c.car->rewind();
+    }
     stream_.rewind();
     reading_ = false;
     ++readGeneration_;
@@ -171,6 +174,13 @@ void RecordPlayer::deliverNext() {
   }
   auto c = cars_.find(f.car);  // a car the summary did not see: the file changed since
   if (c == cars_.end()) return;
+  if (f.link) {  // the link went up or down then
+    delivering_ = time;
+    c->second.link->recorded(f.link->up, f.link->reason,
+                             {f.link->writeFailures, f.link->stalls, f.link->rssi});
+    delivering_.reset();
+    return;
+  }
   if (f.tx) {  // what the run sent: told, never sent again
     if (onSent) {
       if (auto decoded = anki::decode(f.bytes)) onSent(*c->second.car, *decoded);

@@ -79,6 +79,41 @@ std::variant<std::vector<std::uint8_t>, std::string> hexBytes(const std::string&
   return std::move(*bytes);
 }
 
+// A link line's "link": {"up":bool,"reason":"…","writeFailures":n,"stalls":n,"rssi":n|null}
+// (connects and drops may be there too: what the run counted; a replay counts them again).
+std::variant<RecordedFrame, std::string> parseLink(const json& link, RecordedFrame frame) {
+  if (!link.is_object()) return "\"link\" is not an object: " + shown(link);
+  auto up = link.find("up");
+  if (up == link.end() || !up->is_boolean())
+    return "\"link\" needs \"up\", true or false: " + shown(link);
+  RecordedFrame::Link l;
+  l.up = up->get<bool>();
+  if (auto reason = link.find("reason"); reason != link.end() && !reason->is_null()) {
+    if (!reason->is_string()) return "\"link\".\"reason\" is not a string: " + shown(*reason);
+    l.reason = printable(reason->get_ref<const std::string&>(), kMaxRecordedName * 4);
+  }
+  auto count = [&](const char* name, int& out) -> std::optional<std::string> {
+    auto v = link.find(name);
+    if (v == link.end() || v->is_null()) return std::nullopt;
+    if (!v->is_number_integer() || v->get<std::int64_t>() < 0 ||
+        v->get<std::int64_t>() > 1'000'000'000)
+      return "\"link\".\"" + std::string(name) + "\" must be a count 0..1000000000, not " +
+             shown(*v);
+    out = static_cast<int>(v->get<std::int64_t>());
+    return std::nullopt;
+  };
+  if (auto why = count("writeFailures", l.writeFailures)) return *why;
+  if (auto why = count("stalls", l.stalls)) return *why;
+  if (auto rssi = link.find("rssi"); rssi != link.end() && !rssi->is_null()) {
+    if (!rssi->is_number_integer() || rssi->get<std::int64_t>() < -127 ||
+        rssi->get<std::int64_t>() > 20)
+      return "\"link\".\"rssi\" must be dBm, an integer -127..20, not " + shown(*rssi);
+    l.rssi = static_cast<int>(rssi->get<std::int64_t>());
+  }
+  frame.link = std::move(l);
+  return frame;
+}
+
 }  // namespace
 
 std::string lineTooLong(std::size_t length) {
@@ -160,6 +195,9 @@ std::variant<RecordedFrame, std::string> parseRecordLine(std::string_view line, 
     return "\"car\" must be an integer 1.." + std::to_string(kMaxRecordedCar) + ", not " +
            shown(*car);
   frame.car = car->get<int>();
+
+  if (auto link = j.find("link"); link != j.end() && j.find("dir") == j.end())
+    return parseLink(*link, std::move(frame));
 
   auto dir = j.find("dir");
   if (dir == j.end()) return std::string("no \"dir\" (\"rx\" or \"tx\")");
@@ -295,6 +333,10 @@ Record readRecord(std::istream& in) {
       record.races.push_back(std::move(*frame));
       continue;
     }
+    if (frame->link) {
+      record.links.push_back(std::move(*frame));
+      continue;
+    }
     if (!frame->name.empty()) record.names.emplace(frame->car, frame->name);
     if (record.layout.empty()) record.layout = frame->layout;
     record.frames.push_back(std::move(*frame));
@@ -310,6 +352,11 @@ RecordSummary scanRecord(std::istream& in) {
     summary.duration = std::max(summary.duration, frame->t);
     if (frame->car == 0) {  // a race line: no car's
       ++summary.raceLines;
+      continue;
+    }
+    if (frame->link) {  // a link line: no frame
+      if (!frame->link->up) ++summary.drops[frame->car];
+      summary.framesOut.try_emplace(frame->car, 0);
       continue;
     }
     ++summary.frames;

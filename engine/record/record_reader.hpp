@@ -33,6 +33,16 @@ struct RecordedFrame {
   // A line {"t":…,"race":{…}} (car 0, no bytes): the race as the race library reported it at t
   // (pitwall.view.race; "null" when it ended), as JSON text for a replay's view.
   std::string race;
+  // A line {"t":…,"car":N,"link":{"up":…,"reason":…,"writeFailures":…,"stalls":…,"rssi":…}}
+  // (no bytes): the car's link went up or down (docs/cli.md "Record format").
+  struct Link {
+    bool up = false;
+    std::string reason;  // why it went down; printable, at most kMaxRecordedName * 4 bytes
+    int writeFailures = 0;
+    int stalls = 0;
+    std::optional<int> rssi;
+  };
+  std::optional<Link> link;
 };
 
 struct BadLine {
@@ -56,6 +66,7 @@ struct Record {
   std::vector<RecordedFrame> frames;  // in file order; times never go backwards by more than
                                       // kBackwardsSlack
   std::vector<RecordedFrame> races;   // the race lines (car 0), in file order
+  std::vector<RecordedFrame> links;   // the cars' link lines (RecordedFrame::link), in file order
   std::vector<BadLine> bad;           // every one
   std::map<int, std::string> names;   // the cars' names, where the record keeps them
   std::string layout;                 // the track's layout text; empty: the record keeps none
@@ -66,6 +77,7 @@ struct Record {
 struct RecordSummary {
   std::size_t frames = 0;
   std::size_t raceLines = 0;  // lines of the race (car 0), not counted in frames
+  std::map<int, int> drops;   // the link lines that say a car's link went down, by car
   double duration = 0;        // the last line's time (the latest of all)
   BadLines bad;
   std::map<int, std::string> names;        // as in Record

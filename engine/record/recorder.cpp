@@ -173,6 +173,15 @@ bool Recorder::writeRace(double t, std::string_view race) {
   return true;
 }
 
+void Recorder::writeLink(double t, int car, std::string_view link) {
+  char head[64];
+  std::snprintf(head, sizeof head, "{\"t\":%.6f,\"car\":%d,\"link\":", t, car);
+  std::string line;
+  line.reserve(link.size() + 64);
+  line.append(head).append(link).append("}\n");
+  if (line.size() - 1 <= kMaxLineBytes) append(line);
+}
+
 void Recorder::append(const std::string& line) {
   ++lines_;
   if (used_ + line.size() > kCapacity) flush();

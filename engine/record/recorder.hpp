@@ -41,6 +41,9 @@ class Recorder {
   // object or null. One over kMaxLineBytes of a record is not written (a replay could not read
   // it); false then.
   bool writeRace(double t, std::string_view race);
+  // A link line, {"t":…,"car":N,"link":LINK} (docs/cli.md "Record format"): `link` is a JSON
+  // object's text, at most a few hundred bytes.
+  void writeLink(double t, int car, std::string_view link);
   // Everything written so far reaches the file.
   void flush();
   std::size_t lines() const { return lines_; }

@@ -19,6 +19,14 @@ void ReplayLink::connect() {
   handshake_ = false;
 }
 
+void ReplayLink::recorded(bool up, const std::string& reason, const LinkHealth& health) {
+  health_ = health;
+  if (up) return connect();
+  if (!connected_) return;
+  connected_ = false;
+  deliverState(false, reason);
+}
+
 void ReplayLink::disconnect() {
   if (!connected_) return;
   connected_ = false;

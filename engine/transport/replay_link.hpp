@@ -19,7 +19,18 @@ class ReplayLink : public Link {
   // One recorded frame from the car.
   void deliver(std::span<const std::uint8_t> frame) { deliverFrame(frame); }
 
+  // A recorded link line: the link goes down (with its reason) or up again, as it did in the
+  // run, and health() tells what the run's link told then.
+  void recorded(bool up, const std::string& reason, const LinkHealth& health);
+  // Back to the record's start (a seek back): connected, as every car is there, with no news of
+  // its health; nothing is reported (the car rewinds itself).
+  void rewind() {
+    connected_ = true;
+    health_ = {};
+  }
+
   bool send(std::span<const std::uint8_t> frame) override;  // logs it; true while connected
+  LinkHealth health() const override { return health_; }
   bool connected() const override { return connected_; }
   void disconnect() override;
   std::string address() const override { return "replay:" + label_; }
@@ -28,6 +39,7 @@ class ReplayLink : public Link {
   std::string label_;
   bool connected_ = false;
   bool handshake_ = false;  // while connect() reports the car: the controller's greeting
+  LinkHealth health_;
 };
 
 }  // namespace pitwall

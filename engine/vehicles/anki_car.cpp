@@ -170,6 +170,7 @@ AnkiCar::Sent AnkiCar::disconnect() {
 void AnkiCar::rewind() {
   state_ = CarState{};
   state_.connected = link_.connected();
+  state_.connects = state_.connected ? 1 : 0;  // (connected before what is replayed again)
   state_.offset_mm = link_.knownOffset().value_or(0);
   pingSentAt_.reset();
   lastPingRtt_.reset();

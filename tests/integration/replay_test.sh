@@ -39,7 +39,7 @@ check "the replay's laps agree with the race's" "agree 4" "$agree"
 
 table=$($PITWALL replay "$TMP/r.jsonl" 2>/dev/null)
 check "without options: the table, a row per car" 5 "$(echo "$table" | wc -l | tr -d ' ')"
-contains "the table's header" "CAR  NAME              LAPS      BEST      LAST       IN      OUT MALFORMED" "$table"
+contains "the table's header" "CAR  NAME              LAPS      BEST      LAST       IN      OUT MALFORMED DROPS" "$table"
 contains "the cars by the names the record keeps" "1    groundshock" "$table"
 check "no \"not sent\" line for the greeting every car gets when it connects" 0 \
   "$($PITWALL replay "$TMP/r.jsonl" 2>&1 | grep -c 'not sent')"
@@ -81,7 +81,7 @@ contains "the 1 MB line is skipped unread" "h.jsonl:8: a line of 1000037 bytes, 
 contains "deep nesting is refused" "h.jsonl:6: nested deeper than 16 levels" "$(cat "$TMP/h.err")"
 out=$($PITWALL replay "$TMP/h.jsonl.good" --json 2>"$TMP/hg.err")
 check "hostile lines beside good ones: exit status 0" 0 "$?"
-contains "the good frames replay, the malformed one counted" '"framesIn":1,"framesOut":0,"malformed":1' "$out"
+contains "the good frames replay, the malformed one counted" '"framesIn":1,"framesOut":0,"malformed":1,"drops":0' "$out"
 
 $PITWALL replay "$TMP/none.jsonl" 2>"$TMP/e.err"
 check "a missing file: exit status 2" 2 "$?"

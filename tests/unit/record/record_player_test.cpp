@@ -173,3 +173,51 @@ TEST_CASE("record player: a long run of bad lines is read with the loop turning"
     CHECK(out.ticks > 2);
   }
 }
+
+// A record's link lines play as the run's link went: the car drops (with the run's reason) and
+// comes back, its health is what the run's link told; a seek back plays them again, not twice.
+TEST_CASE("record player: a link line drops the replayed car and brings it back, with its health") {
+  const std::string text =
+      pings(10) +
+      R"({"t":0.020000,"car":1,"link":{"up":false,"reason":"bluetoothd went away","writeFailures":2,"stalls":1,"rssi":-66}})"
+      "\n"
+      R"({"t":0.030000,"car":1,"link":{"up":true,"writeFailures":2,"stalls":1,"rssi":-60}})"
+      "\n"
+      R"({"t":0.040000,"car":1,"link":{"up":false,"reason":"the car rebooted"}})"
+      "\n";
+  std::istringstream scan(text);
+  RecordSummary summary = scanRecord(scan);
+  CHECK(summary.drops[1] == 2);
+  std::istringstream in(text);
+  Loop loop(ClockKind::Virtual);
+  Fleet fleet(loop);
+  RecordPlayer player(loop, fleet, in, summary);
+  AnkiCar* car = player.car(1);
+  REQUIRE(car != nullptr);
+  auto settle = [&] {
+    loop.after(1s, [&] { loop.stop(); });
+    loop.run();
+  };
+  std::vector<std::string> seen;
+  auto sub = car->connectionChanged.connect(
+      [&](bool up, const std::string& reason) { seen.push_back(up ? "up" : "down: " + reason); });
+  player.pause(true);
+  player.seek(0.035);
+  settle();
+  CHECK(seen == std::vector<std::string>{"down: bluetoothd went away", "up"});
+  CHECK(car->state().connected);
+  CHECK(car->state().drops == 1);
+  CHECK(car->state().connects == 2);
+  CHECK(car->link().health().writeFailures == 2);
+  CHECK(car->link().health().rssi == -60);
+  player.seek(0.05);
+  settle();
+  CHECK_FALSE(car->state().connected);
+  CHECK(car->state().last_drop == "the car rebooted");
+  CHECK(car->state().drops == 2);
+  player.seek(0.035);  // back: from the start again, each line once
+  settle();
+  CHECK(car->state().connected);
+  CHECK(car->state().drops == 1);
+  CHECK(car->state().connects == 2);
+}

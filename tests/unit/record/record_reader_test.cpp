@@ -248,3 +248,63 @@ TEST_CASE("record stream: the same frames as readRecord, one at a time, again af
     REQUIRE(stream.rewind());
   }
 }
+
+TEST_CASE("record reader: a link line is the car's link going down or up, kept apart from frames") {
+  RecordedFrame down =
+      frameOf(R"({"t":12.5,"car":3,"link":{"up":false,"reason":"the link dropped","connects":1,)"
+              R"("drops":1,"writeFailures":4,"stalls":1,"rssi":-71}})");
+  CHECK(down.car == 3);
+  CHECK(down.bytes.empty());
+  REQUIRE(down.link);
+  CHECK_FALSE(down.link->up);
+  CHECK(down.link->reason == "the link dropped");
+  CHECK(down.link->writeFailures == 4);
+  CHECK(down.link->stalls == 1);
+  CHECK(down.link->rssi == -71);
+  RecordedFrame up = frameOf(R"({"t":14,"car":3,"link":{"up":true,"reason":null,"rssi":null}})");
+  REQUIRE(up.link);
+  CHECK(up.link->up);
+  CHECK_FALSE(up.link->rssi);
+  // a reason with control characters reaches no terminal as they are
+  RecordedFrame odd =
+      frameOf("{\"t\":1,\"car\":1,\"link\":{\"up\":false,\"reason\":\"a\\u001b[2Jb\"}}");
+  CHECK(printable(odd.link->reason));
+
+  Record r = read(kLine + "\n" + R"({"t":0.5,"car":1,"link":{"up":false,"reason":"x"}})" + "\n" +
+                  R"({"t":0.6,"car":1,"link":{"up":true}})" + "\n");
+  CHECK(r.frames.size() == 1);
+  CHECK(r.links.size() == 2);
+  CHECK(r.bad.empty());
+  std::istringstream in(kLine + "\n" + R"({"t":0.5,"car":2,"link":{"up":false,"reason":"x"}})" +
+                        "\n");
+  RecordSummary s = scanRecord(in);
+  CHECK(s.frames == 1);
+  CHECK(s.drops[2] == 1);
+  CHECK(s.framesOut.count(2) == 1);  // a car the record names only in a link line is a car
+}
+
+TEST_CASE("record reader: a hostile link line is set aside with the reason") {
+  struct Case {
+    std::string line, why;
+  };
+  const Case cases[] = {
+      {R"({"t":1,"car":1,"link":7})", R"("link" is not an object)"},
+      {R"({"t":1,"car":1,"link":{}})", R"("link" needs "up")"},
+      {R"({"t":1,"car":1,"link":{"up":"yes"}})", R"("link" needs "up")"},
+      {R"({"t":1,"car":1,"link":{"up":false,"reason":[1]}})", R"("reason" is not a string)"},
+      {R"({"t":1,"car":1,"link":{"up":true,"stalls":-1}})", R"("stalls" must be a count)"},
+      {R"({"t":1,"car":1,"link":{"up":true,"writeFailures":1e300}})", "must be a count"},
+      {R"({"t":1,"car":1,"link":{"up":true,"writeFailures":99999999999999999999999}})",
+       "must be a count"},
+      {R"({"t":1,"car":1,"link":{"up":true,"rssi":-300}})", R"("rssi" must be dBm)"},
+      {R"({"t":1,"car":1,"link":{"up":true,"rssi":"-60"}})", R"("rssi" must be dBm)"},
+      {R"({"t":1,"car":0,"link":{"up":true}})", R"("car" must be an integer 1..64)"},
+      {R"({"t":1,"car":1,"link":{"up":true,"x":)" + nested(100) + "}}", "nested deeper than 16"},
+  };
+  for (const Case& c : cases) {
+    CAPTURE(c.line.substr(0, 80));
+    std::string why = whyNot(c.line);
+    CHECK_MESSAGE(why.find(c.why) != std::string::npos, why);
+    CHECK_MESSAGE(printable(why), why);
+  }
+}
