@@ -12,6 +12,9 @@
 //                                   (no position, delocalized, off the road), `disconnected`
 //                                   when the car is not connected
 //   #leaderboard tbody tr           one per car (race.rows when a race runs, else the cars)
+//   #leaderboard td.link            the car's link: "down", else its RSSI and drops ("ok" when
+//                                   nothing to tell); `data-drops`, and the whole story in
+//                                   its title (connections, last drop, failed writes, stalls)
 //   #race-phase                     the race's phase (scan, grid, lights, racing, ending, done)
 //   #connection                     exactly "live" when connected, "engine gone" when not
 //   #events li                      the event log, newest first
@@ -377,7 +380,7 @@ function renderBoard() {
   while (tbody.rows.length > rows.length) tbody.deleteRow(-1);
   while (tbody.rows.length < rows.length) {
     const tr = tbody.insertRow();
-    for (let i = 0; i < 9; i++) tr.insertCell();
+    for (let i = 0; i < 10; i++) tr.insertCell();
   }
   rows.forEach((r, i) => {
     const tr = tbody.rows[i];
@@ -404,7 +407,34 @@ function renderBoard() {
       if (k > 2 && k !== 1) td.className = "num";
     });
     tr.cells[5].classList.toggle("best", r.bestLap != null && r.bestLap === best);
+    renderLink(tr.cells[9], car);
   });
+}
+
+// The Link cell: what a racer needs at a glance (down; RSSI; how often it dropped), and the rest
+// in its title. A car of the feed without link health (an older engine) shows "–".
+function renderLink(td, car) {
+  const l = car.link;
+  let text = "–", title = "";
+  if (car.connected === false) {
+    text = "down";
+  } else if (l) {
+    const parts = [];
+    if (l.rssi != null) parts.push(`${l.rssi} dBm`);
+    if (l.drops > 0) parts.push(`${l.drops} drop${l.drops > 1 ? "s" : ""}`);
+    text = parts.join(" · ") || "ok";
+  }
+  if (l) {
+    title = `${l.connects} connection${l.connects === 1 ? "" : "s"}, ${l.drops} drop${l.drops === 1 ? "" : "s"}` +
+      (l.lastDrop ? ` (last: ${l.lastDrop})` : "") +
+      `, ${l.writeFailures} failed write${l.writeFailures === 1 ? "" : "s"}, ${l.stalls} stall${l.stalls === 1 ? "" : "s"}` +
+      (l.rssi != null ? `, RSSI ${l.rssi} dBm` : "");
+  }
+  td.className = "link";
+  td.classList.toggle("troubled", car.connected === false || !!(l && (l.drops || l.writeFailures || l.stalls)));
+  if (td.textContent !== text) td.textContent = text;
+  if (td.title !== title) td.title = title;
+  td.dataset.drops = l ? l.drops : "";
 }
 
 function escapeHtml(s) {
