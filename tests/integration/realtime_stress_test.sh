@@ -90,7 +90,7 @@ rows, laps = json.load(open(sys.argv[1])), int(sys.argv[2])
 bad = []
 for r in rows:
     if not r.get("finished") or r.get("laps") != laps:
-        bad.append(f"{r['car']} did not finish its {laps} laps ({r.get('laps')})")
+        bad.append(f"{r['car']} did not finish its {laps} laps ({r.get('laps')}, {r.get('status')})")
         continue
     # the best lap is the best clean one: a car whose every lap was unclean (a lap in which it
     # lost the track, under a 1 % CPU quota) has none, and its last lap stands in for it
@@ -103,6 +103,12 @@ print("ok" if len(rows) == 4 and not bad else "; ".join(bad) or f"{len(rows)} ro
 PY
 )
     check "$name: every car finishes, none averaging over 1.5x its best lap" ok "$verdict"
+    if [ "$verdict" != ok ]; then  # what the race and the engine said, for the one who reads it
+      echo "--- $name: its results, and what its log said beyond info"
+      cat "$TMP/$name.json"
+      grep -vE '^(info|debug) ' "$TMP/$name.err" | tail -40
+      grep -E 'race:|marshal' "$TMP/$name.err" | tail -40
+    fi
   done
 }
 behind() { grep -c 'the engine is falling behind real time' "$TMP/$1.err"; }
