@@ -81,7 +81,10 @@ struct BlePeripheral::State {
 
   std::unique_ptr<sdbus::IObject> app, service, notifyChar, writeChar, advert;
   std::unique_ptr<sdbus::IProxy> adapter, device;
-  sdbus::Slot propertiesMatch, addedMatch, removedMatch;
+  sdbus::Slot propertiesMatch, addedMatch, removedMatch, ownerMatch;
+  Loop::TimerId againTimer = 0;  // registering again after bluetoothd came back
+  int againTries = 0;
+  int bluezLives = 0;  // bluetoothd went away this many times: an answer from before is no news
 
   std::vector<std::uint8_t> value;  // last notified value: ReadValue and the Value property
   bool notifying = false;
@@ -100,6 +103,9 @@ struct BlePeripheral::State {
     notifyPath = servicePath + "/char0";
     writePath = servicePath + "/char1";
     advPath = "/org/pitwall/advertisement/" + spec.adapter;
+  }
+  ~State() {
+    if (againTimer) pump.loop().cancel(againTimer);
   }
 
   void exportObjects() {
@@ -247,6 +253,20 @@ struct BlePeripheral::State {
           if (connected != device->second.end() && connected->second.get<bool>())
             deviceConnected(path);
         }));
+    // bluetoothd restarting takes the link and both registrations with it: as a real car is
+    // found again after its host's restart, the emulated one registers again when BlueZ is back
+    ownerMatch = conn.addMatch(
+        "type='signal',sender='org.freedesktop.DBus',path='/org/freedesktop/DBus',"
+        "interface='org.freedesktop.DBus',member='NameOwnerChanged',arg0='org.bluez'",
+        ([this](sdbus::Message& m) {
+          std::string name, oldOwner, newOwner;
+          m >> name >> oldOwner >> newOwner;
+          if (name != api::kService) return;
+          if (newOwner.empty())
+            bluezGone();
+          else
+            bluezBack();
+        }));
     removedMatch = conn.addMatch(
         "type='signal',interface='org.freedesktop.DBus.ObjectManager',member='InterfacesRemoved',"
         "path='/'",
@@ -286,6 +306,50 @@ struct BlePeripheral::State {
     linkUp = false;
     log::debug(kComponent, why);
     if (self.onDisconnected) self.onDisconnected();
+  }
+
+  // bluetoothd went away (restarted, or it died): the central's link and our registrations
+  // went with it.
+  void bluezGone() {
+    log::warn(kComponent, "BlueZ went away (bluetoothd stopped): off the air until it is back");
+    if (againTimer) pump.loop().cancel(againTimer);
+    againTimer = 0;
+    peer.clear();
+    if (notifying) setNotifying(false);
+    down("bluetoothd went away");
+    appRegistered = advertising = readvertising = false;
+    ++bluezLives;
+  }
+
+  // bluetoothd is back: once the adapter is there and powered (looked at every 0.5 s for 30 s),
+  // the application and the advertisement are registered again.
+  void bluezBack() {
+    if (againTimer) pump.loop().cancel(againTimer);
+    againTimer = 0;
+    againTries = 0;
+    registerAgain();
+  }
+
+  void registerAgain() {
+    checkAdapter([this](const std::string& error) {
+      if (!error.empty()) {
+        if (++againTries >= 60)
+          return log::error(kComponent, "BlueZ is back, but " + error + ": off the air");
+        againTimer = pump.loop().after(std::chrono::milliseconds(500), [this] {
+          againTimer = 0;
+          registerAgain();
+        });
+        return;
+      }
+      registerApplication([this](const std::string& error) {
+        if (!error.empty()) return log::error(kComponent, "BlueZ is back, but " + error);
+        form = NameForm::RawData;
+        registerAdvertisement([this](const std::string& error) {
+          if (!error.empty()) return log::error(kComponent, "BlueZ is back, but " + error);
+          log::info(kComponent, "BlueZ is back: advertising again on " + spec.adapter);
+        });
+      });
+    });
   }
 
   void setNotifying(bool on) {
@@ -373,9 +437,11 @@ struct BlePeripheral::State {
         .onInterface(api::kAdvertisingManager)
         .withTimeout(kCallTimeout)
         .withArguments(sdbus::ObjectPath(advPath))
-        .uponReplyInvoke([this](const sdbus::Error*) {
+        .uponReplyInvoke([this, lives = bluezLives](const sdbus::Error*) {
+          if (lives != bluezLives) return;  // bluetoothd went away meanwhile: registered anew
           advertising = false;
-          registerAdvertisement([this](const std::string& error) {
+          registerAdvertisement([this, lives](const std::string& error) {
+            if (lives != bluezLives) return;
             readvertising = false;
             if (!error.empty())
               log::error(kComponent, "cannot advertise again: " + error);

@@ -29,6 +29,7 @@ class DbusPump {
   // Processes what is pending and re-arms, soon, on the loop. Cheap; calls coalesce.
   void kick();
   sdbus::IConnection& connection() { return connection_; }
+  Loop& loop() { return loop_; }
   // Drains and re-arms now (tests and shutdown paths that must flush before returning).
   void process();
 

@@ -13,7 +13,7 @@ set -uo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/boot_lib.sh"
 
 # Who plays the central on hci1 (PITWALL_QEMU_CENTRAL): one or more of these, separated by
-# commas, one after the other against the same car in one boot (default bleak,pitwall):
+# commas, one after the other against the same car in one boot (default bleak,pitwall,links):
 #   bleak    `pitwall scan` must show the car's name clean, with its state and version; then a
 #            client on Debian's bleak that behaves as py-drivesdk does (central_drivesdk.py): it
 #            finds the car by py-drivesdk's name rules, drives it with py-drivesdk's short
@@ -24,8 +24,11 @@ source "$(dirname "${BASH_SOURCE[0]}")/boot_lib.sh"
 #            advertisement (service UUID, manufacturer data, name), connects, subscribes, writes
 #            a ping `01 16`, expects the notification `01 17`, disconnects and does it again.
 #   both     tools,pitwall (a reconnection by another central).
+#   links    `pitwall run tests/qemu/links_ble.lua` drives the car while hci1 is powered off for
+#            3 s, then bluetoothd is restarted: the car must drive again after each, within a
+#            bound (docs/bluetooth.md "What survives what").
 #   script:FILE  a developer's own check, sourced inside the guest by guest.sh.
-CENTRAL=${PITWALL_QEMU_CENTRAL:-bleak,pitwall}
+CENTRAL=${PITWALL_QEMU_CENTRAL:-bleak,pitwall,links}
 # Debian packages the harness needs (installed by the project's ./dev, never by this script).
 PACKAGES=(qemu-system-x86 busybox-static cpio kmod bluez bluez-test-tools dbus-daemon dbus-bin)
 [[ ",$CENTRAL," == *,bleak,* ]] && PACKAGES+=(python3-bleak)
@@ -35,8 +38,8 @@ IFS=, read -r -a centrals <<<"$CENTRAL"
 [ ${#centrals[@]} -gt 0 ] || fail "PITWALL_QEMU_CENTRAL is empty"
 for c in "${centrals[@]}"; do
   case "$c" in
-    bleak | pitwall | tools | both | script:?*) ;;
-    *) fail "PITWALL_QEMU_CENTRAL: '$c' is none of bleak, pitwall, tools, both, script:FILE" ;;
+    bleak | pitwall | tools | both | links | script:?*) ;;
+    *) fail "PITWALL_QEMU_CENTRAL: '$c' is none of bleak, pitwall, tools, both, links, script:FILE" ;;
   esac
 done
 

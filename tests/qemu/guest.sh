@@ -34,14 +34,19 @@ debug=()
 [ "${PITWALL_QEMU_LOG:-info}" = debug ] && debug=(-d)
 # No plugins: the GATT server, the GATT client and advertising are bluetoothd's core; the
 # plugins (audio, input, policy, …) only add start-up time under TCG.
-"$BLUETOOTHD" -n -E -P '*' "${debug[@]}" >"$LOGS/bluetoothd.log" 2>&1 &
-until_ok 10 bluez_get /org/bluez/hci1 org.bluez.Adapter1 Address || fail "bluetoothd has no hci1"
+start_bluetoothd() {
+  "$BLUETOOTHD" -n -E -P '*' "${debug[@]}" >>"$LOGS/bluetoothd.log" 2>&1 &
+  BLUETOOTHD_PID=$!
+  until_ok 10 bluez_get /org/bluez/hci1 org.bluez.Adapter1 Address
+}
+start_bluetoothd || fail "bluetoothd has no hci1"
 # Setting Powered while bluetoothd still sets the adapter up answers org.bluez.Error.Busy: retry.
-power_on() {
+set_powered() {  # set_powered hciN true|false
   dbus-send --system --print-reply --dest=org.bluez "/org/bluez/$1" \
     org.freedesktop.DBus.Properties.Set string:org.bluez.Adapter1 string:Powered \
-    variant:boolean:true && until_ok 1 powered "$1"
+    "variant:boolean:$2"
 }
+power_on() { set_powered "$1" true && until_ok 1 powered "$1"; }
 for hci in hci0 hci1; do
   until_ok 10 power_on "$hci" || fail "$hci did not power on"
 done
@@ -74,6 +79,39 @@ central_pitwall() {
 }
 
 # pitwall's scanner, then a py-drivesdk-like client on bleak (tests/qemu/central_drivesdk.py).
+# links: a race's link through the real bluetoothd's faults (issue 36, docs/bluetooth.md "What
+# survives what"): the car driven by tests/qemu/links_ble.lua on hci1; the central's controller
+# powered off for 3 s, then bluetoothd restarted (the emulated car registers again when it is
+# back). After each the car must drive again within LINKS_BOUND s (measured: the "back" lines).
+LINKS_BOUND=30
+central_links() {
+  local out="$LOGS/links.out" pid status
+  : >"$out"
+  "$PITWALL" run "$SRC/tests/qemu/links_ble.lua" --ble --adapter hci1 --car "$ADDR0" \
+    --duration 150 > >(tee -a "$out" | sed -u 's/^/[links] /') 2>&1 &
+  pid=$!
+  until_ok 40 grep -q '^driving' "$out" || { say "the car never drove"; kill -INT "$pid"; return 1; }
+  say "links: the car drives; hci1 (the central's controller) powered off for 3 s"
+  set_powered hci1 false >/dev/null || { say "cannot power hci1 off"; kill -INT "$pid"; return 1; }
+  sleep 3  # the fault's length: the controller stays off this long
+  power_on hci1 >/dev/null || { say "hci1 did not power on again"; kill -INT "$pid"; return 1; }
+  until_ok "$LINKS_BOUND" grep -q '^back 1 ' "$out" ||
+    { say "the car did not drive again within $LINKS_BOUND s of hci1 powered on"; kill -INT "$pid"; return 1; }
+  say "links: power cycle: $(grep -m1 '^back 1 ' "$out")"
+  say "links: bluetoothd restarted"
+  kill -TERM "$BLUETOOTHD_PID"
+  wait "$BLUETOOTHD_PID"
+  start_bluetoothd || { say "bluetoothd did not come back"; kill -INT "$pid"; return 1; }
+  for hci in hci0 hci1; do until_ok 10 power_on "$hci" || { say "$hci did not power on"; kill -INT "$pid"; return 1; }; done
+  until_ok "$LINKS_BOUND" grep -q '^back 2 ' "$out" ||
+    { say "the car did not drive again within $LINKS_BOUND s of bluetoothd's restart"; kill -INT "$pid"; return 1; }
+  say "links: bluetoothd restart: $(grep -m1 '^back 2 ' "$out")"
+  kill -INT "$pid"
+  wait "$pid"
+  status=$?
+  [ "$status" -eq 130 ] || { say "pitwall run ended with status $status after Ctrl-C, not 130"; return 1; }
+}
+
 central_bleak() {
   # `pitwall scan` through the real BlueZ: the emulated car's Anki-shaped name (state byte,
   # version, filler, user name) reads as a clean name with its state and version.
@@ -106,6 +144,7 @@ for central in "${centrals[@]}"; do
       ;;
     pitwall) central_pitwall || status=$? ;;
     bleak) central_bleak || status=$? ;;
+    links) central_links || status=$? ;;
     script:*)  # a developer's own check, sourced here with this file's variables
       source "${central#script:}" || status=$?
       ;;
