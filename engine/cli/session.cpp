@@ -480,21 +480,15 @@ void Session::record(const std::string& path) {
   });
   // The link's health at each drop and each connection (a replay shows it as it was); not the
   // cars let go at the end of the run, which is no drop
-  linkRecording_ = fleet_.connectionChanged.connect([this](AnkiCar& car, bool up,
-                                                           const std::string& reason) {
-    if (finishing_) return;
-    const CarState& s = car.state();
-    const LinkHealth h = car.link().health();
-    nlohmann::json link = {{"up", up},
-                           {"reason", up ? nlohmann::json(nullptr) : nlohmann::json(reason)},
-                           {"connects", s.connects},
-                           {"drops", s.drops},
-                           {"writeFailures", h.writeFailures},
-                           {"stalls", h.stalls},
-                           {"rssi", h.rssi ? nlohmann::json(*h.rssi) : nlohmann::json(nullptr)}};
-    recorder_->writeLink(loop_.seconds(), car.identity().number,
-                         link.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
-  });
+  linkRecording_ =
+      fleet_.connectionChanged.connect([this](AnkiCar& car, bool up, const std::string& reason) {
+        if (finishing_) return;
+        nlohmann::json link = view::linkJson(car);  // as the view has it, and up or down
+        link["up"] = up;
+        link["reason"] = up ? nlohmann::json(nullptr) : nlohmann::json(reason);
+        recorder_->writeLink(loop_.seconds(), car.identity().number,
+                             link.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
+      });
 }
 
 // The race into the record, for a replay's view (docs/cli.md "Record format"): every change of

@@ -198,7 +198,7 @@ void Feed::event(const std::string& level, const std::string& text) {
 }
 
 // The link's health, as car.link has it (docs/view.md "State")
-static nlohmann::json linkJson(const AnkiCar& car) {
+nlohmann::json linkJson(const AnkiCar& car) {
   const CarState& s = car.state();
   const LinkHealth h = car.link().health();
   return {{"connects", s.connects},

@@ -20,6 +20,10 @@
 
 namespace pitwall::view {
 
+// A car's link health as the view's state and the record carry it (docs/view.md, docs/cli.md
+// "Record format"): {connects, drops, lastDrop, writeFailures, stalls, rssi}.
+nlohmann::json linkJson(const AnkiCar& car);
+
 class Feed {
  public:
   // `source`: what the cars are ("simulator", "ble", "mqtt", "replay"), shown by the page.
