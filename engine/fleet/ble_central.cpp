@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "engine/core/log.hpp"
+#include "engine/fleet/connection_interval.hpp"
 #include "engine/protocol/anki/advertisement.hpp"
 
 namespace pitwall::ble {
@@ -261,6 +262,18 @@ void Central::addCars(const std::vector<Sighting>& sightings) {
     log::info("ble", "found " + car->car->label() + " at " + s.address + " on " +
                          adapter.substr(adapter.rfind('/') + 1));
     cars_.push_back(std::move(car));
+  }
+  // What BlueZ asks each connection for, and whether that suits the cars an adapter now holds
+  const LeInterval interval = leInterval(options_.bluezConfig);
+  for (const auto& [adapter, n] : load) {
+    if (n == 0 || intervalTold_[adapter] == n) continue;
+    intervalTold_[adapter] = n;
+    bool suits = true;
+    std::string sentence = intervalSentence(lastName(adapter), n, interval, suits);
+    if (suits)
+      log::info("ble", sentence);
+    else
+      log::warn("ble", sentence);
   }
   for (auto& c : cars_) enqueue(*c);
 }

@@ -32,6 +32,9 @@ struct CentralOptions {
   // Cars one controller is given at most (docs/bluetooth.md "Adapters"): a car seen only by
   // adapters that hold as many is left out, with a sentence.
   int carsPerAdapter = 6;
+  // BlueZ's configuration, for the connection interval it asks each car for
+  // (connection_interval.hpp): said per adapter, with a warning when too short for its cars.
+  std::string bluezConfig = "/etc/bluetooth/main.conf";
   Duration backoffMin = std::chrono::milliseconds(500);
   Duration backoffMax = std::chrono::seconds(8);
   LinkTimeouts timeouts;
@@ -97,6 +100,7 @@ class Central {
   std::unique_ptr<Bluez> bluez_;
   std::vector<std::unique_ptr<Car>> cars_;
   std::map<std::string, AdapterQueue> queues_;  // by adapter path
+  std::map<std::string, int> intervalTold_;     // by adapter path: the cars it was said for
   std::function<void(std::optional<std::string>)> firstRoundDone_;
   bool shuttingDown_ = false;
   std::shared_ptr<bool> alive_;

@@ -4,6 +4,10 @@
 #include "engine/fleet/ble_central.hpp"
 
 #include <doctest/doctest.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
 
 #include <sdbus-c++/sdbus-c++.h>
 
@@ -483,4 +487,36 @@ TEST_CASE("ble: a device that is not a car on a racing adapter is named in a war
   CHECK(gamepad == 1);
   CHECK(phone == 0);
   CHECK(rig.waitFor([&] { return rig.fleet.connectedCount() == 1; }));  // hci0's car races
+}
+
+TEST_CASE("ble: each adapter says the connection interval BlueZ asks for; too short is a warning") {
+  char name[] = "/tmp/pitwall-main-conf-XXXXXX";
+  int fd = mkstemp(name);
+  REQUIRE(fd >= 0);
+  const std::string conf = "[LE]\nMinConnectionInterval=6\nMaxConnectionInterval=6\n";  // 7.5 ms
+  REQUIRE(write(fd, conf.data(), conf.size()) == static_cast<ssize_t>(conf.size()));
+  close(fd);
+  ble::CentralOptions o = Rig::quick();
+  o.bluezConfig = name;
+  Rig rig(cars(2, 5), o);  // hci0 holds 3 cars, hci1 2: 7.5 ms suits 2
+  std::vector<std::pair<log::Level, std::string>> lines;
+  auto tap = log::addTap([&](log::Level level, std::string_view, std::string_view message) {
+    if (std::string(message).find("connection interval") != std::string::npos)
+      lines.emplace_back(level, std::string(message));
+  });
+  REQUIRE(rig.start() == std::nullopt);
+  log::removeTap(tap);
+  std::remove(name);
+  REQUIRE(lines.size() == 2);  // once per adapter
+  for (const auto& [level, text] : lines) {
+    CAPTURE(text);
+    if (text.rfind("hci0: 3 cars", 0) == 0) {
+      CHECK(level == log::Level::Warn);
+      CHECK(text.find("too short for 3 cars") != std::string::npos);
+    } else {
+      CHECK(text.rfind("hci1: 2 cars", 0) == 0);
+      CHECK(level == log::Level::Info);
+      CHECK(text.find("suits up to 2 cars") != std::string::npos);
+    }
+  }
 }
