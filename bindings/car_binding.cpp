@@ -318,13 +318,16 @@ int index(lua_State* L) {
     }
     if (key == "link") {  // {connects = 2, drops = 1, lastDrop = "…", rssi = -60, …}, fresh
       const LinkHealth h = p.car->link().health();
-      lua_createtable(L, 0, 6);
+      lua_createtable(L, 0, 9);
       lua::setInteger(L, "connects", s.connects);
       lua::setInteger(L, "drops", s.drops);
       if (!s.last_drop.empty()) lua::setString(L, "lastDrop", s.last_drop);
       lua::setInteger(L, "writeFailures", h.writeFailures);
       lua::setInteger(L, "stalls", h.stalls);
       if (h.rssi) lua::setInteger(L, "rssi", *h.rssi);
+      lua::setInteger(L, "silences", s.silences);
+      lua::setNumber(L, "longestSilence", s.longest_silence);
+      if (s.round_trip >= 0) lua::setNumber(L, "roundTrip", s.round_trip);
       return true;
     }
     if (key == "extraBytes") {  // {["position-update"] = {frames = 3, last = "aa"}, …}, fresh

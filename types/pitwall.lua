@@ -396,7 +396,7 @@ function expect.truthy(v, what) end
 ---@field laneChanging boolean a lane change is under way
 ---@field lastPing number? round-trip time of the last answered ping, s
 ---@field lastPositionTime number? engine time of the last position update
----@field link {connects: integer, drops: integer, lastDrop: string?, writeFailures: integer, stalls: integer, rssi: integer?} the link's health: connections made, drops and the last one's reason, refused writes, drops for writes that stalled, RSSI in dBm where the transport tells it (a fresh table)
+---@field link {connects: integer, drops: integer, lastDrop: string?, writeFailures: integer, stalls: integer, rssi: integer?, silences: integer, longestSilence: number, roundTrip: number?} the link's health: connections made, drops and the last one's reason, refused writes, drops for writes that stalled, RSSI in dBm where the transport tells it, silences of a driving car (lost notifications) and the longest in s, the round trip of the last answered request in s (a fresh table)
 ---@field location integer? location id of the last position update
 ---@field malformed integer malformed frames received
 ---@field model string model name (Groundshock); unknown ids read model-<n>

@@ -1,5 +1,6 @@
 #include "engine/vehicles/anki_car.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -58,7 +59,13 @@ AnkiCar::Sent AnkiCar::setSpeed(int speed, int accel, bool respect_limit) {
     return Unexpected{*e};
   auto sent =
       send(SetSpeed{static_cast<int16_t>(speed), static_cast<int16_t>(accel), respect_limit});
-  if (sent) state_.target_speed_mm_s = speed;
+  if (sent) {
+    if (speed == 0)
+      movingSince_ = -1;
+    else if (state_.target_speed_mm_s == 0)
+      movingSince_ = loop_.seconds();
+    state_.target_speed_mm_s = speed;
+  }
   return sent;
 }
 
@@ -151,10 +158,14 @@ AnkiCar::Sent AnkiCar::ping() {
 }
 
 AnkiCar::Sent AnkiCar::requestBattery() {
-  return send(BatteryRequest{});
+  auto sent = send(BatteryRequest{});
+  if (sent) batterySentAt_ = loop_.seconds();
+  return sent;
 }
 AnkiCar::Sent AnkiCar::requestVersion() {
-  return send(VersionRequest{});
+  auto sent = send(VersionRequest{});
+  if (sent) versionSentAt_ = loop_.seconds();
+  return sent;
 }
 AnkiCar::Sent AnkiCar::sdkMode(bool on, std::uint8_t flags) {
   return send(SdkMode{on, flags});
@@ -174,6 +185,10 @@ void AnkiCar::rewind() {
   state_.offset_mm = link_.knownOffset().value_or(0);
   pingSentAt_.reset();
   lastPingRtt_.reset();
+  versionSentAt_.reset();
+  batterySentAt_.reset();
+  movingSince_ = -1;
+  connectedSince_ = state_.connected ? loop_.seconds() : -1;
 }
 
 void AnkiCar::receive(std::span<const std::uint8_t> frame) {
@@ -185,6 +200,7 @@ void AnkiCar::receive(std::span<const std::uint8_t> frame) {
     return;
   }
   ++state_.frames_in;
+  noteSilence();
   if (auto extra = extraBytesOfReceived(frame); !extra.empty()) keepExtra(*decoded, extra);
   apply(*decoded);
   if (onFrame) onFrame(Direction::Rx, frame, *decoded);
@@ -247,8 +263,10 @@ void AnkiCar::apply(const Message& message) {
     speedReportedAt_ = loop_.seconds();
   } else if (auto* b = std::get_if<BatteryResponse>(&message)) {
     state_.battery_mv = b->millivolts;
+    answered(batterySentAt_);
   } else if (auto* v = std::get_if<VersionResponse>(&message)) {
     state_.version = v->version;
+    answered(versionSentAt_);
   } else if (auto* c = std::get_if<CarStatus>(&message)) {
     state_.on_track = c->on_track;
     state_.on_charger = c->on_charger;
@@ -256,14 +274,30 @@ void AnkiCar::apply(const Message& message) {
     if (c->fully_charged) state_.battery_full = *c->fully_charged;
   } else if (std::holds_alternative<PingResponse>(message)) {
     if (pingSentAt_) lastPingRtt_ = loop_.seconds() - *pingSentAt_;
-    pingSentAt_.reset();
+    answered(pingSentAt_);
   }
+}
+
+void AnkiCar::answered(std::optional<double>& sentAt) {
+  if (sentAt) state_.round_trip = loop_.seconds() - *sentAt;
+  sentAt.reset();
+}
+
+// A frame from the car: was it silent, while told to drive and connected, since its last one?
+void AnkiCar::noteSilence() {
+  const double now = loop_.seconds(), last = state_.last_frame_time;
+  state_.last_frame_time = now;
+  if (last < 0 || movingSince_ < 0 || movingSince_ > last || connectedSince_ > last) return;
+  if (now - last < kSilence) return;
+  ++state_.silences;
+  state_.longest_silence = std::max(state_.longest_silence, now - last);
 }
 
 void AnkiCar::linkStateChanged(bool up, const std::string& reason) {
   state_.connected = up;
   if (up) {
     ++state_.connects;
+    connectedSince_ = loop_.seconds();
   } else {
     ++state_.drops;
     state_.last_drop = reason;
@@ -282,8 +316,11 @@ void AnkiCar::linkStateChanged(bool up, const std::string& reason) {
     // is told to stand, so a driver that drives it again after a reconnection sends its speed.
     state_.speed_mm_s = 0;
     state_.target_speed_mm_s = 0;
+    movingSince_ = -1;
     state_.lane_change_target_mm.reset();
     pingSentAt_.reset();
+    versionSentAt_.reset();
+    batterySentAt_.reset();
   }
   log::info(label(), up ? "connected" : "disconnected: " + reason);
   connectionChanged.emit(up, reason);

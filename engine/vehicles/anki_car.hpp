@@ -60,7 +60,19 @@ struct CarState {
   int connects = 0;
   int drops = 0;
   std::string last_drop;
+  // Notifications missed, as far as the model can tell: times a car told to drive, connected all
+  // along, sent nothing for kSilence s or more (a driving car reports several times a second),
+  // counted when it speaks again; and the longest such silence (s).
+  int silences = 0;
+  double longest_silence = 0;
+  double last_frame_time = -1;  // loop seconds of the car's last frame
+  // The round trip of the last request the car answered (ping, version, battery: asked at each
+  // connection), in s; −1 before any.
+  double round_trip = -1;
 };
+
+// A driving car silent this long (s) has lost notifications (CarState::silences).
+inline constexpr double kSilence = 1.0;
 
 // Why a lane change to a car that stands is refused, and what to do (docs/lua-api.md).
 inline constexpr const char* kLaneChangeNeedsMotion =
@@ -140,6 +152,8 @@ class AnkiCar {
   void keepExtra(const anki::Message& message, std::span<const std::uint8_t> extra);
   void linkStateChanged(bool up, const std::string& reason);
   void laneChangeReached();
+  void answered(std::optional<double>& sentAt);  // a request answered: its round trip
+  void noteSilence();
   // Why the car counts as standing (a lane change is refused), or nullopt when it moves.
   std::optional<std::string> standing() const;
 
@@ -152,6 +166,9 @@ class AnkiCar {
   double speedReportedAt_ = -1;  // loop seconds of the last frame that said the car's speed
   std::optional<double> pingSentAt_;
   std::optional<double> lastPingRtt_;
+  std::optional<double> versionSentAt_, batterySentAt_;
+  double movingSince_ = -1;     // loop seconds since the car was told to drive (−1: stands)
+  double connectedSince_ = -1;  // loop seconds of the last connection
   // A car or link that sends only malformed frames: the first warned, then a count each 5 s.
   WarningLimit malformedWarnings_{loop_, "malformed frames ignored"};
 };

@@ -206,7 +206,11 @@ nlohmann::json linkJson(const AnkiCar& car) {
           {"lastDrop", s.last_drop.empty() ? nlohmann::json(nullptr) : nlohmann::json(s.last_drop)},
           {"writeFailures", h.writeFailures},
           {"stalls", h.stalls},
-          {"rssi", h.rssi ? nlohmann::json(*h.rssi) : nlohmann::json(nullptr)}};
+          {"rssi", h.rssi ? nlohmann::json(*h.rssi) : nlohmann::json(nullptr)},
+          {"silences", s.silences},
+          {"longestSilence", round3(s.longest_silence)},
+          {"roundTrip",
+           s.round_trip >= 0 ? nlohmann::json(round3(s.round_trip)) : nlohmann::json(nullptr)}};
 }
 
 nlohmann::json Feed::carJson(const AnkiCar& ankiCar, std::size_t laps) const {

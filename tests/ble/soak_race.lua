@@ -25,7 +25,8 @@ for _, row in ipairs(gp:results()) do
   local car = pitwall.car(row.number)
   local link = car.link
   print(string.format("car %d status=%s laps=%d connected=%s drops=%d connects=%d "
-    .. "writeFailures=%d stalls=%d", row.number, row.status, row.laps, tostring(car.connected),
-    link.drops, link.connects, link.writeFailures, link.stalls))
+    .. "writeFailures=%d stalls=%d silences=%d longestSilence=%.1f roundTrip=%s", row.number,
+    row.status, row.laps, tostring(car.connected), link.drops, link.connects, link.writeFailures,
+    link.stalls, link.silences, link.longestSilence, tostring(link.roundTrip)))
 end
 pitwall.stop()

@@ -428,7 +428,9 @@ function renderLink(td, car) {
     title = `${l.connects} connection${l.connects === 1 ? "" : "s"}, ${l.drops} drop${l.drops === 1 ? "" : "s"}` +
       (l.lastDrop ? ` (last: ${l.lastDrop})` : "") +
       `, ${l.writeFailures} failed write${l.writeFailures === 1 ? "" : "s"}, ${l.stalls} stall${l.stalls === 1 ? "" : "s"}` +
-      (l.rssi != null ? `, RSSI ${l.rssi} dBm` : "");
+      (l.rssi != null ? `, RSSI ${l.rssi} dBm` : "") +
+      (l.silences ? `, ${l.silences} silence${l.silences === 1 ? "" : "s"} (longest ${l.longestSilence} s)` : "") +
+      (l.roundTrip != null ? `, round trip ${Math.round(l.roundTrip * 1000)} ms` : "");
   }
   td.className = "link";
   td.classList.toggle("troubled", car.connected === false || !!(l && (l.drops || l.writeFailures || l.stalls)));

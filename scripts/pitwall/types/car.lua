@@ -139,8 +139,8 @@ Commands check their arguments: out of range raises an error naming the range, a
       malformed = { "integer", "malformed frames received" },
       extraBytes = { "table<string, {frames: integer, last: string}>",
         "frames longer than their layout, by message name (a fresh table)" },
-      link = { "{connects: integer, drops: integer, lastDrop: string?, writeFailures: integer, stalls: integer, rssi: integer?}",
-        "the link's health: connections made, drops and the last one's reason, refused writes, drops for writes that stalled, RSSI in dBm where the transport tells it (a fresh table)" },
+      link = { "{connects: integer, drops: integer, lastDrop: string?, writeFailures: integer, stalls: integer, rssi: integer?, silences: integer, longestSilence: number, roundTrip: number?}",
+        "the link's health: connections made, drops and the last one's reason, refused writes, drops for writes that stalled, RSSI in dBm where the transport tells it, silences of a driving car (lost notifications) and the longest in s, the round trip of the last answered request in s (a fresh table)" },
     },
     events = {
       onPosition = { "e: pitwall.PositionEvent", "each location code the car reads" },

@@ -309,3 +309,62 @@ TEST_CASE(
   AnkiCar unknown{loop, real, CarIdentity{2, "nuke", 9, 43}};
   CHECK(unknown.state().offset_mm == 0.0);
 }
+
+namespace {
+// Lets `seconds` of virtual time pass.
+void pass(Loop& loop, double seconds) {
+  loop.after(fromSeconds(seconds), [&loop] { loop.stop(); });
+  loop.run();
+}
+PositionUpdate at(int piece) {
+  PositionUpdate p;
+  p.piece_id = static_cast<std::uint8_t>(piece);
+  p.speed_mm_s = 800;
+  return p;
+}
+}  // namespace
+
+TEST_CASE_FIXTURE(Fixture,
+                  "link health: a driving car silent for a second or more has lost notifications") {
+  link.setConnected(true);
+  REQUIRE(car.setSpeed(800));
+  link.carSends(at(17));
+  pass(loop, 0.3);
+  link.carSends(at(18));  // 0.3 s: as a driving car reports
+  CHECK(car.state().silences == 0);
+  pass(loop, 2.5);
+  link.carSends(at(20));  // 2.5 s of nothing while told to drive
+  CHECK(car.state().silences == 1);
+  CHECK(car.state().longest_silence == doctest::Approx(2.5));
+  // not silences: a standing car says nothing; nor the time a car was away
+  REQUIRE(car.stop());
+  pass(loop, 5);
+  link.carSends(at(20));
+  REQUIRE(car.setSpeed(800));  // it starts reporting as it rolls
+  pass(loop, 0.3);
+  link.carSends(at(21));
+  link.setConnected(false);
+  pass(loop, 4);
+  link.setConnected(true);
+  REQUIRE(car.setSpeed(800));
+  pass(loop, 0.2);
+  link.carSends(at(23));
+  CHECK(car.state().silences == 1);
+}
+
+TEST_CASE_FIXTURE(Fixture, "link health: the round trip of the last request the car answered") {
+  CHECK(car.state().round_trip < 0);  // before any
+  link.setConnected(true);            // version and battery asked now
+  pass(loop, 0.04);
+  link.carSends(VersionResponse{0x2b70});
+  CHECK(car.state().round_trip == doctest::Approx(0.04));
+  pass(loop, 0.02);
+  link.carSends(BatteryResponse{3900});
+  CHECK(car.state().round_trip == doctest::Approx(0.06));
+  REQUIRE(car.ping());
+  pass(loop, 0.1);
+  link.carSends(PingResponse{});
+  CHECK(car.state().round_trip == doctest::Approx(0.1));
+  link.carSends(PingResponse{});  // unasked: no news
+  CHECK(car.state().round_trip == doctest::Approx(0.1));
+}
