@@ -60,10 +60,12 @@ AnkiCar::Sent AnkiCar::setSpeed(int speed, int accel, bool respect_limit) {
   auto sent =
       send(SetSpeed{static_cast<int16_t>(speed), static_cast<int16_t>(accel), respect_limit});
   if (sent) {
-    if (speed == 0)
+    if (speed == 0) {
+      if (movingSince_ >= 0) stoppedAt_ = loop_.seconds();
       movingSince_ = -1;
-    else if (state_.target_speed_mm_s == 0)
+    } else if (state_.target_speed_mm_s == 0) {
       movingSince_ = loop_.seconds();
+    }
     state_.target_speed_mm_s = speed;
   }
   return sent;
@@ -187,7 +189,8 @@ void AnkiCar::rewind() {
   lastPingRtt_.reset();
   versionSentAt_.reset();
   batterySentAt_.reset();
-  movingSince_ = -1;
+  movingSince_ = stoppedAt_ = -1;
+  silenceSpeed_ = 0;
   connectedSince_ = state_.connected ? loop_.seconds() : -1;
 }
 
@@ -203,6 +206,7 @@ void AnkiCar::receive(std::span<const std::uint8_t> frame) {
   noteSilence();
   if (auto extra = extraBytesOfReceived(frame); !extra.empty()) keepExtra(*decoded, extra);
   apply(*decoded);
+  silenceSpeed_ = movingSince_ >= 0 ? state_.speed_mm_s : 0;
   if (onFrame) onFrame(Direction::Rx, frame, *decoded);
   if (onMessage) onMessage(*decoded);
 }
@@ -283,14 +287,17 @@ void AnkiCar::answered(std::optional<double>& sentAt) {
   sentAt.reset();
 }
 
-// A frame from the car: was it silent, while told to drive and connected, since its last one?
+// A frame from the car: was it silent since its last one — driving then, connected all along —
+// for longer than its speed explains (until now, or until it was told to stop)?
 void AnkiCar::noteSilence() {
   const double now = loop_.seconds(), last = state_.last_frame_time;
   state_.last_frame_time = now;
-  if (last < 0 || movingSince_ < 0 || movingSince_ > last || connectedSince_ > last) return;
-  if (now - last < kSilence) return;
+  if (last < 0 || silenceSpeed_ <= 0 || connectedSince_ > last) return;
+  const double end = stoppedAt_ >= last ? stoppedAt_ : now;
+  const double gap = end - last;
+  if (gap < std::max(kSilence, kSilenceMm / silenceSpeed_)) return;
   ++state_.silences;
-  state_.longest_silence = std::max(state_.longest_silence, now - last);
+  state_.longest_silence = std::max(state_.longest_silence, gap);
 }
 
 void AnkiCar::linkStateChanged(bool up, const std::string& reason) {
@@ -317,6 +324,7 @@ void AnkiCar::linkStateChanged(bool up, const std::string& reason) {
     state_.speed_mm_s = 0;
     state_.target_speed_mm_s = 0;
     movingSince_ = -1;
+    silenceSpeed_ = 0;
     state_.lane_change_target_mm.reset();
     pingSentAt_.reset();
     versionSentAt_.reset();

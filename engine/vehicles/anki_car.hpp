@@ -60,9 +60,10 @@ struct CarState {
   int connects = 0;
   int drops = 0;
   std::string last_drop;
-  // Notifications missed, as far as the model can tell: times a car told to drive, connected all
-  // along, sent nothing for kSilence s or more (a driving car reports several times a second),
-  // counted when it speaks again; and the longest such silence (s).
+  // Notifications missed, as far as the model can tell: times a car told to drive and reporting
+  // a speed, connected all along, sent nothing for longer than it takes to cross two pieces at
+  // that speed (kSilenceMm; a real car sends a transition at every piece boundary) and at least
+  // kSilence s — until it speaks again or is told to stop; and the longest such silence (s).
   int silences = 0;
   double longest_silence = 0;
   double last_frame_time = -1;  // loop seconds of the car's last frame
@@ -71,8 +72,10 @@ struct CarState {
   double round_trip = -1;
 };
 
-// A driving car silent this long (s) has lost notifications (CarState::silences).
+// A driving car silent this long (s), and over this distance at its speed (mm: two of the
+// longest pieces), has lost notifications (CarState::silences).
 inline constexpr double kSilence = 1.0;
+inline constexpr double kSilenceMm = 1120;
 
 // Why a lane change to a car that stands is refused, and what to do (docs/lua-api.md).
 inline constexpr const char* kLaneChangeNeedsMotion =
@@ -169,6 +172,8 @@ class AnkiCar {
   std::optional<double> versionSentAt_, batterySentAt_;
   double movingSince_ = -1;     // loop seconds since the car was told to drive (−1: stands)
   double connectedSince_ = -1;  // loop seconds of the last connection
+  double stoppedAt_ = -1;       // loop seconds the car was last told to stop
+  int silenceSpeed_ = 0;        // its speed at its last frame if it was told to drive, else 0
   // A car or link that sends only malformed frames: the first warned, then a count each 5 s.
   WarningLimit malformedWarnings_{loop_, "malformed frames ignored"};
 };

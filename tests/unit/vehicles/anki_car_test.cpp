@@ -325,17 +325,25 @@ PositionUpdate at(int piece) {
 }  // namespace
 
 TEST_CASE_FIXTURE(Fixture,
-                  "link health: a driving car silent for a second or more has lost notifications") {
+                  "link health: a driving car silent over two pieces has lost notifications") {
   link.setConnected(true);
   REQUIRE(car.setSpeed(800));
   link.carSends(at(17));
   pass(loop, 0.3);
   link.carSends(at(18));  // 0.3 s: as a driving car reports
+  pass(loop, 1.3);
+  link.carSends(at(19));  // 1.3 s at 800 mm/s: 1040 mm, a long piece's transitions apart
   CHECK(car.state().silences == 0);
   pass(loop, 2.5);
   link.carSends(at(20));  // 2.5 s of nothing while told to drive
   CHECK(car.state().silences == 1);
   CHECK(car.state().longest_silence == doctest::Approx(2.5));
+  pass(loop, 0.5);
+  REQUIRE(car.stop());  // told to stop 0.5 s after its last frame: a silence ends there
+  pass(loop, 3);
+  REQUIRE(car.setSpeed(800));
+  link.carSends(at(20));
+  CHECK(car.state().silences == 1);
   // not silences: a standing car says nothing; nor the time a car was away
   REQUIRE(car.stop());
   pass(loop, 5);
