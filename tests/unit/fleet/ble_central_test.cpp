@@ -508,7 +508,9 @@ TEST_CASE("ble: each adapter says the connection interval BlueZ asks for; too sh
   log::removeTap(tap);
   std::remove(name);
   REQUIRE(lines.size() == 2);  // once per adapter
-  for (const auto& [level, text] : lines) {
+  for (const auto& line : lines) {
+    const log::Level level = line.first;
+    const std::string& text = line.second;
     CAPTURE(text);
     if (text.rfind("hci0: 3 cars", 0) == 0) {
       CHECK(level == log::Level::Warn);
