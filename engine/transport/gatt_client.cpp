@@ -49,7 +49,6 @@ void GattClient::connect(Done done) {
   auto attempt = ++attempt_;
   done_ = std::move(done);
   disconnectRequested_ = false;
-  abandonedConnect_ = false;
   step_ = Step::Connecting;
   std::weak_ptr<bool> alive = alive_;
   log::debug(label(), "connecting");
@@ -79,15 +78,8 @@ void GattClient::deviceChanged(const Device& d) {
   // Connected=true signal arrives: a false seen before any true is not a loss.
   bool wasConnected = sawConnected_;
   sawConnected_ = d.connected;
-  if (step_ == Step::Idle) {
-    // A Connect given up on (sd-bus drops a reply that comes after the call's timeout) may
-    // still succeed: hang up, or the device stays taken and invisible to the next scan.
-    if (abandonedConnect_ && d.connected) {
-      abandonedConnect_ = false;
-      disconnectQuietly();
-    }
-    return;
-  }
+  // (A Connect given up on is cancelled when it is given up: fail().)
+  if (step_ == Step::Idle) return;
   if (!d.connected && wasConnected && step_ != Step::Connecting) {
     if (step_ == Step::Up)
       lost(address_ + " disconnected");
@@ -159,7 +151,6 @@ void GattClient::ready() {
 
 void GattClient::fail(const std::string& reason) {
   bool reachedDevice = step_ != Step::Connecting;
-  abandonedConnect_ = !reachedDevice;
   ++attempt_;  // replies still on their way belong to a finished attempt
   bluez_.loop().cancel(stepTimer_);
   if (onClosed) onClosed();
@@ -168,6 +159,14 @@ void GattClient::fail(const std::string& reason) {
   if (reachedDevice) {
     const Device* d = bluez_.device(devicePath_);
     if (d && d->connected) disconnectQuietly();
+  } else {
+    // A Connect given up on (timed out, or refused as one already under way) may still pend
+    // in bluetoothd, which answers every next one InProgress for as long as it keeps trying:
+    // Disconnect cancels it (org.bluez.Device1), so the next attempt is a fresh one. Seen
+    // against the real bluetoothd after its restart (tests/qemu, 2026-11-29). (Should BlueZ
+    // have connected meanwhile, the same Disconnect hangs up, or the device would stay taken
+    // and invisible to the next scan.)
+    disconnectQuietly();
   }
   auto done = std::move(done_);
   done_ = nullptr;

@@ -104,8 +104,7 @@ class GattClient {
   Done done_;
   Loop::TimerId stepTimer_ = 0;
   bool disconnectRequested_ = false;
-  bool sawConnected_ = false;      // BlueZ's Connected as last seen
-  bool abandonedConnect_ = false;  // the last attempt gave up while Connect was under way
+  bool sawConnected_ = false;  // BlueZ's Connected as last seen
   std::shared_ptr<bool> alive_;
 };
 

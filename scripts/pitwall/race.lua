@@ -386,8 +386,10 @@ function Race:_safety(now)
           if behind > 0 and behind <= range then
             e.limit = speed
             if e.limitedBy ~= d then
-              pitwall.log("warn", string.format("race: %s slowed to %d mm/s: %s left the track "
-                .. "%.0f mm ahead", tostring(e.car), speed, tostring(d.car), behind))
+              -- a car whose link is down stands where it was lost, as far as anyone knows
+              local why = d.car.connected and "left the track" or "stands, disconnected,"
+              pitwall.log("warn", string.format("race: %s slowed to %d mm/s: %s %s %.0f mm ahead",
+                tostring(e.car), speed, tostring(d.car), why, behind))
             end
             e.limitedBy = d
           end

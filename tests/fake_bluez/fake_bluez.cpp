@@ -516,6 +516,12 @@ void FakeBluez::State::exportDevice(Device& d) {
       .onInterface(api::kDevice)
       .implementedAs([this, dp](sdbus::Result<>&& result) { connect(*dp, std::move(result)); });
   obj->registerMethod("Disconnect").onInterface(api::kDevice).implementedAs([this, dp] {
+    // device.c: Disconnect also cancels a Connect still pending
+    if (dp->connecting && !dp->connected) {
+      log::debug(kComponent, dp->address + ": a pending connection cancelled by the client");
+      ++dp->counters.connectsCancelled;
+      return failConnect(*dp, "le-connection-abort-by-local");
+    }
     if (!dp->connected) throw notConnected();
     log::debug(kComponent, dp->address + ": disconnected by the client");
     linkDown(*dp, true);

@@ -51,6 +51,8 @@ struct FakeBluezCounters {
   std::size_t framesToCar = 0;     // frames written by the client (WriteValue or fd)
   std::size_t framesToClient = 0;  // car frames delivered (PropertiesChanged or fd)
   std::size_t framesDropped = 0;   // car frames nobody was subscribed to
+  int connectsInProgress = 0;      // Connect calls answered InProgress (one was pending)
+  int connectsCancelled = 0;       // pending Connects a Disconnect cancelled
 };
 
 class FakeBluez {
@@ -67,7 +69,20 @@ class FakeBluez {
   //   Mute       its notifications are lost for `lasting` (the link stays up)
   //   WriteFail  the write socket closes, and writes (WriteValue, AcquireWrite) fail for `lasting`
   //   WriteHang  the write socket is not read for `lasting` (what was written arrives late)
-  enum class Fault { Drop, Burst, Vanish, Garbage, Reboot, Mute, WriteFail, WriteHang };
+  //   ConnectHang  the link drops and for `lasting` a connection attempt neither succeeds nor
+  //              fails (the car does not answer; BlueZ keeps trying, and a second Connect is
+  //              answered InProgress) until Disconnect cancels it or the time is over
+  enum class Fault {
+    Drop,
+    Burst,
+    Vanish,
+    Garbage,
+    Reboot,
+    Mute,
+    WriteFail,
+    WriteHang,
+    ConnectHang
+  };
 
   // Exports the adapters, then requests the name org.bluez on `connection` (unless the
   // connection already owns it). Throws std::invalid_argument for bad options (unknown track,

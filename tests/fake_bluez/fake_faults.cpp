@@ -42,6 +42,8 @@ void FakeBluez::State::arm(Device& d, const Device::Scheduled& f) {
                                std::to_string(toSeconds(f.lasting)) + " s (fault)");
     after(f.lasting, [this, dp, flag] {
       dp->*flag = false;
+      // the car answers again: an attempt still pending succeeds, as BlueZ's would
+      if (flag == &Device::connectHangs && dp->connecting && !dp->connectTimer) finishConnect(*dp);
       // a write socket that was not read: read what waits in it now
       if (flag == &Device::writesHang && dp->writeChar && dp->writeChar->writeIo)
         watchWriteIo(*dp, *dp->writeChar);
@@ -74,6 +76,10 @@ void FakeBluez::State::arm(Device& d, const Device::Scheduled& f) {
       case Fault::WriteFail:
         window(&Device::writesFail, "writes fail");
         if (dp->writeChar) closeWriteIo(*dp->writeChar);
+        break;
+      case Fault::ConnectHang:
+        window(&Device::connectHangs, "connection attempts pend");
+        drop(*dp);
         break;
       case Fault::WriteHang:
         window(&Device::writesHang, "writes hang");

@@ -335,9 +335,13 @@ void FakeBluez::State::connect(Device& d, sdbus::Result<>&& result) {
   ++d.counters.connectCalls;
   if (!d.adapter->powered) return result.returnError(notReady());
   if (d.connected) return result.returnResults();  // device.c: already connected over LE
-  if (d.connecting) return result.returnError(inProgress());
+  if (d.connecting) {
+    ++d.counters.connectsInProgress;
+    return result.returnError(inProgress());
+  }
   d.connecting = true;
   d.pendingConnect = std::make_shared<sdbus::Result<>>(std::move(result));
+  if (d.connectHangs) return;  // pends: the fault's end or a Disconnect settles it
   Device* dp = &d;
   d.connectTimer = after(kConnectDelay, [this, dp] {
     dp->connectTimer = 0;

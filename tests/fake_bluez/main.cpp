@@ -46,10 +46,15 @@ Timed parseTimed(const std::string& flag, const std::string& text) {
 void scheduleFault(pitwall::testing::FakeBluez& fake, const std::string& text) {
   using pitwall::fromSeconds;
   using Fault = pitwall::testing::FakeBluez::Fault;
-  static const std::map<std::string, Fault> kinds{
-      {"drop", Fault::Drop},           {"burst", Fault::Burst},        {"vanish", Fault::Vanish},
-      {"garbage", Fault::Garbage},     {"reboot", Fault::Reboot},      {"mute", Fault::Mute},
-      {"writefail", Fault::WriteFail}, {"writehang", Fault::WriteHang}};
+  static const std::map<std::string, Fault> kinds{{"drop", Fault::Drop},
+                                                  {"burst", Fault::Burst},
+                                                  {"vanish", Fault::Vanish},
+                                                  {"garbage", Fault::Garbage},
+                                                  {"reboot", Fault::Reboot},
+                                                  {"mute", Fault::Mute},
+                                                  {"writefail", Fault::WriteFail},
+                                                  {"writehang", Fault::WriteHang},
+                                                  {"connecthang", Fault::ConnectHang}};
   auto bad = [&] {
     return std::invalid_argument(
         "--fault '" + text +
@@ -113,7 +118,7 @@ int main(int argc, char** argv) {
   app.add_option("--garbage", garbage, "ADDR@SECONDS: the car sends malformed frames");
   app.add_option("--fault", faults,
                  "KIND:ADDR@SECONDS[+LASTING]: KIND drop, burst, vanish, garbage, reboot, mute, "
-                 "writefail or writehang, seconds after that car's first connection; "
+                 "writefail, writehang or connecthang, seconds after that car's first connection; "
                  "unplug:hciN@SECONDS+LASTING and restart@SECONDS+LASTING, seconds from now "
                  "(repeatable)");
   app.add_option("--alphabots", options.alphabots,

@@ -267,9 +267,10 @@ struct Device {
     Duration after, lasting;
   };
   std::vector<Scheduled> scheduled;
-  bool muted = false;       // Mute: notifications are lost
-  bool writesFail = false;  // WriteFail: writes fail
-  bool writesHang = false;  // WriteHang: the write socket is not read
+  bool muted = false;         // Mute: notifications are lost
+  bool writesFail = false;    // WriteFail: writes fail
+  bool writesHang = false;    // WriteHang: the write socket is not read
+  bool connectHangs = false;  // ConnectHang: a connection attempt pends
 
   FakeBluezCounters counters;
 

@@ -63,6 +63,9 @@ for n in $(seq 1 $((N - 1))); do
 done
 contains "soak: car $N is out, disconnected" "car $N status=DNF (disconnected)" "$out"
 contains "soak: the log says why car $N is out" "$(car "$N") vanished" "$(cat "$TMP/run.err")"
+# its body stays where it died, an obstacle: the cars behind it are slowed for a car that stands
+contains "soak: the cars behind the vanished car are slowed for it" "stands, disconnected," \
+  "$(grep "slowed to" "$TMP/run.err")"
 # car.link counted what the fake did: car 1 dropped (its own drop, bluetoothd's restart)
 line=$(echo "$out" | grep "^car 1 ")
 d=$(echo "$line" | sed -n 's/.* drops=\([0-9]*\).*/\1/p')

@@ -143,11 +143,11 @@ EOF
 # does not find it in 10 s: the failure is shown to be the emulation's (btvirt under TCG on a
 # loaded machine), not pitwall's (tests/qemu/README.md "A failed boot").
 radios_deaf() {
-  btmgmt --index 0 advinfo >"$LOGS/radios.out" 2>&1
-  grep -Eq "Instances list with [1-9]" "$LOGS/radios.out" || return 1
-  timeout 10 stdbuf -oL btmgmt --index 1 find -l >>"$LOGS/radios.out" 2>&1
-  btmgmt --index 1 stop-find -l >>"$LOGS/radios.out" 2>&1
-  ! grep -qi "dev_found: $ADDR0 " "$LOGS/radios.out"
+  btmgmt --index 0 advinfo >"$LOGS/radios.log" 2>&1
+  grep -Eq "Instances list with [1-9]" "$LOGS/radios.log" || return 1
+  timeout 10 stdbuf -oL btmgmt --index 1 find -l >>"$LOGS/radios.log" 2>&1
+  btmgmt --index 1 stop-find -l >>"$LOGS/radios.log" 2>&1
+  ! grep -qi "dev_found: $ADDR0 " "$LOGS/radios.log"
 }
 
 central_status=0 deaf=0
@@ -169,7 +169,7 @@ for central in "${centrals[@]}"; do
   if [ "$status" -eq 0 ]; then
     say "central '$central' passed"
   elif radios_deaf; then
-    say "central '$central' FAILED with status $status, and BlueZ's own btmgmt on hci1 does not hear hci0 advertising either: the emulated radios, not pitwall ($(tr '\n' ' ' <"$LOGS/radios.out" | cut -c1-200))"
+    say "central '$central' FAILED with status $status, and BlueZ's own btmgmt on hci1 does not hear hci0 advertising either: the emulated radios, not pitwall (what btmgmt said: radios.log, below)"
     deaf=1
   else
     say "central '$central' FAILED with status $status"

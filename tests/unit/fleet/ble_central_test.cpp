@@ -231,9 +231,10 @@ TEST_CASE("ble: each step of a connection has a timeout that names it") {
   REQUIRE(rig.waitFor([&] { return done; }));
   CHECK(reason == std::string("connecting to ") + kCar1 + " timed out");
   CHECK_FALSE(link.connected());
-  // BlueZ connected after the attempt was given up: the link hangs up again
-  CHECK(rig.waitFor([&] { return rig.fake.counters(kCar1).connects == 1; }));
-  CHECK(rig.waitFor([&] { return !rig.fake.connected(kCar1); }));
+  // the attempt given up on is cancelled in BlueZ, which does not connect
+  CHECK(rig.waitFor([&] { return rig.fake.counters(kCar1).connectsCancelled == 1; }));
+  CHECK(rig.fake.counters(kCar1).connects == 0);
+  CHECK_FALSE(rig.fake.connected(kCar1));
 
   // the next step: services resolve 50 ms after the link is up
   timeouts = {};
@@ -521,4 +522,20 @@ TEST_CASE("ble: each adapter says the connection interval BlueZ asks for; too sh
       CHECK(text.find("suits up to 2 cars") != std::string::npos);
     }
   }
+}
+
+TEST_CASE("ble: a connection attempt given up on is cancelled, so the next is not refused") {
+  // The car does not answer for a while: BlueZ keeps a Connect pending (and answers another
+  // InProgress) until Disconnect cancels it. pitwall gives up on its call after the connect
+  // timeout: it cancels the attempt, so each retry is a fresh one, and the car comes back.
+  ble::CentralOptions o = Rig::quick();
+  o.timeouts.connect = 300ms;
+  Rig rig(cars(1, 1), o);
+  REQUIRE(rig.start() == std::nullopt);
+  REQUIRE(rig.waitFor([&] { return rig.fleet.connectedCount() == 1; }));
+  rig.fake.schedule(FakeBluez::Fault::ConnectHang, kCar1, 0ms, 1500ms);
+  REQUIRE(rig.waitFor([&] { return rig.fleet.connectedCount() == 0; }));
+  CHECK(rig.waitFor([&] { return rig.fleet.connectedCount() == 1; }, 8s));
+  CHECK(rig.fake.counters(kCar1).connectCalls >= 3);        // it tried while the car was silent
+  CHECK(rig.fake.counters(kCar1).connectsInProgress == 0);  // each time afresh
 }
