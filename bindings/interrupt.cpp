@@ -19,6 +19,7 @@ std::atomic<int> g_depth{0};
 std::atomic<int> g_kind{0};
 std::atomic<std::uint64_t> g_call{0};
 std::atomic<int> g_reason{kNoReason};
+std::atomic<long long> g_budgetMs{0};
 }  // namespace detail
 
 namespace {
@@ -29,6 +30,7 @@ enum Reason : int { kNone = detail::kNoReason, kUser = 1, kBudget = 2, kMessage 
 // on the loop's thread too (the watchdog sends it there), so it sees the loop's own writes.
 // Scope's own state (g_running, g_depth, g_kind, g_call, g_reason) is in interrupt.hpp's
 // detail namespace, so that Scope is inline on the event hot path.
+using detail::g_budgetMs;
 using detail::g_call;
 using detail::g_depth;
 using detail::g_kind;
@@ -36,7 +38,6 @@ using detail::g_reason;
 using detail::g_running;
 std::atomic<std::uint64_t> g_target{0};      // the call the watchdog found over budget
 std::atomic<std::uint64_t> g_reasonCall{0};  // … and which call that is
-std::atomic<long long> g_budgetMs{100};
 std::atomic<pthread_t> g_loopThread{};
 std::atomic<clockid_t> g_loopClock{};  // the CPU-time clock of the loop's thread
 std::atomic<bool> g_haveClock{false};
@@ -107,21 +108,32 @@ std::optional<std::chrono::nanoseconds> loopCpuTime() {
   return std::chrono::seconds(ts.tv_sec) + std::chrono::nanoseconds(ts.tv_nsec);
 }
 
-// Wakes a quarter budget apart; a call seen in progress twice, a budget of the loop thread's CPU
-// time apart, is over budget. CPU time, not the wall clock: a callback is not to blame for a
-// machine busy with other work, a slow disk or a stopped process (a race must not end because the
-// host compiled something), while one that loops uses CPU time at the wall clock's pace.
+// Wakes a quarter of the running call's budget apart (its world's), at most kIdleNap; a call seen
+// in progress twice, a budget of the loop thread's CPU time apart, is over budget. CPU time, not
+// the wall clock: a callback is not to blame for a machine busy with other work, a slow disk or a
+// stopped process (a race must not end because the host compiled something), while one that loops
+// uses CPU time at the wall clock's pace.
+constexpr std::chrono::milliseconds kIdleNap{20};
+
+bool budgetedCallRunning() {
+  return g_depth.load(std::memory_order_relaxed) > 0 &&
+         g_kind.load(std::memory_order_relaxed) == static_cast<int>(Kind::Callback) &&
+         g_budgetMs.load(std::memory_order_relaxed) > 0;
+}
+
 void watch() {
   std::uint64_t seen = 0;
   std::chrono::nanoseconds since{};
   bool sent = false;
   for (;;) {
-    long long ms = g_budgetMs.load(std::memory_order_relaxed);
-    auto nap = std::chrono::milliseconds(ms > 0 ? std::max(1LL, ms / 4) : 100);
-    std::this_thread::sleep_for(nap);
-    if (ms <= 0) continue;
-    bool busy = g_depth.load(std::memory_order_relaxed) > 0 &&
-                g_kind.load(std::memory_order_relaxed) == static_cast<int>(Kind::Callback);
+    // Never longer than kIdleNap: the next call may belong to a world with a smaller budget.
+    const long long before = budgetedCallRunning() ? g_budgetMs.load(std::memory_order_relaxed) : 0;
+    std::this_thread::sleep_for(
+        before > 0 ? std::min<std::chrono::milliseconds>(
+                         kIdleNap, std::chrono::milliseconds(std::max(1LL, before / 4)))
+                   : kIdleNap);
+    const bool busy = budgetedCallRunning();
+    const long long ms = g_budgetMs.load(std::memory_order_relaxed);
     std::uint64_t call = g_call.load(std::memory_order_relaxed);
     auto cpu = loopCpuTime();
     if (!busy || !cpu) {
@@ -302,24 +314,14 @@ Running::~Running() {
   if (previous_ && armedNow()) lua_sethook(previous_, hook, kHookMask, 1);
 }
 
-void setBudget(std::chrono::milliseconds budget) {
-  g_budgetMs.store(budget.count() > 0 ? budget.count() : 0, std::memory_order_relaxed);
-  if (budget.count() > 0 && g_loopThread.load(std::memory_order_relaxed) != pthread_t{})
-    startWatchdog();
-}
-
-void watchThisThread() {
+void watchThisThread(bool budgeted) {
   g_loopThread.store(pthread_self(), std::memory_order_relaxed);
   clockid_t clock{};
   if (pthread_getcpuclockid(pthread_self(), &clock) == 0) {
     g_loopClock.store(clock, std::memory_order_relaxed);
     g_haveClock.store(true, std::memory_order_relaxed);
   }
-  if (g_budgetMs.load(std::memory_order_relaxed) > 0) startWatchdog();
-}
-
-std::chrono::milliseconds budget() {
-  return std::chrono::milliseconds(g_budgetMs.load(std::memory_order_relaxed));
+  if (budgeted) startWatchdog();
 }
 
 bool requestFromSignal() {

@@ -33,20 +33,24 @@ extern std::atomic<int> g_depth;           // scopes on the stack
 extern std::atomic<int> g_kind;            // Kind of the outermost scope
 extern std::atomic<std::uint64_t> g_call;  // numbers the outermost scopes
 extern std::atomic<int> g_reason;          // why the current call is being interrupted
+extern std::atomic<long long> g_budgetMs;  // the outermost call's budget (its world's); 0: none
 inline constexpr int kNoReason = 0;
 }  // namespace detail
 
-// Around every call from the engine into Lua (ScriptHost does this). Only the outermost scope
-// on the stack counts; nested ones (a handler that triggers an event) are free.
+// Around every call from the engine into Lua (ScriptHost does this), with the budget of the world
+// called (its own: worlds side by side may differ; zero: none). Only the outermost scope on the
+// stack counts, with its budget; nested ones (a handler that triggers an event, a world that
+// calls another) are free.
 class Scope {
  public:
-  Scope(lua_State* running, Kind kind)
+  Scope(lua_State* running, Kind kind, std::chrono::milliseconds budget)
       : outermost_(detail::g_depth.load(std::memory_order_relaxed) == 0),
         previous_(detail::g_running.load(std::memory_order_relaxed)) {
     using namespace detail;
     if (outermost_) {
       g_call.store(g_call.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
       g_kind.store(static_cast<int>(kind), std::memory_order_relaxed);
+      g_budgetMs.store(budget.count() > 0 ? budget.count() : 0, std::memory_order_relaxed);
     }
     g_running.store(running, std::memory_order_relaxed);
     std::atomic_signal_fence(std::memory_order_seq_cst);
@@ -81,13 +85,12 @@ class Running {
   lua_State* previous_;
 };
 
-// The budget for Kind::Callback calls, in CPU time of the loop's thread; zero turns it off.
-// Default 100 ms.
-void setBudget(std::chrono::milliseconds budget);
-std::chrono::milliseconds budget();
+// A world's budget for its Kind::Callback calls, in CPU time of the loop's thread, unless it
+// chooses its own (HostOptions::budget, --budget); zero turns it off.
+inline constexpr std::chrono::milliseconds kDefaultBudget{100};
 // The calling thread runs the Lua code (ScriptHost's constructor says so): the watchdog signals
-// it. Starts the watchdog (once) while the budget is on.
-void watchThisThread();
+// it. With `budgeted` (the world has a budget), starts the watchdog (once, for the process).
+void watchThisThread(bool budgeted);
 
 // For a SIGINT handler (async-signal-safe): interrupts the Lua code running now with the error
 // "interrupted". Returns false when no Lua code is running (the caller then cancels the line).

@@ -139,13 +139,24 @@ const char* errorText(lua_State* L, int idx);
 // protected), else "(error object is a TYPE value)".
 const char* errorObjectText(lua_State* L, int idx);
 
-// Pushes `msg` and a traceback of L1 from `level` onto L, as luaL_traceback does; while
-// `libraryFrames` is off (pitwall test without --verbose) only the script's own frames are
-// listed: the library's (scripts/pitwall/) and C functions' are left out.
+// How a world's tracebacks and blame tell the shipped library's frames from the user's: the
+// library's chunk names ("@/usr/share/pitwall/scripts/pitwall/") and whether tracebacks list its
+// frames (not in pitwall test without --verbose). Each world's own (its host keeps it, setFrames),
+// found from any of its threads; a state with none set gets these defaults.
+struct Frames {
+  std::string libraryChunks = "@scripts/pitwall/";
+  bool libraryFrames = true;
+};
+void setFrames(lua_State* L, const Frames* frames);  // `frames` outlives L (nullptr: defaults)
+const Frames& framesOf(lua_State* L);
+
+// Pushes `msg` and a traceback of L1 from `level` onto L, as luaL_traceback does; while L's
+// world has libraryFrames off only the script's own frames are listed: the library's
+// (scripts/pitwall/) and C functions' are left out.
 void pushTraceback(lua_State* L, lua_State* L1, const char* msg, int level);
-extern bool libraryFrames;
-// True for a chunk of the shipped library (scripts/pitwall/…): frames the user did not write.
-bool isLibrarySource(const char* source);
+// True for a chunk of L's world's shipped library (scripts/pitwall/…): frames the user did not
+// write.
+bool isLibrarySource(lua_State* L, const char* source);
 
 // t[key] = value for the table on top of the stack.
 inline void setInteger(lua_State* L, const char* key, lua_Integer v) {

@@ -21,8 +21,6 @@ namespace pitwall::sandbox {
 
 namespace {
 
-std::atomic<std::size_t> g_limit{std::size_t{512} << 20};
-
 // Once the cap is reached, the engine still needs a little memory to report the error and end
 // the run (error messages, tracebacks): allocations up to this much above the cap are served.
 constexpr std::size_t kHeadroom = std::size_t{4} << 20;
@@ -303,14 +301,6 @@ int linesOfFile(lua_State* L) {
 
 }  // namespace
 
-void setMemoryLimit(std::size_t bytes) {
-  g_limit.store(bytes, std::memory_order_relaxed);
-}
-
-std::size_t memoryLimit() {
-  return g_limit.load(std::memory_order_relaxed);
-}
-
 std::string memoryMessage(const Memory& memory) {
   return "script memory limit of " + std::to_string(memory.limit >> 20) +
          " MB reached (the script keeps too much: drop what it no longer needs, or raise the "
@@ -318,7 +308,6 @@ std::string memoryMessage(const Memory& memory) {
 }
 
 lua_State* newState(Memory& memory) {
-  memory.limit = memoryLimit();
   lua_State* L = lua_newstate(allocate, &memory);
   if (L) lua_atpanic(L, panic);
   return L;

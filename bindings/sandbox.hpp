@@ -27,10 +27,13 @@
 
 namespace pitwall::sandbox {
 
+// A world's cap unless it chooses its own (HostOptions::memory_limit, --lua-memory MB).
+inline constexpr std::size_t kDefaultMemoryLimit = std::size_t{512} << 20;
+
 // The memory of one Lua world. `limit` 0: no cap.
 struct Memory {
   std::size_t used = 0;
-  std::size_t limit = 0;
+  std::size_t limit = kDefaultMemoryLimit;
   // What the engine keeps for this world outside Lua and charges to its cap (the copy of the race
   // table pitwall.view.race gave the view, bindings/copy_budget.hpp).
   std::size_t outside = 0;
@@ -42,13 +45,11 @@ struct Memory {
   int refusals = 0;
 };
 
-// The cap for worlds made from now on (--lua-memory MB); 0 turns it off.
-void setMemoryLimit(std::size_t bytes);
-std::size_t memoryLimit();
 // "script memory limit of 512 MB reached (…what to do…)"
 std::string memoryMessage(const Memory& memory);
 
-// A new Lua state whose allocations are counted in `memory` (which must outlive it).
+// A new Lua state whose allocations are counted in `memory` (which must outlive it), against
+// its `limit` (0: no cap), which the world chose.
 lua_State* newState(Memory& memory);
 
 // After luaL_openlibs: the restrictions above (os.exit is the host's, see ScriptHost).

@@ -77,30 +77,43 @@ int traceback(lua_State* L) {
   return 1;
 }
 
-// The library's modules are loaded through package.path as <scripts>/pitwall/….lua
-// (openLibraries), so their chunk names start with this; set when a host opens the library, so
-// an error never looks for the data folder again (it may have moved since).
-std::string libraryChunks = "@scripts/pitwall/";
+namespace {
+const Frames kDefaultFrames;
+const char kFramesKey = 0;  // its address: the registry key of a world's Frames
+}  // namespace
+
+void setFrames(lua_State* L, const Frames* frames) {
+  if (frames)
+    lua_pushlightuserdata(L, const_cast<Frames*>(frames));
+  else
+    lua_pushnil(L);
+  lua_rawsetp(L, LUA_REGISTRYINDEX, &kFramesKey);
+}
+
+const Frames& framesOf(lua_State* L) {
+  lua_rawgetp(L, LUA_REGISTRYINDEX, &kFramesKey);
+  const auto* frames = static_cast<const Frames*>(lua_touserdata(L, -1));
+  lua_pop(L, 1);
+  return frames ? *frames : kDefaultFrames;
+}
 
 void pushUserWhere(lua_State* L) {
   lua_Debug ar;
   for (int level = 1; lua_getstack(L, level, &ar); ++level) {
     if (!lua_getinfo(L, "Sl", &ar) || ar.currentline <= 0) continue;  // C functions
-    if (isLibrarySource(ar.source)) continue;
+    if (isLibrarySource(L, ar.source)) continue;
     lua_pushfstring(L, "%s:%d: ", ar.short_src, ar.currentline);
     return;
   }
   luaL_where(L, 1);  // only the library on the stack (an engine call into it): its own line
 }
 
-bool isLibrarySource(const char* source) {
-  return std::string_view(source).starts_with(libraryChunks);
+bool isLibrarySource(lua_State* L, const char* source) {
+  return std::string_view(source).starts_with(framesOf(L).libraryChunks);
 }
 
-bool libraryFrames = true;
-
 void pushTraceback(lua_State* L, lua_State* L1, const char* msg, int level) {
-  if (libraryFrames) return luaL_traceback(L, L1, msg, level);
+  if (framesOf(L).libraryFrames) return luaL_traceback(L, L1, msg, level);
   luaL_Buffer b;
   luaL_buffinit(L, &b);
   if (msg) {
@@ -112,7 +125,7 @@ void pushTraceback(lua_State* L, lua_State* L1, const char* msg, int level) {
   int listed = 0;
   for (; lua_getstack(L1, level, &ar); ++level) {
     if (!lua_getinfo(L1, "Slnt", &ar)) continue;
-    if (ar.currentline <= 0 || isLibrarySource(ar.source)) continue;
+    if (ar.currentline <= 0 || isLibrarySource(L, ar.source)) continue;
     if (++listed > 20) {
       luaL_addstring(&b, "\n\t...");
       break;
@@ -207,9 +220,10 @@ int scriptExit(lua_State* L) {
 
 ScriptHost::ScriptHost(Loop& loop, Fleet& fleet, SimSession* sim, HostOptions options)
     : loop_(loop), fleet_(fleet), sim_(sim), options_(std::move(options)) {
+  memory_.limit = options_.memory_limit;
   L_ = sandbox::newState(memory_);
   if (!L_) throw std::runtime_error("cannot create a Lua state (out of memory)");
-  interrupt::watchThisThread();
+  interrupt::watchThisThread(options_.budget.count() > 0);
   *static_cast<ScriptHost**>(lua_getextraspace(L_)) = this;
   cars_ = std::make_unique<CarBinding>(*this);
   openLibraries();
@@ -280,8 +294,12 @@ void ScriptHost::openLibraries() {
   std::string path;
   for (const auto& dir : options_.library_paths) path += dir + "/?.lua;" + dir + "/?/init.lua;";
   std::string lib = scriptsDir();
-  lua::libraryChunks = "@" + lib + "/pitwall/";
-  lua::libraryFrames = options_.library_frames;
+  // The library's modules are loaded through package.path as <lib>/pitwall/….lua, so their
+  // chunk names start with this; kept now, so an error never looks for the data folder again
+  // (it may have moved since).
+  frames_.libraryChunks = "@" + lib + "/pitwall/";
+  frames_.libraryFrames = options_.library_frames;
+  lua::setFrames(L, &frames_);
   path += lib + "/?.lua;" + lib + "/?/init.lua;";
   lua_getglobal(L, "package");
   lua_getfield(L, -1, "path");
@@ -361,7 +379,7 @@ bool ScriptHost::call(int nargs, int nresults, const char* what, std::string_vie
   lua_insert(L, base);
   int status;
   {
-    interrupt::Scope scope(L, interrupt::Kind::Callback);
+    interrupt::Scope scope(L, interrupt::Kind::Callback, options_.budget);
     status = lua_pcall(L, nargs, nresults, base);
   }
   lua_remove(L, base);
@@ -383,7 +401,8 @@ bool ScriptHost::protectedCall(int nargs, int nresults, std::string& error, bool
   lua_insert(L, base);
   int status;
   {
-    interrupt::Scope scope(L, console ? interrupt::Kind::Console : interrupt::Kind::Callback);
+    interrupt::Scope scope(L, console ? interrupt::Kind::Console : interrupt::Kind::Callback,
+                           options_.budget);
     status = lua_pcall(L, nargs, nresults, base);
   }
   lua_remove(L, base);

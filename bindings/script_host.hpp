@@ -10,6 +10,7 @@
 
 #include <nlohmann/json_fwd.hpp>
 
+#include <chrono>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -18,6 +19,7 @@
 #include <vector>
 
 #include "bindings/interrupt.hpp"
+#include "bindings/lua_args.hpp"
 #include "bindings/sandbox.hpp"
 #include "bindings/tasks.hpp"
 #include "bindings/timers.hpp"
@@ -45,8 +47,12 @@ struct SimSession {
 
 struct HostOptions {
   bool test_mode = false;      // callback errors fail the run; `expect` helpers loaded
-  bool library_frames = true;  // tracebacks list the library's frames (lua::libraryFrames)
-  std::uint64_t seed = 1;      // math.randomseed
+  bool library_frames = true;  // tracebacks list the library's frames (lua::Frames)
+  // This world's limits (docs/safety.md): its memory cap in bytes (--lua-memory; 0: none) and
+  // the CPU time each callback may take (--budget; 0: none). Worlds side by side may differ.
+  std::size_t memory_limit = sandbox::kDefaultMemoryLimit;
+  std::chrono::milliseconds budget = interrupt::kDefaultBudget;
+  std::uint64_t seed = 1;                  // math.randomseed
   std::vector<std::string> library_paths;  // extra folders searched by require
   std::string results;                     // --results FILE (pitwall.resultsFile), empty: none
   // Made detached: the cars' events reach this world only after attach() (a hot reload's new
@@ -117,7 +123,7 @@ class ScriptHost {
     }
     int status;
     {
-      interrupt::Scope scope(L_, interrupt::Kind::Callback);
+      interrupt::Scope scope(L_, interrupt::Kind::Callback, options_.budget);
       status = lua_pcall(L_, nargs, 0, -(nargs + 2));
     }
     if (status == LUA_OK) {
@@ -199,6 +205,7 @@ class ScriptHost {
   SimSession* sim_;
   HostOptions options_;
   sandbox::Memory memory_;  // before L_: the state's allocator counts in it until lua_close
+  lua::Frames frames_;      // before L_: its tracebacks read it until lua_close
   lua_State* L_ = nullptr;
   std::unique_ptr<CarBinding> cars_;
   Tasks tasks_{*this};

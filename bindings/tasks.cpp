@@ -67,7 +67,7 @@ std::string Tasks::cancel(lua_State* co) {
   std::string message = "interrupted while waiting";
   lua_Debug ar;
   for (int level = 0; lua_getstack(co, level, &ar); ++level) {
-    if (lua_getinfo(co, "Sl", &ar) && ar.currentline > 0 && !lua::isLibrarySource(ar.source)) {
+    if (lua_getinfo(co, "Sl", &ar) && ar.currentline > 0 && !lua::isLibrarySource(co, ar.source)) {
       message = std::string(ar.short_src) + ":" + std::to_string(ar.currentline) + ": " + message;
       break;
     }
@@ -79,7 +79,7 @@ std::string Tasks::cancel(lua_State* co) {
   tasks_.erase(it);
   {
     // Closing runs the chunk's to-be-closed variables: Lua code, which Ctrl-C must reach too.
-    interrupt::Scope scope(co, task.kind);
+    interrupt::Scope scope(co, task.kind, host_.options().budget);
     closeThread(co);
   }
   luaL_unref(L, LUA_REGISTRYINDEX, task.threadRef);
@@ -107,7 +107,7 @@ std::vector<std::string> Tasks::waiting() const {
     lua_Debug ar;
     for (int level = 0; lua_getstack(co, level, &ar); ++level) {
       if (!lua_getinfo(co, "Sln", &ar)) continue;
-      bool own = ar.currentline > 0 && !lua::isLibrarySource(ar.source);
+      bool own = ar.currentline > 0 && !lua::isLibrarySource(co, ar.source);
       if (!own) {
         if (ar.name) called = ar.name;
         continue;
@@ -138,7 +138,7 @@ void Tasks::resume(lua_State* co, int nargs) {
   int nres = 0;
   int status;
   {
-    interrupt::Scope scope(co, tasks_.at(co).kind);
+    interrupt::Scope scope(co, tasks_.at(co).kind, host_.options().budget);
     status = lua_resume(co, L, nargs, &nres);
   }
   std::string error;

@@ -3,6 +3,7 @@
 #include <lua.hpp>
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <string_view>
 
@@ -107,6 +108,8 @@ ScenarioResult runScenario(const std::string& file, const ScenarioSettings& sett
   host.test_mode = true;
   host.seed = settings.seed;
   host.library_frames = settings.libraryFrames;
+  host.budget = std::chrono::milliseconds(std::llround(settings.budget * 1000));
+  host.memory_limit = static_cast<std::size_t>(settings.luaMemory) << 20;
   auto finishTiming = [&] {
     out.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   };

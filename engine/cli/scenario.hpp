@@ -11,6 +11,8 @@ struct ScenarioSettings {
   std::uint64_t seed = 1;
   double timeout = 600;        // seconds of virtual time
   bool libraryFrames = false;  // --verbose: tracebacks list the library's frames too
+  double budget = 0.1;         // --budget: seconds of CPU time a callback may use; 0: off
+  int luaMemory = 512;         // --lua-memory: MB the scenario's world may hold; 0: no limit
 };
 
 struct ScenarioResult {

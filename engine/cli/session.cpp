@@ -119,9 +119,8 @@ std::unique_ptr<Session> Session::open(const CarSource& source, bool fast, const
     }
   }
   session->source_ = source;
+  session->limitsFromSource_ = true;
   session->catchSignals();
-  interrupt::setBudget(std::chrono::milliseconds(std::llround(source.budget * 1000)));
-  sandbox::setMemoryLimit(static_cast<std::size_t>(source.luaMemory) << 20);
   setHandlerErrorLimit({source.handlerErrors, source.handlerErrorsWindow});
   return session;
 }
@@ -580,6 +579,10 @@ std::optional<std::string> Session::connectRealCars() {
 }
 
 void Session::startHost(HostOptions options) {
+  if (limitsFromSource_) {  // a run, a REPL: the world's limits are the command line's
+    options.budget = std::chrono::milliseconds(std::llround(source_.budget * 1000));
+    options.memory_limit = static_cast<std::size_t>(source_.luaMemory) << 20;
+  }
   if (!sim_.world && design_) options.design = &*design_;
   if (recorder_) options.recordRace = [this](const nlohmann::json& race) { recordRace(race); };
   scripts_ =

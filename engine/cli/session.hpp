@@ -133,6 +133,7 @@ class Session {
   void suspend();
   void flushRecordPeriodically();
   CarSource source_;
+  bool limitsFromSource_ = false;  // opened from a command line: its --budget and --lua-memory
   std::unique_ptr<StopSignals> signals_;
   std::unique_ptr<Watchdog> watchdog_;  // real time: stops the cars when the loop is stuck
   std::unique_ptr<LagMonitor> lag_;     // real time: says when the loop falls behind

@@ -15,8 +15,6 @@
 #include <random>
 #include <sstream>
 
-#include "bindings/interrupt.hpp"
-#include "bindings/sandbox.hpp"
 #include "engine/cli/commands.hpp"
 #include "engine/cli/options.hpp"
 #include "engine/cli/scenario.hpp"
@@ -219,8 +217,6 @@ int test(const TestOptions& options) {
       return 2;
     }
   }
-  interrupt::setBudget(std::chrono::milliseconds(std::lround(options.budget * 1000)));
-  sandbox::setMemoryLimit(static_cast<std::size_t>(options.luaMemory) << 20);
   int jobs = options.jobs > 0 ? options.jobs : availableCores();
 
   std::vector<ReportedScenario> reported;
@@ -234,6 +230,8 @@ int test(const TestOptions& options) {
         settings.seed = (*seeds)[i];
         settings.timeout = options.timeout;
         settings.libraryFrames = options.verbose;
+        settings.budget = options.budget;
+        settings.luaMemory = options.luaMemory;
         return runScenario((*scenarios)[i].path, settings);
       },
       [&](std::size_t i, ScenarioResult result) {

@@ -31,16 +31,14 @@ struct RunawayFixture {
   std::vector<std::string> logged;
 
   explicit RunawayFixture(std::chrono::milliseconds budget = 100ms) {
-    interrupt::setBudget(budget);
     setenv("PITWALL_SCRIPTS", PITWALL_SOURCE_DIR "/scripts", 1);
-    host = std::make_unique<ScriptHost>(loop, fleet, nullptr, HostOptions{});
+    HostOptions options;
+    options.budget = budget;
+    host = std::make_unique<ScriptHost>(loop, fleet, nullptr, options);
     lua_register(host->state(), "markStarted", markStarted);
     log::setSink([this](log::Level, std::string_view line) { logged.emplace_back(line); });
   }
-  ~RunawayFixture() {
-    log::setSink(nullptr);
-    interrupt::setBudget(100ms);
-  }
+  ~RunawayFixture() { log::setSink(nullptr); }
 
   // Calls the global function `name` as an event callback would be called.
   bool callback(const char* name) {

@@ -25,12 +25,13 @@ struct World {
   std::vector<std::string> logged;
   int stops = 0;
 
-  explicit World(std::size_t memoryLimit = sandbox::memoryLimit()) {
+  explicit World(std::size_t memoryLimit = sandbox::kDefaultMemoryLimit,
+                 std::chrono::milliseconds budget = interrupt::kDefaultBudget) {
     setenv("PITWALL_SCRIPTS", PITWALL_SOURCE_DIR "/scripts", 1);
-    std::size_t saved = sandbox::memoryLimit();
-    sandbox::setMemoryLimit(memoryLimit);
-    host = std::make_unique<ScriptHost>(loop, fleet, nullptr, HostOptions{});
-    sandbox::setMemoryLimit(saved);
+    HostOptions options;
+    options.memory_limit = memoryLimit;
+    options.budget = budget;
+    host = std::make_unique<ScriptHost>(loop, fleet, nullptr, options);
     host->onStopRequested = [this] { ++stops; };
     log::setSink([this](log::Level, std::string_view line) { logged.emplace_back(line); });
   }
@@ -117,8 +118,7 @@ TEST_CASE("os.exit's status: none and true are 0, false is 1") {
 }
 
 TEST_CASE("an allocation loop behind pcall reaches the memory cap and the run ends") {
-  interrupt::setBudget(0ms);  // only the cap may end it
-  World w(std::size_t{16} << 20);
+  World w(std::size_t{16} << 20, 0ms);  // only the cap may end it
   auto started = w.host->startString(R"(
     local keep = {}
     while true do
@@ -126,7 +126,6 @@ TEST_CASE("an allocation loop behind pcall reaches the memory cap and the run en
     end
   )",
                                      "hog");
-  interrupt::setBudget(100ms);
   REQUIRE(started);
   REQUIRE(w.host->exitStatus());
   CHECK(*w.host->exitStatus() == 1);
@@ -137,8 +136,7 @@ TEST_CASE("an allocation loop behind pcall reaches the memory cap and the run en
 }
 
 TEST_CASE("memory under the cap is served, and what is freed counts no more") {
-  interrupt::setBudget(0ms);  // twenty full collections take their time under load
-  World w(std::size_t{16} << 20);
+  World w(std::size_t{16} << 20, 0ms);  // twenty full collections take their time under load
   auto started = w.host->startString(R"(
     for round = 1, 20 do
       local t = {}
@@ -149,7 +147,6 @@ TEST_CASE("memory under the cap is served, and what is freed counts no more") {
     done = 1
   )",
                                      "churn");
-  interrupt::setBudget(100ms);
   REQUIRE(started);
   CHECK(w.global("done") == 1);
   CHECK_FALSE(w.host->memory().exceeded);

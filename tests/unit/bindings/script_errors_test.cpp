@@ -131,12 +131,14 @@ TEST_CASE_FIXTURE(FailingHandler, "pitwall.onError still takes every error") {
 }
 
 TEST_CASE_FIXTURE(FailingHandler, "the callback budget's interrupts are counted the same way") {
-  interrupt::setBudget(5ms);
+  host.reset();
+  HostOptions options;
+  options.budget = 5ms;
+  host = std::make_unique<ScriptHost>(loop, fleet, nullptr, options);
   start(R"(
     pitwall.cars()[1].onPosition = function() while true do end end
   )");
   positions(20, 10ms);
-  interrupt::setBudget(100ms);
   CHECK(countLines("still running after 5 ms: interrupted") == 2);  // the traceback, the count
   CHECK(countLines("stack traceback:") == 1);
   CHECK(sum(counts("onPosition handler of car 1 \\(skull\\)")) == 19);

@@ -100,10 +100,8 @@ TEST_CASE("pitwall.view.race: a copy past its size or the memory cap is refused 
   view::Feed feed(loop, fleet, "simulator");
   HostOptions options;
   options.view = &feed;
-  const std::size_t saved = sandbox::memoryLimit();
-  sandbox::setMemoryLimit(std::size_t{64} << 20);
+  options.memory_limit = std::size_t{64} << 20;
   ScriptHost host(loop, fleet, nullptr, options);
-  sandbox::setMemoryLimit(saved);
   lua_State* L = host.state();
   CHECK(error(L, "pitwall.view.race{title = 'before'}") == "");
 
