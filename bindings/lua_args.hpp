@@ -15,6 +15,7 @@
 #include <string>
 #include <string_view>
 
+#include "bindings/protected_call.hpp"
 #include "engine/core/numbers.hpp"
 
 namespace pitwall::lua {
@@ -28,12 +29,7 @@ inline std::string show(double v) {
   return formatNumber(v);
 }
 
-// Pushes "file:line: " of the script's code that called into pitwall: the nearest Lua function
-// on the stack that is not part of the shipped library (scripts/pitwall/), so that an error
-// raised for a bad argument names the user's line even when it was passed through library
-// functions (race.laps → drivers → car:setSpeed). "" when no such function is on the stack.
-void pushUserWhere(lua_State* L);
-
+// guarded's blame, "file:line: " of the user's line: pushUserWhere (bindings/protected_call.hpp).
 template <int (*Body)(lua_State*)>
 int guarded(lua_State* L) {
   int results = 0;
@@ -127,36 +123,6 @@ inline void checkFunction(lua_State* L, int idx, const char* what) {
   if (lua_type(L, idx) != LUA_TFUNCTION)
     throw LuaError(std::string(what) + " must be a function, got " + typeName(L, idx));
 }
-
-// Message handler for lua_pcall: the error text plus a traceback.
-int traceback(lua_State* L);
-
-// The error message at idx as C text for the handlers: a string (or number) with NUL bytes in it
-// is replaced at idx by one with each NUL written \x00, so no part of it is cut off; nullptr
-// when it is no string.
-const char* errorText(lua_State* L, int idx);
-// An error that is no string, as text pushed onto L: what its __tostring says (called
-// protected), else "(error object is a TYPE value)".
-const char* errorObjectText(lua_State* L, int idx);
-
-// How a world's tracebacks and blame tell the shipped library's frames from the user's: the
-// library's chunk names ("@/usr/share/pitwall/scripts/pitwall/") and whether tracebacks list its
-// frames (not in pitwall test without --verbose). Each world's own (its host keeps it, setFrames),
-// found from any of its threads; a state with none set gets these defaults.
-struct Frames {
-  std::string libraryChunks = "@scripts/pitwall/";
-  bool libraryFrames = true;
-};
-void setFrames(lua_State* L, const Frames* frames);  // `frames` outlives L (nullptr: defaults)
-const Frames& framesOf(lua_State* L);
-
-// Pushes `msg` and a traceback of L1 from `level` onto L, as luaL_traceback does; while L's
-// world has libraryFrames off only the script's own frames are listed: the library's
-// (scripts/pitwall/) and C functions' are left out.
-void pushTraceback(lua_State* L, lua_State* L1, const char* msg, int level);
-// True for a chunk of L's world's shipped library (scripts/pitwall/…): frames the user did not
-// write.
-bool isLibrarySource(lua_State* L, const char* source);
 
 // t[key] = value for the table on top of the stack.
 inline void setInteger(lua_State* L, const char* key, lua_Integer v) {

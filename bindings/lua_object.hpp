@@ -125,6 +125,7 @@ void finishEvent(const EventSource& source, std::size_t e, int tableRef);
 
 template <class Fill>
 void emit(const EventSource& source, std::size_t e, int tableRef, Fill&& fill) {
+  PITWALL_STACK_CHECK(source.host.state(), 0, "an event's delivery (lua::emit)");
   if (tableRef != LUA_NOREF && source.slots.hub(e) == LUA_NOREF) {
     // The hot path (a reused table, the handler alone, no listeners) in one piece, inline:
     // what beginEvent and finishEvent do, without their branches and calls.
@@ -155,6 +156,7 @@ void callCallee(const EventSource& source, std::size_t e, bool hub, int nargs);
 
 template <class Push>
 void emitArgs(const EventSource& source, std::size_t e, Push&& push) {
+  PITWALL_STACK_CHECK(source.host.state(), 0, "an event's delivery (lua::emitArgs)");
   for (bool hub : {true, false})
     if (pushCallee(source, e, hub)) callCallee(source, e, hub, push(source.host.state()));
 }

@@ -27,124 +27,6 @@ std::string scriptsDir() {
 }
 }  // namespace
 
-namespace lua {
-const char* errorText(lua_State* L, int idx) {
-  idx = lua_absindex(L, idx);
-  std::size_t len = 0;
-  const char* text = lua_tolstring(L, idx, &len);
-  if (!text || std::strlen(text) == len) return text;
-  luaL_Buffer b;
-  luaL_buffinit(L, &b);
-  for (std::size_t i = 0; i < len; ++i) {
-    if (text[i] == '\0')
-      luaL_addstring(&b, "\\x00");
-    else
-      luaL_addchar(&b, text[i]);
-  }
-  luaL_pushresult(&b);
-  lua_replace(L, idx);
-  return lua_tostring(L, idx);
-}
-
-namespace {
-int toText(lua_State* L) {
-  luaL_tolstring(L, 1, nullptr);
-  return 1;
-}
-}  // namespace
-
-const char* errorObjectText(lua_State* L, int idx) {
-  idx = lua_absindex(L, idx);
-  if (luaL_getmetafield(L, idx, "__tostring") != LUA_TNIL) {
-    lua_pop(L, 1);
-    lua_pushcfunction(L, toText);
-    lua_pushvalue(L, idx);
-    if (lua_pcall(L, 1, 1, 0) == LUA_OK && lua_type(L, -1) == LUA_TSTRING) return errorText(L, -1);
-    lua_pop(L, 1);
-  }
-  return lua_pushfstring(L, "(error object is a %s value)", luaL_typename(L, idx));
-}
-
-int traceback(lua_State* L) {
-  const char* msg = errorText(L, 1);
-  if (!msg) {
-    if (luaL_callmeta(L, 1, "__tostring") && lua_type(L, -1) == LUA_TSTRING) return 1;
-    msg = lua_pushfstring(L, "(error object is a %s value)", luaL_typename(L, 1));
-  } else if (auto explained = explainMissingName(L, 1, msg)) {
-    msg = lua_pushlstring(L, explained->data(), explained->size());
-  }
-  pushTraceback(L, L, msg, 1);
-  return 1;
-}
-
-namespace {
-const Frames kDefaultFrames;
-const char kFramesKey = 0;  // its address: the registry key of a world's Frames
-}  // namespace
-
-void setFrames(lua_State* L, const Frames* frames) {
-  if (frames)
-    lua_pushlightuserdata(L, const_cast<Frames*>(frames));
-  else
-    lua_pushnil(L);
-  lua_rawsetp(L, LUA_REGISTRYINDEX, &kFramesKey);
-}
-
-const Frames& framesOf(lua_State* L) {
-  lua_rawgetp(L, LUA_REGISTRYINDEX, &kFramesKey);
-  const auto* frames = static_cast<const Frames*>(lua_touserdata(L, -1));
-  lua_pop(L, 1);
-  return frames ? *frames : kDefaultFrames;
-}
-
-void pushUserWhere(lua_State* L) {
-  lua_Debug ar;
-  for (int level = 1; lua_getstack(L, level, &ar); ++level) {
-    if (!lua_getinfo(L, "Sl", &ar) || ar.currentline <= 0) continue;  // C functions
-    if (isLibrarySource(L, ar.source)) continue;
-    lua_pushfstring(L, "%s:%d: ", ar.short_src, ar.currentline);
-    return;
-  }
-  luaL_where(L, 1);  // only the library on the stack (an engine call into it): its own line
-}
-
-bool isLibrarySource(lua_State* L, const char* source) {
-  return std::string_view(source).starts_with(framesOf(L).libraryChunks);
-}
-
-void pushTraceback(lua_State* L, lua_State* L1, const char* msg, int level) {
-  if (framesOf(L).libraryFrames) return luaL_traceback(L, L1, msg, level);
-  luaL_Buffer b;
-  luaL_buffinit(L, &b);
-  if (msg) {
-    luaL_addstring(&b, msg);
-    luaL_addchar(&b, '\n');
-  }
-  luaL_addstring(&b, "stack traceback:");
-  lua_Debug ar;
-  int listed = 0;
-  for (; lua_getstack(L1, level, &ar); ++level) {
-    if (!lua_getinfo(L1, "Slnt", &ar)) continue;
-    if (ar.currentline <= 0 || isLibrarySource(L, ar.source)) continue;
-    if (++listed > 20) {
-      luaL_addstring(&b, "\n\t...");
-      break;
-    }
-    lua_pushfstring(L, "\n\t%s:%d: in ", ar.short_src, ar.currentline);
-    luaL_addvalue(&b);
-    if (*ar.what == 'm')
-      lua_pushliteral(L, "main chunk");
-    else if (*ar.namewhat)
-      lua_pushfstring(L, "%s '%s'", ar.namewhat, ar.name);
-    else
-      lua_pushfstring(L, "function <%s:%d>", ar.short_src, ar.linedefined);
-    luaL_addvalue(&b);
-    if (ar.istailcall) luaL_addstring(&b, "\n\t(...tail calls...)");
-  }
-  luaL_pushresult(&b);
-}
-}  // namespace lua
-
 namespace {
 // print and io.write go to the console: straight to stdout, or above the REPL's prompt.
 int consolePrint(lua_State* L) {
@@ -248,6 +130,7 @@ void ScriptHost::carJoined(AnkiCar& car) {
   if (shutDown_) return;
   cars_->bind(car);
   lua_State* L = L_;
+  PITWALL_STACK_CHECK(L, 0, "pitwall.onCar's call (ScriptHost::carJoined)");
   int top = lua_gettop(L);
   lua_getglobal(L, "pitwall");
   if (lua_istable(L, -1) && lua_getfield(L, -1, "onCar") == LUA_TFUNCTION) {
@@ -332,12 +215,16 @@ void ScriptHost::openLibraries() {
   const char* prelude = options_.test_mode
                             ? "require 'pitwall.core'; expect = require 'pitwall.test'"
                             : "require 'pitwall.core'";
-  if (luaL_dostring(L, prelude) != LUA_OK) {
-    std::string err = lua_tostring(L, -1);
+  std::string err;
+  if (luaL_loadstring(L, prelude) != LUA_OK) {
+    err = lua_tostring(L, -1);
     lua_pop(L, 1);
+  } else {
+    callCapturing(0, 0, err);  // the world's budget: a library that never loads is an error too
+  }
+  if (!err.empty())
     throw std::runtime_error("cannot load the pitwall Lua library from " + lib + ": " + err +
                              " (set PITWALL_SCRIPTS to the folder that holds pitwall/core.lua)");
-  }
 }
 
 // require's Lua-file searcher, wrapped: every module file it finds is recorded, so that a hot
@@ -377,11 +264,8 @@ bool ScriptHost::call(int nargs, int nresults, const char* what, std::string_vie
   int base = lua_gettop(L) - nargs;  // the function's slot
   lua_pushcfunction(L, lua::traceback);
   lua_insert(L, base);
-  int status;
-  {
-    interrupt::Scope scope(L, interrupt::Kind::Callback, options_.budget);
-    status = lua_pcall(L, nargs, nresults, base);
-  }
+  const int status =
+      lua::protectedCall(L, nargs, nresults, base, interrupt::Kind::Callback, options_.budget);
   lua_remove(L, base);
   return finishCall(status, what, who);
 }
@@ -399,12 +283,9 @@ bool ScriptHost::protectedCall(int nargs, int nresults, std::string& error, bool
   int base = lua_gettop(L) - nargs;
   lua_pushcfunction(L, lua::traceback);
   lua_insert(L, base);
-  int status;
-  {
-    interrupt::Scope scope(L, console ? interrupt::Kind::Console : interrupt::Kind::Callback,
-                           options_.budget);
-    status = lua_pcall(L, nargs, nresults, base);
-  }
+  const int status = lua::protectedCall(
+      L, nargs, nresults, base, console ? interrupt::Kind::Console : interrupt::Kind::Callback,
+      options_.budget);
   lua_remove(L, base);
   if (status == LUA_OK) return true;
   error = lua_tostring(L, -1) ? lua_tostring(L, -1) : "(error without a message)";
@@ -456,6 +337,7 @@ void ScriptHost::reportError(const std::string& where, const std::string& messag
     }
   } countAfter{*this, where, message};
   lua_State* L = L_;
+  PITWALL_STACK_CHECK(L, 0, "an error's report (ScriptHost::reportError)");
   std::string text = "error in " + where + ": " + message;
   if (!inOnError_) {
     // A script may take its own errors (pitwall.onError): then they are handled, not failures.
@@ -503,6 +385,7 @@ void ScriptHost::shutDown() {
 void ScriptHost::lastWords() {
   if (!shutDown_ || lastWords_) return;
   lua_State* L = L_;
+  PITWALL_STACK_CHECK(L, 0, "the last words (ScriptHost::lastWords)");
   int top = lua_gettop(L);
   lua_getglobal(L, "pitwall");
   if (lua_istable(L, -1) && lua_getfield(L, -1, "_lastWords") == LUA_TFUNCTION) {

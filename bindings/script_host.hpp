@@ -20,6 +20,7 @@
 
 #include "bindings/interrupt.hpp"
 #include "bindings/lua_args.hpp"
+#include "bindings/protected_call.hpp"
 #include "bindings/sandbox.hpp"
 #include "bindings/tasks.hpp"
 #include "bindings/timers.hpp"
@@ -121,11 +122,8 @@ class ScriptHost {
       lua_pop(L_, nargs + 2);
       return false;
     }
-    int status;
-    {
-      interrupt::Scope scope(L_, interrupt::Kind::Callback, options_.budget);
-      status = lua_pcall(L_, nargs, 0, -(nargs + 2));
-    }
+    const int status =
+        lua::protectedCall(L_, nargs, 0, -(nargs + 2), interrupt::Kind::Callback, options_.budget);
     if (status == LUA_OK) {
       lua_pop(L_, 1);  // the handler
       return true;

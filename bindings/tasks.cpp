@@ -158,7 +158,7 @@ void Tasks::resume(lua_State* co, int nargs) {
     if (!msg) {  // its __tostring runs on the host's thread: co died with the error
       lua_pushvalue(co, -1);
       lua_xmove(co, L, 1);
-      lua::errorObjectText(L, -1);
+      lua::errorObjectText(L, -1, host_.options().budget);
       lua_xmove(L, co, 1);  // the text, kept alive on co
       lua_pop(L, 1);        // the error's copy
       msg = lua_tostring(co, -1);

@@ -2,7 +2,7 @@
 """The floors of docs/architecture.md, checked on every #include of engine/ and bindings/.
 
 A file may include only floors below its own (peers on one floor do not include each other), and
-nothing below bindings/ includes Lua. Usage: layers_test.py SOURCE_ROOT [--self-test].
+nothing below bindings/ includes Lua. Usage: tests/structure/layers_test.py SOURCE_ROOT [--self-test].
 Fails naming the file, the line and the floor it reaches.
 """
 import pathlib

@@ -1,0 +1,77 @@
+#!/usr/bin/env python3
+"""The binding layer's one idioms (issue 37, docs/architecture.md "Lua"), checked on the code of
+engine/ and bindings/ (comments left out):
+
+- one file calls into Lua protected: lua_pcall (and luaL_dostring / luaL_dofile, which expand to
+  it) appear only in bindings/protected_call.hpp, whose lua::protectedCall every call path of the
+  engine builds on. (lua_pcallk in bindings/interrupt.cpp is the script's own xpcall: Lua calling
+  Lua.)
+
+Usage: bindings_test.py SOURCE_ROOT. A self-test runs first, so the check cannot pass by finding
+nothing. Fails naming the file, the line and the rule.
+"""
+import pathlib
+import re
+import sys
+
+RULES = [
+    (re.compile(r"\b(lua_pcall|luaL_dostring|luaL_dofile)\s*\("),
+     {"bindings/protected_call.hpp"},
+     "calls into Lua outside lua::protectedCall (bindings/protected_call.hpp): use the world's "
+     "call path (ScriptHost::call, callCapturing, callInteractive)"),
+]
+
+LINE_COMMENT = re.compile(r"//.*$")
+BLOCK_COMMENT = re.compile(r"/\*.*?\*/", re.S)
+STRING = re.compile(r'"(?:\\.|[^"\\])*"')
+
+
+def code_lines(text):
+    """The lines of C++ text with comments and string literals blanked (line numbers kept)."""
+    text = BLOCK_COMMENT.sub(lambda m: "\n" * m.group(0).count("\n"), text)
+    for line in text.splitlines():
+        yield LINE_COMMENT.sub("", STRING.sub('""', line))
+
+
+def violations(files):
+    """files: {relative path: text}. Yields one sentence per use that breaks a rule."""
+    for path, text in sorted(files.items()):
+        for number, line in enumerate(code_lines(text), 1):
+            for pattern, allowed, why in RULES:
+                m = pattern.search(line)
+                if m and path not in allowed:
+                    yield f"{path}:{number}: {m.group(1)}: {why}"
+
+
+def self_test():
+    bad = {
+        "bindings/x.cpp": "int f(lua_State* L) { return lua_pcall(L, 0, 0, 0); }\n",
+        "engine/cli/y.cpp": "void g(lua_State* L) {\n  luaL_dostring(L, \"x = 1\");\n}\n",
+    }
+    good = {
+        "bindings/protected_call.hpp": "  status = lua_pcall(L, nargs, nresults, handler);\n",
+        "bindings/interrupt.cpp": "  return lua_pcallk(L, n, LUA_MULTRET, 2, 0, k);\n",
+        "bindings/z.cpp": "// lua_pcall(L, 0, 0, 0) in a comment\nconst char* s = \"lua_pcall(\";\n",
+    }
+    found = list(violations(bad))
+    assert len(found) == 2 and ":1:" in found[0] and ":2:" in found[1], found
+    assert not list(violations(good)), list(violations(good))
+
+
+def main():
+    root = pathlib.Path(sys.argv[1])
+    self_test()
+    files = {}
+    for top in ("engine", "bindings"):
+        for p in (root / top).rglob("*"):
+            if p.suffix in (".cpp", ".hpp"):
+                files[str(p.relative_to(root))] = p.read_text(encoding="utf-8", errors="replace")
+    found = list(violations(files))
+    for v in found:
+        print(v, file=sys.stderr)
+    print(f"bindings: {len(files)} files, {len(found)} uses against the binding idioms")
+    return 1 if found else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
