@@ -50,10 +50,6 @@ constexpr const char* kEventNames[] = {
 #undef PITWALL_ALPHABOT_EVENT_NAME
 };
 
-constexpr std::array<const char*, 11> kFieldNames = {"connected", "x",         "y",     "heading",
-                                                     "address",   "lastPing",  "pings", "lastError",
-                                                     "toggles",   "malformed", "path"};
-
 struct Robot {
   ScriptHost* host = nullptr;
   std::unique_ptr<Alphabot> model;
@@ -74,10 +70,13 @@ struct Robot {
   bool closed() const { return selfRef == LUA_NOREF; }
 };
 
+const lua::TypeSpec& robotType();
+
+// The robot of the object at idx (its box holds the Robot it owns; nullptr once collected).
 Robot& robotAt(lua_State* L, int idx) {
-  auto** p = static_cast<Robot**>(luaL_testudata(L, idx, kMetatable));
-  if (!p || !*p) throw LuaError(std::string("expected an alphabot, got ") + luaL_typename(L, idx));
-  return **p;
+  Robot* r = lua::check<Robot*>(L, idx, robotType());
+  if (!r) throw LuaError(lua::expectedSentence(L, idx, robotType()));
+  return *r;
 }
 
 // ---- events ----
@@ -284,94 +283,52 @@ int close(lua_State* L) {
 
 // ---- fields and metamethods ----
 
-bool pushField(lua_State* L, Robot& r, std::string_view key) {
-  const AlphabotState& st = r.model->state();
-  auto integer = [&](const std::optional<int>& v) {
-    if (v)
-      lua_pushinteger(L, *v);
-    else
-      lua_pushnil(L);
-    return true;
-  };
-  if (key == "connected") {
-    lua_pushboolean(L, !r.closed() && r.model->connected());
-    return true;
-  }
-  if (key == "x") return integer(st.x);
-  if (key == "y") return integer(st.y);
-  if (key == "heading") return integer(st.heading);
-  if (key == "pings") {
-    lua_pushinteger(L, static_cast<lua_Integer>(st.pings));
-    return true;
-  }
-  if (key == "lastPing") {
-    if (st.lastPing)
-      lua_pushnumber(L, *st.lastPing);
-    else
-      lua_pushnil(L);
-    return true;
-  }
-  if (key == "address") {
-    lua_pushstring(L, r.model->address().c_str());
-    return true;
-  }
-  if (key == "lastError") {
-    std::string e = r.closed() ? r.label + " is closed" : r.model->lastError();
-    if (e.empty())
-      lua_pushnil(L);
-    else
-      lua_pushstring(L, e.c_str());
-    return true;
-  }
-  if (key == "malformed") {
-    lua_pushinteger(L, static_cast<lua_Integer>(st.malformed));
-    return true;
-  }
-  if (key == "toggles") {
-    lua_createtable(L, 0, static_cast<int>(ab::toggleBits().size()));
-    for (const auto& bit : ab::toggleBits())
-      lua::setBoolean(L, bit.name, ab::isSet(st.toggles, bit));
-    return true;
-  }
-  if (key == "path") {
-    pushWaypoints(L, st.path);
-    return true;
-  }
-  return false;
+const AlphabotState& stateAt(lua_State* L, int self) {
+  return robotAt(L, self).model->state();
+}
+void pushOptional(lua_State* L, const std::optional<int>& v) {
+  v ? lua_pushinteger(L, *v) : lua_pushnil(L);
 }
 
-int index(lua_State* L) {
-  // 1: robot, 2: key. Methods, then state, then the script's own fields.
-  Robot& r = robotAt(L, 1);
-  return lua::indexObject(L, [&](std::string_view key) { return pushField(L, r, key); });
-}
-
-const lua::ObjectType& robotType();
-
-int newindex(lua_State* L) {
-  // A closed robot has no more events: setting a handler on it is a mistake worth saying.
-  Robot& r = robotAt(L, 1);
-  if (r.closed() && lua_isfunction(L, 3) && lua_type(L, 2) == LUA_TSTRING &&
-      events().find(lua_tostring(L, 2)) >= 0)
-    throw LuaError(r.label + " is closed: it has no more events");
-  return lua::newindexObject(L, robotType(), r.slots);
-}
-
-int tostring(lua_State* L) {
-  Robot& r = robotAt(L, 1);
-  lua_pushstring(L, r.label.c_str());
-  return 1;
-}
-
-int gc(lua_State* L) {
-  auto** p = static_cast<Robot**>(luaL_testudata(L, 1, kMetatable));
-  if (p && *p) {
-    (*p)->close(L);
-    delete *p;
-    *p = nullptr;
-  }
-  return 0;
-}
+const lua::Field kFields[] = {
+    {"connected",
+     [](lua_State* L, int self) {
+       Robot& r = robotAt(L, self);
+       lua_pushboolean(L, !r.closed() && r.model->connected());
+     }},
+    {"x", [](lua_State* L, int self) { pushOptional(L, stateAt(L, self).x); }},
+    {"y", [](lua_State* L, int self) { pushOptional(L, stateAt(L, self).y); }},
+    {"heading", [](lua_State* L, int self) { pushOptional(L, stateAt(L, self).heading); }},
+    {"address",
+     [](lua_State* L, int self) { lua_pushstring(L, robotAt(L, self).model->address().c_str()); }},
+    {"lastPing",
+     [](lua_State* L, int self) {
+       const auto& ping = stateAt(L, self).lastPing;
+       ping ? lua_pushnumber(L, *ping) : lua_pushnil(L);
+     }},
+    {"pings",
+     [](lua_State* L, int self) {
+       lua_pushinteger(L, static_cast<lua_Integer>(stateAt(L, self).pings));
+     }},
+    {"lastError",
+     [](lua_State* L, int self) {
+       Robot& r = robotAt(L, self);
+       const std::string e = r.closed() ? r.label + " is closed" : r.model->lastError();
+       e.empty() ? lua_pushnil(L) : (void)lua_pushstring(L, e.c_str());
+     }},
+    {"toggles",
+     [](lua_State* L, int self) {
+       const AlphabotState& st = stateAt(L, self);
+       lua_createtable(L, 0, static_cast<int>(ab::toggleBits().size()));
+       for (const auto& bit : ab::toggleBits())
+         lua::setBoolean(L, bit.name, ab::isSet(st.toggles, bit));
+     }},
+    {"malformed",
+     [](lua_State* L, int self) {
+       lua_pushinteger(L, static_cast<lua_Integer>(stateAt(L, self).malformed));
+     }},
+    {"path", [](lua_State* L, int self) { pushWaypoints(L, stateAt(L, self).path); }},
+};
 
 // ---- pitwall.alphabot{…} ----
 
@@ -430,19 +387,15 @@ int newRobot(lua_State* L) {
   robot->host = &scriptHost;
   robot->model = std::make_unique<Alphabot>(loop, std::move(link), options);
   robot->label = robot->model->label();
-  auto** ud = static_cast<Robot**>(lua_newuserdatauv(L, sizeof(Robot*), 1));
-  *ud = nullptr;
-  luaL_setmetatable(L, kMetatable);
-  lua_newtable(L);
-  lua_setiuservalue(L, -2, 1);
-  *ud = robot.release();
+  Robot*& boxed = lua::newBox<Robot*>(L, robotType(), nullptr);
+  boxed = robot.release();  // the box owns it from here (its gc deletes it)
   lua_pushvalue(L, -1);
-  (*ud)->selfRef = luaL_ref(L, LUA_REGISTRYINDEX);  // lives until close() or the world's end
-  hook(**ud);
+  boxed->selfRef = luaL_ref(L, LUA_REGISTRYINDEX);  // lives until close() or the world's end
+  hook(*boxed);
   return 1;
 }
 
-const lua::ObjectType& robotType() {
+const lua::TypeSpec& robotType() {
   static const luaL_Reg methods[] = {{"drive", lua::guarded<drive>},
                                      {"stop", lua::guarded<stop>},
                                      {"measureDistance", lua::guarded<measureDistance>},
@@ -457,16 +410,25 @@ const lua::ObjectType& robotType() {
                                      {"clearObstacles", lua::guarded<clearObstacles>},
                                      {"close", lua::guarded<close>},
                                      {nullptr, nullptr}};
-  static const lua::ObjectType type{
-      kMetatable, "alphabot", methods, kFieldNames, events(), lua::guarded<index>,
-      lua::guarded<newindex>, lua::guarded<tostring>, gc, nullptr,
-      // listeners: not on a closed robot (it has no more events)
-      [](lua_State* L, int idx) -> lua::EventSlots& {
-        Robot& r = robotAt(L, idx);
-        if (r.closed() && lua_isfunction(L, 3))
-          throw LuaError(r.label + " is closed: it has no more events");
-        return r.slots;
-      }};
+  static const lua::TypeSpec type{
+      .metatable = kMetatable,
+      .name = "alphabot",
+      .methods = methods,
+      .fields = kFields,
+      .events = &events(),
+      .slotsOf = [](lua_State* L, int self) -> lua::EventSlots& { return robotAt(L, self).slots; },
+      .ownFields = true,
+      .label = [](lua_State* L, int self) { return robotAt(L, self).label; },
+      .closed = [](lua_State* L, int self) { return robotAt(L, self).closed(); },
+      .gc =
+          [](lua_State* L, int self) {
+            Robot*& r = *lua::test<Robot*>(L, self, robotType());
+            if (!r) return;
+            r->close(L);
+            delete r;
+            r = nullptr;
+          },
+  };
   return type;
 }
 
@@ -491,7 +453,7 @@ end)";
 
 void openAlphabotModule(ScriptHost& host) {
   lua_State* L = host.state();
-  lua::registerObjectType(L, robotType());
+  lua::registerType(L, robotType());
   luaL_getmetatable(L, kMetatable);
   lua_getfield(L, -1, "__methods");
   if (luaL_loadbufferx(L, kPingWaits, std::strlen(kPingWaits), "=alphabot ping", "t") != LUA_OK)

@@ -40,15 +40,13 @@ const lua::EventNames& carEvents() {
 }
 
 namespace {
-const lua::ObjectType& carType();
+const lua::TypeSpec& carType();
 }  // namespace
 
 namespace {
 
 CarBinding::Proxy& proxyAt(lua_State* L, int idx) {
-  auto** p = static_cast<CarBinding::Proxy**>(luaL_testudata(L, idx, kMetatable));
-  if (!p) throw LuaError(std::string("expected a car, got ") + luaL_typename(L, idx));
-  return **p;
+  return *lua::check<CarBinding::Proxy*>(L, idx, carType());
 }
 
 // Narrows a Lua integer for AnkiCar, whose range check then names the value: anything beyond
@@ -224,136 +222,116 @@ int disconnect(lua_State* L) {
   return 0;
 }
 
-// ---- state fields ----
-bool pushField(lua_State* L, const AnkiCar& car, std::string_view key) {
-  const CarState& s = car.state();
-  const CarIdentity& id = car.identity();
-  auto integer = [&](long long v) {
-    lua_pushinteger(L, v);
-    return true;
-  };
-  auto number = [&](double v) {
-    lua_pushnumber(L, v);
-    return true;
-  };
-  auto boolean = [&](bool v) {
-    lua_pushboolean(L, v);
-    return true;
-  };
-  auto string = [&](const std::string& v) {
-    lua_pushlstring(L, v.data(), v.size());
-    return true;
-  };
-  auto known = [&](long long v) {
-    if (v < 0) {
-      lua_pushnil(L);
-      return true;
-    }
-    return integer(v);
-  };
-  if (key == "speed") return integer(s.speed_mm_s);
-  if (key == "piece") return known(s.piece);
-  if (key == "location") return known(s.location);
-  if (key == "offset") return number(s.offset_mm);
-  if (key == "name") return string(id.name);
-  if (key == "number") return integer(id.number);
-  if (key == "model") return string(modelName(id.model_id));
-  if (key == "modelId") return integer(id.model_id);
-  if (key == "identifier") return integer(id.identifier);
-  if (key == "address") return string(const_cast<AnkiCar&>(car).link().address());
-  if (key == "connected") return boolean(s.connected);
-  if (key == "onTrack") return boolean(s.on_track);
-  if (key == "onCharger") return boolean(s.on_charger);
-  if (key == "delocalized") return boolean(s.delocalized);
-  if (key == "reverse") return boolean(s.reverse);
-  if (key == "targetSpeed") return integer(s.target_speed_mm_s);
-  if (key == "prevPiece") return known(s.prev_piece);
-  if (key == "laneChanging") return boolean(s.lane_change_target_mm.has_value());
-  if (key == "targetOffset") {
-    if (!s.lane_change_target_mm) {
-      lua_pushnil(L);
-      return true;
-    }
-    return number(*s.lane_change_target_mm);
-  }
-  if (key == "batteryLevel") return known(s.battery_mv > 0 ? s.battery_mv : -1);
-  if (key == "batteryLow") return boolean(s.battery_low);
-  if (key == "batteryFull") return boolean(s.battery_full);
-  if (key == "firmware") return known(s.version > 0 ? s.version : -1);
-  if (key == "lastPing") {
-    if (auto rtt = car.lastPingRtt()) return number(*rtt);
+// ---- state fields: one entry each (docs/lua-api.md "Car fields") ----
+
+const CarState& stateAt(lua_State* L, int self) {
+  return proxyAt(L, self).car->state();
+}
+const CarIdentity& identityAt(lua_State* L, int self) {
+  return proxyAt(L, self).car->identity();
+}
+// A count or a reading that is not known yet (negative): nil.
+void pushKnown(lua_State* L, long long v) {
+  if (v < 0)
     lua_pushnil(L);
-    return true;
+  else
+    lua_pushinteger(L, v);
+}
+void pushString(lua_State* L, const std::string& v) {
+  lua_pushlstring(L, v.data(), v.size());
+}
+
+// {connects = 2, drops = 1, lastDrop = "…", rssi = -60, …}, fresh
+void pushLink(lua_State* L, int self) {
+  const AnkiCar& car = *proxyAt(L, self).car;
+  const CarState& s = car.state();
+  const LinkHealth h = const_cast<AnkiCar&>(car).link().health();
+  lua_createtable(L, 0, 9);
+  lua::setInteger(L, "connects", s.connects);
+  lua::setInteger(L, "drops", s.drops);
+  if (!s.last_drop.empty()) lua::setString(L, "lastDrop", s.last_drop);
+  lua::setInteger(L, "writeFailures", h.writeFailures);
+  lua::setInteger(L, "stalls", h.stalls);
+  if (h.rssi) lua::setInteger(L, "rssi", *h.rssi);
+  lua::setInteger(L, "silences", s.silences);
+  lua::setNumber(L, "longestSilence", s.longest_silence);
+  if (s.round_trip >= 0) lua::setNumber(L, "roundTrip", s.round_trip);
+}
+
+// {["position-update"] = {frames = 3, last = "aa"}, …}, fresh
+void pushExtraBytes(lua_State* L, int self) {
+  const CarState& s = stateAt(L, self);
+  lua_createtable(L, 0, static_cast<int>(s.extra_bytes.size()));
+  for (const auto& [name, extra] : s.extra_bytes) {
+    lua_createtable(L, 0, 2);
+    lua::setInteger(L, "frames", static_cast<lua_Integer>(extra.frames));
+    lua::setString(L, "last", toHex(extra.last));
+    lua_setfield(L, -2, name.c_str());
   }
-  if (key == "lastPositionTime") {
-    if (s.last_position_time < 0) {
-      lua_pushnil(L);
-      return true;
-    }
-    return number(s.last_position_time);
-  }
-  return false;
 }
 
-constexpr std::array<const char*, 29> kFieldNames = {
-    "speed",       "piece",       "location",     "offset",       "name",
-    "number",      "model",       "modelId",      "identifier",   "address",
-    "connected",   "onTrack",     "onCharger",    "delocalized",  "reverse",
-    "targetSpeed", "prevPiece",   "laneChanging", "targetOffset", "batteryLevel",
-    "batteryLow",  "batteryFull", "firmware",     "lastPing",     "lastPositionTime",
-    "frames",      "malformed",   "extraBytes",   "link"};
-
-int index(lua_State* L) {
-  // 1: car, 2: key. Methods first, then state, then the car's own fields.
-  auto& p = proxyAt(L, 1);
-  return lua::indexObject(L, [&](std::string_view key) {
-    const CarState& s = p.car->state();
-    if (key == "frames") {
-      lua_pushinteger(L, static_cast<lua_Integer>(s.frames_in + s.frames_out));
-      return true;
-    }
-    if (key == "malformed") {
-      lua_pushinteger(L, static_cast<lua_Integer>(s.malformed));
-      return true;
-    }
-    if (key == "link") {  // {connects = 2, drops = 1, lastDrop = "…", rssi = -60, …}, fresh
-      const LinkHealth h = p.car->link().health();
-      lua_createtable(L, 0, 9);
-      lua::setInteger(L, "connects", s.connects);
-      lua::setInteger(L, "drops", s.drops);
-      if (!s.last_drop.empty()) lua::setString(L, "lastDrop", s.last_drop);
-      lua::setInteger(L, "writeFailures", h.writeFailures);
-      lua::setInteger(L, "stalls", h.stalls);
-      if (h.rssi) lua::setInteger(L, "rssi", *h.rssi);
-      lua::setInteger(L, "silences", s.silences);
-      lua::setNumber(L, "longestSilence", s.longest_silence);
-      if (s.round_trip >= 0) lua::setNumber(L, "roundTrip", s.round_trip);
-      return true;
-    }
-    if (key == "extraBytes") {  // {["position-update"] = {frames = 3, last = "aa"}, …}, fresh
-      lua_createtable(L, 0, static_cast<int>(s.extra_bytes.size()));
-      for (const auto& [name, extra] : s.extra_bytes) {
-        lua_createtable(L, 0, 2);
-        lua::setInteger(L, "frames", static_cast<lua_Integer>(extra.frames));
-        lua::setString(L, "last", toHex(extra.last));
-        lua_setfield(L, -2, name.c_str());
-      }
-      return true;
-    }
-    return pushField(L, *p.car, key);
-  });
-}
-
-int newindex(lua_State* L) {
-  return lua::newindexObject(L, carType(), proxyAt(L, 1).slots);
-}
-
-int tostring(lua_State* L) {
-  auto& p = proxyAt(L, 1);
-  std::string s = p.car->label();
-  lua_pushlstring(L, s.data(), s.size());
-  return 1;
-}
+const lua::Field kFields[] = {
+    {"speed", [](lua_State* L, int c) { lua_pushinteger(L, stateAt(L, c).speed_mm_s); }},
+    {"piece", [](lua_State* L, int c) { pushKnown(L, stateAt(L, c).piece); }},
+    {"location", [](lua_State* L, int c) { pushKnown(L, stateAt(L, c).location); }},
+    {"offset", [](lua_State* L, int c) { lua_pushnumber(L, stateAt(L, c).offset_mm); }},
+    {"name", [](lua_State* L, int c) { pushString(L, identityAt(L, c).name); }},
+    {"number", [](lua_State* L, int c) { lua_pushinteger(L, identityAt(L, c).number); }},
+    {"model", [](lua_State* L, int c) { pushString(L, modelName(identityAt(L, c).model_id)); }},
+    {"modelId", [](lua_State* L, int c) { lua_pushinteger(L, identityAt(L, c).model_id); }},
+    {"identifier", [](lua_State* L, int c) { lua_pushinteger(L, identityAt(L, c).identifier); }},
+    {"address", [](lua_State* L, int c) { pushString(L, proxyAt(L, c).car->link().address()); }},
+    {"connected", [](lua_State* L, int c) { lua_pushboolean(L, stateAt(L, c).connected); }},
+    {"onTrack", [](lua_State* L, int c) { lua_pushboolean(L, stateAt(L, c).on_track); }},
+    {"onCharger", [](lua_State* L, int c) { lua_pushboolean(L, stateAt(L, c).on_charger); }},
+    {"delocalized", [](lua_State* L, int c) { lua_pushboolean(L, stateAt(L, c).delocalized); }},
+    {"reverse", [](lua_State* L, int c) { lua_pushboolean(L, stateAt(L, c).reverse); }},
+    {"targetSpeed",
+     [](lua_State* L, int c) { lua_pushinteger(L, stateAt(L, c).target_speed_mm_s); }},
+    {"prevPiece", [](lua_State* L, int c) { pushKnown(L, stateAt(L, c).prev_piece); }},
+    {"laneChanging",
+     [](lua_State* L, int c) {
+       lua_pushboolean(L, stateAt(L, c).lane_change_target_mm.has_value());
+     }},
+    {"targetOffset",
+     [](lua_State* L, int c) {
+       const auto& target = stateAt(L, c).lane_change_target_mm;
+       target ? lua_pushnumber(L, *target) : lua_pushnil(L);
+     }},
+    {"batteryLevel",
+     [](lua_State* L, int c) {
+       const CarState& s = stateAt(L, c);
+       pushKnown(L, s.battery_mv > 0 ? s.battery_mv : -1);
+     }},
+    {"batteryLow", [](lua_State* L, int c) { lua_pushboolean(L, stateAt(L, c).battery_low); }},
+    {"batteryFull", [](lua_State* L, int c) { lua_pushboolean(L, stateAt(L, c).battery_full); }},
+    {"firmware",
+     [](lua_State* L, int c) {
+       const CarState& s = stateAt(L, c);
+       pushKnown(L, s.version > 0 ? s.version : -1);
+     }},
+    {"lastPing",
+     [](lua_State* L, int c) {
+       const auto rtt = proxyAt(L, c).car->lastPingRtt();
+       rtt ? lua_pushnumber(L, *rtt) : lua_pushnil(L);
+     }},
+    {"lastPositionTime",
+     [](lua_State* L, int c) {
+       const CarState& s = stateAt(L, c);
+       s.last_position_time < 0 ? lua_pushnil(L) : lua_pushnumber(L, s.last_position_time);
+     }},
+    {"frames",
+     [](lua_State* L, int c) {
+       const CarState& s = stateAt(L, c);
+       lua_pushinteger(L, static_cast<lua_Integer>(s.frames_in + s.frames_out));
+     }},
+    {"malformed",
+     [](lua_State* L, int c) {
+       lua_pushinteger(L, static_cast<lua_Integer>(stateAt(L, c).malformed));
+     }},
+    {"extraBytes", pushExtraBytes},
+    {"link", pushLink},
+};
 
 }  // namespace
 
@@ -376,7 +354,7 @@ void CarBinding::detach() {
 }
 
 namespace {
-const lua::ObjectType& carType() {
+const lua::TypeSpec& carType() {
   static const luaL_Reg methods[] = {{"setSpeed", lua::guarded<setSpeed>},
                                      {"stop", lua::guarded<stop>},
                                      {"changeLane", lua::guarded<changeLane>},
@@ -391,25 +369,23 @@ const lua::ObjectType& carType() {
                                      {"version", lua::guarded<version>},
                                      {"disconnect", lua::guarded<disconnect>},
                                      {nullptr, nullptr}};
-  static const lua::ObjectType type{
-      kMetatable,
-      "car",
-      methods,
-      kFieldNames,
-      carEvents(),
-      lua::guarded<index>,
-      lua::guarded<newindex>,
-      lua::guarded<tostring>,
-      nullptr,
-      nullptr,
-      [](lua_State* L, int idx) -> lua::EventSlots& { return proxyAt(L, idx).slots; },
-      "onMessage"};
+  static const lua::TypeSpec type{
+      .metatable = kMetatable,
+      .name = "car",
+      .methods = methods,
+      .fields = kFields,
+      .events = &carEvents(),
+      .slotsOf = [](lua_State* L, int self) -> lua::EventSlots& { return proxyAt(L, self).slots; },
+      .unlistened = "onMessage",
+      .ownFields = true,
+      .label = [](lua_State* L, int self) { return proxyAt(L, self).car->label(); },
+  };
   return type;
 }
 }  // namespace
 
 void CarBinding::registerType(lua_State* L) {
-  lua::registerObjectType(L, carType());
+  lua::registerType(L, carType());
 }
 
 AnkiCar& CarBinding::check(lua_State* L, int idx) {
@@ -491,7 +467,7 @@ void CarBinding::handlerFailedIn(std::string_view where, std::string_view messag
 }
 
 AnkiCar* CarBinding::test(lua_State* L, int idx) {
-  auto** p = static_cast<CarBinding::Proxy**>(luaL_testudata(L, idx, kMetatable));
+  auto** p = lua::test<Proxy*>(L, idx, carType());
   return p ? (*p)->car : nullptr;
 }
 
@@ -502,11 +478,7 @@ void CarBinding::bind(AnkiCar& car) {
   p.car = &car;
   p.label = car.label();
   lua_State* L = L_;
-  auto** ud = static_cast<Proxy**>(lua_newuserdatauv(L, sizeof(Proxy*), 1));
-  *ud = &p;
-  luaL_setmetatable(L, kMetatable);
-  lua_newtable(L);
-  lua_setiuservalue(L, -2, 1);
+  lua::newBox<Proxy*>(L, carType(), &p);
   p.selfRef = luaL_ref(L, LUA_REGISTRYINDEX);  // cars live as long as the run
   for (auto& t : p.tables) {
     lua_createtable(L, 0, 8);

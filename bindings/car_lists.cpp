@@ -1,5 +1,7 @@
 #include "bindings/car_lists.hpp"
 
+#include "bindings/lua_object.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <string_view>
@@ -11,6 +13,8 @@
 namespace pitwall::lua {
 
 namespace {
+
+constexpr const char* kCarListMetatable = "pitwall.carlist";
 
 // The note of the last miss: a table in the registry under this address (a light key: the
 // registry's string keys are metatables, which are locked, and this is none).
@@ -80,19 +84,11 @@ bool isIdentifier(std::string_view s) {
 }  // namespace
 
 void makeCarList(lua_State* L, int idx) {
-  idx = lua_absindex(L, idx);
-  lua_createtable(L, 0, 1);
-  lua_pushcfunction(L, missingCar);
-  lua_setfield(L, -2, "__index");
-  lua_setmetatable(L, idx);
+  lua::setTableType(L, idx, kCarListMetatable, "car list", missingCar);
 }
 
 bool isCarList(lua_State* L, int idx) {
-  if (!lua_getmetatable(L, idx)) return false;
-  const bool is =
-      rawField(L, -1, "__index") == LUA_TFUNCTION && lua_tocfunction(L, -1) == missingCar;
-  lua_pop(L, 2);
-  return is;
+  return lua::hasTableType(L, idx, kCarListMetatable);
 }
 
 std::string carsThereAre(const std::vector<std::pair<long long, std::string>>& cars) {

@@ -1,8 +1,9 @@
 #pragma once
-// Objects with events: the one way a binding gives Lua a device (a car, a remote car, a robot).
-// Each type has one metatable whose methods, read-only state fields and `on…` events come from
-// one list each (ObjectType); each object is a full userdata whose table (its uservalue 1) keeps
-// the script's own fields. An object owns the Lua functions its events call (EventSlots: the
+// Objects: the one way a binding gives Lua an engine object (a car, a robot, a timer, a seat, the
+// script under test). Each type is a TypeSpec (below): one metatable whose methods, read-only
+// state fields and `on…` events come from one list each; each object is a full userdata (its
+// box) whose table (its uservalue 1) keeps the script's own fields, where the type allows them.
+// An object with events owns the Lua functions its events call (EventSlots: the
 // handler the script set, and the hub that runs the library's listeners), and every binding
 // delivers an event the same way (emit): the listeners first, then the handler, with one table
 // (emitArgs: with positional arguments, for the events whose handlers always took them).
@@ -11,10 +12,12 @@
 #include <array>
 #include <cctype>
 #include <cstddef>
+#include <new>
 #include <span>
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "bindings/lua_args.hpp"
@@ -161,134 +164,95 @@ void emitArgs(const EventSource& source, std::size_t e, Push&& push) {
     if (pushCallee(source, e, hub)) callCallee(source, e, hub, push(source.host.state()));
 }
 
-// A userdata type seen from Lua: one metatable under `metatable` in the registry.
-struct ObjectType {
-  const char* metatable;  // registry key, "pitwall.car"
-  const char* name;       // __name, and how errors name the object: "car"
-  const luaL_Reg* methods;
-  std::span<const char* const> fields;  // read-only state fields
-  const EventNames& events;             // onX handlers
-  lua_CFunction index;                  // both get the methods table as upvalue 1
-  lua_CFunction newindex;
-  lua_CFunction tostring;
-  lua_CFunction gc = nullptr;
-  const char* what = nullptr;  // how errors name the object when not by `name` ("robot")
-  // The object's event slots, for pitwall._setHub (listeners); it may refuse (throw LuaError),
-  // e.g. a hub for a closed object. nullptr: the type takes no listeners.
-  EventSlots& (*slotsOf)(lua_State* L, int idx) = nullptr;
-  const char* unlistened = nullptr;  // an event that takes no listeners (the car's onMessage)
+// ---- The object idiom: one way for an engine object to reach Lua ----
+//
+// A type is a TypeSpec, declared with named fields: its metatable's registry key and name, its
+// methods, its read-only state fields (name + getter), its events (or none), whether the script
+// may keep its own fields on it, and its lifetime hooks. registerType makes its one metatable
+// with the generic __index, __newindex, __tostring and __gc below, and locks it
+// (bindings/metatables.hpp): no script changes an engine type. Each object is one full userdata,
+// its box, holding a T (a pointer to an object the binding owns, or a small value: a timer's
+// handle); newBox makes one, check<T> and test<T> read one, with one wording for a wrong value.
+// Only this file (and its .cpp) creates metatables or userdata (tests/structure/bindings_test.py).
+
+// One state field: its name, and how its value is pushed for the object at stack index `self`.
+// The types generator reads the names (__fields); adding a field is one entry.
+struct Field {
+  const char* name;
+  void (*push)(lua_State* L, int self);
 };
 
-// Registers the type's metatable (once): __index and __newindex as closures over the methods
-// table, __tostring, __gc, __name, and __methods / __fields / __events, which the REPL completes
-// from without calling __index (scripts/pitwall/repl.lua).
-inline void registerObjectType(lua_State* L, const ObjectType& type) {
-  if (!luaL_newmetatable(L, type.metatable)) {
-    lua_pop(L, 1);
-    return;
-  }
-  lua_newtable(L);
-  luaL_setfuncs(L, type.methods, 0);
-  lua_pushvalue(L, -1);
-  lua_setfield(L, -3, "__methods");
-  for (auto [names, key] :
-       {std::pair{type.fields, "__fields"}, std::pair{type.events.names(), "__events"}}) {
-    lua_createtable(L, static_cast<int>(names.size()), 0);
-    for (std::size_t i = 0; i < names.size(); ++i) {
-      lua_pushstring(L, names[i]);
-      lua_rawseti(L, -2, static_cast<lua_Integer>(i + 1));
-    }
-    lua_setfield(L, -3, key);
-  }
-  lua_pushvalue(L, -1);
-  lua_pushcclosure(L, type.index, 1);
-  lua_setfield(L, -3, "__index");
-  lua_pushcclosure(L, type.newindex, 1);
-  lua_setfield(L, -2, "__newindex");
-  lua_pushcfunction(L, type.tostring);
-  lua_setfield(L, -2, "__tostring");
-  if (type.gc) {
-    lua_pushcfunction(L, type.gc);
-    lua_setfield(L, -2, "__gc");
-  }
-  lua_pushstring(L, type.name);
-  lua_setfield(L, -2, "__name");
-  // The type itself, for what works on every object type (setHub).
-  lua_pushlightuserdata(L, const_cast<ObjectType*>(&type));
-  lua_setfield(L, -2, "__objecttype");
-  lockMetatable(L, -1);
-  lua_pop(L, 1);
+struct TypeSpec {
+  const char* metatable;       // registry key: "pitwall.car"
+  const char* name;            // __name, and how errors name the object: "car"
+  const char* what = nullptr;  // how errors name it when not by `name` ("robot")
+  const luaL_Reg* methods = nullptr;
+  std::span<const Field> fields = {};
+  const EventNames* events = nullptr;  // its onX events; none: no events
+  // Its event slots (handlers, and the hubs of pitwall.listen); with events only.
+  EventSlots& (*slotsOf)(lua_State* L, int self) = nullptr;
+  const char* unlistened = nullptr;  // an event that takes no listeners (the car's onMessage)
+  bool ownFields = false;            // the script may keep its own fields on it (uservalue 1)
+  bool strict = false;  // reading a key it does not have is an error naming what it has
+  // Lifetime: how it names itself in messages and prints ("car 1 (skull)"; default: `name`),
+  // whether it is closed (no more events: a handler or listener set on it is refused), and what
+  // its box does when it goes (garbage, or the world's end: Lua 5.4 runs every finalizer before
+  // it frees anything, so the registry is whole there).
+  std::string (*label)(lua_State* L, int self) = nullptr;
+  bool (*closed)(lua_State* L, int self) = nullptr;
+  void (*gc)(lua_State* L, int self) = nullptr;
+};
+
+// Registers the type's metatable (once per world).
+void registerType(lua_State* L, const TypeSpec& type);
+
+// A plain table given a type of the engine's (pitwall.cars()'s list): its metatable is the one
+// under `metatable` in the registry (made once, named `name`, locked) with `index` as __index.
+void setTableType(lua_State* L, int idx, const char* metatable, const char* name,
+                  lua_CFunction index);
+// The table at idx has that type.
+bool hasTableType(lua_State* L, int idx, const char* metatable);
+
+// "expected a car, got number": the one sentence for a value that is not an object of `type`.
+std::string expectedSentence(lua_State* L, int idx, const TypeSpec& type);
+
+// How errors name an object of `type`: its `what`, else its `name`.
+inline const char* whatOf(const TypeSpec& type) {
+  return type.what ? type.what : type.name;
 }
 
-// __index of an object (1: the object, 2: the key): a method (the methods table is upvalue 1),
-// else a state field — `field(key)` pushes it and returns true —, else the object's own table.
-template <class Field>
-int indexObject(lua_State* L, Field&& field) {
-  lua_pushvalue(L, 2);
-  if (lua_rawget(L, lua_upvalueindex(1)) != LUA_TNIL) return 1;
-  lua_pop(L, 1);
-  if (lua_type(L, 2) == LUA_TSTRING && field(std::string_view(lua_tostring(L, 2)))) return 1;
-  lua_getiuservalue(L, 1, 1);
-  lua_pushvalue(L, 2);
-  lua_rawget(L, -2);
-  return 1;
+// A new object of `type` on the stack: its box holds a T made from `args`, its metatable is the
+// type's, and with ownFields its own table. A T that is not trivially destructible is the type's
+// gc hook's to end (destroyBox).
+void* newBoxRaw(lua_State* L, const TypeSpec& type, std::size_t size);
+template <class T, class... Args>
+T& newBox(lua_State* L, const TypeSpec& type, Args&&... args) {
+  return *new (newBoxRaw(L, type, sizeof(T))) T(std::forward<Args>(args)...);
+}
+template <class T>
+void destroyBox(lua_State* L, int self, const TypeSpec& type) {
+  if (void* p = luaL_testudata(L, self, type.metatable)) static_cast<T*>(p)->~T();
 }
 
-// __newindex of an object (1: the object, 2: the key, 3: the value): an event's handler is
-// checked (a function or nil) and taken into `slots`; a state field, a method, or an onX that is
-// no event (a typo would never be called) is refused by name; anything else is the script's own
-// field. Every value set is also kept in the object's table, so reading it gives it back.
-inline int newindexObject(lua_State* L, const ObjectType& type, EventSlots& slots) {
-  if (lua_type(L, 2) == LUA_TSTRING) {
-    const std::string key = lua_tostring(L, 2);
-    const std::string what = type.what ? type.what : type.name;
-    if (int e = type.events.find(key); e >= 0) {
-      if (!lua_isnil(L, 3) && !lua_isfunction(L, 3))
-        throw LuaError(what + "." + key + " must be a function or nil, got " + typeName(L, 3));
-      slots.setHandler(L, static_cast<std::size_t>(e), 3);
-    } else {
-      if (key.size() > 2 && key[0] == 'o' && key[1] == 'n' &&
-          std::isupper(static_cast<unsigned char>(key[2])))
-        throw LuaError(what + "." + key + " is not an event; the events are " +
-                       joinNames(type.events.names()));
-      for (const char* f : type.fields)
-        if (key == f)
-          throw LuaError(what + "." + key + " is read-only (it is the " + what + "'s state)");
-      lua_pushvalue(L, 2);
-      const bool isMethod = lua_rawget(L, lua_upvalueindex(1)) != LUA_TNIL;
-      lua_pop(L, 1);
-      if (isMethod) throw LuaError(what + ":" + key + " is a method and cannot be replaced");
-    }
-  }
-  lua_settop(L, 3);
-  lua_getiuservalue(L, 1, 1);
-  lua_pushvalue(L, 2);
-  lua_pushvalue(L, 3);
-  lua_rawset(L, 4);
-  return 0;
+// The object of `type` at idx, or nullptr.
+template <class T>
+T* test(lua_State* L, int idx, const TypeSpec& type) {
+  return static_cast<T*>(luaL_testudata(L, idx, type.metatable));
+}
+// The box of the object of `type` at idx; anything else raises expectedSentence.
+inline void* checkBox(lua_State* L, int idx, const TypeSpec& type) {
+  if (void* p = luaL_testudata(L, idx, type.metatable)) return p;
+  throw LuaError(expectedSentence(L, idx, type));
+}
+// The object of `type` at idx; anything else raises expectedSentence.
+template <class T>
+T& check(lua_State* L, int idx, const TypeSpec& type) {
+  return *static_cast<T*>(checkBox(L, idx, type));
 }
 
 // pitwall._setHub(object, "onX", fn | nil): the function that runs the library's listeners of
 // that event (scripts/pitwall/core.lua, pitwall.listen), for an object of any type registered
 // with slotsOf: cars, remote cars, robots.
 int setHub(lua_State* L);
-
-// setHub's work for a type: `except` names an event that takes no listeners (the car's
-// onMessage: only through car.onMessage).
-inline void setHubOf(lua_State* L, const ObjectType& type, EventSlots& slots,
-                     const char* except = nullptr) {
-  const EventNames& events = type.events;
-  const std::string name = checkString(L, 2, "event name");
-  const int e = events.find(name);
-  if (e < 0 || (except && name == except))
-    throw LuaError(
-        "cannot listen to '" + name + "'; the events are " + joinNames(events.names()) +
-        (except ? std::string(" (") + except + " only through " + type.name + "." + except + ")"
-                : std::string()));
-  if (!lua_isnil(L, 3) && !lua_isfunction(L, 3))
-    throw LuaError(std::string("a listener hub must be a function or nil, got ") +
-                   luaL_typename(L, 3));
-  slots.setHub(L, static_cast<std::size_t>(e), 3);
-}
 
 }  // namespace pitwall::lua

@@ -45,8 +45,6 @@ constexpr const char* kEvents[] = {
     PITWALL_MINDROAD_EVENTS(PITWALL_MINDROAD_EVENT_NAME)
 #undef PITWALL_MINDROAD_EVENT_NAME
 };
-constexpr std::array<const char*, 8> kFields = {"connected", "host",  "port",      "udp",
-                                                "watchdog",  "phase", "lastError", "contacts"};
 
 struct Robot {
   std::unique_ptr<MindroadRobot> client;  // closed, not destroyed, by close(): a handler may
@@ -59,10 +57,11 @@ struct Robot {
   MindroadOptions options;  // host, port, … stay readable after close()
 };
 
+const lua::TypeSpec& robotType();
+
+// The robot at idx: its box holds the Robot itself (its gc ends it).
 Robot& robotAt(lua_State* L, int idx) {
-  auto* r = static_cast<Robot*>(luaL_testudata(L, idx, kMetatable));
-  if (!r) throw LuaError(std::string("expected a mindroad robot, got ") + luaL_typename(L, idx));
-  return *r;
+  return lua::check<Robot>(L, idx, robotType());
 }
 
 bool isOpen(const Robot& r) {
@@ -193,64 +192,47 @@ int close(lua_State* L) {
   return 0;
 }
 
-int gc(lua_State* L) {
-  auto* r = static_cast<Robot*>(luaL_testudata(L, 1, kMetatable));
-  if (r) {
-    // The registry is still whole here, even in lua_close: Lua 5.4 runs every finalizer before it
-    // frees anything (luaC_freeallobjects).
-    closeRobot(L, *r);
-    r->~Robot();
-  }
-  return 0;
+std::string robotLabel(lua_State* L, int self) {
+  Robot& r = robotAt(L, self);
+  return r.label + " (" + (isOpen(r) ? r.client->phaseName() : "closed") + ")";
 }
 
-int tostring(lua_State* L) {
-  Robot& r = robotAt(L, 1);
-  std::string s = r.label + " (" + (isOpen(r) ? r.client->phaseName() : "closed") + ")";
-  lua_pushlstring(L, s.data(), s.size());
-  return 1;
+// ---- state fields: one entry each ----
+const MindroadOptions& optionsAt(lua_State* L, int self) {
+  return robotAt(L, self).options;
 }
 
-bool pushField(lua_State* L, Robot& r, std::string_view key) {
-  const MindroadOptions* o = &r.options;
-  if (key == "connected") {
-    lua_pushboolean(L, isOpen(r) && r.client->connected());
-  } else if (key == "phase") {
-    lua_pushstring(L, isOpen(r) ? r.client->phaseName().c_str() : "closed");
-  } else if (key == "lastError") {
-    if (isOpen(r) && !r.client->lastError().empty())
-      lua_pushstring(L, r.client->lastError().c_str());
-    else
-      lua_pushnil(L);
-  } else if (key == "contacts") {
-    lua_pushinteger(L, isOpen(r) ? static_cast<lua_Integer>(r.client->contacts()) : 0);
-  } else if (key == "host") {
-    lua_pushstring(L, o->host.c_str());
-  } else if (key == "port") {
-    lua_pushinteger(L, o->port);
-  } else if (key == "udp") {
-    lua_pushboolean(L, o->udp);
-  } else if (key == "watchdog") {
-    lua_pushnumber(L, o->watchdog);
-  } else {
-    return false;
-  }
-  return true;
-}
+const lua::Field kFields[] = {
+    {"connected",
+     [](lua_State* L, int self) {
+       Robot& r = robotAt(L, self);
+       lua_pushboolean(L, isOpen(r) && r.client->connected());
+     }},
+    {"host", [](lua_State* L, int self) { lua_pushstring(L, optionsAt(L, self).host.c_str()); }},
+    {"port", [](lua_State* L, int self) { lua_pushinteger(L, optionsAt(L, self).port); }},
+    {"udp", [](lua_State* L, int self) { lua_pushboolean(L, optionsAt(L, self).udp); }},
+    {"watchdog", [](lua_State* L, int self) { lua_pushnumber(L, optionsAt(L, self).watchdog); }},
+    {"phase",
+     [](lua_State* L, int self) {
+       Robot& r = robotAt(L, self);
+       lua_pushstring(L, isOpen(r) ? r.client->phaseName().c_str() : "closed");
+     }},
+    {"lastError",
+     [](lua_State* L, int self) {
+       Robot& r = robotAt(L, self);
+       if (isOpen(r) && !r.client->lastError().empty())
+         lua_pushstring(L, r.client->lastError().c_str());
+       else
+         lua_pushnil(L);
+     }},
+    {"contacts",
+     [](lua_State* L, int self) {
+       Robot& r = robotAt(L, self);
+       lua_pushinteger(L, isOpen(r) ? static_cast<lua_Integer>(r.client->contacts()) : 0);
+     }},
+};
 
-int index(lua_State* L) {
-  // 1: robot, 2: key. Methods, then state fields, then the script's own fields.
-  Robot& r = robotAt(L, 1);
-  return lua::indexObject(L, [&](std::string_view key) { return pushField(L, r, key); });
-}
-
-const lua::ObjectType& robotType();
-
-int newindex(lua_State* L) {
-  return lua::newindexObject(L, robotType(), robotAt(L, 1).slots);
-}
-
-const lua::ObjectType& robotType() {
+const lua::TypeSpec& robotType() {
   static const luaL_Reg methods[] = {{"steer", lua::guarded<steer>},
                                      {"click", lua::guarded<click>},
                                      {"buttons", lua::guarded<buttons>},
@@ -260,16 +242,25 @@ const lua::ObjectType& robotType() {
                                      {"shutdown", lua::guarded<shutdown>},
                                      {"close", lua::guarded<close>},
                                      {nullptr, nullptr}};
-  static const lua::ObjectType type{
-      kMetatable, "mindroad", methods, kFields, events(), lua::guarded<index>,
-      lua::guarded<newindex>, lua::guarded<tostring>, gc, "robot",
-      // listeners: not on a closed robot (it has no more events)
-      [](lua_State* L, int idx) -> lua::EventSlots& {
-        Robot& r = robotAt(L, idx);
-        if (!isOpen(r) && lua_isfunction(L, 3))
-          throw LuaError(r.label + " is closed: it has no more events");
-        return r.slots;
-      }};
+  static const lua::TypeSpec type{
+      .metatable = kMetatable,
+      .name = "mindroad",
+      .what = "robot",
+      .methods = methods,
+      .fields = kFields,
+      .events = &events(),
+      .slotsOf = [](lua_State* L, int self) -> lua::EventSlots& { return robotAt(L, self).slots; },
+      .ownFields = true,
+      .label = robotLabel,
+      .closed = [](lua_State* L, int self) { return !isOpen(robotAt(L, self)); },
+      // The registry is still whole here, even in lua_close: Lua 5.4 runs every finalizer
+      // before it frees anything (luaC_freeallobjects).
+      .gc =
+          [](lua_State* L, int self) {
+            closeRobot(L, robotAt(L, self));
+            lua::destroyBox<Robot>(L, self, robotType());
+          },
+  };
   return type;
 }
 
@@ -317,10 +308,7 @@ MindroadOptions readOptions(lua_State* L, int idx) {
 int newRobot(lua_State* L) {
   MindroadOptions options = readOptions(L, 1);
   ScriptHost& host = ScriptHost::from(L);
-  auto* r = new (lua_newuserdatauv(L, sizeof(Robot), 1)) Robot();
-  luaL_setmetatable(L, kMetatable);
-  lua_newtable(L);
-  lua_setiuservalue(L, -2, 1);
+  Robot* r = &lua::newBox<Robot>(L, robotType());
   r->host = &host;
   r->options = options;
   r->client =
@@ -346,7 +334,7 @@ int newRobot(lua_State* L) {
 
 void openMindroadModule(ScriptHost& host) {
   lua_State* L = host.state();
-  lua::registerObjectType(L, robotType());
+  lua::registerType(L, robotType());
   lua_getglobal(L, "pitwall");
   lua_pushcfunction(L, lua::guarded<newRobot>);
   lua_setfield(L, -2, "mindroad");

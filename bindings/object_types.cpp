@@ -1,13 +1,6 @@
 #include "bindings/object_types.hpp"
 
-#include <cstring>
-
 namespace pitwall::lua {
-
-namespace {
-constexpr const char* kTimerMetatable = "pitwall.timer";  // bindings/pitwall_module.cpp
-constexpr const char* kSeatMetatable = "pitwall.seat";    // bindings/seat_binding.cpp
-}  // namespace
 
 void pushObjectTypes(lua_State* L) {
   lua_newtable(L);
@@ -18,9 +11,7 @@ void pushObjectTypes(lua_State* L) {
     if (lua_type(L, -2) == LUA_TSTRING && lua_istable(L, -1)) {
       const bool object = lua_getfield(L, -1, "__objecttype") != LUA_TNIL;
       lua_pop(L, 1);
-      const char* key = lua_tostring(L, -2);
-      if (object || std::strcmp(key, kTimerMetatable) == 0 ||
-          std::strcmp(key, kSeatMetatable) == 0) {
+      if (object) {
         // Its public face (bindings/metatables.hpp): what getmetatable gives a script, with the
         // same names; the metatable itself is not handed to Lua code.
         lua_pushvalue(L, -2);

@@ -6,10 +6,9 @@
 namespace pitwall::lua {
 
 // Pushes a table: registry key → metatable (its locked public face, bindings/metatables.hpp),
-// for every type registered through
-// registerObjectType (its __methods, __fields, __events) and for pitwall.timer (its __index
-// holds the timer's methods). Scripts reach a metatable only through an object; the generator
-// must see every type, robots included, without making one.
+// for every type registered through lua::registerType (its __methods, __fields, __events). Scripts
+// reach a metatable only through an object; the generator must see every type, robots included,
+// without making one.
 void pushObjectTypes(lua_State* L);
 
 }  // namespace pitwall::lua

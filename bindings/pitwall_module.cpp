@@ -102,10 +102,10 @@ int now(lua_State* L) {
   return 1;
 }
 
+const lua::TypeSpec& timerType();
+
 int pushTimer(lua_State* L, int handle) {
-  auto* h = static_cast<int*>(lua_newuserdatauv(L, sizeof(int), 0));
-  *h = handle;
-  luaL_setmetatable(L, kTimerMetatable);
+  lua::newBox<int>(L, timerType(), handle);  // its handle in Timers
   return 1;
 }
 
@@ -127,9 +127,7 @@ int every(lua_State* L) {
 }
 
 int cancelTimer(lua_State* L) {
-  auto* h = static_cast<int*>(luaL_testudata(L, 1, kTimerMetatable));
-  if (!h) throw LuaError(std::string("expected a timer, got ") + luaL_typename(L, 1));
-  lua_pushboolean(L, ScriptHost::from(L).timers().cancel(*h));
+  lua_pushboolean(L, ScriptHost::from(L).timers().cancel(lua::check<int>(L, 1, timerType())));
   return 1;
 }
 
@@ -419,27 +417,25 @@ int terminal(lua_State* L) {
   return 1;
 }
 
-int timerToString(lua_State* L) {
-  auto* h = static_cast<int*>(luaL_checkudata(L, 1, kTimerMetatable));
-  lua_pushfstring(L, "timer %d", *h);
-  return 1;
+const lua::TypeSpec& timerType() {
+  static const luaL_Reg methods[] = {{"cancel", lua::guarded<cancelTimer>}, {nullptr, nullptr}};
+  static const lua::TypeSpec type{
+      .metatable = kTimerMetatable,
+      .name = "timer",
+      .methods = methods,
+      .label =
+          [](lua_State* L, int self) {
+            return "timer " + std::to_string(lua::check<int>(L, self, timerType()));
+          },
+  };
+  return type;
 }
 
 }  // namespace
 
 void openPitwallModule(ScriptHost& host) {
   lua_State* L = host.state();
-  luaL_newmetatable(L, kTimerMetatable);
-  lua_pushstring(L, "timer");  // how errors name it ("timer has no method cancle; …")
-  lua_setfield(L, -2, "__name");
-  lua_newtable(L);
-  lua_pushcfunction(L, lua::guarded<cancelTimer>);
-  lua_setfield(L, -2, "cancel");
-  lua_setfield(L, -2, "__index");
-  lua_pushcfunction(L, timerToString);
-  lua_setfield(L, -2, "__tostring");
-  lua::lockMetatable(L, -1);
-  lua_pop(L, 1);
+  lua::registerType(L, timerType());
 
   static const luaL_Reg functions[] = {{"cars", lua::guarded<cars>},
                                        {"car", lua::guarded<car>},

@@ -8,7 +8,7 @@
 #include <memory>
 
 #include "bindings/lua_args.hpp"
-#include "bindings/metatables.hpp"
+#include "bindings/lua_object.hpp"
 #include "bindings/pitwall_module.hpp"
 #include "bindings/reloader.hpp"
 #include "engine/core/log.hpp"
@@ -53,20 +53,20 @@ struct UnderTest {
   }
 };
 
-UnderTest*& current(lua_State* L) {
-  // one per scenario world: kept in its registry
-  static char key;
-  if (lua_rawgetp(L, LUA_REGISTRYINDEX, &key) != LUA_TUSERDATA) {
-    lua_pop(L, 1);
-    auto** slot = static_cast<UnderTest**>(lua_newuserdatauv(L, sizeof(UnderTest*), 0));
-    *slot = nullptr;
-    lua_pushvalue(L, -1);
-    lua_rawsetp(L, LUA_REGISTRYINDEX, &key);
-  }
-  auto** slot = static_cast<UnderTest**>(lua_touserdata(L, -1));
+// The scenario world's script under test (one at a time; kept in its registry), or nullptr.
+char kCurrentKey;
+UnderTest* current(lua_State* L) {
+  lua_rawgetp(L, LUA_REGISTRYINDEX, &kCurrentKey);
+  auto* ut = static_cast<UnderTest*>(lua_touserdata(L, -1));
   lua_pop(L, 1);
-  return *slot;
+  return ut;
 }
+void setCurrent(lua_State* L, UnderTest* ut) {
+  lua_pushlightuserdata(L, ut);
+  lua_rawsetp(L, LUA_REGISTRYINDEX, &kCurrentKey);
+}
+
+const lua::TypeSpec& underTestType();
 
 // A path when it names a file, else source text.
 bool isFile(const std::string& s) {
@@ -101,13 +101,11 @@ int create(lua_State* L) {
     throw LuaError(std::string("sim.script: options must be a table {results =, name =}, got ") +
                    luaL_typename(L, 2));
   }
-  auto* ut = static_cast<UnderTest*>(lua_newuserdatauv(L, sizeof(UnderTest), 0));
-  new (ut) UnderTest();
-  luaL_setmetatable(L, kMetatable);
+  UnderTest* ut = &lua::newBox<UnderTest>(L, underTestType());
   lua_pushvalue(L, -1);
   luaL_ref(L, LUA_REGISTRYINDEX);  // lives as long as the scenario's world
   ut->scenario = &host;
-  current(L) = ut;
+  setCurrent(L, ut);
   bool file = isFile(what);
   host.atShutDown([ut] { ut->end(); });
   // Started on the loop, not inside the scenario's call: one Lua world runs at a time.
@@ -165,55 +163,60 @@ int reload(lua_State* L) {
   return 0;
 }
 
-int index(lua_State* L) {
-  auto* ut = static_cast<UnderTest*>(luaL_checkudata(L, 1, kMetatable));
-  std::string key = lua::checkString(L, 2, "field");
-  Reloader* r = ut->reloader.get();
-  if (key == "started") {
-    lua_pushboolean(L, ut->started);
-  } else if (key == "finished") {
-    lua_pushboolean(L, ut->finished);
-  } else if (key == "version") {
-    lua_pushinteger(L, r ? r->stats().reloads + 1 : 0);
-  } else if (key == "reloads") {
-    lua_pushinteger(L, r ? r->stats().reloads : 0);
-  } else if (key == "refused") {
-    lua_pushinteger(L, ut->refused);
-  } else if (key == "refusal") {
-    if (ut->refusal.empty())
-      lua_pushnil(L);
-    else
-      lua_pushstring(L, ut->refusal.c_str());
-  } else if (key == "died") {
-    lua_pushboolean(L, r && r->host().mainFailed());
-  } else if (key == "errors") {
-    lua_pushinteger(L, r ? r->host().errorCount() : 0);
-  } else {
-    throw LuaError("a script under test has no field '" + key +
-                   "' (started, finished, version, reloads, refused, refusal, died, errors)");
-  }
-  return 1;
+// ---- state fields: one entry each ----
+UnderTest& underTestAt(lua_State* L, int self) {
+  return lua::check<UnderTest>(L, self, underTestType());
+}
+Reloader* reloaderAt(lua_State* L, int self) {
+  return underTestAt(L, self).reloader.get();
 }
 
-int gc(lua_State* L) {
-  auto* ut = static_cast<UnderTest*>(luaL_checkudata(L, 1, kMetatable));
-  ut->~UnderTest();
-  return 0;
+const lua::Field kFields[] = {
+    {"started", [](lua_State* L, int self) { lua_pushboolean(L, underTestAt(L, self).started); }},
+    {"finished", [](lua_State* L, int self) { lua_pushboolean(L, underTestAt(L, self).finished); }},
+    {"version",
+     [](lua_State* L, int self) {
+       Reloader* r = reloaderAt(L, self);
+       lua_pushinteger(L, r ? r->stats().reloads + 1 : 0);
+     }},
+    {"reloads",
+     [](lua_State* L, int self) {
+       Reloader* r = reloaderAt(L, self);
+       lua_pushinteger(L, r ? r->stats().reloads : 0);
+     }},
+    {"refused", [](lua_State* L, int self) { lua_pushinteger(L, underTestAt(L, self).refused); }},
+    {"refusal",
+     [](lua_State* L, int self) {
+       const std::string& why = underTestAt(L, self).refusal;
+       why.empty() ? lua_pushnil(L) : (void)lua_pushstring(L, why.c_str());
+     }},
+    {"died",
+     [](lua_State* L, int self) {
+       Reloader* r = reloaderAt(L, self);
+       lua_pushboolean(L, r && r->host().mainFailed());
+     }},
+    {"errors",
+     [](lua_State* L, int self) {
+       Reloader* r = reloaderAt(L, self);
+       lua_pushinteger(L, r ? r->host().errorCount() : 0);
+     }},
+};
+
+const lua::TypeSpec& underTestType() {
+  static const lua::TypeSpec type{
+      .metatable = kMetatable,
+      .name = "script under test",
+      .fields = kFields,
+      .strict = true,
+      .gc = [](lua_State* L, int self) { lua::destroyBox<UnderTest>(L, self, underTestType()); },
+  };
+  return type;
 }
 
 }  // namespace
 
 void openScriptUnderTest(lua_State* L) {
-  if (luaL_newmetatable(L, kMetatable)) {
-    lua_pushcfunction(L, lua::guarded<index>);
-    lua_setfield(L, -2, "__index");
-    lua_pushcfunction(L, gc);
-    lua_setfield(L, -2, "__gc");
-    lua_pushstring(L, "script under test");
-    lua_setfield(L, -2, "__name");
-    lua::lockMetatable(L, -1);
-  }
-  lua_pop(L, 1);
+  lua::registerType(L, underTestType());
   // on pitwall.sim, which is on top of the stack
   lua_pushcfunction(L, lua::guarded<create>);
   lua_setfield(L, -2, "script");

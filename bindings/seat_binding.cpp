@@ -14,7 +14,7 @@
 
 #include "bindings/car_binding.hpp"
 #include "bindings/lua_args.hpp"
-#include "bindings/metatables.hpp"
+#include "bindings/lua_object.hpp"
 #include "bindings/pitwall_module.hpp"
 #include "bindings/script_host.hpp"
 #include "engine/drive/seats.hpp"
@@ -35,8 +35,10 @@ std::string scriptHolder(int number) {
   return "script#" + std::to_string(number);
 }
 
+const lua::TypeSpec& seatType();
+
 int seatNumber(lua_State* L, int idx) {
-  return *static_cast<int*>(luaL_checkudata(L, idx, kSeatMetatable));
+  return lua::check<int>(L, idx, seatType());
 }
 
 const drive::Seat& checkSeat(lua_State* L, int idx) {
@@ -48,46 +50,40 @@ const drive::Seat& checkSeat(lua_State* L, int idx) {
 }
 
 void pushSeat(lua_State* L, int number) {
-  *static_cast<int*>(lua_newuserdatauv(L, sizeof(int), 0)) = number;
-  luaL_setmetatable(L, kSeatMetatable);
+  lua::newBox<int>(L, seatType(), number);
 }
 
-int seatIndex(lua_State* L) {
-  const drive::Seat& s = checkSeat(L, 1);
-  const char* key = lua_tostring(L, 2);
-  if (!key) return 0;
-  const std::string k = key;
-  if (k == "number") {
-    lua_pushinteger(L, s.number);
-  } else if (k == "car") {
-    ScriptHost& host = ScriptHost::from(L);
-    if (AnkiCar* car = host.fleet().find(s.number))
-      host.cars().push(L, *car);
-    else
-      lua_pushnil(L);
-  } else if (k == "held") {
-    lua_pushboolean(L, s.held());
-  } else if (k == "live") {
-    lua_pushboolean(L, s.live);
-  } else if (k == "holder") {
-    if (s.held())
-      lua_pushstring(L, drive::holderName(s.kind));
-    else
-      lua_pushnil(L);
-  } else if (k == "player") {
-    if (s.held() && !s.player.empty())
-      lua_pushstring(L, s.player.c_str());
-    else
-      lua_pushnil(L);
-  } else if (k == "throttle") {
-    lua_pushnumber(L, s.live ? s.throttle : 0.0);
-  } else {
-    lua_getmetatable(L, 1);
-    lua_getfield(L, -1, "__methods");
-    lua_getfield(L, -1, key);
-  }
-  return 1;
+// ---- state fields: one entry each ----
+void pushOptionalString(lua_State* L, bool present, const std::string& v) {
+  present ? (void)lua_pushlstring(L, v.data(), v.size()) : lua_pushnil(L);
 }
+
+const lua::Field kSeatFields[] = {
+    {"number", [](lua_State* L, int self) { lua_pushinteger(L, checkSeat(L, self).number); }},
+    {"car",
+     [](lua_State* L, int self) {
+       ScriptHost& host = ScriptHost::from(L);
+       AnkiCar* car = host.fleet().find(checkSeat(L, self).number);
+       car ? host.cars().push(L, *car) : lua_pushnil(L);
+     }},
+    {"held", [](lua_State* L, int self) { lua_pushboolean(L, checkSeat(L, self).held()); }},
+    {"live", [](lua_State* L, int self) { lua_pushboolean(L, checkSeat(L, self).live); }},
+    {"holder",
+     [](lua_State* L, int self) {
+       const drive::Seat& s = checkSeat(L, self);
+       pushOptionalString(L, s.held(), s.held() ? drive::holderName(s.kind) : "");
+     }},
+    {"player",
+     [](lua_State* L, int self) {
+       const drive::Seat& s = checkSeat(L, self);
+       pushOptionalString(L, s.held() && !s.player.empty(), s.player);
+     }},
+    {"throttle",
+     [](lua_State* L, int self) {
+       const drive::Seat& s = checkSeat(L, self);
+       lua_pushnumber(L, s.live ? s.throttle : 0.0);
+     }},
+};
 
 int seatLanes(lua_State* L) {
   const drive::Seat& s = checkSeat(L, 1);
@@ -125,8 +121,8 @@ int seatRelease(lua_State* L) {
   return 0;
 }
 
-int seatToString(lua_State* L) {
-  const int number = seatNumber(L, 1);
+std::string seatLabel(lua_State* L, int self) {
+  const int number = seatNumber(L, self);
   drive::Seats* seats = seatsOf(L);
   const drive::Seat* s = seats ? seats->seat(number) : nullptr;
   std::string text = "seat " + std::to_string(number);
@@ -135,8 +131,23 @@ int seatToString(lua_State* L) {
             (s->player.empty() ? "" : " " + s->player) + (s->live ? "" : ", no input") + ")";
   else
     text += " (free)";
-  lua_pushstring(L, text.c_str());
-  return 1;
+  return text;
+}
+
+const lua::TypeSpec& seatType() {
+  static const luaL_Reg methods[] = {{"lanes", lua::guarded<seatLanes>},
+                                     {"feed", lua::guarded<seatFeed>},
+                                     {"release", lua::guarded<seatRelease>},
+                                     {"driving", lua::guarded<seatDriving>},
+                                     {nullptr, nullptr}};
+  static const lua::TypeSpec type{
+      .metatable = kSeatMetatable,
+      .name = "seat",
+      .methods = methods,
+      .fields = kSeatFields,
+      .label = seatLabel,
+  };
+  return type;
 }
 
 int seatsList(lua_State* L) {
@@ -178,31 +189,7 @@ int openSeats(lua_State* L) {
 
 void openSeatModule(ScriptHost& host) {
   lua_State* L = host.state();
-  luaL_newmetatable(L, kSeatMetatable);
-  lua_pushstring(L, "seat");
-  lua_setfield(L, -2, "__name");
-  static const luaL_Reg methods[] = {{"lanes", lua::guarded<seatLanes>},
-                                     {"feed", lua::guarded<seatFeed>},
-                                     {"release", lua::guarded<seatRelease>},
-                                     {"driving", lua::guarded<seatDriving>},
-                                     {nullptr, nullptr}};
-  luaL_newlib(L, methods);
-  lua_setfield(L, -2, "__methods");
-  // its fields, for the editor's definitions (scripts/pitwall/types.lua checks them)
-  // (listed as bindings/lua_object.hpp lists an object type's; no events, so no ObjectType)
-  lua_newtable(L);
-  lua_Integer k = 0;
-  for (const char* field : {"number", "car", "held", "live", "holder", "player", "throttle"}) {
-    lua_pushstring(L, field);
-    lua_rawseti(L, -2, ++k);
-  }
-  lua_setfield(L, -2, "__fields");
-  lua_pushcfunction(L, lua::guarded<seatIndex>);
-  lua_setfield(L, -2, "__index");
-  lua_pushcfunction(L, lua::guarded<seatToString>);
-  lua_setfield(L, -2, "__tostring");
-  lua::lockMetatable(L, -1);
-  lua_pop(L, 1);
+  lua::registerType(L, seatType());
 
   lua_getglobal(L, "pitwall");
   lua_pushcfunction(L, lua::guarded<seatsList>);

@@ -711,20 +711,21 @@ function Alphabot:stop() end
 ---@class pitwall.sim.Sensor
 ---@field model? "real"|"ideal"|"transitions" real (the default): fitted to real cars, position updates thin out with speed; ideal: every code; transitions: no position update at all (the worst case)
 
----A script under test (sim.script).
----@class pitwall.sim.ScriptUnderTest
----@field started boolean
----@field finished boolean it called pitwall.stop()
----@field version integer
----@field reloads integer
----@field refused integer versions refused
----@field refusal string? why the last version was refused
----@field died boolean
----@field errors integer
-
 ---@class pitwall.sim.ScriptOptions
 ---@field results? string its pitwall.resultsFile
 ---@field name? string how source text is named in errors (default script_under_test.lua)
+
+---A script under test (sim.script): read-only; reading a field it does not have is an error.
+---@class pitwall.sim.ScriptUnderTest
+---@field died boolean its main chunk failed
+---@field errors integer errors its world reported
+---@field finished boolean it called pitwall.stop() (or the scenario ended it)
+---@field refusal string? why the last version was refused
+---@field refused integer versions refused
+---@field reloads integer versions that took over
+---@field started boolean its first version was started (or refused)
+---@field version integer the version running: 1, then one more per reload
+local ScriptUnderTest = {}
 
 ---The simulator (present when the run uses the built-in simulator; require "pitwall.sim").
 ---See docs/testing.md and docs/simulator.md.

@@ -72,10 +72,14 @@ d=$(echo "$line" | sed -n 's/.* drops=\([0-9]*\).*/\1/p')
 [ "${d:-0}" -ge 2 ] && echo "ok: soak: car.link counted car 1's drops ($d)" ||
   fail "soak: car.link of car 1: ${d:-none} drops: $line"
 contains "soak: car.link: connected again after each drop" "connects=$((d + 1))" "$line"
-# The muted car's lost notifications show in car.link: a silence of about the mute's 3 s
+# The muted car's lost notifications show in car.link: a silence of at least the 1 s a silence
+# needs, and no longer than the mute's 3 s (and a tick). It may be shorter than the mute: a silence
+# counts until the car speaks or is told to stop (engine/vehicles/anki_car.cpp, noteSilence), and
+# its driver may tell it to stand within the mute (a follower closing on the car ahead: in clean
+# clone run 18, under a CPU quota, 2.1 s).
 muted=$(echo "$out" | grep "^car $(nth 4) ")
 sil=$(echo "$muted" | sed -n 's/.* silences=\([0-9]*\) longestSilence=\([0-9.]*\).*/\1 \2/p')
-awk -v s="$sil" 'BEGIN { split(s, a, " "); exit !(a[1] >= 1 && a[2] >= 2.5) }' &&
+awk -v s="$sil" 'BEGIN { split(s, a, " "); exit !(a[1] >= 1 && a[2] >= 1.0 && a[2] <= 3.5) }' &&
   echo "ok: soak: car.link shows car $(nth 4)'s lost notifications (silences, longest: $sil)" ||
   fail "soak: car $(nth 4) was muted for 3 s, car.link says silences/longest [$sil]: $muted"
 contains "soak: car.link has a round trip" "roundTrip=0." "$(echo "$out" | grep "^car 1 ")"

@@ -6,6 +6,9 @@ engine/ and bindings/ (comments left out):
   it) appear only in bindings/protected_call.hpp, whose lua::protectedCall every call path of the
   engine builds on. (lua_pcallk in bindings/interrupt.cpp is the script's own xpcall: Lua calling
   Lua.)
+- only the object idiom (bindings/lua_object.hpp/.cpp) makes metatables and userdata and reads
+  userdata back (lua::registerType, newBox, check<T>, test<T>); bindings/metatables.cpp, which
+  locks them, gives each its face.
 
 Usage: bindings_test.py SOURCE_ROOT. A self-test runs first, so the check cannot pass by finding
 nothing. Fails naming the file, the line and the rule.
@@ -14,11 +17,22 @@ import pathlib
 import re
 import sys
 
+IDIOM = {"bindings/lua_object.hpp", "bindings/lua_object.cpp"}
 RULES = [
     (re.compile(r"\b(lua_pcall|luaL_dostring|luaL_dofile)\s*\("),
      {"bindings/protected_call.hpp"},
      "calls into Lua outside lua::protectedCall (bindings/protected_call.hpp): use the world's "
      "call path (ScriptHost::call, callCapturing, callInteractive)"),
+    # bindings/metatables.cpp gives each locked metatable its face (a table with a metatable)
+    (re.compile(r"\b(luaL_newmetatable|lua_newuserdatauv|lua_newuserdata|luaL_setmetatable|"
+                r"lua_setmetatable)\s*\("),
+     IDIOM | {"bindings/metatables.cpp"},
+     "makes a metatable or a userdata outside the object idiom: declare a lua::TypeSpec and use "
+     "lua::registerType and lua::newBox (bindings/lua_object.hpp)"),
+    (re.compile(r"\b(luaL_checkudata|luaL_testudata)\s*\("),
+     IDIOM,
+     "reads a userdata outside the object idiom: use lua::check<T> or lua::test<T> with the "
+     "type's TypeSpec (one wording for a wrong value)"),
 ]
 
 LINE_COMMENT = re.compile(r"//.*$")
@@ -47,14 +61,19 @@ def self_test():
     bad = {
         "bindings/x.cpp": "int f(lua_State* L) { return lua_pcall(L, 0, 0, 0); }\n",
         "engine/cli/y.cpp": "void g(lua_State* L) {\n  luaL_dostring(L, \"x = 1\");\n}\n",
+        "bindings/seat.cpp": "  luaL_newmetatable(L, kSeat);\n",
+        "bindings/timer.cpp": "  auto* h = static_cast<int*>(lua_newuserdatauv(L, 4, 0));\n",
+        "bindings/robot.cpp": "  auto* r = luaL_testudata(L, 1, kRobot);\n",
     }
     good = {
         "bindings/protected_call.hpp": "  status = lua_pcall(L, nargs, nresults, handler);\n",
         "bindings/interrupt.cpp": "  return lua_pcallk(L, n, LUA_MULTRET, 2, 0, k);\n",
         "bindings/z.cpp": "// lua_pcall(L, 0, 0, 0) in a comment\nconst char* s = \"lua_pcall(\";\n",
+        "bindings/lua_object.cpp": "  void* p = lua_newuserdatauv(L, size, 1);\n",
     }
     found = list(violations(bad))
-    assert len(found) == 2 and ":1:" in found[0] and ":2:" in found[1], found
+    assert len(found) == 5, found
+    assert [f.split(":")[0] for f in found] == sorted(bad), found
     assert not list(violations(good)), list(violations(good))
 
 

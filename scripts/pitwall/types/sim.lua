@@ -56,20 +56,25 @@ return {
 ---@class pitwall.sim.Sensor
 ---@field model? "real"|"ideal"|"transitions" real (the default): fitted to real cars, position updates thin out with speed; ideal: every code; transitions: no position update at all (the worst case)
 
----A script under test (sim.script).
----@class pitwall.sim.ScriptUnderTest
----@field started boolean
----@field finished boolean it called pitwall.stop()
----@field version integer
----@field reloads integer
----@field refused integer versions refused
----@field refusal string? why the last version was refused
----@field died boolean
----@field errors integer
-
 ---@class pitwall.sim.ScriptOptions
 ---@field results? string its pitwall.resultsFile
 ---@field name? string how source text is named in errors (default script_under_test.lua)]],
+  },
+  {
+    metatable = "pitwall.script_under_test",
+    class = "pitwall.sim.ScriptUnderTest",
+    localName = "ScriptUnderTest",
+    doc = [[A script under test (sim.script): read-only; reading a field it does not have is an error.]],
+    fields = {
+      started = { "boolean", "its first version was started (or refused)" },
+      finished = { "boolean", "it called pitwall.stop() (or the scenario ended it)" },
+      version = { "integer", "the version running: 1, then one more per reload" },
+      reloads = { "integer", "versions that took over" },
+      refused = { "integer", "versions refused" },
+      refusal = { "string?", "why the last version was refused" },
+      died = { "boolean", "its main chunk failed" },
+      errors = { "integer", "errors its world reported" },
+    },
   },
   {
     class = "pitwall.sim",
