@@ -480,16 +480,6 @@ void openPitwallModule(ScriptHost& host) {
   lua_pushvalue(L, -2);
   lua_setfield(L, -2, "pitwall");
   lua_pop(L, 2);
-
-  if (host.sim()) openSimModule(host);
-  openMindroadModule(host);
-  openAlphabotModule(host);
-  openViewModule(host);
-  openSeatModule(host);
-
-  // Cars already known get their Lua objects now; later ones when they join
-  // (ScriptHost::carJoined).
-  for (AnkiCar* c : host.fleet().cars()) host.cars().bind(*c);
 }
 
 }  // namespace pitwall

@@ -7,98 +7,14 @@
 #include "bindings/interrupt.hpp"
 #include "bindings/lua_args.hpp"
 #include "bindings/misspelled_method.hpp"
-#include "bindings/pitwall_module.hpp"
 #include "bindings/script_file.hpp"
+#include "bindings/world.hpp"
 #include "engine/core/console.hpp"
 #include "engine/core/data_dir.hpp"
 #include "engine/core/log.hpp"
 #include "engine/drive/seats.hpp"
 
 namespace pitwall {
-
-namespace {
-// The shipped library: $PITWALL_SCRIPTS (the tests' source tree), else scripts/ in the data
-// folder found beside the binary (engine/core/data_dir.hpp).
-std::string scriptsDir() {
-  if (const char* env = std::getenv("PITWALL_SCRIPTS"); env && *env) return env;
-  auto data = dataDir();
-  if (!data) throw std::runtime_error(data.error());
-  return (*data / "scripts").string();
-}
-}  // namespace
-
-namespace {
-// print and io.write go to the console: straight to stdout, or above the REPL's prompt.
-int consolePrint(lua_State* L) {
-  int n = lua_gettop(L);
-  luaL_Buffer b;
-  luaL_buffinit(L, &b);
-  for (int i = 1; i <= n; ++i) {
-    luaL_tolstring(L, i, nullptr);
-    luaL_addvalue(&b);
-    luaL_addchar(&b, i < n ? '\t' : '\n');
-  }
-  if (n == 0) luaL_addchar(&b, '\n');
-  luaL_pushresult(&b);
-  size_t len = 0;
-  const char* text = lua_tolstring(L, -1, &len);
-  console::write({text, len});
-  return 0;
-}
-
-// io.write(...) and pitwall.stdout:write(...): strings and numbers, as io.write takes them.
-int consoleWriteFrom(lua_State* L, int first) {
-  int n = lua_gettop(L);
-  luaL_Buffer b;
-  luaL_buffinit(L, &b);
-  for (int i = first; i <= n; ++i) {
-    if (lua_type(L, i) == LUA_TNUMBER) {
-      luaL_tolstring(L, i, nullptr);
-    } else {
-      luaL_checkstring(L, i);
-      lua_pushvalue(L, i);
-    }
-    luaL_addvalue(&b);
-  }
-  luaL_pushresult(&b);
-  size_t len = 0;
-  const char* text = lua_tolstring(L, -1, &len);
-  console::write({text, len});
-  return 0;
-}
-
-int consoleIoWrite(lua_State* L) {
-  consoleWriteFrom(L, 1);
-  lua_getglobal(L, "io");  // io.write returns the file it wrote to
-  lua_getfield(L, -1, "stdout");
-  return 1;
-}
-
-int consoleFileWrite(lua_State* L) {
-  consoleWriteFrom(L, 2);
-  lua_settop(L, 1);
-  return 1;
-}
-
-int consoleFileFlush(lua_State* L) {
-  lua_settop(L, 1);
-  return 1;
-}
-
-// os.exit([code]): the run ends through the engine's stop path (the cars get their stop, the
-// record is flushed) with this exit status; the code running now is ended like an interrupt.
-int scriptExit(lua_State* L) {
-  int status = EXIT_SUCCESS;
-  if (lua_isboolean(L, 1))
-    status = lua_toboolean(L, 1) ? EXIT_SUCCESS : EXIT_FAILURE;
-  else if (!lua_isnoneornil(L, 1))
-    status = static_cast<int>(luaL_checkinteger(L, 1) & 0xff);
-  ScriptHost::from(L).requestExit(status);
-  interrupt::abortRunning("os.exit: the run is ending");
-  return 0;
-}
-
-}  // namespace
 
 ScriptHost::ScriptHost(Loop& loop, Fleet& fleet, SimSession* sim, HostOptions options)
     : loop_(loop), fleet_(fleet), sim_(sim), options_(std::move(options)) {
@@ -108,7 +24,7 @@ ScriptHost::ScriptHost(Loop& loop, Fleet& fleet, SimSession* sim, HostOptions op
   interrupt::watchThisThread(options_.budget.count() > 0);
   *static_cast<ScriptHost**>(lua_getextraspace(L_)) = this;
   cars_ = std::make_unique<CarBinding>(*this);
-  openLibraries();
+  openWorld(*this);
   if (!options_.detached) attach();
 }
 
@@ -153,106 +69,19 @@ void ScriptHost::openSeats(int count) {
   ownSeats_ = std::make_unique<drive::Seats>(loop_, fleet_, count);
 }
 
+void ScriptHost::fileLoaded(const std::string& path) {
+  loadedFiles_.push_back(path);
+  if (onFileLoaded) onFileLoaded(path);
+}
+
+void ScriptHost::setLibrary(const std::string& folder) {
+  frames_.libraryChunks = "@" + folder + "/pitwall/";
+  frames_.libraryFrames = options_.library_frames;
+  lua::setFrames(L_, &frames_);
+}
+
 ScriptHost& ScriptHost::from(lua_State* L) {
   return **static_cast<ScriptHost**>(lua_getextraspace(L));
-}
-
-void ScriptHost::openLibraries() {
-  lua_State* L = L_;
-  luaL_openlibs(L);
-  sandbox::restrict(L);
-  lua_getglobal(L, "os");
-  lua_pushcfunction(L, scriptExit);
-  lua_setfield(L, -2, "exit");
-  lua_pop(L, 1);
-  interrupt::openCoroutineTracking(L);
-  trackRequire();
-  lua_pushcfunction(L, consolePrint);
-  lua_setglobal(L, "print");
-  lua_getglobal(L, "io");
-  lua_pushcfunction(L, consoleIoWrite);
-  lua_setfield(L, -2, "write");
-  lua_pop(L, 1);
-  // require: the shipped library first, then the extra folders (the script's own joins later).
-  std::string path;
-  for (const auto& dir : options_.library_paths) path += dir + "/?.lua;" + dir + "/?/init.lua;";
-  std::string lib = scriptsDir();
-  // The library's modules are loaded through package.path as <lib>/pitwall/….lua, so their
-  // chunk names start with this; kept now, so an error never looks for the data folder again
-  // (it may have moved since).
-  frames_.libraryChunks = "@" + lib + "/pitwall/";
-  frames_.libraryFrames = options_.library_frames;
-  lua::setFrames(L, &frames_);
-  path += lib + "/?.lua;" + lib + "/?/init.lua;";
-  lua_getglobal(L, "package");
-  lua_getfield(L, -1, "path");
-  path += lua_tostring(L, -1);
-  lua_pop(L, 1);
-  lua_pushlstring(L, path.data(), path.size());
-  lua_setfield(L, -2, "path");
-  lua_pop(L, 1);
-
-  // Same seed, same random numbers: part of a deterministic run.
-  lua_getglobal(L, "math");
-  lua_getfield(L, -1, "randomseed");
-  lua_pushinteger(L, static_cast<lua_Integer>(options_.seed));
-  lua_call(L, 1, 0);
-  lua_pop(L, 1);
-
-  cars_->registerType(L);
-  openPitwallModule(*this);
-  // pitwall.stdout: a file-like object (write, flush) that writes to the console.
-  lua_getglobal(L, "pitwall");
-  lua_createtable(L, 0, 2);
-  lua_pushcfunction(L, consoleFileWrite);
-  lua_setfield(L, -2, "write");
-  lua_pushcfunction(L, consoleFileFlush);
-  lua_setfield(L, -2, "flush");
-  lua_setfield(L, -2, "stdout");
-  lua_pop(L, 1);
-
-  // The Lua half of the module (waitUntil, copy, …) and, in tests, the expectations.
-  const char* prelude = options_.test_mode
-                            ? "require 'pitwall.core'; expect = require 'pitwall.test'"
-                            : "require 'pitwall.core'";
-  std::string err;
-  if (luaL_loadstring(L, prelude) != LUA_OK) {
-    err = lua_tostring(L, -1);
-    lua_pop(L, 1);
-  } else {
-    callCapturing(0, 0, err);  // the world's budget: a library that never loads is an error too
-  }
-  if (!err.empty())
-    throw std::runtime_error("cannot load the pitwall Lua library from " + lib + ": " + err +
-                             " (set PITWALL_SCRIPTS to the folder that holds pitwall/core.lua)");
-}
-
-// require's Lua-file searcher, wrapped: every module file it finds is recorded, so that a hot
-// reload watches the modules of a script as well as the script.
-void ScriptHost::trackRequire() {
-  lua_State* L = L_;
-  lua_getglobal(L, "package");
-  lua_getfield(L, -1, "searchers");
-  lua_rawgeti(L, -1, 2);
-  lua_pushcclosure(L, searchAndRecord, 1);
-  lua_rawseti(L, -2, 2);
-  lua_pop(L, 2);
-}
-
-int ScriptHost::searchAndRecord(lua_State* L) {
-  lua_settop(L, 1);
-  lua_pushvalue(L, lua_upvalueindex(1));
-  lua_insert(L, 1);
-  lua_call(L, 1, 2);
-  if (lua_isfunction(L, 1) && lua_type(L, 2) == LUA_TSTRING) {
-    std::error_code ignored;
-    std::string path =
-        std::filesystem::absolute(lua_tostring(L, 2), ignored).lexically_normal().string();
-    ScriptHost& host = from(L);
-    host.loadedFiles_.push_back(path);
-    if (host.onFileLoaded) host.onFileLoaded(path);
-  }
-  return 2;
 }
 
 bool ScriptHost::call(int nargs, int nresults, const char* what, std::string_view who) {

@@ -146,6 +146,11 @@ class ScriptHost {
   // The files this world loaded from disk: the script and every module found by require.
   const std::vector<std::string>& loadedFiles() const { return loadedFiles_; }
   std::function<void(const std::string& path)> onFileLoaded;
+  // require found a module file (bindings/world.cpp): recorded, and onFileLoaded told.
+  void fileLoaded(const std::string& path);
+  // The shipped library's folder, as require finds it: its chunks are the library's frames in
+  // this world's tracebacks and blame (lua::Frames).
+  void setLibrary(const std::string& folder);
   // Reports a script error: to pitwall.onError if set, else the log (a flood from one `where`:
   // the first in full, then a count a second); in test mode, a failure.
   void reportError(const std::string& where, const std::string& message);
@@ -188,10 +193,7 @@ class ScriptHost {
   static ScriptHost& from(lua_State* L);
 
  private:
-  void openLibraries();
-  void trackRequire();
   void carJoined(AnkiCar& car);
-  static int searchAndRecord(lua_State* L);
   bool protectedCall(int nargs, int nresults, std::string& error, bool console);
   bool finishCall(int status, const char* what, std::string_view who);
   // callAboveHandler's error path, out of line: the error over the handler.

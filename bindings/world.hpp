@@ -1,0 +1,15 @@
+#pragma once
+// What a Lua world holds, in one list (bindings/world.cpp, openWorld): Lua's libraries as the
+// sandbox leaves them, the console, require's path, the engine's types, the `pitwall` module and
+// its parts, and the Lua half of the library. A new part of a world is one more line there.
+//
+// The private protocol between the C++ and the Lua library — the `pitwall._*` names, which
+// scripts are not meant to use — is listed there too, and in docs/architecture.md.
+namespace pitwall {
+
+class ScriptHost;
+
+// Opens everything a new world holds, in order (ScriptHost's constructor, once).
+void openWorld(ScriptHost& host);
+
+}  // namespace pitwall
