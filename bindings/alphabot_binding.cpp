@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "bindings/lua_object.hpp"
+#include "bindings/lua_options.hpp"
 #include "bindings/pitwall_module.hpp"
 #include "bindings/script_host.hpp"
 #include "engine/core/log.hpp"
@@ -338,31 +339,11 @@ int newRobot(lua_State* L) {
         "pitwall.alphabot takes a table: {host = \"127.0.0.1\", port = 4000} or "
         "{ble = \"AA:BB:CC:DD:EE:FF\"}");
   static constexpr std::array<const char*, 4> kOptions = {"host", "port", "connectTimeout", "ble"};
-  lua::checkOptions(L, 1, "pitwall.alphabot", kOptions);
-  std::string host, ble;
-  long long port = 0;
-  double timeout = 3.0;
-  lua_pushnil(L);
-  while (lua_next(L, 1) != 0) {
-    std::string key = lua_type(L, -2) == LUA_TSTRING ? lua_tostring(L, -2) : "";
-    if (key == "host")
-      host = lua::checkString(L, -1, "host");
-    else if (key == "port") {
-      port = lua::checkInteger(L, -1, "port");
-      if (auto e = checkRange("port", static_cast<double>(port), 1, 65535)) throw LuaError(*e);
-    } else if (key == "ble")
-      ble = lua::checkString(L, -1, "ble (the robot's Bluetooth address)");
-    else if (key == "connectTimeout") {
-      timeout = lua::checkNumber(L, -1, "connectTimeout (s)");
-      if (timeout <= 0 || timeout > 60)
-        throw LuaError("connectTimeout " + lua::show(timeout) + " is out of range (0, 60] s");
-    } else {
-      throw LuaError("pitwall.alphabot: unknown option '" +
-                     (key.empty() ? lua::typeName(L, -2) : key) +
-                     "'; the options are host, port, connectTimeout, ble");
-    }
-    lua_pop(L, 1);
-  }
+  lua::Options read(L, 1, "pitwall.alphabot", kOptions, "host=, port= or ble=");
+  const std::string host = read.string("host").value_or("");
+  const std::string ble = read.string("ble").value_or("");
+  const long long port = read.integer("port", 1, 65535).value_or(0);
+  const double timeout = read.number("connectTimeout", 0.001, 60, "s").value_or(3.0);
   if (host.empty() == ble.empty())
     throw LuaError("pitwall.alphabot needs either host (and port) for WLAN or ble for Bluetooth");
   ScriptHost& scriptHost = ScriptHost::from(L);

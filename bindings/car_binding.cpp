@@ -11,6 +11,7 @@
 #include <string_view>
 
 #include "bindings/lua_object.hpp"
+#include "bindings/lua_options.hpp"
 #include "bindings/script_host.hpp"
 #include "engine/core/hex.hpp"
 #include "engine/core/log.hpp"

@@ -105,12 +105,6 @@ inline long long optRounded(lua_State* L, int idx, const char* what, long long f
   return lua_isnoneornil(L, idx) ? fallback : checkRounded(L, idx, what);
 }
 
-// An option table (`sim.addCar{…}`, `car:lights{…}`) at stack index idx holds only the keys in
-// `known`: else raises "<fn>: unknown option <key>; did you mean <nearest>? (the options are …)".
-// A key that is not a string (`{3}`, `{[true] = 1}`) is refused by its type and value; a key too
-// long or not printable is shown shortened and escaped. Nothing happens when idx is not a table.
-void checkOptions(lua_State* L, int idx, std::string_view fn, std::span<const char* const> known);
-
 inline std::string checkString(lua_State* L, int idx, const char* what) {
   if (lua_type(L, idx) != LUA_TSTRING)
     throw LuaError(std::string(what) + " must be a string, got " + typeName(L, idx));

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "bindings/lua_options.hpp"
+
 #include "bindings/lua_args.hpp"
 #include "engine/core/printable.hpp"
 #include "engine/core/suggest.hpp"
@@ -75,6 +77,57 @@ void checkOptions(lua_State* L, int idx, std::string_view fn, std::span<const ch
   std::string all;
   for (const char* name : known) all += (all.empty() ? "" : ", ") + std::string(name);
   throw LuaError(std::string(fn) + ": " + problem + " (the options are " + all + ")");
+}
+
+Options::Options(lua_State* L, int idx, std::string_view fn, std::span<const char* const> known,
+                 std::string_view shape)
+    : L_(L), idx_(lua_absindex(L, idx)), fn_(fn), table_(lua_istable(L, idx)) {
+  if (!table_ && !lua_isnoneornil(L, idx))
+    throw LuaError(std::string(fn) + " takes a table {" + std::string(shape) + "}, got " +
+                   typeName(L, idx));
+  if (table_) checkOptions(L, idx_, fn, known);
+}
+
+bool Options::push(const char* key) {
+  if (!table_) return false;
+  if (lua_getfield(L_, idx_, key) != LUA_TNIL) return true;
+  lua_pop(L_, 1);
+  return false;
+}
+
+std::optional<std::string> Options::string(const char* key, const char* what) {
+  if (!push(key)) return std::nullopt;
+  std::string v = checkString(L_, -1, what ? what : key);
+  lua_pop(L_, 1);
+  return v;
+}
+
+std::optional<bool> Options::boolean(const char* key) {
+  if (!push(key)) return std::nullopt;
+  if (!lua_isboolean(L_, -1))
+    throw LuaError(std::string(key) + " must be true or false, got " + typeName(L_, -1));
+  const bool v = lua_toboolean(L_, -1);
+  lua_pop(L_, 1);
+  return v;
+}
+
+std::optional<double> Options::number(const char* key, double lo, double hi, std::string_view unit,
+                                      std::string_view why) {
+  if (!push(key)) return std::nullopt;
+  const double v = checkNumber(L_, -1, key);
+  lua_pop(L_, 1);
+  requireRange(key, v, lo, hi, unit, why);
+  return v;
+}
+
+std::optional<long long> Options::integer(const char* key, long long lo, long long hi,
+                                          std::string_view unit, std::string_view why) {
+  if (!push(key)) return std::nullopt;
+  const long long v = checkInteger(L_, -1, key);
+  lua_pop(L_, 1);
+  requireRange(key, static_cast<double>(v), static_cast<double>(lo), static_cast<double>(hi), unit,
+               why);
+  return v;
 }
 
 }  // namespace pitwall::lua

@@ -15,6 +15,7 @@
 
 #include "bindings/interrupt.hpp"
 #include "bindings/lua_object.hpp"
+#include "bindings/lua_options.hpp"
 #include "bindings/pitwall_module.hpp"
 #include "bindings/script_host.hpp"
 #include "engine/core/console.hpp"
@@ -267,41 +268,18 @@ const lua::TypeSpec& robotType() {
 // Reads the options table at idx into o; unknown keys are refused (a typo would silently fall
 // back to a default).
 MindroadOptions readOptions(lua_State* L, int idx) {
-  MindroadOptions o;
-  if (lua_isnoneornil(L, idx)) return o;
-  if (!lua_istable(L, idx))
-    throw LuaError("pitwall.mindroad takes a table {host=, port=, udp=, watchdog=}, got " +
-                   lua::typeName(L, idx));
   static constexpr std::array<const char*, 5> kOptions = {"host", "port", "udp", "watchdog",
                                                           "contactTimeout"};
-  lua::checkOptions(L, idx, "pitwall.mindroad", kOptions);
-  lua_pushnil(L);
-  while (lua_next(L, idx)) {
-    const int v = lua_gettop(L);
-    const std::string key = lua_tostring(L, v - 1);
-    if (key == "host") {
-      o.host = lua::checkString(L, v, "host");
-      if (o.host.empty()) throw LuaError("host must not be empty");
-    } else if (key == "port") {
-      auto port = lua::checkInteger(L, v, "port");
-      if (port < 1 || port > 65535)
-        throw LuaError("port " + std::to_string(port) + " is out of range 1..65535");
-      o.port = static_cast<std::uint16_t>(port);
-    } else if (key == "udp") {
-      if (!lua_isboolean(L, v)) throw LuaError("udp must be a boolean, got " + lua::typeName(L, v));
-      o.udp = lua_toboolean(L, v);
-    } else if (key == "watchdog") {
-      o.watchdog = lua::checkNumber(L, v, "watchdog (s)");
-      if (o.watchdog < 0.03 || o.watchdog > 60)
-        throw LuaError("watchdog " + lua::show(o.watchdog) + " s is out of range 0.03..60 s");
-    } else if (key == "contactTimeout") {
-      o.contactTimeout = lua::checkNumber(L, v, "contactTimeout (s)");
-      if (o.contactTimeout < 0.1 || o.contactTimeout > 600)
-        throw LuaError("contactTimeout " + lua::show(o.contactTimeout) +
-                       " s is out of range 0.1..600 s");
-    }
-    lua_pop(L, 1);
+  lua::Options options(L, idx, "pitwall.mindroad", kOptions, "host=, port=, udp=, watchdog=");
+  MindroadOptions o;
+  if (auto host = options.string("host")) {
+    if (host->empty()) throw LuaError("host must not be empty");
+    o.host = *host;
   }
+  if (auto port = options.integer("port", 1, 65535)) o.port = static_cast<std::uint16_t>(*port);
+  if (auto udp = options.boolean("udp")) o.udp = *udp;
+  if (auto watchdog = options.number("watchdog", 0.03, 60, "s")) o.watchdog = *watchdog;
+  if (auto timeout = options.number("contactTimeout", 0.1, 600, "s")) o.contactTimeout = *timeout;
   return o;
 }
 

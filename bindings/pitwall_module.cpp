@@ -18,6 +18,7 @@
 #include "bindings/copy_budget.hpp"
 #include "bindings/lua_args.hpp"
 #include "bindings/lua_object.hpp"
+#include "bindings/lua_options.hpp"
 #include "bindings/metatables.hpp"
 #include "bindings/results.hpp"
 #include "bindings/script_host.hpp"

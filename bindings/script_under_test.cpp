@@ -9,6 +9,7 @@
 
 #include "bindings/lua_args.hpp"
 #include "bindings/lua_object.hpp"
+#include "bindings/lua_options.hpp"
 #include "bindings/pitwall_module.hpp"
 #include "bindings/reloader.hpp"
 #include "engine/core/log.hpp"

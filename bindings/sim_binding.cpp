@@ -6,6 +6,7 @@
 
 #include "bindings/car_binding.hpp"
 #include "bindings/lua_args.hpp"
+#include "bindings/lua_options.hpp"
 #include "bindings/pitwall_module.hpp"
 #include "bindings/script_host.hpp"
 #include "bindings/track_table.hpp"
@@ -229,26 +230,12 @@ int place(lua_State* L) {
 int noise(lua_State* L) {
   SimSession& s = session(L);
   sim::Noise n = s.world->noise();
-  if (!lua_isnoneornil(L, 1)) {
-    if (!lua_istable(L, 1)) throw LuaError("sim.noise takes a table {drop=, late=, lateBy=}");
-    static constexpr std::array<const char*, 3> kOptions = {"drop", "late", "lateBy"};
-    lua::checkOptions(L, 1, "sim.noise", kOptions);
-    auto prob = [L](const char* key, double& out) {
-      if (lua_getfield(L, 1, key) != LUA_TNIL) {
-        double v = lua::checkNumber(L, -1, key);
-        lua::requireRange(std::string("noise ") + key, v, 0, 1, {}, "a probability");
-        out = v;
-      }
-      lua_pop(L, 1);
-    };
-    prob("drop", n.drop);
-    prob("late", n.late);
-    if (lua_getfield(L, 1, "lateBy") != LUA_TNIL) {
-      double v = lua::checkNumber(L, -1, "lateBy (s)");
-      lua::requireRange("noise lateBy", v, 0, 10, "s");
-      n.late_by = fromSeconds(v);
-    }
-    lua_pop(L, 1);
+  static constexpr std::array<const char*, 3> kOptions = {"drop", "late", "lateBy"};
+  lua::Options read(L, 1, "sim.noise", kOptions, "drop=, late=, lateBy=");
+  if (read.given()) {
+    n.drop = read.number("drop", 0, 1, {}, "a probability").value_or(n.drop);
+    n.late = read.number("late", 0, 1, {}, "a probability").value_or(n.late);
+    if (auto by = read.number("lateBy", 0, 10, "s")) n.late_by = fromSeconds(*by);
     s.world->setNoise(n);
   }
   lua_createtable(L, 0, 3);
@@ -262,22 +249,16 @@ int noise(lua_State* L) {
 // (docs/simulator.md "Sensor model"); returns the current setting.
 int sensor(lua_State* L) {
   SimSession& s = session(L);
-  if (!lua_isnoneornil(L, 1)) {
-    if (!lua_istable(L, 1))
-      throw LuaError("sim.sensor takes a table {model = \"real\", \"ideal\" or \"transitions\"}");
-    static constexpr std::array<const char*, 1> kOptions = {"model"};
-    lua::checkOptions(L, 1, "sim.sensor", kOptions);
-    if (lua_getfield(L, 1, "model") != LUA_TNIL) {
-      std::string name = lua::checkString(L, -1, "sensor model");
-      auto model = sim::sensorModelNamed(name);
-      if (!model)
-        throw LuaError("sensor model '" + printable(name, 40) +
-                       "' is not one the simulator has; use \"real\" (fitted to real cars: "
-                       "positions thin out with speed), \"ideal\" (every code) or "
-                       "\"transitions\" (no position update at all: the worst case)");
-      s.world->setSensor(*model);
-    }
-    lua_pop(L, 1);
+  static constexpr std::array<const char*, 1> kOptions = {"model"};
+  lua::Options read(L, 1, "sim.sensor", kOptions, "model = \"real\", \"ideal\" or \"transitions\"");
+  if (auto name = read.string("model", "sensor model")) {
+    auto model = sim::sensorModelNamed(*name);
+    if (!model)
+      throw LuaError("sensor model '" + printable(*name, 40) +
+                     "' is not one the simulator has; use \"real\" (fitted to real cars: "
+                     "positions thin out with speed), \"ideal\" (every code) or "
+                     "\"transitions\" (no position update at all: the worst case)");
+    s.world->setSensor(*model);
   }
   lua_createtable(L, 0, 1);
   std::string_view name = sim::sensorModelName(s.world->sensor());

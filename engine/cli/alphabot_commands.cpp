@@ -8,6 +8,7 @@
 #include <iostream>
 
 #include "engine/cli/commands.hpp"
+#include "engine/cli/fail.hpp"
 #include "engine/core/hex.hpp"
 #include "engine/core/log.hpp"
 #include "engine/protocol/alphabot/ble_codec.hpp"
@@ -53,16 +54,14 @@ int decodeAlphabot(const std::vector<std::uint8_t>& bytes, const std::string& si
     // `pitwall decode alphabot-ble CHARACTERISTIC HEX`: the BLE codec (ble_codec.hpp).
     auto json = alphabot::decodeBle(side, bytes);
     if (!json) {
-      std::cerr << "pitwall decode: " << json.error() << "\n";
-      return 2;
+      return fail("decode", json.error());
     }
     std::cout << json->dump() << "\n";
     return 0;
   }
   auto packet = alphabot::wlan::decode(bytes);
   if (!packet) {
-    std::cerr << "pitwall decode: " << packet.error().message() << "\n";
-    return 2;
+    return fail("decode", packet.error().message());
   }
   nlohmann::json j = std::visit([](const auto& m) { return alphabot::toJson(m); }, *packet);
   std::cout << j.dump() << "\n";
@@ -76,8 +75,7 @@ int encodeAlphabot(const std::vector<std::string>& words) {
   }
   auto request = alphabot::parseRequest(words);
   if (!request) {
-    std::cerr << "pitwall encode: " << request.error() << "\n";
-    return 2;
+    return fail("encode", request.error());
   }
   std::cout << toHex(alphabot::wlan::encode(*request)) << "\n";
   return 0;
@@ -91,15 +89,13 @@ int simRobotAlphabot(const SimRobotOptions& options) {
   std::string host, error;
   std::uint16_t port = 0;
   if (!splitListen(options.listen, host, port, error)) {
-    std::cerr << "pitwall sim-robot: " << error << "\n";
-    return 2;
+    return fail("sim-robot", error);
   }
   sim::alphabot::Room room = sim::alphabot::defaultRoom();
   if (!options.room.empty()) {
     auto loaded = sim::alphabot::loadRoom(options.room);
     if (!loaded) {
-      std::cerr << "pitwall sim-robot: " << loaded.error() << "\n";
-      return 2;
+      return fail("sim-robot", loaded.error());
     }
     room = std::move(*loaded);
   }
@@ -111,7 +107,7 @@ int simRobotAlphabot(const SimRobotOptions& options) {
   try {
     server = std::make_unique<sim::alphabot::RobotServer>(loop, robot, host, port);
   } catch (const std::exception& e) {
-    std::cerr << "pitwall sim-robot: " << e.what() << "\n";
+    fail("sim-robot", e.what());
     log::setTimeSource(nullptr);
     return 2;
   }

@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "engine/cli/commands.hpp"
+#include "engine/cli/fail.hpp"
 #include "engine/cli/options.hpp"
 #include "engine/core/hex.hpp"
 #include "engine/protocol/anki/codec.hpp"
@@ -62,8 +63,7 @@ int decode(const std::string& protocol, const std::vector<std::string>& hex) {
   }
   auto bytes = parseHex(words);
   if (!bytes) {
-    std::cerr << "pitwall decode: " << bytes.error() << "\n";
-    return 2;
+    return fail("decode", bytes.error());
   }
   if (protocol == "mindroad") return decodeMindroad(*bytes);
   if (protocol == "alphabot" || alphabotBle) return decodeAlphabot(*bytes, side);
@@ -71,8 +71,7 @@ int decode(const std::string& protocol, const std::vector<std::string>& hex) {
   // past a layout are shown, not dropped (anki-overdrive.md **Decision**).
   auto message = anki::decodeCommand(*bytes);
   if (!message) {
-    std::cerr << "pitwall decode: " << message.error().message() << "\n";
-    return 2;
+    return fail("decode", message.error().message());
   }
   nlohmann::json json = anki::toJson(*message);
   if (auto extra = anki::extraBytes(*bytes); !extra.empty()) json["extra_bytes"] = toHex(extra);
@@ -90,8 +89,7 @@ int encode(const std::string& protocol, const std::vector<std::string>& words) {
   }
   auto message = anki::parseCommand(words);
   if (!message) {
-    std::cerr << "pitwall encode: " << message.error() << "\n";
-    return 2;
+    return fail("encode", message.error());
   }
   std::cout << toHex(anki::encode(*message).span()) << "\n";
   return 0;

@@ -9,6 +9,7 @@
 #include <sdbus-c++/sdbus-c++.h>
 
 #include "engine/cli/commands.hpp"
+#include "engine/cli/fail.hpp"
 #include "engine/cli/options.hpp"
 #include "engine/core/log.hpp"
 #include "engine/protocol/anki/advertisement.hpp"
@@ -42,8 +43,7 @@ int emulateCar(const EmulateOptions& options) {
   }
   auto track = sim::loadLayout(options.track);
   if (!track) {
-    std::cerr << "pitwall emulate-car: " << track.error() << "\n";
-    return 2;
+    return fail("emulate-car", track.error());
   }
 
   std::unique_ptr<sdbus::IConnection> bus;
@@ -131,7 +131,7 @@ int emulateCar(const EmulateOptions& options) {
 
   peripheral.start([&](const std::string& error) {
     if (!error.empty()) {
-      std::cerr << "pitwall emulate-car: " << error << "\n";
+      fail("emulate-car", error);
       status = 2;
       stopping = true;
       loop.stop();

@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "engine/cli/commands.hpp"
+#include "engine/cli/fail.hpp"
 #include "engine/core/hex.hpp"
 #include "engine/core/log.hpp"
 #include "engine/core/loop.hpp"
@@ -32,15 +33,13 @@ int decodeMindroad(const std::vector<std::uint8_t>& bytes) {
     std::cout << mindroad::contactAnswerJson().dump() << "\n";
     return 0;
   }
-  std::cerr << "pitwall decode: " << instruction.error().message() << "\n";
-  return 2;
+  return fail("decode", instruction.error().message());
 }
 
 int encodeMindroad(const std::vector<std::string>& words) {
   auto instruction = mindroad::parseCommand(words);
   if (!instruction) {
-    std::cerr << "pitwall encode: " << instruction.error() << "\n";
-    return 2;
+    return fail("encode", instruction.error());
   }
   std::cout << toHex(mindroad::encode(*instruction).span()) << "\n";
   return 0;
@@ -106,8 +105,7 @@ int simRobotMindroad(const SimRobotOptions& options) {
   sim::MindroadServerOptions server;
   std::string error;
   if (!splitAddress(options.listen, server.host, server.port, error)) {
-    std::cerr << "pitwall sim-robot: " << error << "\n";
-    return 2;
+    return fail("sim-robot", error);
   }
   server.udp = options.udp;
   server.robot.watchdog = options.watchdog;
@@ -118,7 +116,7 @@ int simRobotMindroad(const SimRobotOptions& options) {
   try {
     robot = std::make_unique<sim::MindroadRobotServer>(loop, server);
   } catch (const std::exception& e) {
-    std::cerr << "pitwall sim-robot: " << e.what() << "\n";
+    fail("sim-robot", e.what());
     log::setTimeSource(nullptr);
     return 2;
   }

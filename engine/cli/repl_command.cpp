@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "engine/cli/commands.hpp"
+#include "engine/cli/fail.hpp"
 #include "engine/cli/options.hpp"
 #include "engine/cli/repl.hpp"
 #include "engine/cli/session.hpp"
@@ -43,7 +44,7 @@ int repl(const ReplOptions& options) {
   try {
     session.startHost(host);
   } catch (const std::exception& e) {
-    std::cerr << "pitwall repl: " << e.what() << "\n";
+    fail("repl", e.what());
     session.finish();  // the cars are connected: they get their stop
     loop.run();
     return 1;

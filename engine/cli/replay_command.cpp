@@ -14,6 +14,7 @@
 
 #include "bindings/script_file.hpp"
 #include "engine/cli/commands.hpp"
+#include "engine/cli/fail.hpp"
 #include "engine/cli/options.hpp"
 #include "engine/cli/session.hpp"
 #include "engine/core/log.hpp"
@@ -112,8 +113,7 @@ int replay(const ReplayOptions& options) {
   const std::string& file = options.file;
   if (!options.script.empty()) {  // refused before the record is read
     if (auto problem = script_file::check(options.script)) {
-      std::cerr << "pitwall replay: " << *problem << "\n";
-      return 2;
+      return fail("replay", *problem);
     }
   }
   std::error_code ec;
@@ -203,8 +203,7 @@ int replay(const ReplayOptions& options) {
     if (layout)
       track = std::move(*layout);
     else if (options.track) {
-      std::cerr << "pitwall replay: " << layout.error() << "\n";
-      return 2;
+      return fail("replay", layout.error());
     }
   }
   if (options.view) {
@@ -296,8 +295,7 @@ int replay(const ReplayOptions& options) {
     try {
       session->startHost(host);
     } catch (const std::exception& e) {
-      std::cerr << "pitwall replay: " << e.what() << "\n";
-      return 1;
+      return fail("replay", e.what(), 1);
     }
     player.onEnd = [&session, &player] {
       log::info("replay",
@@ -306,7 +304,7 @@ int replay(const ReplayOptions& options) {
     };
     auto started = session->scripts().start(options.script);
     if (!started) {
-      std::cerr << "pitwall replay: " << started.error() << "\n";
+      fail("replay", started.error());
       session->finish();
       loop.run();
       return 1;

@@ -8,6 +8,7 @@
 #include "bindings/results.hpp"
 #include "bindings/script_file.hpp"
 #include "engine/cli/commands.hpp"
+#include "engine/cli/fail.hpp"
 #include "engine/cli/options.hpp"
 #include "engine/cli/repl.hpp"
 #include "engine/cli/session.hpp"
@@ -38,15 +39,14 @@ int run(const RunOptions& options) {
     std::error_code ec;
     const bool missing = !std::filesystem::is_regular_file(options.script, ec);
     if (missing || !options.watch) {
-      std::cerr << "pitwall run: " << *problem << "\n";
+      fail("run", *problem);
       return missing ? 2 : 1;
     }
   }
   if (!options.results.empty()) {  // refused now, not after the race
     auto checked = results::writable(options.results);
     if (!checked) {
-      std::cerr << "pitwall run: " << checked.error() << "\n";
-      return 2;
+      return fail("run", checked.error());
     }
   }
   if (options.humans > 0 && options.fast && options.view) {  // phones live in real time
@@ -65,8 +65,7 @@ int run(const RunOptions& options) {
     try {
       session.record(options.record);
     } catch (const std::exception& e) {
-      std::cerr << "pitwall run: " << e.what() << "\n";
-      return 2;
+      return fail("run", e.what());
     }
   }
   Loop& loop = session.loop();
@@ -83,7 +82,7 @@ int run(const RunOptions& options) {
   try {
     session.openRecord();
   } catch (const std::exception& e) {
-    std::cerr << "pitwall run: " << e.what() << "\n";
+    fail("run", e.what());
     session.finish();
     loop.run();
     return 2;
@@ -97,7 +96,7 @@ int run(const RunOptions& options) {
   try {
     session.startHost(host);
   } catch (const std::exception& e) {
-    std::cerr << "pitwall run: " << e.what() << "\n";
+    fail("run", e.what());
     session.finish();  // the cars are connected: they get their stop
     loop.run();
     return 1;
@@ -139,7 +138,7 @@ int run(const RunOptions& options) {
   }
   auto started = scripts.start(options.script);
   if (!started && !options.watch) {
-    std::cerr << "pitwall run: " << started.error() << "\n";
+    fail("run", started.error());
     session.finish();
     loop.run();
     return 1;
@@ -148,7 +147,7 @@ int run(const RunOptions& options) {
     if (!started)  // a broken first version: wait for a fix, as the later ones do
       log::error("pitwall", started.error() + "\n  waiting for the script to be saved again");
     if (auto watching = scripts.watch(); !watching) {
-      std::cerr << "pitwall run: " << watching.error() << "\n";
+      fail("run", watching.error());
       session.finish();
       loop.run();
       return 2;

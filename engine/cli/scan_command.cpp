@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "engine/cli/commands.hpp"
+#include "engine/cli/fail.hpp"
 #include "engine/cli/options.hpp"
 #include "engine/core/log.hpp"
 #include "engine/fleet/ble_central.hpp"
@@ -101,27 +102,25 @@ int scan(const ScanOptions& options) {
   try {
     bluez = std::make_unique<ble::Bluez>(loop);
   } catch (const ble::BleError& e) {
-    std::cerr << "pitwall scan: " << e.what() << "\n";
-    return 2;
+    return fail("scan", e.what());
   }
   int status = 0;
   std::vector<ble::Sighting> found;
-  auto fail = [&](const std::string& why) {
-    std::cerr << "pitwall scan: " << why << "\n";
-    status = 2;
+  auto failed = [&](const std::string& why) {
+    status = fail("scan", why);
     loop.stop();
   };
   bluez->start([&](std::optional<std::string> error) {
-    if (error) return fail(*error);
+    if (error) return failed(*error);
     std::vector<const ble::Adapter*> adapters;
     try {
       adapters = bluez->pickAdapters(options.adapters);
     } catch (const ble::BleError& e) {
-      return fail(e.what());
+      return failed(e.what());
     }
     ble::scanForCars(*bluez, adapters, fromSeconds(options.timeout), {},
                      [&](std::optional<std::string> error, std::vector<ble::Sighting> cars) {
-                       if (error) return fail(*error);
+                       if (error) return failed(*error);
                        found = std::move(cars);
                        // Let StopDiscovery reach BlueZ before leaving.
                        loop.after(std::chrono::milliseconds(50), [&] { loop.stop(); });

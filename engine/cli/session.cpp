@@ -14,9 +14,11 @@
 #include "bindings/car_binding.hpp"
 #include "bindings/interrupt.hpp"
 #include "bindings/sandbox.hpp"
+#include "engine/cli/fail.hpp"
 #include "engine/cli/options.hpp"
 #include "engine/core/console.hpp"
 #include "engine/core/log.hpp"
+#include "engine/core/numbers.hpp"
 #include "engine/protocol/anki/advertisement.hpp"
 #include "engine/sim/grid.hpp"
 #include "engine/transport/sim_link.hpp"
@@ -42,21 +44,13 @@ Session::Session(ClockKind clock) : loop_(clock), fleet_(loop_) {
   log::setTimeSource([this] { return loop_.seconds(); });
 }
 
+// The subsystems go in the reverse of their declaration (session.hpp): the Lua world first,
+// then the view, the seats' holders, MQTT, the radio, the record, the fleet, the loop last. Only
+// the signal handlers and the watchdog go before the record's last flush.
 Session::~Session() {
   watchdog_.reset();
   signals_.reset();
   if (recorder_) recorder_->flush();
-  scripts_.reset();
-  server_.reset();
-  feed_.reset();
-  keyboard_.reset();
-  gamepads_.reset();
-  seats_.reset();
-  bridge_.reset();
-  remote_.reset();
-  mqtt_.reset();
-  central_.reset();
-  log::setTimeSource(nullptr);
 }
 
 std::unique_ptr<Session> Session::open(const CarSource& source, bool fast, const char* command) {
@@ -64,7 +58,7 @@ std::unique_ptr<Session> Session::open(const CarSource& source, bool fast, const
   if (!source.ble) {
     auto track = sim::loadLayout(source.track);
     if (!track) {
-      std::cerr << "pitwall " << command << ": " << track.error() << "\n";
+      fail(command, track.error());
       return nullptr;
     }
     if (source.cars > sim::gridCapacity(*track)) {
@@ -74,15 +68,14 @@ std::unique_ptr<Session> Session::open(const CarSource& source, bool fast, const
                          std::to_string(sim::gridCapacity(*track)) + " (four on each piece)";
       std::string longer = sim::ovalLayoutFor(source.cars);
       if (source.trackGiven) {
-        std::cerr << "pitwall " << command << ": " << fits << "; give a layout of at least "
-                  << (source.cars + 3) / 4
-                  << " pieces, or leave out --track for an oval that holds them (" << longer
-                  << ")\n";
+        fail(command,
+             fits + "; give a layout of at least " + std::to_string((source.cars + 3) / 4) +
+                 " pieces, or leave out --track for an oval that holds them (" + longer + ")");
         return nullptr;
       }
       track = sim::parseLayout(longer, "oval");
       if (!track) {  // ovalLayoutFor's layouts close (world_test): a bug if this is reached
-        std::cerr << "pitwall " << command << ": internal error: " << track.error() << "\n";
+        fail(command, "internal error: " + track.error());
         return nullptr;
       }
       char lap[32];
@@ -100,7 +93,7 @@ std::unique_ptr<Session> Session::open(const CarSource& source, bool fast, const
     if (source.trackGiven) {
       auto track = sim::loadLayout(source.track);
       if (!track) {
-        std::cerr << "pitwall " << command << ": " << track.error() << "\n";
+        fail(command, track.error());
         return nullptr;
       }
       design = std::move(*track);
@@ -114,7 +107,7 @@ std::unique_ptr<Session> Session::open(const CarSource& source, bool fast, const
       session = std::make_unique<Session>(std::move(central));
       session->design_ = std::move(design);
     } catch (const ble::BleError& e) {
-      std::cerr << "pitwall " << command << ": " << e.what() << "\n";
+      fail(command, e.what());
       return nullptr;
     }
   }
@@ -290,8 +283,7 @@ int Session::startBridge(const MqttSettings& settings, const std::string& hostId
                          const char* command) {
   auto options = mqttOptions(settings);
   if (!options) {
-    std::cerr << "pitwall " << command << ": " << options.error() << "\n";
-    return 2;
+    return fail(command, options.error());
   }
   std::string host = topics::hostId(hostId.empty() ? machineName() : hostId);
   options->will = MqttBridge::will(host);
@@ -314,8 +306,7 @@ int Session::startBridge(const MqttSettings& settings, const std::string& hostId
         pitwall::BridgeOptions{host, readOnly, topics::PayloadLimits{settings.maxPayload}},
         std::move(connections));
   } catch (const std::invalid_argument& e) {
-    std::cerr << "pitwall " << command << ": " << e.what() << "\n";
-    return 2;
+    return fail(command, e.what());
   }
   // The first answer decides: a refusal (credentials, authorisation) ends the bridge; a broker
   // that cannot be reached yet is retried for as long as the bridge runs.
@@ -336,17 +327,13 @@ int Session::startBridge(const MqttSettings& settings, const std::string& hostId
   // A broker that refuses at once (nobody listens on the port) answers inside connect(): the
   // loop's stop() came before run(), which would forget it.
   if (!answered) {
-    auto timeout = loop_.after(fromSeconds(source_.mqttTimeout), [this] { loop_.stop(); });
-    loop_.run();
-    loop_.cancel(timeout);
+    loop_.runAtMost(fromSeconds(source_.mqttTimeout));
   }
   mqtt_->onConnected = previousConnected;
   mqtt_->onDisconnected = nullptr;  // the client logs why; it reconnects by itself
   if (interrupted_) return 130;
   if (refused) {
-    std::cerr << "pitwall " << command << ": the broker refused the connection: " << *refused
-              << "\n";
-    return 2;
+    return fail(command, "the broker refused the connection: " + *refused);
   }
   return 0;
 }
@@ -354,14 +341,12 @@ int Session::startBridge(const MqttSettings& settings, const std::string& hostId
 int Session::connectRemoteCars(const char* command) {
   auto options = mqttOptions(source_.mqtt);
   if (!options) {
-    std::cerr << "pitwall " << command << ": " << options.error() << "\n";
-    return 2;
+    return fail(command, options.error());
   }
   try {
     mqtt_ = std::make_unique<MqttClient>(loop_, std::move(*options));
   } catch (const std::invalid_argument& e) {
-    std::cerr << "pitwall " << command << ": " << e.what() << "\n";
-    return 2;
+    return fail(command, e.what());
   }
   remote_ = std::make_unique<RemoteCars>(loop_, fleet_, *mqtt_,
                                          topics::PayloadLimits{source_.mqtt.maxPayload});
@@ -389,9 +374,7 @@ int Session::connectRemoteCars(const char* command) {
         start->failed = reason;
         loop_.stop();
       });
-  auto timeout = loop_.after(fromSeconds(source_.mqttTimeout), [this] { loop_.stop(); });
-  loop_.run();
-  loop_.cancel(timeout);
+  loop_.runAtMost(fromSeconds(source_.mqttTimeout));
   start->waiting = false;
   remote_->onChange = nullptr;
   const bool synced = start->synced;
@@ -399,25 +382,21 @@ int Session::connectRemoteCars(const char* command) {
   if (interrupted_) return 130;
   std::string where = " (" + source_.mqtt.url + ")";
   if (failed) {
-    std::cerr << "pitwall " << command << ": the broker refused the connection" << where << ": "
-              << *failed << "\n";
-    return 2;
+    return fail(command, "the broker refused the connection" + where + ": " + *failed);
   }
   if (!synced) {
+    const std::string timeout = formatNumber(source_.mqttTimeout) + " s";
     if (mqtt_->state() == MqttClient::State::Connected)
-      std::cerr << "pitwall " << command << ": the MQTT broker" << where
-                << " did not return pitwall's sync message in " << source_.mqttTimeout
-                << " s (does its access control allow pitwall/sync/#?)\n";
-    else
-      std::cerr << "pitwall " << command << ": no connection to the MQTT broker" << where << " in "
-                << source_.mqttTimeout << " s\n";
-    return 2;
+      return fail(command, "the MQTT broker" + where +
+                               " did not return pitwall's sync message in " + timeout +
+                               " (does its access control allow pitwall/sync/#?)");
+    return fail(command, "no connection to the MQTT broker" + where + " in " + timeout);
   }
   if (!enough()) {
-    std::cerr << "pitwall " << command << ": " << remote_->onlineCount() << " remote car"
-              << (remote_->onlineCount() == 1 ? "" : "s") << " online after " << source_.mqttTimeout
-              << " s, --remote-cars asked for " << source_.remoteCars << "\n";
-    return 2;
+    return fail(command, std::to_string(remote_->onlineCount()) + " remote car" +
+                             (remote_->onlineCount() == 1 ? "" : "s") + " online after " +
+                             formatNumber(source_.mqttTimeout) + " s, --remote-cars asked for " +
+                             std::to_string(source_.remoteCars));
   }
   log::info("mqtt", std::to_string(remote_->onlineCount()) + " remote car" +
                         (remote_->onlineCount() == 1 ? "" : "s") + " through " + source_.mqtt.url);
@@ -442,7 +421,7 @@ int Session::connectLocalCars(const char* command) {
     auto error = connectRealCars();
     if (interrupted_) return 130;
     if (error) {
-      std::cerr << "pitwall " << command << ": " << *error << "\n";
+      fail(command, *error);
       finish();
       loop_.run();
       return 2;
@@ -451,8 +430,7 @@ int Session::connectLocalCars(const char* command) {
   }
   if (!addGridCars(source_.cars)) {
     if (interrupted_) return 130;
-    std::cerr << "pitwall " << command << ": not every simulated car connected\n";
-    return 1;
+    return fail(command, "not every simulated car connected", 1);
   }
   return 0;
 }
@@ -562,9 +540,7 @@ bool Session::addGridCars(int count) {
   Subscription joined = fleet_.carJoined.connect([&](AnkiCar&) {
     if (fleet_.connectedCount() == static_cast<std::size_t>(count)) loop_.stop();
   });
-  auto timeout = loop_.after(std::chrono::seconds(5), [this] { loop_.stop(); });
-  loop_.run();
-  loop_.cancel(timeout);
+  loop_.runAtMost(std::chrono::seconds(5));
   return fleet_.connectedCount() == static_cast<std::size_t>(count);
 }
 
@@ -594,15 +570,13 @@ int Session::startView(const std::string& endpoint, const std::string& source,
                        const char* command) {
   auto options = view::parseEndpoint(endpoint);
   if (!options) {
-    std::cerr << "pitwall " << command << ": " << options.error()
-              << " (--view takes an optional [HOST:]PORT: write --view=PORT, or put --view after "
-                 "the script)\n";
-    return 2;
+    return fail(command, options.error() +
+                             " (--view takes an optional [HOST:]PORT: write --view=PORT, or put "
+                             "--view after the script)");
   }
   auto assets = view::findAssets();
   if (!assets) {
-    std::cerr << "pitwall " << command << ": " << assets.error() << "\n";
-    return 2;
+    return fail(command, assets.error());
   }
   options->assets = *assets;
   options->names = viewHosts();
@@ -610,7 +584,7 @@ int Session::startView(const std::string& endpoint, const std::string& source,
   feed_->followLog(true);
   server_ = std::make_unique<view::Server>(loop_, *feed_, *options);
   if (auto started = server_->start(); !started) {
-    std::cerr << "pitwall " << command << ": " << started.error() << "\n";
+    fail(command, started.error());
     server_.reset();
     feed_.reset();
     return 2;
@@ -642,15 +616,13 @@ int Session::startSeats(const CarSource& source, const char* command) {
     if (const char* dir = std::getenv("PITWALL_INPUT_DIR"); dir && *dir) options.folder = dir;
     gamepads_ = std::make_unique<drive::Gamepads>(loop_, *seats_, options);
     if (auto started = gamepads_->start(); !started) {
-      std::cerr << "pitwall " << command << ": " << started.error() << "\n";
-      return 2;
+      return fail(command, started.error());
     }
   }
   if (source.keyboard) {
     keyboard_ = std::make_unique<drive::Keyboard>(loop_, *seats_, 0);
     if (auto started = keyboard_->start(); !started) {
-      std::cerr << "pitwall " << command << ": " << started.error() << "\n";
-      return 2;
+      return fail(command, started.error());
     }
   }
   const std::string cars =

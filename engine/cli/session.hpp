@@ -11,6 +11,7 @@
 #include "engine/cli/commands.hpp"
 #include "engine/core/emergency_stops.hpp"
 #include "engine/core/lag_monitor.hpp"
+#include "engine/core/log.hpp"
 #include "engine/core/loop.hpp"
 #include "engine/core/stop_signals.hpp"
 #include "engine/drive/gamepads.hpp"
@@ -100,7 +101,20 @@ class Session {
   int exitStatus(int otherwise);
 
  private:
+  int connectLocalCars(const char* command);
+  int connectRemoteCars(const char* command);
+  void catchSignals();
+  void suspend();
+  void flushRecordPeriodically();
+
+  // The subsystems, in the order they depend on each other: each is destroyed before what is
+  // declared above it (the destructor adds nothing but the record's last flush).
   Loop loop_;  // first made, last destroyed: everything below schedules on it
+  // The log's time source (a command sets it to loop_'s clock) is reset once everything below
+  // has gone, so their last lines keep their times.
+  struct ResetLogTime {
+    ~ResetLogTime() { log::setTimeSource(nullptr); }
+  } resetLogTime_;
   SimSession sim_;
   std::optional<sim::Track> design_;  // --ble --track: the layout the real cars are on
   Fleet fleet_;
@@ -111,7 +125,6 @@ class Session {
   double raceWritten_ = -1e9;   // when (loop seconds)
   bool raceTooLong_ = false;
   std::unique_ptr<ble::Central> central_;  // real cars; after the fleet: its links live there
-  std::unique_ptr<Reloader> scripts_;
   // MQTT (docs/mqtt.md): the client, and either remote cars (--mqtt) or the bridge
   std::unique_ptr<MqttClient> mqtt_;
   std::unique_ptr<RemoteCars> remote_;
@@ -123,21 +136,17 @@ class Session {
   // the race view: the feed follows the fleet (restores its hooks when destroyed, before it)
   std::unique_ptr<view::Feed> feed_;
   std::unique_ptr<view::Server> server_;
-  int connectLocalCars(const char* command);
-  int connectRemoteCars(const char* command);
+  std::unique_ptr<Reloader> scripts_;  // the Lua world: it holds the seats, the feed and the cars
+  CarSource source_;
+  bool limitsFromSource_ = false;  // opened from a command line: its --budget and --lua-memory
   bool finishing_ = false;
   bool spectator_ = false;
   bool suspending_ = false;  // Ctrl-Z: the cars paused, the process about to stop
   bool outputGone_ = false;  // SIGPIPE on stdout/stderr ended the run (status 141)
-  void catchSignals();
-  void suspend();
-  void flushRecordPeriodically();
-  CarSource source_;
-  bool limitsFromSource_ = false;  // opened from a command line: its --budget and --lua-memory
+  bool interrupted_ = false;
+  std::unique_ptr<LagMonitor> lag_;  // real time: says when the loop falls behind
   std::unique_ptr<StopSignals> signals_;
   std::unique_ptr<Watchdog> watchdog_;  // real time: stops the cars when the loop is stuck
-  std::unique_ptr<LagMonitor> lag_;     // real time: says when the loop falls behind
-  bool interrupted_ = false;
 };
 
 }  // namespace pitwall::cli

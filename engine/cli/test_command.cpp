@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "engine/cli/commands.hpp"
+#include "engine/cli/fail.hpp"
 #include "engine/cli/options.hpp"
 #include "engine/cli/scenario.hpp"
 #include "engine/cli/test_pool.hpp"
@@ -183,13 +184,11 @@ std::string runOptions(const TestOptions& o) {
 int test(const TestOptions& options) {
   auto files = collect(options.paths);
   if (!files) {
-    std::cerr << "pitwall test: " << files.error() << "\n";
-    return 2;
+    return fail("test", files.error());
   }
   auto scenarios = select(*files, options.filters);
   if (!scenarios) {
-    std::cerr << "pitwall test: " << scenarios.error() << "\n";
-    return 2;
+    return fail("test", scenarios.error());
   }
   if (options.list) {
     for (const auto& s : *scenarios) {
@@ -205,8 +204,7 @@ int test(const TestOptions& options) {
   }
   auto seeds = seedsFor(options.seed, scenarios->size());
   if (!seeds) {
-    std::cerr << "pitwall test: " << seeds.error() << "\n";
-    return 2;
+    return fail("test", seeds.error());
   }
   std::ofstream junit;
   if (!options.junit.empty()) {

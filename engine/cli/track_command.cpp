@@ -11,6 +11,7 @@
 #include <memory>
 
 #include "engine/cli/commands.hpp"
+#include "engine/cli/fail.hpp"
 #include "engine/cli/options.hpp"
 #include "engine/cli/print_module.hpp"
 #include "engine/sim/track.hpp"
@@ -41,8 +42,7 @@ std::string scaledToFit(std::string svg) {
 int trackShow(const TrackShowOptions& options) {
   auto track = sim::loadLayout(options.layout);
   if (!track) {
-    std::cerr << "pitwall track show: " << track.error() << "\n";
-    return 2;
+    return fail("track show", track.error());
   }
   // With the drawing on stdout, the summary goes to stderr: stdout stays one SVG document.
   (options.svg == "-" ? std::cerr : std::cout) << view::trackSummary(*track);

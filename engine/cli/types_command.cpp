@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "bindings/object_types.hpp"
+#include "engine/cli/fail.hpp"
 #include "engine/cli/options.hpp"
 #include "engine/cli/session.hpp"
 #include "engine/core/result.hpp"
@@ -149,8 +150,7 @@ int writeLuarc(const fs::path& dir) {
 int types(const TypesOptions& options) {
   auto files = generate();
   if (!files) {
-    std::cerr << "pitwall types: " << files.error() << "\n";
-    return 1;
+    return fail("types", files.error(), 1);
   }
   const fs::path dir = options.dir;
   if (options.check) {

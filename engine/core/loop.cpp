@@ -75,6 +75,35 @@ void Loop::run() {
     runReal();
 }
 
+bool Loop::runAtMost(Duration limit) {
+  bool timedOut = false;
+  const TimerId deadline = after(limit, [this, &timedOut] {
+    timedOut = true;
+    stop();
+  });
+  run();
+  cancel(deadline);
+  return !timedOut;
+}
+
+bool Loop::runUntil(const std::function<bool()>& done, Duration limit) {
+  if (done()) return true;
+  bool met = false;
+  TimerId poll = 0;
+  std::function<void()> check = [&] {
+    poll = 0;
+    if (done()) {
+      met = true;
+      return stop();
+    }
+    poll = after(std::chrono::milliseconds(1), check);
+  };
+  poll = after(std::chrono::milliseconds(1), check);
+  runAtMost(limit);
+  if (poll) cancel(poll);
+  return met;
+}
+
 void Loop::runVirtual() {
   // No work guard here: an empty poll() then stops the context and we restart it (a mutex round
   // trip), but with a guard an empty poll() runs the reactor instead — an epoll_wait syscall per

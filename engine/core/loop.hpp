@@ -61,6 +61,13 @@ class Loop {
 
   // Runs until stop() is called, or until nothing is left that could ever run.
   void run();
+  // Runs until stop() is called or `limit` of loop time has passed: false when the limit ended
+  // it. (A stop() before the call is forgotten, as run() forgets it.)
+  bool runAtMost(Duration limit);
+  // Runs until done() holds, checked every millisecond of loop time (and not called again once
+  // it held: it may consume what it checks), or `limit` has passed: false when the limit ended
+  // it. Leaves no timer behind.
+  bool runUntil(const std::function<bool()>& done, Duration limit);
   // stop() ends run() after the current callback; it can be called from any callback.
   void stop();
   bool stopped() const { return stopped_; }

@@ -1,7 +1,6 @@
 #pragma once
-// Runs a real-clock loop until a condition holds, for tests and benchmarks that wait for
-// something to happen over a real bus or socket: the condition is checked every millisecond of
-// loop time; the deadline bounds the wait. Leaves no timer behind.
+// Runs a loop until a condition holds, for tests and benchmarks that wait for something to
+// happen over a real bus or socket (Loop::runUntil, with the tests' default limit of 5 s).
 #include <functional>
 
 #include "engine/core/loop.hpp"
@@ -10,23 +9,7 @@ namespace pitwall::testing {
 
 inline bool runUntil(Loop& loop, const std::function<bool()>& done,
                      Duration limit = std::chrono::seconds(5)) {
-  if (done()) return true;
-  bool met = false;  // done() may consume what it checks (a read): it is not called again
-  Loop::TimerId poll = 0;
-  std::function<void()> check = [&] {
-    poll = 0;
-    if (done()) {
-      met = true;
-      return loop.stop();
-    }
-    poll = loop.after(std::chrono::milliseconds(1), check);
-  };
-  poll = loop.after(std::chrono::milliseconds(1), check);
-  auto deadline = loop.after(limit, [&] { loop.stop(); });
-  loop.run();
-  loop.cancel(deadline);
-  if (poll) loop.cancel(poll);
-  return met;
+  return loop.runUntil(done, limit);
 }
 
 // Runs the loop for `d` of loop time.

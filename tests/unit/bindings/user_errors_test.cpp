@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include "bindings/lua_args.hpp"
+#include "bindings/lua_options.hpp"
 #include "bindings/misspelled_method.hpp"
 #include "bindings/script_file.hpp"
 #include "bindings/script_host.hpp"
