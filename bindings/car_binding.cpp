@@ -94,32 +94,20 @@ int uturn(lua_State* L) {
   raiseIfRefused(CarBinding::command(L, 1).turn(TurnType::UTurn));
   return 0;
 }
+constexpr std::pair<const char*, TurnType> kTurnTypes[] = {{"left", TurnType::Left},
+                                                           {"right", TurnType::Right},
+                                                           {"uturn", TurnType::UTurn},
+                                                           {"uturn-jump", TurnType::UTurnJump},
+                                                           {"none", TurnType::None}};
+constexpr std::pair<const char*, TurnTrigger> kTurnTriggers[] = {
+    {"immediate", TurnTrigger::Immediate}, {"intersection", TurnTrigger::Intersection}};
 int turn(lua_State* L) {
   AnkiCar& car = CarBinding::command(L, 1);
-  std::string type = lua::checkString(L, 2, "turn type");
-  std::string trigger = lua_isnoneornil(L, 3) ? "immediate" : lua::checkString(L, 3, "trigger");
-  TurnType t;
-  if (type == "left")
-    t = TurnType::Left;
-  else if (type == "right")
-    t = TurnType::Right;
-  else if (type == "uturn")
-    t = TurnType::UTurn;
-  else if (type == "uturn-jump")
-    t = TurnType::UTurnJump;
-  else if (type == "none")
-    t = TurnType::None;
-  else
-    throw LuaError("turn type '" + type +
-                   "' is unknown; use left, right, uturn, uturn-jump or none");
-  TurnTrigger g;
-  if (trigger == "immediate")
-    g = TurnTrigger::Immediate;
-  else if (trigger == "intersection")
-    g = TurnTrigger::Intersection;
-  else
-    throw LuaError("turn trigger '" + trigger + "' is unknown; use immediate or intersection");
-  raiseIfRefused(car.turn(t, g));
+  const TurnType type = lua::checkName(L, 2, "turn type", kTurnTypes);
+  const TurnTrigger trigger = lua_isnoneornil(L, 3)
+                                  ? TurnTrigger::Immediate
+                                  : lua::checkName(L, 3, "turn trigger", kTurnTriggers);
+  raiseIfRefused(car.turn(type, trigger));
   return 0;
 }
 int lights(lua_State* L) {
@@ -146,24 +134,24 @@ int lights(lua_State* L) {
   raiseIfRefused(car.lights(static_cast<int>(mask)));
   return 0;
 }
-int nameOrNumber(lua_State* L, int idx, const char* what, std::initializer_list<const char*> names,
-                 long long max) {
-  if (lua_type(L, idx) == LUA_TSTRING) {
-    std::string s = lua_tostring(L, idx);
-    int i = 0;
-    std::string all;
-    for (const char* n : names) {
-      if (s == n) return i;
-      all += (all.empty() ? "" : ", ") + std::string(n);
-      ++i;
-    }
-    throw LuaError(std::string(what) + " '" + s + "' is unknown; use one of " + all);
-  }
+// A channel or an effect: by name (its position in `names`), or by number 0..max.
+template <std::size_t N>
+int nameOrNumber(lua_State* L, int idx, const char* what,
+                 const std::pair<const char*, int> (&names)[N], long long max) {
+  if (lua_type(L, idx) == LUA_TSTRING) return lua::checkName(L, idx, what, names);
   auto v = lua::checkInteger(L, idx, what);
-  if (auto e = checkRange(what, static_cast<double>(v), 0, static_cast<double>(max)))
-    throw LuaError(*e);
+  lua::requireRange(what, static_cast<double>(v), 0, static_cast<double>(max));
   return static_cast<int>(v);
 }
+int intensity(lua_State* L, int idx, const char* what, long long max) {
+  auto v = lua::checkInteger(L, idx, what);
+  lua::requireRange(what, static_cast<double>(v), 0, static_cast<double>(max));
+  return static_cast<int>(v);
+}
+constexpr std::pair<const char*, int> kChannels[] = {
+    {"red", 0}, {"tail", 1}, {"blue", 2}, {"green", 3}, {"front-left", 4}, {"front-right", 5}};
+constexpr std::pair<const char*, int> kEffects[] = {
+    {"steady", 0}, {"fade", 1}, {"throb", 2}, {"flash", 3}, {"random", 4}};
 int lightsPattern(lua_State* L) {
   AnkiCar& car = CarBinding::check(L, 1);
   if (!lua_istable(L, 2))
@@ -185,22 +173,18 @@ int lightsPattern(lua_State* L) {
     lua::checkOptions(L, t, "car:lightsPattern", kOptions);
     auto& c = p.channels[i - 1];
     lua_getfield(L, t, "channel");
-    c.channel = static_cast<uint8_t>(nameOrNumber(
-        L, -1, "channel", {"red", "tail", "blue", "green", "front-left", "front-right"}, 5));
+    c.channel = static_cast<uint8_t>(nameOrNumber(L, -1, "channel", kChannels, 5));
     lua_getfield(L, t, "effect");
-    c.effect = static_cast<uint8_t>(
-        lua_isnil(L, -1)
-            ? 0
-            : nameOrNumber(L, -1, "effect", {"steady", "fade", "throb", "flash", "random"}, 4));
+    c.effect =
+        static_cast<uint8_t>(lua_isnil(L, -1) ? 0 : nameOrNumber(L, -1, "effect", kEffects, 4));
     lua_getfield(L, t, "from");
-    c.start = static_cast<uint8_t>(
-        lua_isnil(L, -1) ? 0 : nameOrNumber(L, -1, "from (intensity)", {}, 14));
+    c.start = static_cast<uint8_t>(lua_isnil(L, -1) ? 0 : intensity(L, -1, "from (intensity)", 14));
     lua_getfield(L, t, "to");
-    c.end = static_cast<uint8_t>(lua_isnil(L, -1) ? c.start
-                                                  : nameOrNumber(L, -1, "to (intensity)", {}, 14));
+    c.end =
+        static_cast<uint8_t>(lua_isnil(L, -1) ? c.start : intensity(L, -1, "to (intensity)", 14));
     lua_getfield(L, t, "cycles");
-    c.cycles_per_10s = static_cast<uint8_t>(
-        lua_isnil(L, -1) ? 0 : nameOrNumber(L, -1, "cycles (per 10 s)", {}, 255));
+    c.cycles_per_10s =
+        static_cast<uint8_t>(lua_isnil(L, -1) ? 0 : intensity(L, -1, "cycles (per 10 s)", 255));
     lua_settop(L, t - 1);
   }
   raiseIfRefused(car.lightsPattern(p));

@@ -79,6 +79,16 @@ void checkOptions(lua_State* L, int idx, std::string_view fn, std::span<const ch
   throw LuaError(std::string(fn) + ": " + problem + " (the options are " + all + ")");
 }
 
+std::string unknownName(std::string_view what, std::string_view name,
+                        std::span<const char* const> names) {
+  std::vector<std::string> candidates(names.begin(), names.end());
+  std::string all;
+  for (std::size_t i = 0; i < names.size(); ++i)
+    all += std::string(i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
+  return std::string(what) + " '" + printable(std::string(name), kMaxKeyShown) + "' is unknown" +
+         (name.size() <= 64 ? didYouMean(name, candidates) : "") + " (use " + all + ")";
+}
+
 Options::Options(lua_State* L, int idx, std::string_view fn, std::span<const char* const> known,
                  std::string_view shape)
     : L_(L), idx_(lua_absindex(L, idx)), fn_(fn), table_(lua_istable(L, idx)) {

@@ -7,6 +7,7 @@
 // engine/core/numbers.hpp), a name turned into an enum with the names it could have been.
 #include <lua.hpp>
 
+#include <array>
 #include <optional>
 #include <span>
 #include <string>
@@ -22,6 +23,23 @@ namespace pitwall::lua {
 // A key that is not a string (`{3}`, `{[true] = 1}`) is refused by its type and value; a key too
 // long or not printable is shown shortened and escaped. Nothing happens when idx is not a table.
 void checkOptions(lua_State* L, int idx, std::string_view fn, std::span<const char* const> known);
+
+// "WHAT 'NAME' is unknown; did you mean X? (use a, b or c)": the one wording for a name that is
+// none of `names`.
+std::string unknownName(std::string_view what, std::string_view name,
+                        std::span<const char* const> names);
+
+// The name at idx among `names` (name, value pairs): its value; anything else is refused with
+// unknownName's sentence.
+template <class E, std::size_t N>
+E checkName(lua_State* L, int idx, const char* what, const std::pair<const char*, E> (&names)[N]) {
+  const std::string name = checkString(L, idx, what);
+  for (const auto& [n, value] : names)
+    if (name == n) return value;
+  std::array<const char*, N> list;
+  for (std::size_t i = 0; i < N; ++i) list[i] = names[i].first;
+  throw LuaError(unknownName(what, name, list));
+}
 
 class Options {
  public:
@@ -40,17 +58,6 @@ class Options {
                                std::string_view why = {});
   std::optional<long long> integer(const char* key, long long lo, long long hi,
                                    std::string_view unit = {}, std::string_view why = {});
-  // A name among `names` (name, value): anything else is refused naming them all.
-  template <class E>
-  std::optional<E> oneOf(const char* key, std::span<const std::pair<const char*, E>> names) {
-    auto name = string(key);
-    if (!name) return std::nullopt;
-    for (const auto& [n, value] : names)
-      if (*name == n) return value;
-    std::string all;
-    for (const auto& entry : names) all += (all.empty() ? "" : ", ") + std::string(entry.first);
-    throw LuaError(std::string(fn_) + ": " + key + " '" + *name + "' is not one of " + all);
-  }
 
  private:
   // Pushes the option's value; false (nothing pushed) when it is absent.

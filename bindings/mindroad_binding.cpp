@@ -107,12 +107,11 @@ int click(lua_State* L) {
   return 0;
 }
 
-std::uint8_t buttonByName(const std::string& name) {
-  if (auto b = mindroad::buttonFromName(name)) return static_cast<std::uint8_t>(*b);
-  static const std::vector<std::string> kButtons = {"manual", "automatic", "sensitivity-up",
-                                                    "sensitivity-down"};
-  throw LuaError("button '" + name + "' is unknown" + didYouMean(name, kButtons) +
-                 " (use manual, automatic, sensitivity-up or sensitivity-down)");
+constexpr std::pair<const char*, int> kButtons[] = {
+    {"manual", 0}, {"automatic", 1}, {"sensitivity-up", 2}, {"sensitivity-down", 3}};
+std::uint8_t buttonAt(lua_State* L, int idx) {
+  const int b = lua::checkName(L, idx, "button", kButtons);
+  return static_cast<std::uint8_t>(*mindroad::buttonFromName(kButtons[b].first));
 }
 
 // buttons("automatic"): the byte is that button's id (seed table 2); buttons{"manual",
@@ -121,7 +120,7 @@ int buttons(lua_State* L) {
   auto& c = open(L, 1);
   long long raw = 0;
   if (lua_type(L, 2) == LUA_TSTRING) {
-    raw = buttonByName(lua_tostring(L, 2));
+    raw = buttonAt(L, 2);
   } else if (lua_istable(L, 2)) {
     const auto n = luaL_len(L, 2);
     for (lua_Integer i = 1; i <= n; ++i) {
@@ -129,7 +128,7 @@ int buttons(lua_State* L) {
       if (lua_type(L, -1) != LUA_TSTRING)
         throw LuaError("buttons{…} takes button names, got " + lua::typeName(L, -1) + " at " +
                        std::to_string(i));
-      raw |= 1 << buttonByName(lua_tostring(L, -1));
+      raw |= 1 << buttonAt(L, -1);
       lua_pop(L, 1);
     }
   } else if (lua_type(L, 2) == LUA_TNUMBER) {
