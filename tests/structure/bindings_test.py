@@ -13,9 +13,10 @@ engine/ and bindings/ (comments left out):
 Usage: bindings_test.py SOURCE_ROOT. A self-test runs first, so the check cannot pass by finding
 nothing. Fails naming the file, the line and the rule.
 """
-import pathlib
 import re
 import sys
+
+import structure_check
 
 IDIOM = {"bindings/lua_object.hpp", "bindings/lua_object.cpp"}
 RULES = [
@@ -77,20 +78,5 @@ def self_test():
     assert not list(violations(good)), list(violations(good))
 
 
-def main():
-    root = pathlib.Path(sys.argv[1])
-    self_test()
-    files = {}
-    for top in ("engine", "bindings"):
-        for p in (root / top).rglob("*"):
-            if p.suffix in (".cpp", ".hpp"):
-                files[str(p.relative_to(root))] = p.read_text(encoding="utf-8", errors="replace")
-    found = list(violations(files))
-    for v in found:
-        print(v, file=sys.stderr)
-    print(f"bindings: {len(files)} files, {len(found)} uses against the binding idioms")
-    return 1 if found else 0
-
-
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(structure_check.run("bindings", "uses against the binding idioms", self_test, violations))

@@ -5,9 +5,10 @@ A file may include only floors below its own (peers on one floor do not include 
 nothing below bindings/ includes Lua. Usage: tests/structure/layers_test.py SOURCE_ROOT [--self-test].
 Fails naming the file, the line and the floor it reaches.
 """
-import pathlib
 import re
 import sys
+
+import structure_check
 
 # Lower first. Peers share a rank: they may not include each other.
 FLOORS = {
@@ -76,20 +77,5 @@ def self_test():
     assert not list(violations(good)), list(violations(good))
 
 
-def main():
-    root = pathlib.Path(sys.argv[1])
-    self_test()
-    files = {}
-    for top in ("engine", "bindings"):
-        for p in (root / top).rglob("*"):
-            if p.suffix in (".cpp", ".hpp"):
-                files[str(p.relative_to(root))] = p.read_text(encoding="utf-8", errors="replace")
-    found = list(violations(files))
-    for v in found:
-        print(v, file=sys.stderr)
-    print(f"layers: {len(files)} files, {len(found)} includes out of order")
-    return 1 if found else 0
-
-
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(structure_check.run("layers", "includes out of order", self_test, violations))
