@@ -44,10 +44,13 @@ int repl(const ReplOptions& options) {
   try {
     session.startHost(host);
   } catch (const std::exception& e) {
-    fail("repl", e.what());
+    const std::string why = e.what();
     session.finish();  // the cars are connected: they get their stop
     loop.run();
-    return 1;
+    // A Ctrl-C while the world was made interrupts its library's loading: no error of its own
+    // (the signal reaches the session in the loop just run).
+    if (!session.interrupted()) fail("repl", why);
+    return session.exitStatus(1);
   }
 
   Repl prompt(loop, [&]() -> ScriptHost& { return session.host(); },

@@ -295,6 +295,7 @@ int replay(const ReplayOptions& options) {
     try {
       session->startHost(host);
     } catch (const std::exception& e) {
+      if (session->interrupted()) return session->exitStatus(1);  // Ctrl-C while it was made
       return fail("replay", e.what(), 1);
     }
     player.onEnd = [&session, &player] {

@@ -96,10 +96,13 @@ int run(const RunOptions& options) {
   try {
     session.startHost(host);
   } catch (const std::exception& e) {
-    fail("run", e.what());
+    const std::string why = e.what();
     session.finish();  // the cars are connected: they get their stop
     loop.run();
-    return 1;
+    // A Ctrl-C while the world was made interrupts its library's loading: no error of its own
+    // (the signal reaches the session in the loop just run).
+    if (!session.interrupted()) fail("run", why);
+    return session.exitStatus(1);
   }
 
   if (options.duration) {

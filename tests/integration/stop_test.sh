@@ -88,6 +88,33 @@ for sig in INT TERM INT2; do
   expect_stopped "SIG$sig" "$TMP/$sig.jsonl" 2
 done
 
+# SIGINT while the world is being made (its Lua library still loading, here a library that takes
+# 5 s of CPU to load): an exit of 130 with the cars stopped, and no error of the library's
+# (clean clone run 19 saw `pitwall run` exit 1 when a Ctrl-C came that early).
+cp -r "$SRC/scripts" "$TMP/slowlib"
+{
+  echo 'print("loading the library")'
+  echo 'local t = os.clock(); while os.clock() - t < 5 do end'
+  cat "$SRC/scripts/pitwall/core.lua"
+} >"$TMP/slowlib/pitwall/core.lua"
+mkfifo "$TMP/out.slow"
+PITWALL_SCRIPTS="$TMP/slowlib" MODE=none $PITWALL run "$NAGGING" --cars 2 --budget 0 \
+  --record "$TMP/slow.jsonl" >"$TMP/out.slow" 2>"$TMP/slow.err" &
+pid=$!
+exec 3<"$TMP/out.slow"
+read -r -t 20 line <&3
+check "SIGINT while the library loads: it is loading" "loading the library" "$line"
+kill -INT $pid
+wait_bounded $pid
+check "SIGINT while the library loads: exit status" 130 $?
+exec 3<&-
+expect_stopped "SIGINT while the library loads" "$TMP/slow.jsonl" 2
+if grep -q "cannot load" "$TMP/slow.err"; then
+  fail "SIGINT while the library loads: no error of the library's: $(cat "$TMP/slow.err")"
+else
+  echo "ok: SIGINT while the library loads: no error of the library's"
+fi
+
 # The same in a --fast run, which never sleeps: the signal reaches it through the loop's pass
 # check (Loop::setPassCheck), not through a read kept pending on the loop. Without the signal the
 # run would go on for 24 simulated hours (--fast-cap), minutes of wall time.
