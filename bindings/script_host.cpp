@@ -43,7 +43,7 @@ void ScriptHost::detach() {
 }
 
 void ScriptHost::carJoined(AnkiCar& car) {
-  if (shutDown_) return;
+  if (isShutDown()) return;
   cars_->bind(car);
   lua_State* L = L_;
   PITWALL_STACK_CHECK(L, 0, "pitwall.onCar's call (ScriptHost::carJoined)");
@@ -86,7 +86,7 @@ ScriptHost& ScriptHost::from(lua_State* L) {
 
 bool ScriptHost::call(int nargs, int nresults, const char* what, std::string_view who) {
   lua_State* L = L_;
-  if (shutDown_ && !lastWords_) {
+  if (life_ == Life::ShutDown) {
     lua_pop(L, nargs + 1);
     return false;
   }
@@ -200,8 +200,8 @@ void ScriptHost::requestExit(int status) {
 }
 
 void ScriptHost::shutDown() {
-  if (shutDown_) return;
-  shutDown_ = true;
+  if (isShutDown()) return;
+  life_ = Life::ShutDown;
   flood_.flush();  // counts of errors not yet logged: none is lost
   // The handlers stay hooked until the world closes (this may run inside one of them); call()
   // turns every call into Lua away from now on.
@@ -212,7 +212,7 @@ void ScriptHost::shutDown() {
 }
 
 void ScriptHost::lastWords() {
-  if (!shutDown_ || lastWords_) return;
+  if (life_ != Life::ShutDown) return;
   lua_State* L = L_;
   PITWALL_STACK_CHECK(L, 0, "the last words (ScriptHost::lastWords)");
   int top = lua_gettop(L);
@@ -221,15 +221,15 @@ void ScriptHost::lastWords() {
     // once: a second call finds the field gone
     lua_pushnil(L);
     lua_setfield(L, -3, "_lastWords");
-    lastWords_ = true;
+    life_ = Life::LastWords;
     call(0, 0, "the end of the run (pitwall._lastWords)");
-    lastWords_ = false;
+    life_ = Life::ShutDown;
   }
   lua_settop(L, top);
 }
 
 void ScriptHost::atShutDown(std::function<void()> fn) {
-  if (shutDown_)
+  if (isShutDown())
     fn();
   else
     atShutDown_.push_back(std::move(fn));
@@ -272,11 +272,11 @@ Result<bool, std::string> ScriptHost::loadFile(const std::string& path) {
 
 Result<bool, std::string> ScriptHost::startLoadedFile(StartMode mode) {
   if (mode == StartMode::Run) return startLoaded(LUA_OK);
-  trial_ = true;
-  trialError_.reset();
+  std::optional<std::string> error;
+  trialError_ = &error;
   auto started = startLoaded(LUA_OK);
-  trial_ = false;
-  if (started && trialError_) return Unexpected{*trialError_};
+  trialError_ = nullptr;
+  if (started && error) return Unexpected{*error};
   return started;
 }
 
@@ -302,16 +302,14 @@ Result<bool, std::string> ScriptHost::startString(const std::string& code,
 }
 
 void ScriptHost::mainEnded(const std::string& where, const std::string& error) {
-  mainFinished_ = true;
-  if (trial_ && !error.empty()) {  // a trial start gives the error back instead
-    mainFailed_ = true;
-    trialError_ = error;
+  main_ = error.empty() ? Main::Returned : Main::Failed;
+  if (trialError_ && !error.empty()) {  // a trial start gives the error back instead
+    *trialError_ = error;
     return;
   }
   if (!error.empty()) {
     reportError(where, error);
     // The script died: the run ends and its cars are stopped (DESIGN.md, "keeps cars safe").
-    mainFailed_ = true;
     requestStop();
   }
   if (options_.test_mode) requestStop();  // a scenario ends with its main chunk

@@ -106,8 +106,8 @@ class ScriptHost {
   Result<bool, std::string> loadString(const std::string& code, const std::string& chunkname);
   // Same for a chunk of text (tests, benchmarks).
   Result<bool, std::string> startString(const std::string& code, const std::string& chunkname);
-  bool mainFinished() const { return mainFinished_; }
-  bool mainFailed() const { return mainFailed_; }
+  bool mainFinished() const { return main_ != Main::Running; }
+  bool mainFailed() const { return main_ == Main::Failed; }
 
   // Calls the function under the top `nargs` values with the traceback handler. On error the
   // failure is reported as happening in `what` of `who`, when given: "onPosition handler" of
@@ -118,7 +118,7 @@ class ScriptHost {
   // The same with no results, for a caller that pushed lua::traceback itself right under the
   // function (the event hot path: no stack rotation). Pops the handler too.
   bool callAboveHandler(int nargs, const char* what, std::string_view who = {}) {
-    if (shutDown_) {
+    if (life_ != Life::Running) {
       lua_pop(L_, nargs + 2);
       return false;
     }
@@ -167,7 +167,7 @@ class ScriptHost {
   // The run is ending (docs/safety.md): nothing of this world runs again — no timer, task, event
   // handler or callback — except a chunk typed at the REPL. Final.
   void shutDown();
-  bool isShutDown() const { return shutDown_; }
+  bool isShutDown() const { return life_ != Life::Running; }
   // Runs `fn` when this world shuts down (what it started that must end with it), or at once
   // when it already has.
   void atShutDown(std::function<void()> fn);
@@ -210,11 +210,11 @@ class ScriptHost {
   std::unique_ptr<CarBinding> cars_;
   Tasks tasks_{*this};
   Timers timers_{*this};
-  bool mainFinished_ = false;
-  bool mainFailed_ = false;
-  bool stopRequested_ = false;
-  bool shutDown_ = false;
-  bool lastWords_ = false;  // lastWords() is running: its call() is let through
+  // The world's life: running; shut down (nothing of it runs again); saying its last words (the
+  // one call let through after the shutdown).
+  enum class Life { Running, ShutDown, LastWords } life_ = Life::Running;
+  enum class Main { Running, Returned, Failed } main_ = Main::Running;  // its main chunk
+  bool stopRequested_ = false;  // pitwall.stop() or a failure asked the run to end
   bool memoryReported_ = false;
   std::optional<int> exitStatus_;
   bool inOnError_ = false;
@@ -223,8 +223,8 @@ class ScriptHost {
   ErrorFlood flood_{loop_, "script"};  // errors to the log: one traceback per place, then counts
   bool attached_ = false;
   Subscription joined_;  // Fleet::carJoined, while attached
-  bool trial_ = false;
-  std::optional<std::string> trialError_;
+  // While a trial start runs: where its main chunk's error goes (instead of being reported).
+  std::optional<std::string>* trialError_ = nullptr;
   std::vector<std::string> loadedFiles_;
   std::vector<std::function<void()>> atShutDown_;
   std::unique_ptr<drive::Seats> ownSeats_;  // sim.openSeats: after L_, which reads them
