@@ -265,7 +265,8 @@ TEST_CASE_FIXTURE(RobotLua, "mindroad: a closed robot refuses commands and says 
   REQUIRE(waitFor("done"));
   CHECK(string("label") == "mindroad tcp 127.0.0.1:" + port() + " (closed)");
   // (called through pcall: the error names the line that called pcall)
-  CHECK(string("closedError") == "test.lua:6: mindroad tcp 127.0.0.1:" + port() + " is closed");
+  CHECK(string("closedError") ==
+        "test.lua:6: mindroad tcp 127.0.0.1:" + port() + " is closed; nothing sent");
 }
 
 TEST_CASE_FIXTURE(RobotLua, "mindroad: ready when made: in a task the next line can steer") {
