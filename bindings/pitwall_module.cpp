@@ -24,7 +24,6 @@
 #include "bindings/script_host.hpp"
 #include "bindings/track_table.hpp"
 #include "engine/core/console.hpp"
-#include "engine/core/data_dir.hpp"
 #include "engine/core/log.hpp"
 #include "engine/core/printable.hpp"
 #include "engine/core/suggest.hpp"
@@ -169,16 +168,6 @@ int stop(lua_State* L) {
   return 0;
 }
 
-// A chunk of pitwall's Lua library (data dir's scripts/pitwall/), by its source ("@path").
-bool fromLibrary(const char* source) {
-  static const std::string library = [] {
-    auto dir = dataDir();
-    return dir ? ((*dir) / "scripts" / "pitwall").string() + "/" : std::string();
-  }();
-  return source && source[0] == '@' && !library.empty() &&
-         std::string_view(source + 1).starts_with(library);
-}
-
 int logBody(lua_State* L) {
   int n = lua_gettop(L);
   log::Level level = log::Level::Info;
@@ -198,7 +187,7 @@ int logBody(lua_State* L) {
   lua_Debug ar;
   std::string where = "script";
   if (lua_getstack(L, 1, &ar) && lua_getinfo(L, "Sl", &ar)) {
-    if (fromLibrary(ar.source)) {
+    if (lua::isLibrarySource(L, ar.source)) {  // the world's library (lua::Frames)
       // pitwall's own library says what it is about ("race: scan lap with …"): no file and
       // line of an installed file that is not the user's
       const auto colon = text.find(": ");

@@ -130,3 +130,27 @@ TEST_CASE("two worlds side by side keep their own memory caps, budgets and trace
     CHECK(seen[1].find("pitwall/core.lua") != std::string::npos);
   }
 }
+
+// pitwall.log from the world's own library names what it is about ("race: …"), never an
+// installed file's line; from the script, its file and line. The library is the world's (here
+// the source tree's, PITWALL_SCRIPTS), not the data folder's.
+TEST_CASE("pitwall.log tells the world's library from the script") {
+  Loop loop{ClockKind::Virtual};
+  std::vector<std::string> logged;
+  log::setSink([&](log::Level, std::string_view line) { logged.emplace_back(line); });
+  struct Unsink {
+    ~Unsink() { log::setSink(nullptr); }
+  } unsink;
+  World world(loop, sandbox::kDefaultMemoryLimit, interrupt::kDefaultBudget, true);
+  lua_State* L = world.host->state();
+  const std::string library = lua::framesOf(L).libraryChunks;  // "@…/scripts/pitwall/"
+  REQUIRE(library.find(PITWALL_SOURCE_DIR "/scripts/pitwall/") != std::string::npos);
+  const std::string code = "assert(load('pitwall.log(\"warn\", \"race: from the library\")', '" +
+                           library + "fake.lua'))()\npitwall.log('warn', 'from the script')";
+  REQUIRE(luaL_loadbuffer(L, code.data(), code.size(), "@user.lua") == LUA_OK);
+  REQUIRE(world.host->call(0, 0, "test"));
+  REQUIRE(logged.size() == 2);
+  CHECK(logged[0].find("race: from the library") != std::string::npos);
+  CHECK(logged[0].find("fake.lua") == std::string::npos);
+  CHECK(logged[1].find("user.lua:2: from the script") != std::string::npos);
+}
