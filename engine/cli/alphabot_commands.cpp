@@ -83,8 +83,7 @@ int encodeAlphabot(const std::vector<std::string>& words) {
 
 int simRobotAlphabot(const SimRobotOptions& options) {
   if (options.udp) {
-    std::cerr << "pitwall sim-robot: --udp is for the mindroad robot; the alphabot speaks TCP\n";
-    return 2;
+    return fail("sim-robot", "--udp is for the mindroad robot; the alphabot speaks TCP");
   }
   std::string host, error;
   std::uint16_t port = 0;

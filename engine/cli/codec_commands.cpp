@@ -46,17 +46,16 @@ int decode(const std::string& protocol, const std::vector<std::string>& hex) {
   // `pitwall decode alphabot-ble CHARACTERISTIC HEX`: the first word names the characteristic.
   bool alphabotBle = protocol == "alphabot-ble";
   if (protocol != "anki" && protocol != "mindroad" && protocol != "alphabot" && !alphabotBle) {
-    std::cerr << "pitwall decode: unknown protocol '" << protocol << "'; known: " << kProtocols
-              << ", alphabot-ble\n";
-    return 2;
+    return fail("decode", "unknown protocol '" + protocol + "'; known: " + std::string(kProtocols) +
+                              ", alphabot-ble");
   }
   std::vector<std::string> words = hex;
   std::string side;
   if (alphabotBle) {
     if (words.size() < 2) {
-      std::cerr << "pitwall decode: alphabot-ble needs a characteristic name and the bytes, e.g. "
-                   "pitwall decode alphabot-ble sensor \"80 2d 64 00 00\"\n";
-      return 2;
+      return fail("decode",
+                  "alphabot-ble needs a characteristic name and the bytes, e.g. pitwall decode "
+                  "alphabot-ble sensor \"80 2d 64 00 00\"");
     }
     side = words.front();
     words.erase(words.begin());
@@ -83,9 +82,7 @@ int encode(const std::string& protocol, const std::vector<std::string>& words) {
   if (protocol == "mindroad") return encodeMindroad(words);
   if (protocol == "alphabot") return encodeAlphabot(words);
   if (protocol != "anki") {
-    std::cerr << "pitwall encode: unknown protocol '" << protocol << "'; known: " << kProtocols
-              << "\n";
-    return 2;
+    return fail("encode", "unknown protocol '" + protocol + "'; known: " + std::string(kProtocols));
   }
   auto message = anki::parseCommand(words);
   if (!message) {

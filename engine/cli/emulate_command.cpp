@@ -38,8 +38,7 @@ std::string hex32(std::uint32_t v) {
 
 int emulateCar(const EmulateOptions& options) {
   if (auto problem = anki::userNameProblem(options.name); !problem.empty()) {
-    std::cerr << "pitwall emulate-car: --name: " << problem << "\n";
-    return 2;
+    return fail("emulate-car", "--name: " + problem);
   }
   auto track = sim::loadLayout(options.track);
   if (!track) {
@@ -50,9 +49,9 @@ int emulateCar(const EmulateOptions& options) {
   try {
     bus = sdbus::createSystemBusConnection();
   } catch (const sdbus::Error& e) {
-    std::cerr << "pitwall emulate-car: cannot connect to the system bus (" << e.getMessage()
-              << "): is D-Bus running? (DBUS_SYSTEM_BUS_ADDRESS chooses another bus)\n";
-    return 2;
+    return fail("emulate-car", "cannot connect to the system bus (" + e.getMessage() +
+                                   "): is D-Bus running? (DBUS_SYSTEM_BUS_ADDRESS chooses another "
+                                   "bus)");
   }
 
   Loop loop(ClockKind::Real);
@@ -88,9 +87,8 @@ int emulateCar(const EmulateOptions& options) {
     local.user_name = options.name;  // whole: the simulator's bytes keep 11 of its 12
     auto text = anki::localNameText(local);
     if (!text) {
-      std::cerr << "pitwall emulate-car: cannot advertise the car's local name: " << text.error()
-                << " (--plain-name advertises the name alone)\n";
-      return 2;
+      return fail("emulate-car", "cannot advertise the car's local name: " + text.error() +
+                                     " (--plain-name advertises the name alone)");
     }
     peripheralSpec.localNameText = *text;
   }

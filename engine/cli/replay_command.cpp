@@ -118,19 +118,16 @@ int replay(const ReplayOptions& options) {
   }
   std::error_code ec;
   if (std::filesystem::is_directory(file, ec)) {
-    std::cerr << "pitwall replay: " << file << " is a folder; give a --record file\n";
-    return 2;
+    return fail("replay", file + " is a folder; give a --record file");
   }
   if (std::filesystem::exists(file, ec) && !std::filesystem::is_regular_file(file, ec)) {
-    std::cerr << "pitwall replay: " << file
-              << " is not a file (a pipe or a device); a replay reads its record twice, from a "
-                 "file: save it to a file first\n";
-    return 2;
+    return fail("replay", file +
+                              " is not a file (a pipe or a device); a replay reads its record "
+                              "twice, from a file: save it to a file first");
   }
   std::ifstream file_in(file, std::ios::binary);
   if (!file_in) {
-    std::cerr << "pitwall replay: cannot read " << file << ": " << std::strerror(errno) << "\n";
-    return 2;
+    return fail("replay", "cannot read " + file + ": " + std::strerror(errno));
   }
   // A capture without times (docs/cli.md "Captures without times") is read whole and given
   // times; a record is played from its file.
@@ -140,8 +137,7 @@ int replay(const ReplayOptions& options) {
   if (RecordKind kind = recordKind(file_in); kind != RecordKind::Timed) {
     auto timed = timeCapture(file_in, kind, CaptureTiming{options.interval});
     if (!timed) {
-      std::cerr << "pitwall replay: " << file << ": " << timed.error() << "\n";
-      return 2;
+      return fail("replay", file + ": " + timed.error());
     }
     log::info("replay", file +
                             (kind == RecordKind::IndexedJson
@@ -152,18 +148,16 @@ int replay(const ReplayOptions& options) {
     captureBad = std::move(timed->bad);
     source = &captured;
   } else if (options.interval) {
-    std::cerr << "pitwall replay: --interval states the time between the frames of a capture "
-                 "without times, and "
-              << file << " has its times (\"t\"): leave it out\n";
-    return 2;
+    return fail("replay",
+                "--interval states the time between the frames of a capture without times, and " +
+                    file + " has its times (\"t\"): leave it out");
   }
   std::istream& in = *source;
   // One pass to count and check; the frames are read again as they are played (RecordPlayer):
   // neither pass keeps more than a line, a frame and the first bad lines.
   RecordSummary record = scanRecord(in);
   if (in.bad()) {
-    std::cerr << "pitwall replay: cannot read " << file << ": " << std::strerror(errno) << "\n";
-    return 2;
+    return fail("replay", "cannot read " + file + ": " + std::strerror(errno));
   }
   if (captureBad) record.bad = std::move(*captureBad);  // the capture's lines, not ours
   const auto& bad = record.bad;
@@ -172,12 +166,13 @@ int replay(const ReplayOptions& options) {
   if (bad.count > kBadLinesShown)
     std::cerr << file << ": " << bad.count - kBadLinesShown << " more bad lines\n";
   if (record.frames == 0) {
-    std::cerr << "pitwall replay: " << file
-              << (bad.count == 0 ? " is empty"
-                                 : " has no line that is a frame (" + std::to_string(bad.count) +
-                                       " bad lines)")
-              << "; a record is what `pitwall run --record FILE` writes\n";
-    return 1;
+    return fail("replay",
+                file +
+                    (bad.count == 0 ? " is empty"
+                                    : " has no line that is a frame (" + std::to_string(bad.count) +
+                                          " bad lines)") +
+                    "; a record is what `pitwall run --record FILE` writes",
+                1);
   }
   if (bad.count > 0)
     log::warn("replay", std::to_string(bad.count) + " bad line" + (bad.count == 1 ? "" : "s") +
@@ -186,10 +181,9 @@ int replay(const ReplayOptions& options) {
   in.clear();
   in.seekg(0);
   if (!in) {
-    std::cerr << "pitwall replay: cannot read " << file
-              << " from its start again (a replay reads a record twice): give a file, not a "
-                 "pipe\n";
-    return 2;
+    return fail("replay", "cannot read " + file +
+                              " from its start again (a replay reads a record twice): give a "
+                              "file, not a pipe");
   }
 
   // The track drawn: --track, else the record's own layout, else the default oval. A summary
@@ -211,10 +205,8 @@ int replay(const ReplayOptions& options) {
                   : record.layout.empty() ? sim::loadLayout("oval")
                                           : sim::parseLayout(record.layout, "recorded");
     if (!layout) {
-      std::cerr << "pitwall replay: " << (options.track ? "" : "the record's layout: ")
-                << layout.error() << (options.track ? "" : "; draw another with --track LAYOUT")
-                << "\n";
-      return 2;
+      return fail("replay", (options.track ? "" : "the record's layout: ") + layout.error() +
+                                (options.track ? "" : "; draw another with --track LAYOUT"));
     }
     track = std::move(*layout);
   }

@@ -50,9 +50,9 @@ int run(const RunOptions& options) {
     }
   }
   if (options.humans > 0 && options.fast && options.view) {  // phones live in real time
-    std::cerr << "pitwall run: phones drive in real time: --humans with --view needs no --fast "
-                 "(a phone's second of silence would pass in an instant)\n";
-    return 2;
+    return fail("run",
+                "phones drive in real time: --humans with --view needs no --fast (a phone's "
+                "second of silence would pass in an instant)");
   }
   auto made = Session::open(options, options.fast, "run");
   if (!made) return 2;

@@ -3,6 +3,7 @@
 #include <memory>
 
 #include "engine/cli/commands.hpp"
+#include "engine/cli/fail.hpp"
 #include "engine/cli/options.hpp"
 
 namespace pitwall::cli {
@@ -10,9 +11,7 @@ namespace pitwall::cli {
 int simRobot(const SimRobotOptions& options) {
   if (options.kind == "mindroad") return simRobotMindroad(options);
   if (options.kind == "alphabot") return simRobotAlphabot(options);
-  std::cerr << "pitwall sim-robot: unknown robot '" << options.kind
-            << "'; known: mindroad, alphabot\n";
-  return 2;
+  return fail("sim-robot", "unknown robot '" + options.kind + "'; known: mindroad, alphabot");
 }
 
 Command addSimRobotCommand(CLI::App& app) {

@@ -210,9 +210,8 @@ int test(const TestOptions& options) {
   if (!options.junit.empty()) {
     junit.open(options.junit, std::ios::trunc);
     if (!junit) {
-      std::cerr << "pitwall test: --junit " << printable(options.junit, 200)
-                << ": cannot write the file: " << std::strerror(errno) << "\n";
-      return 2;
+      return fail("test", "--junit " + printable(options.junit, 200) +
+                              ": cannot write the file: " + std::strerror(errno));
     }
   }
   int jobs = options.jobs > 0 ? options.jobs : availableCores();
@@ -253,9 +252,8 @@ int test(const TestOptions& options) {
     writeJUnit(junit, reported, wall);
     junit.close();
     if (!junit) {
-      std::cerr << "pitwall test: --junit " << printable(options.junit, 200)
-                << ": the report could not be written\n";
-      return 2;
+      return fail("test",
+                  "--junit " + printable(options.junit, 200) + ": the report could not be written");
     }
   }
   return failed ? 1 : 0;

@@ -56,9 +56,7 @@ int trackShow(const TrackShowOptions& options) {
   if (out) out << svg;
   if (out) out.close();
   if (!out) {
-    std::cerr << "pitwall track show: cannot write " << options.svg << ": " << std::strerror(errno)
-              << "\n";
-    return 2;
+    return fail("track show", "cannot write " + options.svg + ": " + std::strerror(errno));
   }
   std::cerr << "wrote " << options.svg << "\n";
   return 0;

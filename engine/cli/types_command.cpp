@@ -79,8 +79,7 @@ bool writeFile(const fs::path& path, const std::string& text) {
   out << text;
   out.close();
   if (!out) {
-    std::cerr << "pitwall types: cannot write " << path.string() << ": " << std::strerror(errno)
-              << "\n";
+    fail("types", "cannot write " + path.string() + ": " + std::strerror(errno));
     return false;
   }
   return true;
@@ -100,16 +99,18 @@ int writeLuarc(const fs::path& dir) {
     const bool comments =
         !config.is_discarded() && nlohmann::json::parse(text, nullptr, false, false).is_discarded();
     if (comments && config.is_object()) {
-      std::cerr << "pitwall types: " << path.string()
-                << " has comments, which rewriting it would lose: left as it is; add \"types\" "
-                   "to its \"workspace.library\" yourself\n";
-      return 1;
+      return fail("types",
+                  path.string() +
+                      " has comments, which rewriting it would lose: left as it is; add "
+                      "\"types\" to its \"workspace.library\" yourself",
+                  1);
     }
     if (config.is_discarded() || !config.is_object()) {
-      std::cerr << "pitwall types: " << path.string()
-                << " is not a JSON object: left as it is; add \"types\" to its "
-                   "\"workspace.library\" yourself\n";
-      return 1;
+      return fail("types",
+                  path.string() +
+                      " is not a JSON object: left as it is; add \"types\" to its "
+                      "\"workspace.library\" yourself",
+                  1);
     }
   } else {
     config["$schema"] =
@@ -132,10 +133,11 @@ int writeLuarc(const fs::path& dir) {
         !(config.contains("runtime") && config["runtime"].contains("version")))
       config["runtime"]["version"] = "Lua 5.4";
   } catch (const nlohmann::json::exception&) {
-    std::cerr << "pitwall types: " << path.string()
-              << " has a \"workspace\" or \"runtime\" that is not an object: left as it is; add "
-                 "\"types\" to its workspace.library yourself\n";
-    return 1;
+    return fail("types",
+                path.string() +
+                    " has a \"workspace\" or \"runtime\" that is not an object: left as "
+                    "it is; add \"types\" to its workspace.library yourself",
+                1);
   }
   if (existed && listed) {
     std::cout << "kept " << path.string() << " (it lists types already)\n";
@@ -175,18 +177,19 @@ int types(const TypesOptions& options) {
         }
       }
     if (differ) {
-      std::cerr << "pitwall types: " << differ << " file(s) of " << (dir / "types").string()
-                << " are not what this binary generates; regenerate with `pitwall types "
-                << dir.string() << "`\n";
-      return 1;
+      return fail("types",
+                  std::to_string(differ) + " file(s) of " + (dir / "types").string() +
+                      " are not what this binary generates; regenerate with `pitwall "
+                      "types " +
+                      dir.string() + "`",
+                  1);
     }
     std::cout << (dir / "types").string() << " is up to date (" << files->size() << " files)\n";
     return 0;
   }
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) {
-    std::cerr << "pitwall types: " << dir.string() << " is not a folder\n";
-    return 2;
+    return fail("types", dir.string() + " is not a folder");
   }
   for (const auto& [name, text] : *files)
     if (!writeFile(dir / "types" / name, text)) return 2;
