@@ -70,11 +70,13 @@ namespace {
 
 // The TypeSpec of the object at idx (its metatable's __objecttype), or nullptr.
 const TypeSpec* specOf(lua_State* L, int idx) {
-  const TypeSpec* type = nullptr;
-  if (luaL_getmetafield(L, idx, "__objecttype") != LUA_TNIL) {
-    type = static_cast<const TypeSpec*>(lua_touserdata(L, -1));
-    lua_pop(L, 1);
-  }
+  // Only a userdata's: a script sets a table's metatable, and could give it any __objecttype.
+  if (lua_type(L, idx) != LUA_TUSERDATA) return nullptr;
+  const int kind = luaL_getmetafield(L, idx, "__objecttype");
+  if (kind == LUA_TNIL) return nullptr;
+  const auto* type =
+      kind == LUA_TLIGHTUSERDATA ? static_cast<const TypeSpec*>(lua_touserdata(L, -1)) : nullptr;
+  lua_pop(L, 1);
   return type;
 }
 
@@ -124,12 +126,11 @@ int index(lua_State* L) {
   return 1;
 }
 
-// __newindex (1: the object, 2: the key, 3: the value): an event's handler is checked (a function
-// or nil) and taken into the object's slots; a state field, a method, or an onX that is no event
-// (a typo would never be called) is refused by name; with ownFields anything else is the
-// script's own field (kept in the object's table, so reading it gives it back), else refused.
-int newindex(lua_State* L) {
-  const auto& type = *static_cast<const TypeSpec*>(lua_touserdata(L, lua_upvalueindex(2)));
+// __newindex's checks (1: the object, 2: the key, 3: the value): an event's handler is checked
+// (a function or nil) and taken into the object's slots (true: done); a state field, a method, or
+// an onX that is no event (a typo would never be called) is refused by name; without ownFields
+// anything else is refused. False: the value is the script's own field.
+bool assignChecked(lua_State* L, const TypeSpec& type) {
   checkBox(L, 1, type);
   const std::string what = whatOf(type);
   if (lua_type(L, 2) == LUA_TSTRING) {
@@ -140,26 +141,32 @@ int newindex(lua_State* L) {
       if (lua_isfunction(L, 3) && type.closed && type.closed(L, 1))
         throw LuaError(labelOf(L, 1, type) + " is closed: it has no more events");
       type.slotsOf(L, 1).setHandler(L, static_cast<std::size_t>(e), 3);
-    } else {
-      if (startsLikeEvent(key))
-        throw LuaError(what + "." + key + " is not an event; " +
-                       (type.events ? "the events are " + joinNames(type.events->names())
-                                    : "a " + what + " has no events"));
-      for (const Field& f : type.fields)
-        if (key == f.name)
-          throw LuaError(what + "." + key + " is read-only (it is the " + what + "'s state)");
-      lua_pushvalue(L, 2);
-      const bool isMethod = lua_rawget(L, lua_upvalueindex(1)) != LUA_TNIL;
-      lua_pop(L, 1);
-      if (isMethod) throw LuaError(what + ":" + key + " is a method and cannot be replaced");
+      return !type.ownFields;  // kept in its own table too, so reading it gives it back
     }
+    if (startsLikeEvent(key))
+      throw LuaError(what + "." + key + " is not an event; " +
+                     (type.events ? "the events are " + joinNames(type.events->names())
+                                  : "a " + what + " has no events"));
+    for (const Field& f : type.fields)
+      if (key == f.name)
+        throw LuaError(what + "." + key + " is read-only (it is the " + what + "'s state)");
+    lua_pushvalue(L, 2);
+    const bool isMethod = lua_rawget(L, lua_upvalueindex(1)) != LUA_TNIL;
+    lua_pop(L, 1);
+    if (isMethod) throw LuaError(what + ":" + key + " is a method and cannot be replaced");
   }
-  if (!type.ownFields) {
-    if (lua_type(L, 2) == LUA_TSTRING && type.events && type.events->find(lua_tostring(L, 2)) >= 0)
-      return 0;
+  if (!type.ownFields)
     throw LuaError("cannot set " + std::string(luaL_tolstring(L, 2, nullptr)) + " on a " + what +
                    ": it keeps no fields of a script's own (keep them in a table of yours)");
-  }
+  return false;
+}
+
+// __newindex (1: the object, 2: the key, 3: the value). Upvalues: 1 the methods table, 2 the
+// TypeSpec. The checks run first, their strings gone before Lua may raise an error of its own
+// (a nil or NaN key) here: a longjmp must not cross a live C++ object.
+int newindex(lua_State* L) {
+  const auto& type = *static_cast<const TypeSpec*>(lua_touserdata(L, lua_upvalueindex(2)));
+  if (assignChecked(L, type)) return 0;
   lua_settop(L, 3);
   lua_getiuservalue(L, 1, 1);
   lua_pushvalue(L, 2);
@@ -207,14 +214,16 @@ std::string expectedSentence(lua_State* L, int idx, const TypeSpec& type) {
   return std::string("expected ") + (vowel ? "an " : "a ") + what + ", got " + got;
 }
 
-void* newBoxRaw(lua_State* L, const TypeSpec& type, std::size_t size) {
-  void* p = lua_newuserdatauv(L, size, type.ownFields ? 1 : 0);
+void* allocateBox(lua_State* L, const TypeSpec& type, std::size_t size) {
+  return lua_newuserdatauv(L, size, type.ownFields ? 1 : 0);
+}
+
+void finishBox(lua_State* L, const TypeSpec& type) {
   luaL_setmetatable(L, type.metatable);
   if (type.ownFields) {
     lua_newtable(L);
     lua_setiuservalue(L, -2, 1);
   }
-  return p;
 }
 
 void registerType(lua_State* L, const TypeSpec& type) {

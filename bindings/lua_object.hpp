@@ -224,10 +224,15 @@ inline const char* whatOf(const TypeSpec& type) {
 // A new object of `type` on the stack: its box holds a T made from `args`, its metatable is the
 // type's, and with ownFields its own table. A T that is not trivially destructible is the type's
 // gc hook's to end (destroyBox).
-void* newBoxRaw(lua_State* L, const TypeSpec& type, std::size_t size);
+// (The T is made before the box gets its metatable: a gc hook never meets a T not yet made,
+// whatever fails after.)
+void* allocateBox(lua_State* L, const TypeSpec& type, std::size_t size);
+void finishBox(lua_State* L, const TypeSpec& type);
 template <class T, class... Args>
 T& newBox(lua_State* L, const TypeSpec& type, Args&&... args) {
-  return *new (newBoxRaw(L, type, sizeof(T))) T(std::forward<Args>(args)...);
+  T* made = new (allocateBox(L, type, sizeof(T))) T(std::forward<Args>(args)...);
+  finishBox(L, type);
+  return *made;
 }
 template <class T>
 void destroyBox(lua_State* L, int self, const TypeSpec& type) {

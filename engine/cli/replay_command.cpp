@@ -287,8 +287,11 @@ int replay(const ReplayOptions& options) {
     try {
       session->startHost(host);
     } catch (const std::exception& e) {
-      if (session->interrupted()) return session->exitStatus(1);  // Ctrl-C while it was made
-      return fail("replay", e.what(), 1);
+      const std::string why = e.what();
+      session->finish();
+      session->loop().run();  // a Ctrl-C while the world was made reaches the session here
+      if (session->interrupted()) return session->exitStatus(1);
+      return fail("replay", why, 1);
     }
     player.onEnd = [&session, &player] {
       log::info("replay",

@@ -133,6 +133,24 @@ TEST_CASE("issue 33's attack: a finalizer on the timers' metatable is refused wi
   )") == "");
 }
 
+// pitwall._setHub trusted any value's __objecttype: a table given one that is a timer made the
+// engine read a timer's box as a type (the review of issue 37's rework). Only an engine object's
+// type counts now; the rest is refused with the sentence for a wrong value.
+TEST_CASE("a table dressed as an engine object is refused, not read as one") {
+  for (const char* fake : {"{__objecttype = pitwall.after(1e9, print)}", "{__objecttype = 42}",
+                           "{__objecttype = {}}"}) {
+    LockedWorld w;  // (a world each: the log tells one place's repeated error as a count)
+    const std::string error =
+        w.run(std::string("pitwall._setHub(setmetatable({}, ") + fake + "), 'onPing', print)");
+    CAPTURE(std::string(fake));
+    CAPTURE(error);
+    CHECK(error.find("expected a car or a robot (an object with events), got table") !=
+          std::string::npos);
+  }
+  // a real car still takes its hub
+  CHECK(LockedWorld().run("pitwall._setHub(pitwall.cars()[1], 'onPing', print)") == "");
+}
+
 // Each back door a script could try, and the sentence that refuses it ("" for none: the chunk
 // itself errors when the attempt had an effect it must not have).
 TEST_CASE("the sandbox's back doors, tried one by one, are each refused or harmless") {
