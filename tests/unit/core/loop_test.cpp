@@ -132,3 +132,24 @@ TEST_CASE("a virtual run calls its pass check once per pass, and may be stopped 
   loop.run();
   CHECK(fired == 5);
 }
+
+TEST_CASE("runAtMost ends at its limit or at stop(), and says which; runUntil leaves no timer") {
+  Loop loop(ClockKind::Virtual);
+  // nothing stops it: the limit does, at the limit's time
+  loop.after(10s, [] {});
+  CHECK_FALSE(loop.runAtMost(2s));
+  CHECK(loop.seconds() == 2.0);
+  CHECK(loop.pendingTimers() == 1);  // its own deadline is gone; the 10 s timer waits
+  // a stop() before the limit: true, at the stop's time
+  loop.after(1s, [&] { loop.stop(); });
+  CHECK(loop.runAtMost(5s));
+  CHECK(loop.seconds() == 3.0);
+  CHECK(loop.pendingTimers() == 1);
+  // runUntil: a condition that comes true, then one that never does
+  bool flag = false;
+  loop.after(500ms, [&] { flag = true; });
+  CHECK(loop.runUntil([&] { return flag; }, 5s));
+  CHECK(loop.seconds() == doctest::Approx(3.501).epsilon(0.001));
+  CHECK_FALSE(loop.runUntil([] { return false; }, 1s));
+  CHECK(loop.pendingTimers() == 1);  // only the 10 s timer: no poll, no deadline left behind
+}
