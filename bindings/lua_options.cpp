@@ -98,7 +98,7 @@ Options::Options(lua_State* L, int idx, std::string_view fn, std::span<const cha
   if (table_) checkOptions(L, idx_, fn, known);
 }
 
-bool Options::push(const char* key) {
+bool Options::value(const char* key) {
   if (!table_) return false;
   if (lua_getfield(L_, idx_, key) != LUA_TNIL) return true;
   lua_pop(L_, 1);
@@ -106,14 +106,14 @@ bool Options::push(const char* key) {
 }
 
 std::optional<std::string> Options::string(const char* key, const char* what) {
-  if (!push(key)) return std::nullopt;
+  if (!value(key)) return std::nullopt;
   std::string v = checkString(L_, -1, what ? what : key);
   lua_pop(L_, 1);
   return v;
 }
 
 std::optional<bool> Options::boolean(const char* key) {
-  if (!push(key)) return std::nullopt;
+  if (!value(key)) return std::nullopt;
   if (!lua_isboolean(L_, -1))
     throw LuaError(std::string(key) + " must be true or false, got " + typeName(L_, -1));
   const bool v = lua_toboolean(L_, -1);
@@ -123,16 +123,23 @@ std::optional<bool> Options::boolean(const char* key) {
 
 std::optional<double> Options::number(const char* key, double lo, double hi, std::string_view unit,
                                       std::string_view why) {
-  if (!push(key)) return std::nullopt;
+  if (!value(key)) return std::nullopt;
   const double v = checkNumber(L_, -1, key);
   lua_pop(L_, 1);
   requireRange(key, v, lo, hi, unit, why);
   return v;
 }
 
+std::optional<double> Options::number(const char* key, const char* what) {
+  if (!value(key)) return std::nullopt;
+  const double v = checkNumber(L_, -1, what);
+  lua_pop(L_, 1);
+  return v;
+}
+
 std::optional<long long> Options::integer(const char* key, long long lo, long long hi,
                                           std::string_view unit, std::string_view why) {
-  if (!push(key)) return std::nullopt;
+  if (!value(key)) return std::nullopt;
   const long long v = checkInteger(L_, -1, key);
   lua_pop(L_, 1);
   requireRange(key, static_cast<double>(v), static_cast<double>(lo), static_cast<double>(hi), unit,

@@ -49,6 +49,11 @@ class Options {
           std::string_view shape);
 
   bool given() const { return table_; }
+  // Pushes the option's value as it is, for a reader of its own (a model by name or number);
+  // false, nothing pushed, when it is absent.
+  bool value(const char* key);
+  // A number with no fixed range (its caller checks it), named `what` in a type error.
+  std::optional<double> number(const char* key, const char* what);
   // Each is unset when the option is absent (or nil). `what` names a wrong value's kind in the
   // error ("sensor model must be a string"); by default the key.
   std::optional<std::string> string(const char* key, const char* what = nullptr);
@@ -60,9 +65,6 @@ class Options {
                                    std::string_view unit = {}, std::string_view why = {});
 
  private:
-  // Pushes the option's value; false (nothing pushed) when it is absent.
-  bool push(const char* key);
-
   lua_State* L_;
   int idx_;
   std::string_view fn_;

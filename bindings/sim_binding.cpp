@@ -99,25 +99,19 @@ void checkOnRoad(double offset_mm) {
 int addCar(lua_State* L) {
   ScriptHost& host = ScriptHost::from(L);
   SimSession& s = *host.sim();
-  if (!lua_isnoneornil(L, 1) && !lua_istable(L, 1))
-    throw LuaError(std::string("sim.addCar takes a table, got ") + luaL_typename(L, 1));
-  if (lua_isnoneornil(L, 1)) {
-    lua_settop(L, 0);
-    lua_newtable(L);
-  }
   static constexpr std::array<const char*, 8> kOptions = {"name", "model",  "piece",   "distance",
                                                           "lane", "offset", "battery", "firmware"};
-  lua::checkOptions(L, 1, "sim.addCar", kOptions);
+  lua::Options read(L, 1, "sim.addCar", kOptions, "name=, model=, piece=, lane=, …");
   const sim::Track& track = s.world->track();
   int index = static_cast<int>(s.world->cars().size());
   sim::CarSpec spec = sim::gridSpec(track, index);
-  if (lua_getfield(L, 1, "model") != LUA_TNIL) spec.model_id = modelFromLua(L, -1);
-  lua_pop(L, 1);
-  if (lua_getfield(L, 1, "piece") != LUA_TNIL) {
-    auto piece = lua::checkInteger(L, -1, "piece (index into the track, from 1)");
-    lua::requireRange("piece", static_cast<double>(piece), 1, static_cast<double>(track.size()), {},
-                      "an index into the track's pieces");
-    spec.piece_index = static_cast<std::size_t>(piece - 1);
+  if (read.value("model")) {
+    spec.model_id = modelFromLua(L, -1);
+    lua_pop(L, 1);
+  }
+  if (auto piece = read.integer("piece", 1, static_cast<long long>(track.size()), {},
+                                "an index into the track's pieces")) {
+    spec.piece_index = static_cast<std::size_t>(*piece - 1);
     spec.distance_mm = 0;
   } else if (index >= sim::gridCapacity(track)) {
     // the next grid slot would be one a car already stands on
@@ -125,47 +119,28 @@ int addCar(lua_State* L) {
                    std::to_string(sim::gridCapacity(track)) +
                    " cars, four on each piece); give this car a place with piece= and lane=");
   }
-  lua_pop(L, 1);
-  if (lua_getfield(L, 1, "distance") != LUA_TNIL) {
-    spec.distance_mm = lua::checkNumber(L, -1, "distance (mm into the piece)");
+  if (auto distance = read.number("distance", "distance (mm into the piece)")) {
+    spec.distance_mm = *distance;
     double len = track.piece(spec.piece_index).length(spec.offset_mm);
     if (spec.distance_mm < 0 || spec.distance_mm >= len)
       throw LuaError("distance " + lua::show(spec.distance_mm) + " mm is outside the piece (0.." +
                      lua::show(len) + " mm)");
   }
-  lua_pop(L, 1);
-  if (lua_getfield(L, 1, "lane") != LUA_TNIL) {
-    auto lane = lua::checkInteger(L, -1, "lane");
-    lua::requireRange("lane", static_cast<double>(lane), 1, 4, {}, "1 is leftmost");
-    spec.offset_mm = sim::kLaneOffsets[lane - 1];
-  }
-  lua_pop(L, 1);
-  if (lua_getfield(L, 1, "offset") != LUA_TNIL) {
-    spec.offset_mm = lua::checkNumber(L, -1, "offset (mm)");
+  if (auto lane = read.integer("lane", 1, 4, {}, "1 is leftmost"))
+    spec.offset_mm = sim::kLaneOffsets[*lane - 1];
+  if (auto offset = read.number("offset", "offset (mm)")) {
+    spec.offset_mm = *offset;
     checkOnRoad(spec.offset_mm);
   }
-  lua_pop(L, 1);
-  if (lua_getfield(L, 1, "battery") != LUA_TNIL) {
-    auto mv = lua::checkInteger(L, -1, "battery (mV)");
-    lua::requireRange("battery", static_cast<double>(mv), 3000, 4300, "mV");
-    spec.battery_mv = static_cast<std::uint16_t>(mv);
-  }
-  lua_pop(L, 1);
+  if (auto mv = read.integer("battery", 3000, 4300, "mV"))
+    spec.battery_mv = static_cast<std::uint16_t>(*mv);
   // docs/simulator.md "Firmware families": 0x266e sends the older layouts
-  if (lua_getfield(L, 1, "firmware") != LUA_TNIL) {
-    auto v = lua::checkInteger(L, -1, "firmware (a version, e.g. 0x266e)");
-    lua::requireRange("firmware", static_cast<double>(v), 1, 0xffff, {},
-                      "a version as `pitwall scan` shows it, e.g. 0x266e or 0x2b70");
-    spec.version = static_cast<std::uint16_t>(v);
-  }
-  lua_pop(L, 1);
+  if (auto v = read.integer("firmware", 1, 0xffff, {},
+                            "a version as `pitwall scan` shows it, e.g. 0x266e or 0x2b70"))
+    spec.version = static_cast<std::uint16_t>(*v);
   std::vector<std::string> taken;
   for (AnkiCar* c : host.fleet().cars()) taken.push_back(c->identity().name);
-  if (lua_getfield(L, 1, "name") != LUA_TNIL)
-    spec.name = lua::checkString(L, -1, "name");
-  else
-    spec.name = anki::uniqueCarName(spec.model_id, taken);
-  lua_pop(L, 1);
+  spec.name = read.string("name").value_or(anki::uniqueCarName(spec.model_id, taken));
   if (std::find(taken.begin(), taken.end(), spec.name) != taken.end())
     throw LuaError("a car named '" + spec.name + "' is already in the run");
 
