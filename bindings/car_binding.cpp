@@ -116,16 +116,10 @@ int lights(lua_State* L) {
     // {headlights=true, brake=false, front=…, engine=…}: touched lights in the low nibble,
     // their values in the high nibble (anki-overdrive.md, set lights).
     static constexpr std::array<const char*, 4> kNames = {"headlights", "brake", "front", "engine"};
-    lua::checkOptions(L, 2, "car:lights", kNames);
+    lua::Options read(L, 2, "car:lights", kNames, "headlights=, brake=, front=, engine=");
     int mask = 0;
-    for (int bit = 0; bit < 4; ++bit) {
-      int type = lua_getfield(L, 2, kNames[bit]);
-      if (type != LUA_TNIL) {
-        mask |= 1 << bit;
-        if (lua_toboolean(L, -1)) mask |= 1 << (bit + 4);
-      }
-      lua_pop(L, 1);
-    }
+    for (int bit = 0; bit < 4; ++bit)
+      if (auto on = read.boolean(kNames[bit])) mask |= (1 << bit) | (*on ? 1 << (bit + 4) : 0);
     raiseIfRefused(car.lights(mask));
     return 0;
   }

@@ -91,17 +91,10 @@ int create(lua_State* L) {
   options.test_mode = false;  // its errors are reported as in a run; the scenario checks them
   options.detached = false;
   options.results.clear();
-  if (lua_istable(L, 2)) {
-    static constexpr std::array<const char*, 2> kOptions = {"results", "name"};
-    lua::checkOptions(L, 2, "sim.script", kOptions);
-    if (lua_getfield(L, 2, "results") == LUA_TSTRING) options.results = lua_tostring(L, -1);
-    lua_pop(L, 1);
-    if (lua_getfield(L, 2, "name") == LUA_TSTRING) name = lua_tostring(L, -1);
-    lua_pop(L, 1);
-  } else if (!lua_isnoneornil(L, 2)) {
-    throw LuaError(std::string("sim.script: options must be a table {results =, name =}, got ") +
-                   luaL_typename(L, 2));
-  }
+  static constexpr std::array<const char*, 2> kOptions = {"results", "name"};
+  lua::Options read(L, 2, "sim.script", kOptions, "results =, name =");
+  options.results = read.string("results").value_or(options.results);
+  name = read.string("name").value_or(name);
   UnderTest* ut = &lua::newBox<UnderTest>(L, underTestType());
   lua_pushvalue(L, -1);
   luaL_ref(L, LUA_REGISTRYINDEX);  // lives as long as the scenario's world
