@@ -11,6 +11,7 @@
 
 #include "bindings/copy_budget.hpp"
 #include "bindings/lua_args.hpp"
+#include "bindings/lua_options.hpp"
 #include "bindings/pitwall_module.hpp"
 #include "bindings/script_host.hpp"
 #include "engine/core/printable.hpp"
@@ -178,12 +179,12 @@ int track(lua_State* L) {
   return 0;
 }
 
+constexpr std::pair<const char*, const char*> kLevels[] = {
+    {"info", "info"}, {"warn", "warn"}, {"error", "error"}};
+
 int event(lua_State* L) {
   std::string text = lua::checkString(L, 1, "the event's text");
-  std::string level = lua_isnoneornil(L, 2) ? "info" : lua::checkString(L, 2, "level");
-  if (level != "info" && level != "warn" && level != "error")
-    throw LuaError("pitwall.view.event: level must be \"info\", \"warn\" or \"error\", got \"" +
-                   level.substr(0, 40) + "\"");
+  const char* level = lua_isnoneornil(L, 2) ? "info" : lua::checkName(L, 2, "level", kLevels);
   if (view::Feed* feed = feedOf(L)) feed->event(level, text.substr(0, 1000));
   return 0;
 }

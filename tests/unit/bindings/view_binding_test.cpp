@@ -57,7 +57,8 @@ TEST_CASE("pitwall.view: data goes to the view; anything else is refused with wh
             .find("more than 100000 values") != std::string::npos);
   CHECK(error(L, "pitwall.view.race{[{}] = 1}").find("has a table key") != std::string::npos);
   CHECK(error(L, "pitwall.view.race(42)") != "");
-  CHECK(error(L, "pitwall.view.event('hello', 'loud')").find("level must be") != std::string::npos);
+  CHECK(error(L, "pitwall.view.event('hello', 'loud')")
+            .find("level 'loud' is unknown (use info, warn or error)") != std::string::npos);
   // a refused table leaves the last good one
   CHECK(feed.state()["race"]["title"] == "GP");
   CHECK(error(L, "pitwall.view.race(nil)") == "");
