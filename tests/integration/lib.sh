@@ -73,9 +73,10 @@ wait_bounded() {
 
 # run_fifo NAME COMMAND…: COMMAND in the background (its pid in RUN_PID), stdin /dev/null,
 # stderr in $TMP/NAME.err, stdout read through a FIFO on fd 4 until its first line, which must
-# be "driving" (tests/integration/nagging.lua and the like say it once they command the cars).
+# be "driving" (tests/integration/nagging.lua and the like say it once they command the cars), or
+# $RUN_FIFO_SAYS when that is set.
 run_fifo() {
-  local name=$1 line
+  local name=$1 line want=${RUN_FIFO_SAYS:-driving}
   shift
   rm -f "$TMP/run.fifo"
   mkfifo "$TMP/run.fifo"
@@ -83,7 +84,7 @@ run_fifo() {
   RUN_PID=$!
   exec 4<"$TMP/run.fifo"
   read -r -t 20 -u 4 line
-  check "$name: the script is driving" "driving" "$line"
+  check "$name: the script says it is $want" "$want" "$line"
 }
 
 # expect_wedged NAME: the script run by run_fifo says it wedges its loop in C code, and the

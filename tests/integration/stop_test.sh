@@ -97,17 +97,12 @@ cp -r "$SRC/scripts" "$TMP/slowlib"
   echo 'local t = os.clock(); while os.clock() - t < 5 do end'
   cat "$SRC/scripts/pitwall/core.lua"
 } >"$TMP/slowlib/pitwall/core.lua"
-mkfifo "$TMP/out.slow"
-PITWALL_SCRIPTS="$TMP/slowlib" MODE=none $PITWALL run "$NAGGING" --cars 2 --budget 0 \
-  --record "$TMP/slow.jsonl" >"$TMP/out.slow" 2>"$TMP/slow.err" &
-pid=$!
-exec 3<"$TMP/out.slow"
-read -r -t 20 line <&3
-check "SIGINT while the library loads: it is loading" "loading the library" "$line"
-kill -INT $pid
-wait_bounded $pid
+RUN_FIFO_SAYS="loading the library" run_fifo slow env PITWALL_SCRIPTS="$TMP/slowlib" MODE=none \
+  $PITWALL run "$NAGGING" --cars 2 --budget 0 --record "$TMP/slow.jsonl"
+kill -INT $RUN_PID
+wait_bounded $RUN_PID
 check "SIGINT while the library loads: exit status" 130 $?
-exec 3<&-
+exec 4<&-
 expect_stopped "SIGINT while the library loads" "$TMP/slow.jsonl" 2
 if grep -q "cannot load" "$TMP/slow.err"; then
   fail "SIGINT while the library loads: no error of the library's: $(cat "$TMP/slow.err")"
