@@ -178,103 +178,65 @@ void hook(Robot& r) {
 
 // ---- commands ----
 
-void raiseIfRefused(const Alphabot::Sent& sent) {
-  if (!sent) throw LuaError(sent.error());
-}
-
 Alphabot& model(lua_State* L, int idx) {
   return *robotAt(L, idx).model;
 }
 
 int drive(lua_State* L) {
   auto& m = model(L, 1);
-  raiseIfRefused(m.drive(lua::checkRounded(L, 2, "speed"), lua::checkRounded(L, 3, "steer")));
-  return 0;
-}
-int stop(lua_State* L) {
-  raiseIfRefused(model(L, 1).stop());
+  lua::raiseIfRefused(m.drive(lua::checkRounded(L, 2, "speed"), lua::checkRounded(L, 3, "steer")));
   return 0;
 }
 int measureDistance(lua_State* L) {
   auto& m = model(L, 1);
-  raiseIfRefused(m.measureDistance(lua::checkRounded(L, 2, "degree")));
-  return 0;
-}
-int calibrateSteering(lua_State* L) {
-  raiseIfRefused(model(L, 1).calibrateSteering());
-  return 0;
-}
-int calibrateCompass(lua_State* L) {
-  raiseIfRefused(model(L, 1).calibrateCompass());
+  lua::raiseIfRefused(m.measureDistance(lua::checkRounded(L, 2, "degree")));
   return 0;
 }
 int set(lua_State* L) {
   Robot& r = robotAt(L, 1);
+  static const std::vector<const char*> kNames = [] {
+    std::vector<const char*> names;
+    for (const auto& bit : ab::toggleBits()) names.push_back(bit.name);
+    return names;
+  }();
   if (!lua_istable(L, 2))
     throw LuaError("set takes a table of toggles, e.g. {collisionAvoidance = true}; names: " +
                    ab::toggleNames());
-  ab::Toggles next = r.model->state().toggles;
-  lua_pushnil(L);
-  while (lua_next(L, 2) != 0) {
-    if (lua_type(L, -2) != LUA_TSTRING)
-      throw LuaError("set: toggle names are strings, got a " + lua::typeName(L, -2) +
-                     " key; names: " + ab::toggleNames());
-    std::string name = lua_tostring(L, -2);
-    const ab::ToggleBit* bit = ab::findToggle(name);
-    if (!bit) {
-      std::vector<std::string> names;  // "a, b, c" → {a, b, c}
-      std::string all = ab::toggleNames();
-      for (std::size_t at = 0; at < all.size();) {
-        auto comma = all.find(", ", at);
-        names.push_back(all.substr(at, comma - at));
-        at = comma == std::string::npos ? all.size() : comma + 2;
-      }
-      throw LuaError("set: unknown toggle '" + name + "'" + didYouMean(name, names) +
-                     "; names: " + all);
-    }
-    if (!lua_isboolean(L, -1))
-      throw LuaError("set: toggle " + name + " must be true or false, got " + lua::typeName(L, -1));
-    ab::setBit(next, *bit, lua_toboolean(L, -1));
-    lua_pop(L, 1);
-  }
+  lua::Options toggles(L, 2, "set", kNames, "collisionAvoidance = true, …");
   // The robot takes the whole field: every bit not named keeps its last value.
-  raiseIfRefused(r.model->setToggles(next));
-  return 0;
-}
-int ping(lua_State* L) {
-  raiseIfRefused(model(L, 1).ping());
+  ab::Toggles next = r.model->state().toggles;
+  for (const auto& bit : ab::toggleBits())
+    if (auto on = toggles.boolean(bit.name)) ab::setBit(next, bit, *on);
+  lua::raiseIfRefused(r.model->setToggles(next));
   return 0;
 }
 int setAnchor(lua_State* L) {
   auto& m = model(L, 1);
-  raiseIfRefused(m.setAnchor(lua::checkInteger(L, 2, "anchor id"),
-                             lua::checkRounded(L, 3, "x (cm)"), lua::checkRounded(L, 4, "y (cm)")));
+  lua::raiseIfRefused(m.setAnchor(lua::checkInteger(L, 2, "anchor id"),
+                                  lua::checkRounded(L, 3, "x (cm)"),
+                                  lua::checkRounded(L, 4, "y (cm)")));
   return 0;
 }
 int navigateTo(lua_State* L) {
   auto& m = model(L, 1);
-  raiseIfRefused(
+  lua::raiseIfRefused(
       m.navigateTo(lua::checkRounded(L, 2, "x (cm)"), lua::checkRounded(L, 3, "y (cm)")));
   return 0;
 }
 int addObstacle(lua_State* L) {
   auto& m = model(L, 1);
-  raiseIfRefused(m.addObstacle(lua::checkRounded(L, 2, "x (cm)"), lua::checkRounded(L, 3, "y (cm)"),
-                               lua::checkRounded(L, 4, "width (cm)"),
-                               lua::checkRounded(L, 5, "height (cm)")));
+  lua::raiseIfRefused(
+      m.addObstacle(lua::checkRounded(L, 2, "x (cm)"), lua::checkRounded(L, 3, "y (cm)"),
+                    lua::checkRounded(L, 4, "width (cm)"), lua::checkRounded(L, 5, "height (cm)")));
   return 0;
 }
 int removeObstacle(lua_State* L) {
   auto& m = model(L, 1);
   if (lua_isnoneornil(L, 3))
-    raiseIfRefused(m.removeObstacle(lua::checkInteger(L, 2, "obstacle id")));
+    lua::raiseIfRefused(m.removeObstacle(lua::checkInteger(L, 2, "obstacle id")));
   else
-    raiseIfRefused(
+    lua::raiseIfRefused(
         m.removeObstacleAt(lua::checkRounded(L, 2, "x (cm)"), lua::checkRounded(L, 3, "y (cm)")));
-  return 0;
-}
-int clearObstacles(lua_State* L) {
-  raiseIfRefused(model(L, 1).clearObstacles());
   return 0;
 }
 int close(lua_State* L) {
@@ -377,20 +339,21 @@ int newRobot(lua_State* L) {
 }
 
 const lua::TypeSpec& robotType() {
-  static const luaL_Reg methods[] = {{"drive", lua::guarded<drive>},
-                                     {"stop", lua::guarded<stop>},
-                                     {"measureDistance", lua::guarded<measureDistance>},
-                                     {"calibrateSteering", lua::guarded<calibrateSteering>},
-                                     {"calibrateCompass", lua::guarded<calibrateCompass>},
-                                     {"set", lua::guarded<set>},
-                                     {"ping", lua::guarded<ping>},
-                                     {"setAnchor", lua::guarded<setAnchor>},
-                                     {"navigateTo", lua::guarded<navigateTo>},
-                                     {"addObstacle", lua::guarded<addObstacle>},
-                                     {"removeObstacle", lua::guarded<removeObstacle>},
-                                     {"clearObstacles", lua::guarded<clearObstacles>},
-                                     {"close", lua::guarded<close>},
-                                     {nullptr, nullptr}};
+  static const luaL_Reg methods[] = {
+      {"drive", lua::guarded<drive>},
+      {"stop", lua::guarded<lua::command<model, &Alphabot::stop>>},
+      {"measureDistance", lua::guarded<measureDistance>},
+      {"calibrateSteering", lua::guarded<lua::command<model, &Alphabot::calibrateSteering>>},
+      {"calibrateCompass", lua::guarded<lua::command<model, &Alphabot::calibrateCompass>>},
+      {"set", lua::guarded<set>},
+      {"ping", lua::guarded<lua::command<model, &Alphabot::ping>>},
+      {"setAnchor", lua::guarded<setAnchor>},
+      {"navigateTo", lua::guarded<navigateTo>},
+      {"addObstacle", lua::guarded<addObstacle>},
+      {"removeObstacle", lua::guarded<removeObstacle>},
+      {"clearObstacles", lua::guarded<lua::command<model, &Alphabot::clearObstacles>>},
+      {"close", lua::guarded<close>},
+      {nullptr, nullptr}};
   static const lua::TypeSpec type{
       .metatable = kMetatable,
       .name = "alphabot",

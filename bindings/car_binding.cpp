@@ -56,21 +56,13 @@ int toInt(long long v) {
   return static_cast<int>(std::clamp(v, -1000000LL, 1000000LL));
 }
 
-void raiseIfRefused(const AnkiCar::Sent& sent) {
-  if (!sent) throw LuaError(sent.error());
-}
-
 // ---- methods ----
 int setSpeed(lua_State* L) {
   AnkiCar& car = CarBinding::command(L, 1);
   auto speed = lua::checkRounded(L, 2, "speed (mm/s)");
   auto accel = lua::optRounded(L, 3, "acceleration (mm/s²)", kDefaultAccel);
   bool limit = lua_toboolean(L, 4);
-  raiseIfRefused(car.setSpeed(toInt(speed), toInt(accel), limit));
-  return 0;
-}
-int stop(lua_State* L) {
-  raiseIfRefused(CarBinding::check(L, 1).stop());
+  lua::raiseIfRefused(car.setSpeed(toInt(speed), toInt(accel), limit));
   return 0;
 }
 int changeLane(lua_State* L) {
@@ -78,20 +70,16 @@ int changeLane(lua_State* L) {
   double offset = lua::checkNumber(L, 2, "offset (mm)");
   auto speed = lua::optRounded(L, 3, "lane-change speed (mm/s)", kDefaultLaneSpeed);
   auto accel = lua::optRounded(L, 4, "lane-change acceleration (mm/s²)", kDefaultLaneAccel);
-  raiseIfRefused(car.changeLane(offset, toInt(speed), toInt(accel)));
+  lua::raiseIfRefused(car.changeLane(offset, toInt(speed), toInt(accel)));
   return 0;
 }
 int setOffset(lua_State* L) {
   AnkiCar& car = CarBinding::command(L, 1);
-  raiseIfRefused(car.setOffset(lua::checkNumber(L, 2, "offset (mm)")));
-  return 0;
-}
-int cancelLaneChange(lua_State* L) {
-  raiseIfRefused(CarBinding::command(L, 1).cancelLaneChange());
+  lua::raiseIfRefused(car.setOffset(lua::checkNumber(L, 2, "offset (mm)")));
   return 0;
 }
 int uturn(lua_State* L) {
-  raiseIfRefused(CarBinding::command(L, 1).turn(TurnType::UTurn));
+  lua::raiseIfRefused(CarBinding::command(L, 1).turn(TurnType::UTurn));
   return 0;
 }
 constexpr std::pair<const char*, TurnType> kTurnTypes[] = {{"left", TurnType::Left},
@@ -107,7 +95,7 @@ int turn(lua_State* L) {
   const TurnTrigger trigger = lua_isnoneornil(L, 3)
                                   ? TurnTrigger::Immediate
                                   : lua::checkName(L, 3, "turn trigger", kTurnTriggers);
-  raiseIfRefused(car.turn(type, trigger));
+  lua::raiseIfRefused(car.turn(type, trigger));
   return 0;
 }
 int lights(lua_State* L) {
@@ -120,12 +108,12 @@ int lights(lua_State* L) {
     int mask = 0;
     for (int bit = 0; bit < 4; ++bit)
       if (auto on = read.boolean(kNames[bit])) mask |= (1 << bit) | (*on ? 1 << (bit + 4) : 0);
-    raiseIfRefused(car.lights(mask));
+    lua::raiseIfRefused(car.lights(mask));
     return 0;
   }
   auto mask = lua::checkInteger(L, 2, "lights mask");
   if (auto e = checkRange("lights mask", static_cast<double>(mask), 0, 255)) throw LuaError(*e);
-  raiseIfRefused(car.lights(static_cast<int>(mask)));
+  lua::raiseIfRefused(car.lights(static_cast<int>(mask)));
   return 0;
 }
 // A channel or an effect: by name (its position in `names`), or by number 0..max.
@@ -181,23 +169,7 @@ int lightsPattern(lua_State* L) {
         static_cast<uint8_t>(lua_isnil(L, -1) ? 0 : intensity(L, -1, "cycles (per 10 s)", 255));
     lua_settop(L, t - 1);
   }
-  raiseIfRefused(car.lightsPattern(p));
-  return 0;
-}
-int ping(lua_State* L) {
-  raiseIfRefused(CarBinding::check(L, 1).ping());
-  return 0;
-}
-int battery(lua_State* L) {
-  raiseIfRefused(CarBinding::check(L, 1).requestBattery());
-  return 0;
-}
-int version(lua_State* L) {
-  raiseIfRefused(CarBinding::check(L, 1).requestVersion());
-  return 0;
-}
-int disconnect(lua_State* L) {
-  raiseIfRefused(CarBinding::check(L, 1).disconnect());
+  lua::raiseIfRefused(car.lightsPattern(p));
   return 0;
 }
 
@@ -334,20 +306,22 @@ void CarBinding::detach() {
 
 namespace {
 const lua::TypeSpec& carType() {
-  static const luaL_Reg methods[] = {{"setSpeed", lua::guarded<setSpeed>},
-                                     {"stop", lua::guarded<stop>},
-                                     {"changeLane", lua::guarded<changeLane>},
-                                     {"setOffset", lua::guarded<setOffset>},
-                                     {"cancelLaneChange", lua::guarded<cancelLaneChange>},
-                                     {"uturn", lua::guarded<uturn>},
-                                     {"turn", lua::guarded<turn>},
-                                     {"lights", lua::guarded<lights>},
-                                     {"lightsPattern", lua::guarded<lightsPattern>},
-                                     {"ping", lua::guarded<ping>},
-                                     {"battery", lua::guarded<battery>},
-                                     {"version", lua::guarded<version>},
-                                     {"disconnect", lua::guarded<disconnect>},
-                                     {nullptr, nullptr}};
+  static const luaL_Reg methods[] = {
+      {"setSpeed", lua::guarded<setSpeed>},
+      {"stop", lua::guarded<lua::command<CarBinding::check, &AnkiCar::stop>>},
+      {"changeLane", lua::guarded<changeLane>},
+      {"setOffset", lua::guarded<setOffset>},
+      {"cancelLaneChange",
+       lua::guarded<lua::command<CarBinding::command, &AnkiCar::cancelLaneChange>>},
+      {"uturn", lua::guarded<uturn>},
+      {"turn", lua::guarded<turn>},
+      {"lights", lua::guarded<lights>},
+      {"lightsPattern", lua::guarded<lightsPattern>},
+      {"ping", lua::guarded<lua::command<CarBinding::check, &AnkiCar::ping>>},
+      {"battery", lua::guarded<lua::command<CarBinding::check, &AnkiCar::requestBattery>>},
+      {"version", lua::guarded<lua::command<CarBinding::check, &AnkiCar::requestVersion>>},
+      {"disconnect", lua::guarded<lua::command<CarBinding::check, &AnkiCar::disconnect>>},
+      {nullptr, nullptr}};
   static const lua::TypeSpec type{
       .metatable = kMetatable,
       .name = "car",
@@ -380,21 +354,9 @@ AnkiCar& CarBinding::command(lua_State* L, int idx) {
   return *p.car;
 }
 
-namespace {
-HandlerErrorLimit g_handlerErrorLimit;
-}  // namespace
-
-void setHandlerErrorLimit(HandlerErrorLimit limit) {
-  g_handlerErrorLimit = limit;
-}
-
-HandlerErrorLimit handlerErrorLimit() {
-  return g_handlerErrorLimit;
-}
-
 void CarBinding::handlerFailed(std::string_view what, std::string_view who,
                                std::string_view message) {
-  const HandlerErrorLimit limit = g_handlerErrorLimit;
+  const HandlerErrorLimit& limit = host_.options().handler_errors;
   if (limit.count <= 0) return;
   // A car's own event handlers and listeners ("onPosition handler", "onPosition listeners",
   // core.lua's "onPosition listener"), and the update of the race library's driver of the car

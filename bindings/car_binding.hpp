@@ -39,17 +39,6 @@ enum class CarEvent {
 };
 inline constexpr std::size_t kCarEventCount = static_cast<std::size_t>(CarEvent::Count_);
 
-// A car whose script keeps failing slows to a stop (docs/safety.md): `count` errors of one
-// handler (or of one event's listeners) of a car within `window` seconds stop that car, and the
-// world that failed commands it no more; the race goes on for the others. A hot reload (a new
-// world) may drive it again. count 0: never stop (--handler-errors 0).
-struct HandlerErrorLimit {
-  int count = 5;
-  double window = 10.0;
-};
-void setHandlerErrorLimit(HandlerErrorLimit limit);
-HandlerErrorLimit handlerErrorLimit();
-
 class CarBinding {
  public:
   explicit CarBinding(ScriptHost& host);
@@ -71,7 +60,8 @@ class CarBinding {
   static AnkiCar& command(lua_State* L, int idx);
   // An error was reported in `what` ("onPosition handler", "onPosition listeners") of `who` (a
   // car's label, "car 1 (skull)"; anything else is not a car of this world and is ignored):
-  // counted against handlerErrorLimit(), and the car stopped when that is reached.
+  // counted against the world's HostOptions::handler_errors, and the car stopped when that is
+  // reached.
   void handlerFailed(std::string_view what, std::string_view who, std::string_view message);
   // The same for an error reported at `where` ("onPosition handler of car 1 (king of hill)"):
   // the car is the one whose label ends it (a name may hold " of " too).

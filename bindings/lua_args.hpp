@@ -50,6 +50,21 @@ int guarded(lua_State* L) {
   return results;
 }
 
+// A vehicle model's answer to a command (Sent: true, or the sentence why nothing was sent),
+// the sentence raised.
+template <class Sent>
+void raiseIfRefused(const Sent& sent) {
+  if (!sent) throw LuaError(sent.error());
+}
+
+// A method that takes no argument and sends one command, robot:stop(): command<modelAt,
+// &Model::stop>, where modelAt(L, 1) is the object's model (checked: another object raises).
+template <auto ModelAt, auto Method>
+int command(lua_State* L) {
+  raiseIfRefused((ModelAt(L, 1).*Method)());
+  return 0;
+}
+
 inline std::string typeName(lua_State* L, int idx) {
   return luaL_typename(L, idx);
 }

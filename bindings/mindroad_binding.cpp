@@ -75,10 +75,6 @@ MindroadRobot& open(lua_State* L, int idx) {
   return *robotAt(L, idx).client;
 }
 
-void raiseIfRefused(const MindroadRobot::Sent& sent) {
-  if (!sent) throw LuaError(sent.error());
-}
-
 const lua::EventNames& events() {
   static const lua::EventNames names(kEvents);
   return names;
@@ -96,14 +92,15 @@ void deliver(Robot& r, Event e, Push&& push) {
 // ---- methods ----
 int steer(lua_State* L) {
   auto& c = open(L, 1);
-  raiseIfRefused(c.steer(lua::checkRounded(L, 2, "steer x (forward/backward)"),
-                         lua::checkRounded(L, 3, "steer y (right/left)")));
+  lua::raiseIfRefused(c.steer(lua::checkRounded(L, 2, "steer x (forward/backward)"),
+                              lua::checkRounded(L, 3, "steer y (right/left)")));
   return 0;
 }
 
 int click(lua_State* L) {
   auto& c = open(L, 1);
-  raiseIfRefused(c.click(lua::checkRounded(L, 2, "click x"), lua::checkRounded(L, 3, "click y")));
+  lua::raiseIfRefused(
+      c.click(lua::checkRounded(L, 2, "click x"), lua::checkRounded(L, 3, "click y")));
   return 0;
 }
 
@@ -137,23 +134,13 @@ int buttons(lua_State* L) {
     throw LuaError("buttons takes a button name, a list of names or a byte 0..255, got " +
                    lua::typeName(L, 2));
   }
-  raiseIfRefused(c.buttons(raw));
+  lua::raiseIfRefused(c.buttons(raw));
   return 0;
 }
 
 int pictureMode(lua_State* L) {
   auto& c = open(L, 1);
-  raiseIfRefused(c.pictureMode(lua::checkString(L, 2, "picture mode")));
-  return 0;
-}
-
-int stop(lua_State* L) {
-  raiseIfRefused(open(L, 1).stop());
-  return 0;
-}
-
-int ping(lua_State* L) {
-  raiseIfRefused(open(L, 1).ping());
+  lua::raiseIfRefused(c.pictureMode(lua::checkString(L, 2, "picture mode")));
   return 0;
 }
 
@@ -165,7 +152,7 @@ int shutdown(lua_State* L) {
   if (interrupt::inConsole()) {
     const TimePoint now = r.host->loop().now();
     if (!r.shutdownAsked || now - *r.shutdownAsked > fromSeconds(kConfirmWindow)) {
-      if (!c.connected()) raiseIfRefused(c.shutdown());  // the same error as without asking
+      if (!c.connected()) lua::raiseIfRefused(c.shutdown());  // the same error as without asking
       r.shutdownAsked = now;
       console::write(r.label +
                      ": shutdown() turns the robot OFF (it needs a person to turn it on again). "
@@ -175,7 +162,7 @@ int shutdown(lua_State* L) {
     }
     r.shutdownAsked.reset();
   }
-  raiseIfRefused(c.shutdown());
+  lua::raiseIfRefused(c.shutdown());
   lua_pushboolean(L, 1);
   return 1;
 }
@@ -233,15 +220,16 @@ const lua::Field kFields[] = {
 };
 
 const lua::TypeSpec& robotType() {
-  static const luaL_Reg methods[] = {{"steer", lua::guarded<steer>},
-                                     {"click", lua::guarded<click>},
-                                     {"buttons", lua::guarded<buttons>},
-                                     {"pictureMode", lua::guarded<pictureMode>},
-                                     {"stop", lua::guarded<stop>},
-                                     {"ping", lua::guarded<ping>},
-                                     {"shutdown", lua::guarded<shutdown>},
-                                     {"close", lua::guarded<close>},
-                                     {nullptr, nullptr}};
+  static const luaL_Reg methods[] = {
+      {"steer", lua::guarded<steer>},
+      {"click", lua::guarded<click>},
+      {"buttons", lua::guarded<buttons>},
+      {"pictureMode", lua::guarded<pictureMode>},
+      {"stop", lua::guarded<lua::command<open, &MindroadRobot::stop>>},
+      {"ping", lua::guarded<lua::command<open, &MindroadRobot::ping>>},
+      {"shutdown", lua::guarded<shutdown>},
+      {"close", lua::guarded<close>},
+      {nullptr, nullptr}};
   static const lua::TypeSpec type{
       .metatable = kMetatable,
       .name = "mindroad",

@@ -46,6 +46,15 @@ struct SimSession {
   std::uint64_t seed = 1;
 };
 
+// A car whose script keeps failing slows to a stop (docs/safety.md): `count` errors of one
+// handler (or of one event's listeners) of a car within `window` seconds stop that car, and the
+// world that failed commands it no more; the race goes on for the others. A hot reload (a new
+// world) may drive it again. count 0: never stop (--handler-errors 0).
+struct HandlerErrorLimit {
+  int count = 5;
+  double window = 10.0;
+};
+
 struct HostOptions {
   bool test_mode = false;      // callback errors fail the run; `expect` helpers loaded
   bool library_frames = true;  // tracebacks list the library's frames (lua::Frames)
@@ -53,6 +62,7 @@ struct HostOptions {
   // the CPU time each callback may take (--budget; 0: none). Worlds side by side may differ.
   std::size_t memory_limit = sandbox::kDefaultMemoryLimit;
   std::chrono::milliseconds budget = interrupt::kDefaultBudget;
+  HandlerErrorLimit handler_errors;        // --handler-errors, --handler-errors-window
   std::uint64_t seed = 1;                  // math.randomseed
   std::vector<std::string> library_paths;  // extra folders searched by require
   std::string results;                     // --results FILE (pitwall.resultsFile), empty: none

@@ -114,7 +114,6 @@ std::unique_ptr<Session> Session::open(const CarSource& source, bool fast, const
   session->source_ = source;
   session->limitsFromSource_ = true;
   session->catchSignals();
-  setHandlerErrorLimit({source.handlerErrors, source.handlerErrorsWindow});
   return session;
 }
 
@@ -558,6 +557,7 @@ void Session::startHost(HostOptions options) {
   if (limitsFromSource_) {  // a run, a REPL: the world's limits are the command line's
     options.budget = std::chrono::milliseconds(std::llround(source_.budget * 1000));
     options.memory_limit = static_cast<std::size_t>(source_.luaMemory) << 20;
+    options.handler_errors = {source_.handlerErrors, source_.handlerErrorsWindow};
   }
   if (!sim_.world && design_) options.design = &*design_;
   if (recorder_) options.recordRace = [this](const nlohmann::json& race) { recordRace(race); };

@@ -138,7 +138,8 @@ class Session {
   std::unique_ptr<view::Server> server_;
   std::unique_ptr<Reloader> scripts_;  // the Lua world: it holds the seats, the feed and the cars
   CarSource source_;
-  bool limitsFromSource_ = false;  // opened from a command line: its --budget and --lua-memory
+  // opened from a command line: its --budget, --lua-memory and --handler-errors
+  bool limitsFromSource_ = false;
   bool finishing_ = false;
   bool spectator_ = false;
   bool suspending_ = false;  // Ctrl-Z: the cars paused, the process about to stop

@@ -41,19 +41,17 @@ struct Race {
 
   explicit Race(HandlerErrorLimit limit) {
     setenv("PITWALL_SCRIPTS", PITWALL_SOURCE_DIR "/scripts", 1);
-    setHandlerErrorLimit(limit);
     sim.world = std::make_unique<sim::World>(loop, *sim::loadLayout("oval"), 1);
     for (int i = 0; i < 2; ++i)
       cars.push_back(
           &testing::addSimulatedCar(loop, fleet, *sim.world, sim::gridSpec(sim.world->track(), i)));
     runFor(1s);
     log::setSink([this](log::Level, std::string_view line) { logged.emplace_back(line); });
-    host = std::make_unique<ScriptHost>(loop, fleet, &sim, HostOptions{});
+    HostOptions options;
+    options.handler_errors = limit;
+    host = std::make_unique<ScriptHost>(loop, fleet, &sim, options);
   }
-  ~Race() {
-    log::setSink(nullptr);
-    setHandlerErrorLimit({});
-  }
+  ~Race() { log::setSink(nullptr); }
   void runFor(std::chrono::milliseconds d) {
     auto until = loop.after(d, [this] { loop.stop(); });
     loop.run();
@@ -151,10 +149,6 @@ TEST_CASE("errors spread wider than the window do not stop the car") {
 // handler that commands on every event raises that refusal, which is not the script's fault: it
 // is not counted, and after the pause the script drives the car again.
 TEST_CASE("errors a pause causes do not stop the car") {
-  setHandlerErrorLimit({3, 10.0});
-  struct Restore {
-    ~Restore() { setHandlerErrorLimit({}); }
-  } restore;
   setenv("PITWALL_SCRIPTS", PITWALL_SOURCE_DIR "/scripts", 1);
   Loop loop{ClockKind::Virtual};
   Fleet fleet{loop};
@@ -164,7 +158,9 @@ TEST_CASE("errors a pause causes do not stop the car") {
   link.setConnected(true);
   std::vector<std::string> logged;
   log::setSink([&](log::Level, std::string_view line) { logged.emplace_back(line); });
-  ScriptHost host(loop, fleet, nullptr, HostOptions{});
+  HostOptions options;
+  options.handler_errors = {3, 10.0};
+  ScriptHost host(loop, fleet, nullptr, options);
   REQUIRE(host.startString(R"(
     pitwall.cars()[1].onPosition = function(c) c:setSpeed(500) end
   )",

@@ -27,18 +27,18 @@ struct FailingHandler {
   FailingHandler() {
     // The car drives on (--handler-errors 0): these are about the log of a flood, not the stop
     // (tests/unit/bindings/handler_errors_test.cpp).
-    setHandlerErrorLimit({0, 10.0});
     auto l = std::make_unique<CaptureLink>();
     link = l.get();
     fleet.add(std::move(l), CarIdentity{0, "skull", 9, 1});
     link->setConnected(true);
     setenv("PITWALL_SCRIPTS", PITWALL_SOURCE_DIR "/scripts", 1);
-    host = std::make_unique<ScriptHost>(loop, fleet, nullptr, HostOptions{});
+    HostOptions options;
+    options.handler_errors = {0, 10.0};
+    host = std::make_unique<ScriptHost>(loop, fleet, nullptr, options);
     log::setTimeSource([this] { return loop.seconds(); });
     log::setSink([this](log::Level, std::string_view line) { logged.emplace_back(line); });
   }
   ~FailingHandler() {
-    setHandlerErrorLimit({});
     log::setSink(nullptr);
     log::setTimeSource(nullptr);
   }
@@ -134,6 +134,7 @@ TEST_CASE_FIXTURE(FailingHandler, "the callback budget's interrupts are counted 
   host.reset();
   HostOptions options;
   options.budget = 5ms;
+  options.handler_errors = {0, 10.0};  // as the fixture's: the car drives on
   host = std::make_unique<ScriptHost>(loop, fleet, nullptr, options);
   start(R"(
     pitwall.cars()[1].onPosition = function() while true do end end
