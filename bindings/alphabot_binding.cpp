@@ -51,25 +51,7 @@ constexpr const char* kEventNames[] = {
 #undef PITWALL_ALPHABOT_EVENT_NAME
 };
 
-struct Robot {
-  ScriptHost* host = nullptr;
-  std::unique_ptr<Alphabot> model;
-  lua::EventSlots slots;
-  int selfRef = LUA_NOREF;
-  std::string label;  // "alphabot tcp:127.0.0.1:4000"
-
-  // Ends the robot's part in the world: a stop for a connected robot, the link closed, no more
-  // events. Safe to call twice, and from __gc during lua_close.
-  void close(lua_State* L) {
-    // The model stays (one of its handlers may be running: a handler that calls
-    // robot:close()); a closed model calls none of them again, and deliver() checks closed().
-    if (model) model->close();
-    slots.release(L);
-    luaL_unref(L, LUA_REGISTRYINDEX, selfRef);
-    selfRef = LUA_NOREF;
-  }
-  bool closed() const { return selfRef == LUA_NOREF; }
-};
+using Robot = lua::Device<Alphabot>;
 
 const lua::TypeSpec& robotType();
 
@@ -90,9 +72,7 @@ const lua::EventNames& events() {
 // Calls robot.onX(robot, ev) with a fresh ev filled by `fill` (the table on top of the stack).
 template <class Fill>
 void deliver(Robot& r, Event e, Fill&& fill) {
-  if (r.closed()) return;
-  lua::emit({*r.host, r.slots, events(), r.selfRef, r.label}, static_cast<std::size_t>(e),
-            LUA_NOREF, fill);
+  if (!r.closed()) lua::emit(r.source(events()), static_cast<std::size_t>(e), LUA_NOREF, fill);
 }
 
 void pushWaypoints(lua_State* L, const std::vector<ab::Waypoint>& waypoints) {
@@ -332,8 +312,7 @@ int newRobot(lua_State* L) {
   robot->label = robot->model->label();
   Robot*& boxed = lua::newBox<Robot*>(L, robotType(), nullptr);
   boxed = robot.release();  // the box owns it from here (its gc deletes it)
-  lua_pushvalue(L, -1);
-  boxed->selfRef = luaL_ref(L, LUA_REGISTRYINDEX);  // lives until close() or the world's end
+  boxed->hold(L);           // lives until close() or the world's end
   hook(*boxed);
   return 1;
 }

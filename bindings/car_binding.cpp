@@ -116,19 +116,20 @@ int lights(lua_State* L) {
   lua::raiseIfRefused(car.lights(static_cast<int>(mask)));
   return 0;
 }
-// A channel or an effect: by name (its position in `names`), or by number 0..max.
+// A channel or an effect (the value on top, popped): by name (its position in `names`), or by
+// number 0..max.
 template <std::size_t N>
-int nameOrNumber(lua_State* L, int idx, const char* what,
-                 const std::pair<const char*, int> (&names)[N], long long max) {
-  if (lua_type(L, idx) == LUA_TSTRING) return lua::checkName(L, idx, what, names);
-  auto v = lua::checkInteger(L, idx, what);
-  lua::requireRange(what, static_cast<double>(v), 0, static_cast<double>(max));
-  return static_cast<int>(v);
-}
-int intensity(lua_State* L, int idx, const char* what, long long max) {
-  auto v = lua::checkInteger(L, idx, what);
-  lua::requireRange(what, static_cast<double>(v), 0, static_cast<double>(max));
-  return static_cast<int>(v);
+std::uint8_t nameOrNumber(lua_State* L, const char* what,
+                          const std::pair<const char*, int> (&names)[N], long long max) {
+  long long v = 0;
+  if (lua_type(L, -1) == LUA_TSTRING) {
+    v = lua::checkName(L, -1, what, names);
+  } else {
+    v = lua::checkInteger(L, -1, what);
+    lua::requireRange(what, static_cast<double>(v), 0, static_cast<double>(max));
+  }
+  lua_pop(L, 1);
+  return static_cast<std::uint8_t>(v);
 }
 constexpr std::pair<const char*, int> kChannels[] = {
     {"red", 0}, {"tail", 1}, {"blue", 2}, {"green", 3}, {"front-left", 4}, {"front-right", 5}};
@@ -147,26 +148,19 @@ int lightsPattern(lua_State* L) {
   p.channel_count = static_cast<uint8_t>(n);
   for (int i = 1; i <= n; ++i) {
     lua_geti(L, 2, i);
-    int t = lua_gettop(L);
+    const int t = lua_gettop(L);
     if (!lua_istable(L, t))
       throw LuaError("lightsPattern channel " + std::to_string(i) + " must be a table");
     static constexpr std::array<const char*, 5> kOptions = {"channel", "effect", "from", "to",
                                                             "cycles"};
-    lua::checkOptions(L, t, "car:lightsPattern", kOptions);
+    lua::Options o(L, t, "car:lightsPattern", kOptions, "channel=, effect=, from=, to=, cycles=");
     auto& c = p.channels[i - 1];
-    lua_getfield(L, t, "channel");
-    c.channel = static_cast<uint8_t>(nameOrNumber(L, -1, "channel", kChannels, 5));
-    lua_getfield(L, t, "effect");
-    c.effect =
-        static_cast<uint8_t>(lua_isnil(L, -1) ? 0 : nameOrNumber(L, -1, "effect", kEffects, 4));
-    lua_getfield(L, t, "from");
-    c.start = static_cast<uint8_t>(lua_isnil(L, -1) ? 0 : intensity(L, -1, "from (intensity)", 14));
-    lua_getfield(L, t, "to");
-    c.end =
-        static_cast<uint8_t>(lua_isnil(L, -1) ? c.start : intensity(L, -1, "to (intensity)", 14));
-    lua_getfield(L, t, "cycles");
-    c.cycles_per_10s =
-        static_cast<uint8_t>(lua_isnil(L, -1) ? 0 : intensity(L, -1, "cycles (per 10 s)", 255));
+    lua_getfield(L, t, "channel");  // required: nil is refused as no channel
+    c.channel = nameOrNumber(L, "channel", kChannels, 5);
+    c.effect = o.value("effect") ? nameOrNumber(L, "effect", kEffects, 4) : 0;
+    c.start = static_cast<uint8_t>(o.integer("from", 0, 14, {}, "an intensity").value_or(0));
+    c.end = static_cast<uint8_t>(o.integer("to", 0, 14, {}, "an intensity").value_or(c.start));
+    c.cycles_per_10s = static_cast<uint8_t>(o.integer("cycles", 0, 255, "per 10 s").value_or(0));
     lua_settop(L, t - 1);
   }
   lua::raiseIfRefused(car.lightsPattern(p));

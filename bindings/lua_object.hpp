@@ -12,6 +12,7 @@
 #include <array>
 #include <cctype>
 #include <cstddef>
+#include <memory>
 #include <new>
 #include <span>
 #include <stdexcept>
@@ -163,6 +164,34 @@ void emitArgs(const EventSource& source, std::size_t e, Push&& push) {
   for (bool hub : {true, false})
     if (pushCallee(source, e, hub)) callCallee(source, e, hub, push(source.host.state()));
 }
+
+// What a robot object holds (the Alphabot, the MindRoad): its model, its world, its events'
+// handlers, and a registry reference that keeps the object while it is open (its events need
+// it; the script may drop it). close() ends its part in the world: the model closed (a
+// connected robot is sent its stop), no more events. Safe twice, and from __gc in lua_close. The
+// model stays: one of its handlers may be running (a handler that calls robot:close()), and a
+// closed model calls none of them again.
+template <class Model>
+struct Device {
+  ScriptHost* host = nullptr;
+  std::unique_ptr<Model> model;
+  EventSlots slots;
+  int selfRef = LUA_NOREF;
+  std::string label;  // "alphabot tcp:127.0.0.1:4000"
+
+  void hold(lua_State* L) {  // the object on top of the stack, until close()
+    lua_pushvalue(L, -1);
+    selfRef = luaL_ref(L, LUA_REGISTRYINDEX);
+  }
+  void close(lua_State* L) {
+    if (model) model->close();
+    slots.release(L);
+    luaL_unref(L, LUA_REGISTRYINDEX, selfRef);
+    selfRef = LUA_NOREF;
+  }
+  bool closed() const { return selfRef == LUA_NOREF; }
+  EventSource source(const EventNames& names) { return {*host, slots, names, selfRef, label}; }
+};
 
 // ---- The object idiom: one way for an engine object to reach Lua ----
 //

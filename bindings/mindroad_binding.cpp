@@ -47,13 +47,7 @@ constexpr const char* kEvents[] = {
 #undef PITWALL_MINDROAD_EVENT_NAME
 };
 
-struct Robot {
-  std::unique_ptr<MindroadRobot> client;  // closed, not destroyed, by close(): a handler may
-                                          // be running in it
-  ScriptHost* host = nullptr;
-  lua::EventSlots slots;
-  int selfRef = LUA_NOREF;  // held while open: events need the object, the script may not
-  std::string label;        // "mindroad tcp 127.0.0.1:4000"
+struct Robot : lua::Device<MindroadRobot> {
   std::optional<TimePoint> shutdownAsked;
   MindroadOptions options;  // host, port, … stay readable after close()
 };
@@ -66,13 +60,13 @@ Robot& robotAt(lua_State* L, int idx) {
 }
 
 bool isOpen(const Robot& r) {
-  return r.client && r.client->phase() != MindroadRobot::Phase::Closed;
+  return r.model && r.model->phase() != MindroadRobot::Phase::Closed;
 }
 
 // The robot's model, which refuses every command once it is closed (its one check of that;
 // events on a closed robot are refused by the type, TypeSpec::closed).
 MindroadRobot& open(lua_State* L, int idx) {
-  return *robotAt(L, idx).client;
+  return *robotAt(L, idx).model;
 }
 
 const lua::EventNames& events() {
@@ -84,9 +78,7 @@ const lua::EventNames& events() {
 // returns how many.
 template <class Push>
 void deliver(Robot& r, Event e, Push&& push) {
-  if (r.selfRef == LUA_NOREF) return;
-  lua::emitArgs({*r.host, r.slots, events(), r.selfRef, r.label}, static_cast<std::size_t>(e),
-                push);
+  if (!r.closed()) lua::emitArgs(r.source(events()), static_cast<std::size_t>(e), push);
 }
 
 // ---- methods ----
@@ -167,21 +159,14 @@ int shutdown(lua_State* L) {
   return 1;
 }
 
-void closeRobot(lua_State* L, Robot& r) {
-  if (r.client) r.client->close();
-  r.slots.release(L);
-  luaL_unref(L, LUA_REGISTRYINDEX, r.selfRef);
-  r.selfRef = LUA_NOREF;
-}
-
 int close(lua_State* L) {
-  closeRobot(L, robotAt(L, 1));
+  robotAt(L, 1).close(L);
   return 0;
 }
 
 std::string robotLabel(lua_State* L, int self) {
   Robot& r = robotAt(L, self);
-  return r.label + " (" + (isOpen(r) ? r.client->phaseName() : "closed") + ")";
+  return r.label + " (" + (isOpen(r) ? r.model->phaseName() : "closed") + ")";
 }
 
 // ---- state fields: one entry each ----
@@ -193,7 +178,7 @@ const lua::Field kFields[] = {
     {"connected",
      [](lua_State* L, int self) {
        Robot& r = robotAt(L, self);
-       lua_pushboolean(L, isOpen(r) && r.client->connected());
+       lua_pushboolean(L, isOpen(r) && r.model->connected());
      }},
     {"host", [](lua_State* L, int self) { lua_pushstring(L, optionsAt(L, self).host.c_str()); }},
     {"port", [](lua_State* L, int self) { lua_pushinteger(L, optionsAt(L, self).port); }},
@@ -202,20 +187,20 @@ const lua::Field kFields[] = {
     {"phase",
      [](lua_State* L, int self) {
        Robot& r = robotAt(L, self);
-       lua_pushstring(L, isOpen(r) ? r.client->phaseName().c_str() : "closed");
+       lua_pushstring(L, isOpen(r) ? r.model->phaseName().c_str() : "closed");
      }},
     {"lastError",
      [](lua_State* L, int self) {
        Robot& r = robotAt(L, self);
-       if (isOpen(r) && !r.client->lastError().empty())
-         lua_pushstring(L, r.client->lastError().c_str());
+       if (isOpen(r) && !r.model->lastError().empty())
+         lua_pushstring(L, r.model->lastError().c_str());
        else
          lua_pushnil(L);
      }},
     {"contacts",
      [](lua_State* L, int self) {
        Robot& r = robotAt(L, self);
-       lua_pushinteger(L, isOpen(r) ? static_cast<lua_Integer>(r.client->contacts()) : 0);
+       lua_pushinteger(L, isOpen(r) ? static_cast<lua_Integer>(r.model->contacts()) : 0);
      }},
 };
 
@@ -245,7 +230,7 @@ const lua::TypeSpec& robotType() {
       // before it frees anything (luaC_freeallobjects).
       .gc =
           [](lua_State* L, int self) {
-            closeRobot(L, robotAt(L, self));
+            robotAt(L, self).close(L);
             lua::destroyBox<Robot>(L, self, robotType());
           },
   };
@@ -276,13 +261,12 @@ int newRobot(lua_State* L) {
   Robot* r = &lua::newBox<Robot>(L, robotType());
   r->host = &host;
   r->options = options;
-  r->client =
+  r->model =
       std::make_unique<MindroadRobot>(host.loop(), makeMindroadLink(host.loop(), options), options);
-  r->label = "mindroad " + r->client->address();
-  lua_pushvalue(L, -1);
-  r->selfRef = luaL_ref(L, LUA_REGISTRYINDEX);
-  r->client->onContact = [r] { deliver(*r, Event::Contact, [](lua_State*) { return 0; }); };
-  r->client->onLost = [r](const std::string& reason) {
+  r->label = "mindroad " + r->model->address();
+  r->hold(L);
+  r->model->onContact = [r] { deliver(*r, Event::Contact, [](lua_State*) { return 0; }); };
+  r->model->onLost = [r](const std::string& reason) {
     deliver(*r, Event::Lost, [&reason](lua_State* S) {
       lua_pushlstring(S, reason.data(), reason.size());
       return 1;
