@@ -18,7 +18,7 @@ startRobot() {
   $PITWALL sim-robot alphabot "$@" >"$TMP/$name.out" 2>"$TMP/$name.err" &
   PIDS+=($!)
   ROBOT_PID=$!
-  wait_for "$TMP/$name.out" "listening on" 5 || { fail "$name: sim-robot did not start: $(cat "$TMP/$name.err")"; return 1; }
+  wait_for "$TMP/$name.out" "listening on" 30 || { fail "$name: sim-robot did not start: $(cat "$TMP/$name.err")"; return 1; }
   PORT=$(sed -n 's/^listening on .*:\([0-9]*\)$/\1/p' "$TMP/$name.out")
 }
 
@@ -229,7 +229,8 @@ c.recv(100)  # wait for the script's goodbye (the stop on close)
 PY
   python3 "$TMP/fake.py" >"$TMP/fake.out" &
   PIDS+=($!)
-  wait_for "$TMP/fake.out" "listening on" 5
+  # (30 s: on a loaded machine Python itself can take seconds to start; the wait ends when it says)
+  wait_for "$TMP/fake.out" "listening on" 30 || fail "the fake robot did not start within 30 s"
   FPORT=$(sed -n 's/^listening on .*:\([0-9]*\)$/\1/p' "$TMP/fake.out")
   cat >"$TMP/malformed.lua" <<'LUA'
 -- made in a callback, the robot returns at once: the handlers are set before the robot's

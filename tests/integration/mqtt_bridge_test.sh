@@ -31,7 +31,7 @@ spawn bridge $PITWALL bridge --mqtt "$MQTT_URL" --host-id pit1 --cars 2 --mqtt-c
 BRIDGE=$LAST_PID
 wait_for "$TMP/bridge.err" "bridging 2 cars as host pit1 on $MQTT_URL" ||
   { fail "the bridge did not start: $(cat "$TMP/bridge.err")"; finish; }
-wait_for "$ALL" '^Anki/Host/pit1/S/Cars \["pit1-sim-[0-9a-f]+","pit1-sim-[0-9a-f]+"\]' 5 ||
+wait_for "$ALL" '^Anki/Host/pit1/S/Cars \["pit1-sim-[0-9a-f]+","pit1-sim-[0-9a-f]+"\]' 30 ||
   { fail "no S/Cars with two cars: $(grep Host "$ALL")"; finish; }
 CARS=($(grep -m1 '^Anki/Host/pit1/S/Cars ' "$ALL" | grep -oE 'pit1-sim-[0-9a-f]+'))
 C1=${CARS[0]}
@@ -196,7 +196,7 @@ since() { tail -n +$((seen + 1)) "$ALL2"; }
 spawn ro $PITWALL bridge --mqtt "$MQTT_URL" --host-id ro --cars 1 --read-only --mqtt-client-id bridge-ro
 RO=$LAST_PID
 wait_for "$TMP/ro.err" "bridging 1 car as host ro" || fail "the read-only bridge did not start: $(cat "$TMP/ro.err")"
-wait_for "$ALL2" '^Anki/Host/ro/S/Cars \["ro-sim-' 5 || fail "no S/Cars from the read-only bridge"
+wait_for "$ALL2" '^Anki/Host/ro/S/Cars \["ro-sim-' 30 || fail "no S/Cars from the read-only bridge"
 RC=$(grep -m1 '^Anki/Host/ro/S/Cars ' "$ALL2" | grep -oE 'ro-sim-[0-9a-f]+')
 contains "the read-only bridge says so" "publishing as host ro (read-only)" "$(cat "$TMP/ro.err")"
 pub "Anki/Car/$RC/I" '{"type":"speed","speed":800,"acceleration":2000}'

@@ -57,7 +57,7 @@ spawn bridge $PITWALL bridge --mqtt "$MQTT_URL" --host-id hostA --cars 2
 BRIDGE=$LAST_PID
 wait_for "$TMP/bridge.err" "bridging 2 cars as host hostA" ||
   { fail "host A's bridge did not start: $(cat "$TMP/bridge.err")"; finish; }
-wait_for "$ALL" '^Anki/Host/hostA/S/Cars \["hostA-sim-[0-9a-f]+","hostA-sim-[0-9a-f]+"\]' 5 ||
+wait_for "$ALL" '^Anki/Host/hostA/S/Cars \["hostA-sim-[0-9a-f]+","hostA-sim-[0-9a-f]+"\]' 30 ||
   { fail "no S/Cars from host A"; finish; }
 CARS=($(grep -m1 '^Anki/Host/hostA/S/Cars ' "$ALL" | grep -oE 'hostA-sim-[0-9a-f]+'))
 

@@ -43,7 +43,7 @@ sim_robot() {
   $PITWALL sim-robot alphabot >"$ROBOT.out" 2>"$ROBOT.err" &
   ROBOT_PID=$!
   PIDS+=($ROBOT_PID)
-  wait_for "$ROBOT.out" "listening on" 5 || fail "sim-robot did not start: $(cat "$ROBOT.err")"
+  wait_for "$ROBOT.out" "listening on" 30 || fail "sim-robot did not start: $(cat "$ROBOT.err")"
   PORT=$(sed -n 's/^listening on .*:\([0-9]*\)$/\1/p' "$ROBOT.out")
 }
 # stop_robot: interrupts the simulated robot, which then says what it was last told
