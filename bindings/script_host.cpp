@@ -143,56 +143,6 @@ bool ScriptHost::finishCall(int status, const char* what, std::string_view who) 
   return false;
 }
 
-void ScriptHost::checkMemory() {
-  if (!memory_.exceeded || memoryReported_) return;
-  memoryReported_ = true;
-  std::string text = "error: " + sandbox::memoryMessage(memory_);
-  if (options_.test_mode && !failure_) failure_ = text;
-  log::error("script", text);
-  requestExit(EXIT_FAILURE);
-}
-
-void ScriptHost::reportError(const std::string& where, const std::string& message) {
-  if (exitStatus_) return;  // os.exit or the memory limit: the run is ending, and said why
-  ++errors_;
-  // An error in a car's handler or listeners ("onPosition handler of car 1 (skull)") counts
-  // towards stopping that car (CarBinding::handlerFailed), after the error itself is reported.
-  struct CountAfter {
-    ScriptHost& host;
-    const std::string& where;
-    const std::string& message;
-    ~CountAfter() {
-      if (host.cars_) host.cars_->handlerFailedIn(where, message);
-    }
-  } countAfter{*this, where, message};
-  lua_State* L = L_;
-  PITWALL_STACK_CHECK(L, 0, "an error's report (ScriptHost::reportError)");
-  std::string text = "error in " + where + ": " + message;
-  if (!inOnError_) {
-    // A script may take its own errors (pitwall.onError): then they are handled, not failures.
-    int top = lua_gettop(L);
-    lua_getglobal(L, "pitwall");
-    bool handler = lua_istable(L, -1) && lua_getfield(L, -1, "onError") == LUA_TFUNCTION;
-    if (handler) {
-      lua_remove(L, -2);
-      lua_pushlstring(L, text.data(), text.size());
-      lua_pushlstring(L, where.data(), where.size());
-      inOnError_ = true;
-      bool handled = call(2, 0, "pitwall.onError");
-      inOnError_ = false;
-      if (handled) return;
-    } else {
-      lua_settop(L, top);
-    }
-  }
-  if (options_.test_mode && !failure_) {
-    failure_ = text;  // the test runner prints it with the scenario's result
-    requestStop();
-    return;
-  }
-  if (flood_.admit(where, message)) log::error("script", text);
-}
-
 void ScriptHost::requestExit(int status) {
   if (!exitStatus_) exitStatus_ = status;
   if (!stopRequested_) return requestStop();
@@ -202,7 +152,7 @@ void ScriptHost::requestExit(int status) {
 void ScriptHost::shutDown() {
   if (isShutDown()) return;
   life_ = Life::ShutDown;
-  flood_.flush();  // counts of errors not yet logged: none is lost
+  errors_.flush();  // counts of errors not yet logged: none is lost
   // The handlers stay hooked until the world closes (this may run inside one of them); call()
   // turns every call into Lua away from now on.
   tasks_.shutDown();

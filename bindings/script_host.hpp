@@ -3,9 +3,8 @@
 // the engine clock (bindings/tasks.hpp, bindings/timers.hpp), the world's life (attach, shut
 // down, last words), and the one protected-call path every call into Lua goes through.
 //
-// Errors: an error in a callback is reported with a traceback (or handed to pitwall.onError) and
-// the run carries on; in test mode it fails the scenario instead. In the log, a place that keeps
-// failing prints one traceback, then a count line a second (engine/core/error_flood.hpp).
+// Errors: an error in a callback is reported (bindings/error_report.hpp: to pitwall.onError, or
+// the log with a traceback) and the run carries on; in test mode it fails the scenario instead.
 #include <lua.hpp>
 
 #include <nlohmann/json_fwd.hpp>
@@ -18,13 +17,13 @@
 #include <string_view>
 #include <vector>
 
+#include "bindings/error_report.hpp"
 #include "bindings/interrupt.hpp"
 #include "bindings/lua_args.hpp"
 #include "bindings/protected_call.hpp"
 #include "bindings/sandbox.hpp"
 #include "bindings/tasks.hpp"
 #include "bindings/timers.hpp"
-#include "engine/core/error_flood.hpp"
 #include "engine/core/loop.hpp"
 #include "engine/core/result.hpp"
 #include "engine/fleet/fleet.hpp"
@@ -161,9 +160,11 @@ class ScriptHost {
   // The shipped library's folder, as require finds it: its chunks are the library's frames in
   // this world's tracebacks and blame (lua::Frames).
   void setLibrary(const std::string& folder);
-  // Reports a script error: to pitwall.onError if set, else the log (a flood from one `where`:
-  // the first in full, then a count a second); in test mode, a failure.
-  void reportError(const std::string& where, const std::string& message);
+  // Reports a script error (ErrorReport::report): to pitwall.onError if set, else the log; in
+  // test mode, a failure.
+  void reportError(const std::string& where, const std::string& message) {
+    errors_.report(where, message);
+  }
 
   // pitwall.stop() and failures end the run through this.
   std::function<void()> onStopRequested;
@@ -192,17 +193,18 @@ class ScriptHost {
   void chargeOutside(std::size_t bytes) { memory_.outside = bytes; }
   // After a failed call into Lua: when the memory limit was reached, says so once and ends the
   // run (exit status 1).
-  void checkMemory();
+  void checkMemory() { errors_.checkMemory(); }
   // How the script's main chunk ended (Tasks): `error` empty when it returned. A failure ends
   // the run (its cars are stopped), or is handed back by a trial start; a scenario ends with it.
   void mainEnded(const std::string& where, const std::string& error);
   // In test mode: the first failure (error in a task or callback, failed expectation).
-  const std::optional<std::string>& failure() const { return failure_; }
-  int errorCount() const { return errors_; }
+  const std::optional<std::string>& failure() const { return errors_.failure(); }
+  int errorCount() const { return errors_.count(); }
 
   static ScriptHost& from(lua_State* L);
 
  private:
+  friend class ErrorReport;  // counts a car's handler errors towards its stop (cars_)
   void carJoined(AnkiCar& car);
   bool protectedCall(int nargs, int nresults, std::string& error, bool console);
   bool finishCall(int status, const char* what, std::string_view who);
@@ -225,12 +227,8 @@ class ScriptHost {
   enum class Life { Running, ShutDown, LastWords } life_ = Life::Running;
   enum class Main { Running, Returned, Failed } main_ = Main::Running;  // its main chunk
   bool stopRequested_ = false;  // pitwall.stop() or a failure asked the run to end
-  bool memoryReported_ = false;
   std::optional<int> exitStatus_;
-  bool inOnError_ = false;
-  std::optional<std::string> failure_;
-  int errors_ = 0;
-  ErrorFlood flood_{loop_, "script"};  // errors to the log: one traceback per place, then counts
+  ErrorReport errors_{*this};
   bool attached_ = false;
   Subscription joined_;  // Fleet::carJoined, while attached
   // While a trial start runs: where its main chunk's error goes (instead of being reported).
