@@ -95,10 +95,18 @@ std::string describe(const sdbus::Error& error, const std::string& step) {
       n == "org.freedesktop.DBus.Error.NameHasNoOwner")
     return "BlueZ is not running (" + step +
            "): start it, e.g. `systemctl start bluetooth` (docs/bluetooth.md)";
-  if (n == "org.freedesktop.DBus.Error.AccessDenied" || n == "org.bluez.Error.NotPermitted" ||
-      n == "org.bluez.Error.NotAuthorized")
+  // (the bus's policy, or BlueZ's authorization: not org.bluez.Error.NotPermitted, which is
+  // BlueZ saying that the operation is not allowed now, with why)
+  if (n == "org.freedesktop.DBus.Error.AccessDenied" || n == "org.bluez.Error.NotAuthorized")
     return "no permission to use BlueZ (" + step +
            "): run as root or as a member of the `bluetooth` group (docs/bluetooth.md)";
+  if (n == "org.bluez.Error.NotPermitted" && error.getMessage() == "Notify acquired")
+    return step +
+           " refused: bluetoothd still holds an earlier request for these notifications that it "
+           "gave up on (org.bluez.Error.NotPermitted: Notify acquired; a bluetoothd bug before "
+           "BlueZ 5.84, after a connection lost while notifications were being enabled): remove "
+           "the car from BlueZ (`bluetoothctl remove` and its address) or restart bluetoothd "
+           "(docs/bluetooth.md)";
   if (n == "org.freedesktop.DBus.Error.NoReply" || n == "org.freedesktop.DBus.Error.Timeout")
     return step + " timed out";
   std::string msg = error.getMessage();

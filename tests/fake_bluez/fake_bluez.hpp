@@ -72,6 +72,9 @@ class FakeBluez {
   //   ConnectHang  the link drops and for `lasting` a connection attempt neither succeeds nor
   //              fails (the car does not answer; BlueZ keeps trying, and a second Connect is
   //              answered InProgress) until Disconnect cancels it or the time is over
+  //   NotifyHeld the link drops and for `lasting` the car's notifications are held by a request
+  //              bluetoothd abandoned: AcquireNotify and StartNotify are refused NotPermitted
+  //              "Notify acquired" (BlueZ 5.66, a disconnect during AcquireNotify: fixed in 5.84)
   enum class Fault {
     Drop,
     Burst,
@@ -81,7 +84,8 @@ class FakeBluez {
     Mute,
     WriteFail,
     WriteHang,
-    ConnectHang
+    ConnectHang,
+    NotifyHeld
   };
 
   // Exports the adapters, then requests the name org.bluez on `connection` (unless the

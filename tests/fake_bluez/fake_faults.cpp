@@ -81,6 +81,10 @@ void FakeBluez::State::arm(Device& d, const Device::Scheduled& f) {
         window(&Device::connectHangs, "connection attempts pend");
         drop(*dp);
         break;
+      case Fault::NotifyHeld:
+        window(&Device::notifyHeld, "notifications held by an abandoned request");
+        drop(*dp);
+        break;
       case Fault::WriteHang:
         window(&Device::writesHang, "writes hang");
         break;

@@ -223,7 +223,7 @@ std::tuple<sdbus::UnixFd, std::uint16_t> FakeBluez::State::acquire(Device& d, Ch
     if (!ch.writeCommand) throw notSupported();
     if (d.writesFail) throw failed("Failed to acquire write");
   } else {
-    if (ch.notifyIo) throw notPermitted("Notify acquired");
+    if (ch.notifyIo || d.notifyHeld) throw notPermitted("Notify acquired");
     if (!ch.notifySessions.empty()) throw inProgress();
     if (!ch.notify) throw notSupported();
   }
@@ -312,7 +312,7 @@ void FakeBluez::State::closeWriteIo(Characteristic& ch) {
 void FakeBluez::State::startNotify(Device& d, Characteristic& ch) {
   // gatt-client.c characteristic_start_notify.
   if (!d.connected) throw notConnected();
-  if (ch.notifyIo) throw notPermitted("Notify acquired");
+  if (ch.notifyIo || d.notifyHeld) throw notPermitted("Notify acquired");
   if (!ch.notify) throw notSupported();
   std::string sender = ch.object->getCurrentlyProcessedMessage()->getSender();
   if (!ch.notifySessions.insert(sender).second) return;  // one session per client

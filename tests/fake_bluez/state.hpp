@@ -271,6 +271,7 @@ struct Device {
   bool writesFail = false;    // WriteFail: writes fail
   bool writesHang = false;    // WriteHang: the write socket is not read
   bool connectHangs = false;  // ConnectHang: a connection attempt pends
+  bool notifyHeld = false;    // NotifyHeld: bluetoothd's leftover notify request refuses all
 
   FakeBluezCounters counters;
 
