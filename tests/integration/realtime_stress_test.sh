@@ -5,7 +5,9 @@
 # connection makes them (the default in real time). A race then gets on average what it needs
 # but no more: every burst beyond it (the start, a lap's bookkeeping, a collection) waits for the
 # next 100 ms period, so the loop runs late by up to a period again and again. Every car
-# finishes; no car's laps average more than 1.5 times its best (no jam, no car left crawling);
+# finishes; no car's laps average more than 2 times its best (no jam, no car left crawling: the
+# jams this test found ran 2.35 and 5 times; the average holds the run-up from the grid to the
+# line, and a follower held behind slower cars in a starved race laps 1.6 times its best);
 # the engine never says it fell behind real time in the free runs. The quota follows the machine
 # because a fixed one is a timed assertion: a fixed 1 % held on one CPU and failed on a slower
 # one (the loop stalled for seconds, the watchdog stopped the cars again and again, and a scan
@@ -131,12 +133,12 @@ for r in rows:
     best = r.get("bestLap") or r.get("lastLap")
     if best is None:
         bad.append(f"{r['car']} finished with no lap time at all")
-    elif r["totalTime"] / r["laps"] > 1.5 * best:
+    elif r["totalTime"] / r["laps"] > 2 * best:
         bad.append(f"{r['car']} averaged {r['totalTime'] / r['laps']:.2f} s a lap, best {best:.2f}")
 print("ok" if len(rows) == 4 and not bad else "; ".join(bad) or f"{len(rows)} rows")
 PY
 )
-    check "$name: every car finishes, none averaging over 1.5x its best lap" ok "$verdict"
+    check "$name: every car finishes, none averaging over 2x its best lap" ok "$verdict"
     if [ "$verdict" != ok ]; then  # what the race and the engine said, for the one who reads it
       echo "--- $name: its results, and what its log said beyond info"
       cat "$TMP/$name.json"
