@@ -40,26 +40,16 @@ constexpr const char* kMetatable = "pitwall.alphabot";
   X(Disconnect) X(Malformed) X(MapSize) X(Anchor) X(Calibrated)
 // clang-format on
 
-enum class Event {
-#define PITWALL_ALPHABOT_EVENT_ENUM(name) name,
-  PITWALL_ALPHABOT_EVENTS(PITWALL_ALPHABOT_EVENT_ENUM)
-#undef PITWALL_ALPHABOT_EVENT_ENUM
-};
-constexpr const char* kEventNames[] = {
-#define PITWALL_ALPHABOT_EVENT_NAME(name) "on" #name,
-    PITWALL_ALPHABOT_EVENTS(PITWALL_ALPHABOT_EVENT_NAME)
-#undef PITWALL_ALPHABOT_EVENT_NAME
-};
+enum class Event { PITWALL_ALPHABOT_EVENTS(PITWALL_EVENT_ENUM) };
+constexpr const char* kEventNames[] = {PITWALL_ALPHABOT_EVENTS(PITWALL_EVENT_NAME)};
 
 using Robot = lua::Device<Alphabot>;
 
 const lua::TypeSpec& robotType();
 
-// The robot of the object at idx (its box holds the Robot it owns; nullptr once collected).
+// The robot at idx: its box holds the Robot itself (its gc ends it).
 Robot& robotAt(lua_State* L, int idx) {
-  Robot* r = lua::check<Robot*>(L, idx, robotType());
-  if (!r) throw LuaError(lua::expectedSentence(L, idx, robotType()));
-  return *r;
+  return lua::check<Robot>(L, idx, robotType());
 }
 
 // ---- events ----
@@ -163,14 +153,11 @@ Alphabot& model(lua_State* L, int idx) {
 }
 
 int drive(lua_State* L) {
-  auto& m = model(L, 1);
-  lua::raiseIfRefused(m.drive(lua::checkRounded(L, 2, "speed"), lua::checkRounded(L, 3, "steer")));
-  return 0;
+  return lua::raiseIfRefused(
+      model(L, 1).drive(lua::checkRounded(L, 2, "speed"), lua::checkRounded(L, 3, "steer")));
 }
 int measureDistance(lua_State* L) {
-  auto& m = model(L, 1);
-  lua::raiseIfRefused(m.measureDistance(lua::checkRounded(L, 2, "degree")));
-  return 0;
+  return lua::raiseIfRefused(model(L, 1).measureDistance(lua::checkRounded(L, 2, "degree")));
 }
 int set(lua_State* L) {
   Robot& r = robotAt(L, 1);
@@ -187,37 +174,28 @@ int set(lua_State* L) {
   ab::Toggles next = r.model->state().toggles;
   for (const auto& bit : ab::toggleBits())
     if (auto on = toggles.boolean(bit.name)) ab::setBit(next, bit, *on);
-  lua::raiseIfRefused(r.model->setToggles(next));
-  return 0;
+  return lua::raiseIfRefused(r.model->setToggles(next));
 }
 int setAnchor(lua_State* L) {
-  auto& m = model(L, 1);
-  lua::raiseIfRefused(m.setAnchor(lua::checkInteger(L, 2, "anchor id"),
-                                  lua::checkRounded(L, 3, "x (cm)"),
-                                  lua::checkRounded(L, 4, "y (cm)")));
-  return 0;
+  return lua::raiseIfRefused(model(L, 1).setAnchor(lua::checkInteger(L, 2, "anchor id"),
+                                                   lua::checkRounded(L, 3, "x (cm)"),
+                                                   lua::checkRounded(L, 4, "y (cm)")));
 }
 int navigateTo(lua_State* L) {
-  auto& m = model(L, 1);
-  lua::raiseIfRefused(
-      m.navigateTo(lua::checkRounded(L, 2, "x (cm)"), lua::checkRounded(L, 3, "y (cm)")));
-  return 0;
+  return lua::raiseIfRefused(
+      model(L, 1).navigateTo(lua::checkRounded(L, 2, "x (cm)"), lua::checkRounded(L, 3, "y (cm)")));
 }
 int addObstacle(lua_State* L) {
-  auto& m = model(L, 1);
-  lua::raiseIfRefused(
-      m.addObstacle(lua::checkRounded(L, 2, "x (cm)"), lua::checkRounded(L, 3, "y (cm)"),
-                    lua::checkRounded(L, 4, "width (cm)"), lua::checkRounded(L, 5, "height (cm)")));
-  return 0;
+  return lua::raiseIfRefused(model(L, 1).addObstacle(
+      lua::checkRounded(L, 2, "x (cm)"), lua::checkRounded(L, 3, "y (cm)"),
+      lua::checkRounded(L, 4, "width (cm)"), lua::checkRounded(L, 5, "height (cm)")));
 }
 int removeObstacle(lua_State* L) {
   auto& m = model(L, 1);
   if (lua_isnoneornil(L, 3))
-    lua::raiseIfRefused(m.removeObstacle(lua::checkInteger(L, 2, "obstacle id")));
-  else
-    lua::raiseIfRefused(
-        m.removeObstacleAt(lua::checkRounded(L, 2, "x (cm)"), lua::checkRounded(L, 3, "y (cm)")));
-  return 0;
+    return lua::raiseIfRefused(m.removeObstacle(lua::checkInteger(L, 2, "obstacle id")));
+  return lua::raiseIfRefused(
+      m.removeObstacleAt(lua::checkRounded(L, 2, "x (cm)"), lua::checkRounded(L, 3, "y (cm)")));
 }
 int close(lua_State* L) {
   robotAt(L, 1).close(L);
@@ -306,14 +284,13 @@ int newRobot(lua_State* L) {
     if (!link) throw LuaError("pitwall.alphabot{ble=\"" + ble + "\"}: " + error);
   }
 
-  auto robot = std::make_unique<Robot>();
-  robot->host = &scriptHost;
-  robot->model = std::make_unique<Alphabot>(loop, std::move(link), options);
-  robot->label = robot->model->label();
-  Robot*& boxed = lua::newBox<Robot*>(L, robotType(), nullptr);
-  boxed = robot.release();  // the box owns it from here (its gc deletes it)
-  boxed->hold(L);           // lives until close() or the world's end
-  hook(*boxed);
+  auto model = std::make_unique<Alphabot>(loop, std::move(link), options);
+  Robot& robot = lua::newBox<Robot>(L, robotType());
+  robot.host = &scriptHost;
+  robot.model = std::move(model);
+  robot.label = robot.model->label();
+  robot.hold(L);  // lives until close() or the world's end
+  hook(robot);
   return 1;
 }
 
@@ -345,11 +322,8 @@ const lua::TypeSpec& robotType() {
       .closed = [](lua_State* L, int self) { return robotAt(L, self).closed(); },
       .gc =
           [](lua_State* L, int self) {
-            Robot*& r = *lua::test<Robot*>(L, self, robotType());
-            if (!r) return;
-            r->close(L);
-            delete r;
-            r = nullptr;
+            robotAt(L, self).close(L);
+            lua::destroyBox<Robot>(L, self, robotType());
           },
   };
   return type;

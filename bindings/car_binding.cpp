@@ -28,10 +28,7 @@ namespace {
 constexpr const char* kMetatable = "pitwall.car";
 
 constexpr std::array<const char*, kCarEventCount> kEventNames = {
-#define PITWALL_CAR_EVENT_NAME(name) "on" #name,
-    PITWALL_CAR_EVENTS(PITWALL_CAR_EVENT_NAME)
-#undef PITWALL_CAR_EVENT_NAME
-};
+    PITWALL_CAR_EVENTS(PITWALL_EVENT_NAME)};
 
 }  // namespace
 
@@ -62,25 +59,21 @@ int setSpeed(lua_State* L) {
   auto speed = lua::checkRounded(L, 2, "speed (mm/s)");
   auto accel = lua::optRounded(L, 3, "acceleration (mm/s²)", kDefaultAccel);
   bool limit = lua_toboolean(L, 4);
-  lua::raiseIfRefused(car.setSpeed(toInt(speed), toInt(accel), limit));
-  return 0;
+  return lua::raiseIfRefused(car.setSpeed(toInt(speed), toInt(accel), limit));
 }
 int changeLane(lua_State* L) {
   AnkiCar& car = CarBinding::command(L, 1);
   double offset = lua::checkNumber(L, 2, "offset (mm)");
   auto speed = lua::optRounded(L, 3, "lane-change speed (mm/s)", kDefaultLaneSpeed);
   auto accel = lua::optRounded(L, 4, "lane-change acceleration (mm/s²)", kDefaultLaneAccel);
-  lua::raiseIfRefused(car.changeLane(offset, toInt(speed), toInt(accel)));
-  return 0;
+  return lua::raiseIfRefused(car.changeLane(offset, toInt(speed), toInt(accel)));
 }
 int setOffset(lua_State* L) {
   AnkiCar& car = CarBinding::command(L, 1);
-  lua::raiseIfRefused(car.setOffset(lua::checkNumber(L, 2, "offset (mm)")));
-  return 0;
+  return lua::raiseIfRefused(car.setOffset(lua::checkNumber(L, 2, "offset (mm)")));
 }
 int uturn(lua_State* L) {
-  lua::raiseIfRefused(CarBinding::command(L, 1).turn(TurnType::UTurn));
-  return 0;
+  return lua::raiseIfRefused(CarBinding::command(L, 1).turn(TurnType::UTurn));
 }
 constexpr std::pair<const char*, TurnType> kTurnTypes[] = {{"left", TurnType::Left},
                                                            {"right", TurnType::Right},
@@ -95,8 +88,7 @@ int turn(lua_State* L) {
   const TurnTrigger trigger = lua_isnoneornil(L, 3)
                                   ? TurnTrigger::Immediate
                                   : lua::checkName(L, 3, "turn trigger", kTurnTriggers);
-  lua::raiseIfRefused(car.turn(type, trigger));
-  return 0;
+  return lua::raiseIfRefused(car.turn(type, trigger));
 }
 int lights(lua_State* L) {
   AnkiCar& car = CarBinding::check(L, 1);
@@ -108,13 +100,11 @@ int lights(lua_State* L) {
     int mask = 0;
     for (int bit = 0; bit < 4; ++bit)
       if (auto on = read.boolean(kNames[bit])) mask |= (1 << bit) | (*on ? 1 << (bit + 4) : 0);
-    lua::raiseIfRefused(car.lights(mask));
-    return 0;
+    return lua::raiseIfRefused(car.lights(mask));
   }
   auto mask = lua::checkInteger(L, 2, "lights mask");
   if (auto e = checkRange("lights mask", static_cast<double>(mask), 0, 255)) throw LuaError(*e);
-  lua::raiseIfRefused(car.lights(static_cast<int>(mask)));
-  return 0;
+  return lua::raiseIfRefused(car.lights(static_cast<int>(mask)));
 }
 // A channel or an effect (the value on top, popped): by name (its position in `names`), or by
 // number 0..max.
@@ -163,8 +153,7 @@ int lightsPattern(lua_State* L) {
     c.cycles_per_10s = static_cast<uint8_t>(o.integer("cycles", 0, 255, "per 10 s").value_or(0));
     lua_settop(L, t - 1);
   }
-  lua::raiseIfRefused(car.lightsPattern(p));
-  return 0;
+  return lua::raiseIfRefused(car.lightsPattern(p));
 }
 
 // ---- state fields: one entry each (docs/lua-api.md "Car fields") ----

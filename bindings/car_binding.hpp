@@ -9,6 +9,7 @@
 #include <string_view>
 #include <unordered_map>
 
+#include "bindings/lua_args.hpp"
 #include "engine/vehicles/anki_car.hpp"
 
 namespace pitwall {
@@ -31,12 +32,7 @@ class EventNames;
   X(Status)                   \
   X(Collision) X(Speed) X(LaneChange) X(Recovery) X(Connect) X(Disconnect) X(Malformed) X(Message)
 
-enum class CarEvent {
-#define PITWALL_CAR_EVENT_ENUM(name) name,
-  PITWALL_CAR_EVENTS(PITWALL_CAR_EVENT_ENUM)
-#undef PITWALL_CAR_EVENT_ENUM
-      Count_
-};
+enum class CarEvent { PITWALL_CAR_EVENTS(PITWALL_EVENT_ENUM) Count_ };
 inline constexpr std::size_t kCarEventCount = static_cast<std::size_t>(CarEvent::Count_);
 
 class CarBinding {

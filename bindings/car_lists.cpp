@@ -24,12 +24,6 @@ constexpr std::size_t kRollMax = 8;        // cars a sentence names; then how ma
 constexpr lua_Integer kReadMax = 100'000;  // entries of a list the explainer reads at most
 constexpr std::string_view kLuaSays = "attempt to index a nil value";
 
-int rawField(lua_State* L, int t, const char* key) {
-  t = lua_absindex(L, t);
-  lua_pushstring(L, key);
-  return lua_rawget(L, t);
-}
-
 // A car list's __index: nil, as any table answers. When the line of a Lua function asked — not
 // ipairs, whose probe one past the end is how it stops, nor another C function — a note of what
 // was asked and where, overwriting the last one.
@@ -134,13 +128,13 @@ std::optional<std::string> explainMissingCar(lua_State* thread, int level,
   if (lua_rawgetp(thread, LUA_REGISTRYINDEX, &kNoteKey) != LUA_TTABLE) return done(std::nullopt);
   const int note = lua_gettop(thread);
   auto integerField = [&](const char* name) {
-    rawField(thread, note, name);
+    lua::rawField(thread, note, name);
     const lua_Integer v = lua_isinteger(thread, -1) ? lua_tointeger(thread, -1) : -1;
     lua_pop(thread, 1);
     return v;
   };
   auto pointerField = [&](const char* name) {
-    rawField(thread, note, name);
+    lua::rawField(thread, note, name);
     const void* p = lua_touserdata(thread, -1);
     lua_pop(thread, 1);
     return p;
@@ -149,13 +143,13 @@ std::optional<std::string> explainMissingCar(lua_State* thread, int level,
   if (pointerField("thread") != thread || pointerField("source") != ar.source ||
       integerField("defined") != ar.linedefined || integerField("line") != ar.currentline)
     return done(std::nullopt);
-  const int keyType = rawField(thread, note, "key");
+  const int keyType = lua::rawField(thread, note, "key");
   const int key = lua_gettop(thread);
   if (keyType == LUA_TNUMBER
           ? wanted == Key::Name
           : wanted == Key::Integer || (wanted == Key::Name && field != lua_tostring(thread, key)))
     return done(std::nullopt);
-  if (rawField(thread, note, "list") != LUA_TTABLE) return done(std::nullopt);
+  if (lua::rawField(thread, note, "list") != LUA_TTABLE) return done(std::nullopt);
   const int list = lua_gettop(thread);
 
   // What the list holds: its cars by number, and the names it keys cars by (the REPL's `cars`).
@@ -174,7 +168,8 @@ std::optional<std::string> explainMissingCar(lua_State* thread, int level,
     lua_pop(thread, 1);
   }
   lua_rawgeti(thread, LUA_REGISTRYINDEX, LUA_RIDX_GLOBALS);
-  const bool global = rawField(thread, -1, "cars") == LUA_TTABLE && lua_rawequal(thread, -1, list);
+  const bool global =
+      lua::rawField(thread, -1, "cars") == LUA_TTABLE && lua_rawequal(thread, -1, list);
 
   std::string sentence;
   if (keyType == LUA_TNUMBER) {

@@ -18,6 +18,11 @@
 #include "bindings/protected_call.hpp"
 #include "engine/core/numbers.hpp"
 
+// A type's events, one X-macro list (X(Position) X(Transition) …), made into its enum's entries
+// and its names ("onPosition", …).
+#define PITWALL_EVENT_ENUM(name) name,
+#define PITWALL_EVENT_NAME(name) "on" #name,
+
 namespace pitwall::lua {
 
 struct LuaError : std::runtime_error {
@@ -51,18 +56,18 @@ int guarded(lua_State* L) {
 }
 
 // A vehicle model's answer to a command (Sent: true, or the sentence why nothing was sent),
-// the sentence raised.
+// the sentence raised; else 0, the command method's results: `return raiseIfRefused(…)`.
 template <class Sent>
-void raiseIfRefused(const Sent& sent) {
+int raiseIfRefused(const Sent& sent) {
   if (!sent) throw LuaError(sent.error());
+  return 0;
 }
 
 // A method that takes no argument and sends one command, robot:stop(): command<modelAt,
 // &Model::stop>, where modelAt(L, 1) is the object's model (checked: another object raises).
 template <auto ModelAt, auto Method>
 int command(lua_State* L) {
-  raiseIfRefused((ModelAt(L, 1).*Method)());
-  return 0;
+  return raiseIfRefused((ModelAt(L, 1).*Method)());
 }
 
 inline std::string typeName(lua_State* L, int idx) {
@@ -131,6 +136,13 @@ inline std::string checkString(lua_State* L, int idx, const char* what) {
 inline void checkFunction(lua_State* L, int idx, const char* what) {
   if (lua_type(L, idx) != LUA_TFUNCTION)
     throw LuaError(std::string(what) + " must be a function, got " + typeName(L, idx));
+}
+
+// t[key] without metamethods (t at index t), its type: nothing of the script runs.
+inline int rawField(lua_State* L, int t, const char* key) {
+  t = lua_absindex(L, t);
+  lua_pushstring(L, key);
+  return lua_rawget(L, t);
 }
 
 // t[key] = value for the table on top of the stack.

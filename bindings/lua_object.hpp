@@ -113,30 +113,35 @@ struct EventSource {
   std::string_view who;
 };
 
-// Delivers event e of `source`: the listeners' hub, then the handler, each called as
-// fn(object, table). The table is the reused one at `tableRef` (the hot path: `fill` writes only
-// what changed) or, with LUA_NOREF, a fresh one; either way both calls see the same table, with
-// `time` (the loop's seconds) and what `fill(L)` writes into it (the table on top of the stack).
-// An error in either is reported by the host, naming the event and `who`; neither stops the
-// other. Nothing is pushed or built when no function wants the event.
-// emit's two halves, out of line, for every case but the hot one (a reused table and the handler
-// alone, no listeners), which emit does inline (docs/performance.md "Frame → Lua: the plumbing cut,
-// and the floor"). begin pushes the traceback handler, the first function (the hub if any, else the
-// handler), the object and the event table with `time` set, and returns false (nothing pushed) when
-// no function wants the event; finish makes the calls.
-bool beginEvent(const EventSource& source, std::size_t e, int tableRef);
-void finishEvent(const EventSource& source, std::size_t e, int tableRef);
+// Delivers event e of `source` to the functions that want it, the listeners' hub first, then
+// the handler (read after the hub ran: a listener may have removed it), each called as
+// fn(object, args…): `push(L)` pushes the arguments and returns how many, once per function
+// called (the MindRoad's onLost(robot, reason)). An error in either is reported by the host,
+// naming the event and `who`; neither stops the other.
+bool pushCallee(const EventSource& source, std::size_t e, bool hub);
+void callCallee(const EventSource& source, std::size_t e, bool hub, int nargs);
 
+template <class Push>
+void emitArgs(const EventSource& source, std::size_t e, Push&& push) {
+  PITWALL_STACK_CHECK(source.host.state(), 0, "an event's delivery (lua::emitArgs)");
+  for (bool hub : {true, false})
+    if (pushCallee(source, e, hub)) callCallee(source, e, hub, push(source.host.state()));
+}
+
+// The same with one table, fn(object, ev), both calls seeing the same one: the reused table at
+// `tableRef` (the hot path: `fill` writes only what changed) or, with LUA_NOREF, a fresh one, with
+// `time` (the loop's seconds) and what `fill(L)` writes into it (the table on top of the stack).
+// Nothing is pushed or built when no function wants the event.
 template <class Fill>
 void emit(const EventSource& source, std::size_t e, int tableRef, Fill&& fill) {
   PITWALL_STACK_CHECK(source.host.state(), 0, "an event's delivery (lua::emit)");
+  ScriptHost& host = source.host;
+  lua_State* L = host.state();
   if (tableRef != LUA_NOREF && source.slots.hub(e) == LUA_NOREF) {
-    // The hot path (a reused table, the handler alone, no listeners) in one piece, inline:
-    // what beginEvent and finishEvent do, without their branches and calls.
+    // The hot path (a reused table, the handler alone, no listeners) in one piece, inline
+    // (docs/performance.md "Frame → Lua: the plumbing cut, and the floor").
     const int handler = source.slots.handler(e);
     if (handler == LUA_NOREF) return;
-    ScriptHost& host = source.host;
-    lua_State* L = host.state();
     lua_pushcfunction(L, traceback);
     lua_rawgeti(L, LUA_REGISTRYINDEX, handler);
     lua_rawgeti(L, LUA_REGISTRYINDEX, source.selfRef);
@@ -147,22 +152,20 @@ void emit(const EventSource& source, std::size_t e, int tableRef, Fill&& fill) {
     host.callAboveHandler(2, source.names.handlerWhat(e), source.who);
     return;
   }
-  if (!beginEvent(source, e, tableRef)) return;
-  fill(source.host.state());
-  finishEvent(source, e, tableRef);
-}
-
-// The same for an event whose functions take positional arguments instead of a table,
-// fn(object, args…) (the MindRoad's onLost(robot, reason)): `push(L)` pushes them and returns how
-// many. It runs once per function called (the hub, then the handler), so each gets its own.
-bool pushCallee(const EventSource& source, std::size_t e, bool hub);
-void callCallee(const EventSource& source, std::size_t e, bool hub, int nargs);
-
-template <class Push>
-void emitArgs(const EventSource& source, std::size_t e, Push&& push) {
-  PITWALL_STACK_CHECK(source.host.state(), 0, "an event's delivery (lua::emitArgs)");
-  for (bool hub : {true, false})
-    if (pushCallee(source, e, hub)) callCallee(source, e, hub, push(source.host.state()));
+  if (!source.slots.wanted(e)) return;
+  if (tableRef != LUA_NOREF)
+    lua_rawgeti(L, LUA_REGISTRYINDEX, tableRef);
+  else
+    lua_createtable(L, 0, 4);
+  lua_pushnumber(L, host.loop().seconds());
+  lua_setfield(L, -2, "time");
+  fill(L);
+  const int table = lua_gettop(L);
+  emitArgs(source, e, [table](lua_State* S) {
+    lua_pushvalue(S, table);
+    return 1;
+  });
+  lua_pop(L, 1);
 }
 
 // What a robot object holds (the Alphabot, the MindRoad): its model, its world, its events'

@@ -36,16 +36,8 @@ constexpr double kConfirmWindow = 5;  // s: shutdown() typed at the REPL must be
 // onContact(robot), onLost(robot, reason) (docs/robots.md).
 #define PITWALL_MINDROAD_EVENTS(X) X(Contact) X(Lost)
 
-enum class Event {
-#define PITWALL_MINDROAD_EVENT_ENUM(name) name,
-  PITWALL_MINDROAD_EVENTS(PITWALL_MINDROAD_EVENT_ENUM)
-#undef PITWALL_MINDROAD_EVENT_ENUM
-};
-constexpr const char* kEvents[] = {
-#define PITWALL_MINDROAD_EVENT_NAME(name) "on" #name,
-    PITWALL_MINDROAD_EVENTS(PITWALL_MINDROAD_EVENT_NAME)
-#undef PITWALL_MINDROAD_EVENT_NAME
-};
+enum class Event { PITWALL_MINDROAD_EVENTS(PITWALL_EVENT_ENUM) };
+constexpr const char* kEvents[] = {PITWALL_MINDROAD_EVENTS(PITWALL_EVENT_NAME)};
 
 struct Robot : lua::Device<MindroadRobot> {
   std::optional<TimePoint> shutdownAsked;
@@ -83,17 +75,13 @@ void deliver(Robot& r, Event e, Push&& push) {
 
 // ---- methods ----
 int steer(lua_State* L) {
-  auto& c = open(L, 1);
-  lua::raiseIfRefused(c.steer(lua::checkRounded(L, 2, "steer x (forward/backward)"),
-                              lua::checkRounded(L, 3, "steer y (right/left)")));
-  return 0;
+  return lua::raiseIfRefused(open(L, 1).steer(lua::checkRounded(L, 2, "steer x (forward/backward)"),
+                                              lua::checkRounded(L, 3, "steer y (right/left)")));
 }
 
 int click(lua_State* L) {
-  auto& c = open(L, 1);
-  lua::raiseIfRefused(
-      c.click(lua::checkRounded(L, 2, "click x"), lua::checkRounded(L, 3, "click y")));
-  return 0;
+  return lua::raiseIfRefused(
+      open(L, 1).click(lua::checkRounded(L, 2, "click x"), lua::checkRounded(L, 3, "click y")));
 }
 
 constexpr std::pair<const char*, int> kButtons[] = {
@@ -126,14 +114,11 @@ int buttons(lua_State* L) {
     throw LuaError("buttons takes a button name, a list of names or a byte 0..255, got " +
                    lua::typeName(L, 2));
   }
-  lua::raiseIfRefused(c.buttons(raw));
-  return 0;
+  return lua::raiseIfRefused(c.buttons(raw));
 }
 
 int pictureMode(lua_State* L) {
-  auto& c = open(L, 1);
-  lua::raiseIfRefused(c.pictureMode(lua::checkString(L, 2, "picture mode")));
-  return 0;
+  return lua::raiseIfRefused(open(L, 1).pictureMode(lua::checkString(L, 2, "picture mode")));
 }
 
 // Turns the robot off. Typed at the REPL it asks first: the first call prints a warning, a

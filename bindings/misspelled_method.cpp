@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "bindings/car_lists.hpp"
+#include "bindings/lua_args.hpp"
 #include "engine/core/suggest.hpp"
 
 namespace pitwall::lua {
@@ -30,13 +31,6 @@ void addFunctionKeys(lua_State* L, int table, std::vector<std::string>& out) {
   }
 }
 
-// t[key] without metamethods (t at index t): nothing of the script runs inside an error handler.
-int rawField(lua_State* L, int t, const char* key) {
-  t = lua_absindex(L, t);
-  lua_pushstring(L, key);
-  return lua_rawget(L, t);
-}
-
 // The kind of the object on top of L's stack, when it has methods; pops nothing. Only raw reads:
 // a metatable's own __index (a "strict" guard, a loop) never runs here.
 std::optional<Kind> kindOf(lua_State* L) {
@@ -45,9 +39,9 @@ std::optional<Kind> kindOf(lua_State* L) {
   if (!lua_getmetatable(L, obj)) return std::nullopt;
   const int mt = lua_gettop(L);
   std::optional<Kind> kind;
-  if (rawField(L, mt, "__name") == LUA_TSTRING) {
+  if (lua::rawField(L, mt, "__name") == LUA_TSTRING) {
     kind = Kind{lua_tostring(L, -1), {}};
-    if (rawField(L, mt, "__methods") == LUA_TTABLE) {
+    if (lua::rawField(L, mt, "__methods") == LUA_TTABLE) {
       addFunctionKeys(L, lua_gettop(L), kind->methods);
     } else {
       // a Lua class: the functions of its __index chain (a few levels of inheritance)
@@ -55,7 +49,7 @@ std::optional<Kind> kindOf(lua_State* L) {
       if (lua_type(L, obj) == LUA_TTABLE) addFunctionKeys(L, obj, kind->methods);
       lua_pushvalue(L, mt);
       for (int depth = 0; depth < 8; ++depth) {
-        if (rawField(L, -1, "__index") != LUA_TTABLE) {
+        if (lua::rawField(L, -1, "__index") != LUA_TTABLE) {
           lua_pop(L, 1);
           break;
         }
@@ -117,7 +111,7 @@ std::vector<Library> libraries(lua_State* L) {
   };
   luaL_getsubtable(L, LUA_REGISTRYINDEX, LUA_LOADED_TABLE);  // never made: the host opened it
   const int loaded = lua_gettop(L);
-  if (rawField(L, loaded, "pitwall") == LUA_TTABLE) {
+  if (lua::rawField(L, loaded, "pitwall") == LUA_TTABLE) {
     const int pitwall = lua_gettop(L);
     out.push_back({pitwall, "pitwall"});
     lua_pushnil(L);
@@ -227,7 +221,7 @@ std::optional<std::string> explainMissingFunction(lua_State* thread, int level,
   std::vector<std::string> tables, suggestions;
   for (const Library& l : libs) {
     if (!l.seen) continue;
-    if (rawField(thread, l.index, field.c_str()) != LUA_TNIL) {
+    if (lua::rawField(thread, l.index, field.c_str()) != LUA_TNIL) {
       lua_pop(thread, 1);
       continue;
     }

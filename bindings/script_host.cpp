@@ -85,18 +85,20 @@ ScriptHost& ScriptHost::from(lua_State* L) {
 }
 
 bool ScriptHost::call(int nargs, int nresults, const char* what, std::string_view who) {
-  lua_State* L = L_;
   if (life_ == Life::ShutDown) {
-    lua_pop(L, nargs + 1);
+    lua_pop(L_, nargs + 1);
     return false;
   }
-  int base = lua_gettop(L) - nargs;  // the function's slot
-  lua_pushcfunction(L, lua::traceback);
-  lua_insert(L, base);
-  const int status =
-      lua::protectedCall(L, nargs, nresults, base, interrupt::Kind::Callback, options_.budget);
-  lua_remove(L, base);
-  return finishCall(status, what, who);
+  return finishCall(tracedCall(nargs, nresults, interrupt::Kind::Callback), what, who);
+}
+
+int ScriptHost::tracedCall(int nargs, int nresults, interrupt::Kind kind) {
+  const int base = lua_gettop(L_) - nargs;  // the function's slot
+  lua_pushcfunction(L_, lua::traceback);
+  lua_insert(L_, base);
+  const int status = lua::protectedCall(L_, nargs, nresults, base, kind, options_.budget);
+  lua_remove(L_, base);
+  return status;
 }
 
 bool ScriptHost::callInteractive(int nargs, int nresults, std::string& error) {
@@ -108,17 +110,11 @@ bool ScriptHost::callCapturing(int nargs, int nresults, std::string& error) {
 }
 
 bool ScriptHost::protectedCall(int nargs, int nresults, std::string& error, bool console) {
-  lua_State* L = L_;
-  int base = lua_gettop(L) - nargs;
-  lua_pushcfunction(L, lua::traceback);
-  lua_insert(L, base);
-  const int status = lua::protectedCall(
-      L, nargs, nresults, base, console ? interrupt::Kind::Console : interrupt::Kind::Callback,
-      options_.budget);
-  lua_remove(L, base);
-  if (status == LUA_OK) return true;
-  error = lua_tostring(L, -1) ? lua_tostring(L, -1) : "(error without a message)";
-  lua_pop(L, 1);
+  if (tracedCall(nargs, nresults, console ? interrupt::Kind::Console : interrupt::Kind::Callback) ==
+      LUA_OK)
+    return true;
+  error = lua_tostring(L_, -1) ? lua_tostring(L_, -1) : "(error without a message)";
+  lua_pop(L_, 1);
   if (memory_.exceeded) error = sandbox::memoryMessage(memory_);
   checkMemory();
   return false;
@@ -191,12 +187,7 @@ void ScriptHost::requestStop() {
   if (onStopRequested) onStopRequested();
 }
 
-Result<bool, std::string> ScriptHost::startLoaded(int status) {
-  if (status != LUA_OK) {
-    std::string err = lua_tostring(L_, -1) ? lua_tostring(L_, -1) : "cannot load the script";
-    lua_pop(L_, 1);
-    return Unexpected{err};
-  }
+Result<bool, std::string> ScriptHost::startLoaded() {
   tasks_.spawn(L_, "main chunk", true);
   return true;
 }
@@ -207,24 +198,17 @@ Result<bool, std::string> ScriptHost::loadFile(const std::string& path) {
   // The script's own folder joins the front of the require path (as messages show it: its
   // modules are named relative to the current folder too).
   fs::path folder = fs::path(script_file::shownPath(path)).parent_path();
-  const std::string dir = folder.empty() ? std::string(".") : folder.string();
-  lua_getglobal(L_, "package");
-  lua_getfield(L_, -1, "path");
-  std::string p = dir + "/?.lua;" + dir + "/?/init.lua;" + lua_tostring(L_, -1);
-  lua_pop(L_, 1);
-  lua_pushlstring(L_, p.data(), p.size());
-  lua_setfield(L_, -2, "path");
-  lua_pop(L_, 1);
+  prependRequirePath(L_, {folder.empty() ? std::string(".") : folder.string()});
   if (auto loaded = script_file::load(L_, path); !loaded) return loaded;
   loadedFiles_.push_back(fs::absolute(path, ec).lexically_normal().string());
   return true;
 }
 
 Result<bool, std::string> ScriptHost::startLoadedFile(StartMode mode) {
-  if (mode == StartMode::Run) return startLoaded(LUA_OK);
+  if (mode == StartMode::Run) return startLoaded();
   std::optional<std::string> error;
   trialError_ = &error;
-  auto started = startLoaded(LUA_OK);
+  auto started = startLoaded();
   trialError_ = nullptr;
   if (started && error) return Unexpected{*error};
   return started;
@@ -247,8 +231,8 @@ Result<bool, std::string> ScriptHost::loadString(const std::string& code,
 
 Result<bool, std::string> ScriptHost::startString(const std::string& code,
                                                   const std::string& chunkname) {
-  return startLoaded(
-      luaL_loadbufferx(L_, code.data(), code.size(), ("@" + chunkname).c_str(), "t"));
+  if (auto loaded = loadString(code, chunkname); !loaded) return loaded;
+  return startLoaded();
 }
 
 void ScriptHost::mainEnded(const std::string& where, const std::string& error) {

@@ -210,7 +210,10 @@ class ScriptHost {
   bool finishCall(int status, const char* what, std::string_view who);
   // callAboveHandler's error path, out of line: the error over the handler.
   bool failedAboveHandler(int status, const char* what, std::string_view who);
-  Result<bool, std::string> startLoaded(int status);
+  Result<bool, std::string> startLoaded();
+  // Calls the function under the top `nargs` values with the traceback handler under it (gone
+  // after): lua::protectedCall's status, the error or the results on the stack.
+  int tracedCall(int nargs, int nresults, interrupt::Kind kind);
 
   Loop& loop_;
   Fleet& fleet_;

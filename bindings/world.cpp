@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "bindings/car_binding.hpp"
 #include "bindings/interrupt.hpp"
@@ -63,17 +64,24 @@ std::string scriptsDir() {
   return (*data / "scripts").string();
 }
 
-// print and io.write go to the console: straight to stdout, or above the REPL's prompt.
-int consolePrint(lua_State* L) {
-  int n = lua_gettop(L);
+// print, io.write and pitwall.stdout:write go to the console: straight to stdout, or above the
+// REPL's prompt. The values from `first` on: print's way (any value, tab-separated, a newline
+// after), or io.write's (strings and numbers only, as they are).
+int consoleWriteFrom(lua_State* L, int first, bool print = false) {
+  const int n = lua_gettop(L);
   luaL_Buffer b;
   luaL_buffinit(L, &b);
-  for (int i = 1; i <= n; ++i) {
-    luaL_tolstring(L, i, nullptr);
+  for (int i = first; i <= n; ++i) {
+    if (print || lua_type(L, i) == LUA_TNUMBER) {
+      luaL_tolstring(L, i, nullptr);
+    } else {
+      luaL_checkstring(L, i);
+      lua_pushvalue(L, i);
+    }
     luaL_addvalue(&b);
-    luaL_addchar(&b, i < n ? '\t' : '\n');
+    if (print) luaL_addchar(&b, i < n ? '\t' : '\n');
   }
-  if (n == 0) luaL_addchar(&b, '\n');
+  if (print && n < first) luaL_addchar(&b, '\n');
   luaL_pushresult(&b);
   size_t len = 0;
   const char* text = lua_tolstring(L, -1, &len);
@@ -81,25 +89,8 @@ int consolePrint(lua_State* L) {
   return 0;
 }
 
-// io.write(...) and pitwall.stdout:write(...): strings and numbers, as io.write takes them.
-int consoleWriteFrom(lua_State* L, int first) {
-  int n = lua_gettop(L);
-  luaL_Buffer b;
-  luaL_buffinit(L, &b);
-  for (int i = first; i <= n; ++i) {
-    if (lua_type(L, i) == LUA_TNUMBER) {
-      luaL_tolstring(L, i, nullptr);
-    } else {
-      luaL_checkstring(L, i);
-      lua_pushvalue(L, i);
-    }
-    luaL_addvalue(&b);
-  }
-  luaL_pushresult(&b);
-  size_t len = 0;
-  const char* text = lua_tolstring(L, -1, &len);
-  console::write({text, len});
-  return 0;
+int consolePrint(lua_State* L) {
+  return consoleWriteFrom(L, 1, true);
 }
 
 int consoleIoWrite(lua_State* L) {
@@ -173,22 +164,6 @@ void openConsole(lua_State* L) {
   lua_pop(L, 1);
 }
 
-// require: the --lib folders first, then the shipped library (`lib`), then Lua's default.
-void openRequirePath(ScriptHost& host, const std::string& lib) {
-  lua_State* L = host.state();
-  std::string path;
-  for (const auto& dir : host.options().library_paths)
-    path += dir + "/?.lua;" + dir + "/?/init.lua;";
-  path += lib + "/?.lua;" + lib + "/?/init.lua;";
-  lua_getglobal(L, "package");
-  lua_getfield(L, -1, "path");
-  path += lua_tostring(L, -1);
-  lua_pop(L, 1);
-  lua_pushlstring(L, path.data(), path.size());
-  lua_setfield(L, -2, "path");
-  lua_pop(L, 1);
-}
-
 void seedRandom(lua_State* L, std::uint64_t seed) {
   lua_getglobal(L, "math");
   lua_getfield(L, -1, "randomseed");
@@ -228,12 +203,27 @@ void openLuaLibrary(ScriptHost& host, const std::string& lib) {
 
 }  // namespace
 
+void prependRequirePath(lua_State* L, const std::vector<std::string>& dirs) {
+  std::string path;
+  for (const auto& dir : dirs) path += dir + "/?.lua;" + dir + "/?/init.lua;";
+  lua_getglobal(L, "package");
+  lua_getfield(L, -1, "path");
+  path += lua_tostring(L, -1);
+  lua_pop(L, 1);
+  lua_pushlstring(L, path.data(), path.size());
+  lua_setfield(L, -2, "path");
+  lua_pop(L, 1);
+}
+
 void openWorld(ScriptHost& host) {
   lua_State* L = host.state();
   const std::string lib = scriptsDir();
   openLuaLibraries(L);
   openConsole(L);
-  openRequirePath(host, lib);
+  // require: the --lib folders first, then the shipped library, then Lua's default
+  std::vector<std::string> dirs = host.options().library_paths;
+  dirs.push_back(lib);
+  prependRequirePath(L, dirs);
   host.setLibrary(lib);  // its chunks' names, for the blame (lua::Frames)
   seedRandom(L, host.options().seed);
   host.cars().registerType(L);

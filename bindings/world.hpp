@@ -5,11 +5,20 @@
 //
 // The private protocol between the C++ and the Lua library — the `pitwall._*` names, which
 // scripts are not meant to use — is listed there too, and in docs/architecture.md.
+#include <string>
+#include <vector>
+
+struct lua_State;
+
 namespace pitwall {
 
 class ScriptHost;
 
 // Opens everything a new world holds, in order (ScriptHost's constructor, once).
 void openWorld(ScriptHost& host);
+
+// Puts `dirs` (each as DIR/?.lua and DIR/?/init.lua) before require's path: the world's library
+// folders when it opens, a script's own folder when it is loaded (ScriptHost::loadFile).
+void prependRequirePath(lua_State* L, const std::vector<std::string>& dirs);
 
 }  // namespace pitwall
