@@ -20,7 +20,6 @@
 #include "bindings/lua_object.hpp"
 #include "bindings/lua_options.hpp"
 #include "bindings/metatables.hpp"
-#include "bindings/results.hpp"
 #include "bindings/script_host.hpp"
 #include "bindings/track_table.hpp"
 #include "engine/core/console.hpp"
@@ -28,6 +27,7 @@
 #include "engine/core/printable.hpp"
 #include "engine/core/suggest.hpp"
 #include "engine/protocol/anki/pieces.hpp"
+#include "engine/record/results.hpp"
 #include "engine/sim/track.hpp"
 #include "engine/sim/world.hpp"
 

@@ -5,7 +5,6 @@
 #include <iostream>
 #include <memory>
 
-#include "bindings/results.hpp"
 #include "bindings/script_file.hpp"
 #include "engine/cli/commands.hpp"
 #include "engine/cli/fail.hpp"
@@ -14,6 +13,7 @@
 #include "engine/cli/session.hpp"
 #include "engine/core/log.hpp"
 #include "engine/core/numbers.hpp"
+#include "engine/record/results.hpp"
 
 namespace pitwall::cli {
 

@@ -1,5 +1,5 @@
-// Results files (bindings/results.hpp) and pitwall.writeResults.
-#include "bindings/results.hpp"
+// Results files (engine/record/results.hpp) and pitwall.writeResults.
+#include "engine/record/results.hpp"
 
 #include <doctest/doctest.h>
 

@@ -1,4 +1,4 @@
-#include "bindings/results.hpp"
+#include "engine/record/results.hpp"
 
 #include "engine/core/numbers.hpp"
 
