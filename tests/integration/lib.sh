@@ -17,8 +17,9 @@ check() {
   if [ "$2" != "$3" ]; then fail "$1: expected [$2], got [$3]"; else echo "ok: $1"; fi
 }
 
-# contains NAME NEEDLE HAYSTACK
+# contains NAME NEEDLE HAYSTACK (an empty needle fails: it would match anything)
 contains() {
+  [ -n "$2" ] || { fail "$1: nothing to look for (an empty needle matches anything)"; return; }
   case "$3" in
     *"$2"*) echo "ok: $1" ;;
     *) fail "$1: expected to contain [$2], got [$3]" ;;

@@ -115,7 +115,7 @@ check "--script: exit status" 0 "$?"
 # (the car by the name its first line in the record carries)
 first=$($PY -c '
 import json, sys
-lines = [l for l in map(json.loads, open(sys.argv[1])) if "car" in l]  # (frames, not the race)
+lines = [l for l in map(json.loads, open(sys.argv[1])) if "dir" in l]  # frames (not the race, links)
 names = {}
 for l in lines:
     names.setdefault(l["car"], l.get("carName"))
