@@ -3,6 +3,7 @@
 #include <sys/socket.h>
 
 #include <sdbus-c++/sdbus-c++.h>
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 
@@ -33,11 +34,30 @@ GattClient::~GattClient() {
 
 void GattClient::armStepTimer(Duration timeout, std::string what) {
   bluez_.loop().cancel(stepTimer_);
+  stepTimeout_ = timeout;
+  stepWhat_ = std::move(what);
+  stepOverdue_ = false;
   auto attempt = attempt_;
-  stepTimer_ = bluez_.loop().after(timeout, [this, attempt, timeout, what] {
+  stepTimer_ = bluez_.loop().after(timeout, [this, attempt] {
     stepTimer_ = 0;
-    if (current(attempt)) fail(what + " timed out after " + seconds(timeout));
+    if (!current(attempt)) return;
+    if (setupCalls_ > 0) {
+      stepOverdue_ = true;
+      log::info(label(), stepWhat_ + " takes longer than " + seconds(stepTimeout_) +
+                             ": waiting for BlueZ's answer (giving up now would leave bluetoothd "
+                             "before 5.84 holding the car's notifications)");
+      return;
+    }
+    fail(stepWhat_ + " timed out after " + seconds(stepTimeout_));
   });
+}
+
+void GattClient::setupCallAnswered(std::uint64_t attempt) {
+  --setupCalls_;
+  if (setupCalls_ == 0 && stepOverdue_ && current(attempt)) {
+    // the step goes on from here with its timeout anew (ready() or fail() cancel it)
+    armStepTimer(stepTimeout_, stepWhat_);
+  }
 }
 
 void GattClient::connect(Done done) {
@@ -111,14 +131,17 @@ void GattClient::acquire(const std::string& path, const char* method,
                          std::function<void(const sdbus::Error*, int fd)> then) {
   auto attempt = attempt_;
   std::weak_ptr<bool> alive = alive_;
+  setupCallSent();
   bluez_.proxy(path)
       .callMethodAsync(method)
       .onInterface(kCharIface)
-      .withTimeout(timeouts_.subscribe)
+      .withTimeout(std::max(timeouts_.subscribe, kSetupCallLimit))
       .withArguments(std::map<std::string, sdbus::Variant>{})
       .uponReplyInvoke([this, alive, attempt, method, then](
                            const sdbus::Error* error, sdbus::UnixFd fd, std::uint16_t /*mtu*/) {
-        if (alive.expired() || !current(attempt)) return;
+        if (alive.expired()) return;
+        setupCallAnswered(attempt);
+        if (!current(attempt)) return;
         if (error) log::debug(label(), std::string(method) + " refused (" + error->getName() + ")");
         then(error, error ? -1 : fd.release());
       });
@@ -129,12 +152,15 @@ void GattClient::startNotify(const std::string& path,
                              std::function<void(const sdbus::Error*)> then) {
   auto attempt = attempt_;
   std::weak_ptr<bool> alive = alive_;
+  setupCallSent();
   bluez_.proxy(path)
       .callMethodAsync("StartNotify")
       .onInterface(kCharIface)
-      .withTimeout(timeouts_.subscribe)
+      .withTimeout(std::max(timeouts_.subscribe, kSetupCallLimit))
       .uponReplyInvoke([this, alive, attempt, then](const sdbus::Error* error) {
-        if (alive.expired() || !current(attempt)) return;
+        if (alive.expired()) return;
+        setupCallAnswered(attempt);
+        if (!current(attempt)) return;
         then(error);
       });
   bluez_.pump().kick();
@@ -153,6 +179,7 @@ void GattClient::fail(const std::string& reason) {
   bool reachedDevice = step_ != Step::Connecting;
   ++attempt_;  // replies still on their way belong to a finished attempt
   bluez_.loop().cancel(stepTimer_);
+  stepOverdue_ = false;
   if (onClosed) onClosed();
   step_ = Step::Idle;
   // Half-connected: leave BlueZ clean for the next attempt.

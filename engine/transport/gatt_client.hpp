@@ -70,8 +70,16 @@ class GattClient {
   // For the profile's own asynchronous steps: the attempt a reply belongs to.
   std::uint64_t attempt() const { return attempt_; }
   bool current(std::uint64_t attempt) const { return attempt == attempt_; }
-  // A timeout for the profile's setup step: fail("<what> timed out after …").
+  // A timeout for the profile's setup step: fail("<what> timed out after …") — except while a
+  // setup call (below) waits for bluetoothd's answer: then the step waits for that answer (as long
+  // as kSetupCallLimit), and the timeout starts again after it. A Disconnect while bluetoothd
+  // still writes a car's notification setting leaves BlueZ before 5.84 holding the notifications
+  // ("Notify acquired", refused until bluetoothd restarts: docs/bluetooth.md), so a slow car is
+  // waited for rather than dropped.
   void armStepTimer(Duration timeout, std::string what);
+  // How long a setup call may wait for bluetoothd: past BlueZ's ATT transaction timeout (30 s),
+  // after which bluetoothd itself has given up on the car and answered.
+  static constexpr Duration kSetupCallLimit = std::chrono::seconds(35);
   // AcquireNotify/AcquireWrite on `path`; then(error or nullptr, the socket) for this attempt.
   void acquire(const std::string& path, const char* method,
                std::function<void(const sdbus::Error*, int fd)> then);
@@ -91,6 +99,8 @@ class GattClient {
   enum class Step { Idle, Connecting, Resolving, Setup, Up };
   void resolved();
   void disconnectQuietly();  // Device1.Disconnect, nobody waiting for the answer
+  void setupCallSent() { ++setupCalls_; }
+  void setupCallAnswered(std::uint64_t attempt);
 
   Bluez& bluez_;
   // The loop itself, not through bluez_: a link may outlive the Bluez (the fleet that holds the
@@ -103,6 +113,10 @@ class GattClient {
   std::uint64_t attempt_ = 0;
   Done done_;
   Loop::TimerId stepTimer_ = 0;
+  Duration stepTimeout_{};
+  std::string stepWhat_;
+  int setupCalls_ = 0;        // setup calls bluetoothd has not answered yet (any attempt's)
+  bool stepOverdue_ = false;  // the step's timeout passed while one was waiting
   bool disconnectRequested_ = false;
   bool sawConnected_ = false;  // BlueZ's Connected as last seen
   std::shared_ptr<bool> alive_;

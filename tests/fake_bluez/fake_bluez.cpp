@@ -523,6 +523,7 @@ void FakeBluez::State::exportDevice(Device& d) {
       return failConnect(*dp, "le-connection-abort-by-local");
     }
     if (!dp->connected) throw notConnected();
+    abandonNotify(*dp);
     log::debug(kComponent, dp->address + ": disconnected by the client");
     linkDown(*dp, true);
   });
@@ -619,6 +620,7 @@ void FakeBluez::State::unexportDevice(Device& d) {
 void FakeBluez::State::forget(Device& d) {
   if (d.connecting) failConnect(d, kConnectionAborted);
   linkDown(d, true);
+  d.notifyHeld = false;  // bluetoothd lets go of what it held for the device
   unexportDevice(d);
   log::debug(kComponent, d.address + ": removed");
 }

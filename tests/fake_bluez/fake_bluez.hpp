@@ -53,6 +53,7 @@ struct FakeBluezCounters {
   std::size_t framesDropped = 0;   // car frames nobody was subscribed to
   int connectsInProgress = 0;      // Connect calls answered InProgress (one was pending)
   int connectsCancelled = 0;       // pending Connects a Disconnect cancelled
+  int notifiesAbandoned = 0;       // Disconnects while AcquireNotify waited (NotifySlow)
 };
 
 class FakeBluez {
@@ -75,6 +76,10 @@ class FakeBluez {
   //   NotifyHeld the link drops and for `lasting` the car's notifications are held by a request
   //              bluetoothd abandoned: AcquireNotify and StartNotify are refused NotPermitted
   //              "Notify acquired" (BlueZ 5.66, a disconnect during AcquireNotify: fixed in 5.84)
+  //   NotifySlow the link drops, and on the next connection the car confirms its notification
+  //              setting `lasting` late: AcquireNotify is answered only then. A Disconnect while it
+  //              waits does what BlueZ before 5.84 does: the notifications stay held (NotifyHeld)
+  //              until the device is removed or bluetoothd restarts
   enum class Fault {
     Drop,
     Burst,
@@ -85,7 +90,8 @@ class FakeBluez {
     WriteFail,
     WriteHang,
     ConnectHang,
-    NotifyHeld
+    NotifyHeld,
+    NotifySlow
   };
 
   // Exports the adapters, then requests the name org.bluez on `connection` (unless the

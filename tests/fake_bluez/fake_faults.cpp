@@ -85,6 +85,10 @@ void FakeBluez::State::arm(Device& d, const Device::Scheduled& f) {
         window(&Device::notifyHeld, "notifications held by an abandoned request");
         drop(*dp);
         break;
+      case Fault::NotifySlow:
+        dp->notifySlow = f.lasting;
+        drop(*dp);
+        break;
       case Fault::WriteHang:
         window(&Device::writesHang, "writes hang");
         break;
@@ -136,7 +140,8 @@ void FakeBluez::State::stopBluez() {
   for (auto& d : devices) {
     if (d->connecting) failConnect(*d, kConnectionAborted);
     linkDown(*d, true);
-    d->object.reset();  // no signal: the process that owned it is gone
+    d->notifyHeld = false;  // a new bluetoothd holds nothing
+    d->object.reset();      // no signal: the process that owned it is gone
     d->alias.clear();
     d->trusted = d->blocked = false;
   }

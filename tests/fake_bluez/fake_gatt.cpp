@@ -48,7 +48,8 @@ std::unique_ptr<Characteristic> FakeBluez::State::makeCharacteristic(
       .onInterface(api::kGattCharacteristic)
       .withInputParamNames("options")
       .withOutputParamNames("fd", "mtu")
-      .implementedAs([this, dp, cp](const Dict&) { return acquire(*dp, *cp, false); });
+      .implementedAs([this, dp, cp](sdbus::Result<sdbus::UnixFd, std::uint16_t>&& result,
+                                    const Dict&) { acquireNotify(*dp, *cp, std::move(result)); });
   obj->registerMethod("StartNotify")
       .onInterface(api::kGattCharacteristic)
       .implementedAs([this, dp, cp] { startNotify(*dp, *cp); });
@@ -242,6 +243,48 @@ std::tuple<sdbus::UnixFd, std::uint16_t> FakeBluez::State::acquire(Device& d, Ch
   }
   log::debug(kComponent, d.address + (write ? ": write" : ": notify") + " socket acquired");
   return {sdbus::UnixFd(fds[1], sdbus::adopt_fd), kMtu};
+}
+
+void FakeBluez::State::acquireNotify(Device& d, Characteristic& ch,
+                                     sdbus::Result<sdbus::UnixFd, std::uint16_t>&& result) {
+  auto answer = [this](Device& dev, Characteristic& c, const auto& pending) {
+    try {
+      auto [fd, mtu] = acquire(dev, c, false);
+      pending.returnResults(fd, mtu);
+    } catch (const sdbus::Error& e) {
+      pending.returnError(e);
+    }
+  };
+  if (d.notifySlow == Duration::zero() || !d.connected) return answer(d, ch, result);
+  log::debug(kComponent, d.address + ": AcquireNotify waits " +
+                             std::to_string(toSeconds(d.notifySlow)) + " s for the car (fault)");
+  auto pending = std::make_shared<sdbus::Result<sdbus::UnixFd, std::uint16_t>>(std::move(result));
+  d.pendingNotify = pending;
+  Device* dp = &d;
+  Characteristic* cp = &ch;
+  const std::uint64_t generation = d.generation;
+  d.notifyTimer = after(std::exchange(d.notifySlow, Duration::zero()),
+                        [this, dp, cp, generation, pending, answer] {
+                          dp->notifyTimer = 0;
+                          if (dp->pendingNotify != pending) return;  // abandoned meanwhile
+                          dp->pendingNotify.reset();
+                          if (!dp->connected || dp->generation != generation)
+                            return pending->returnError(failed("Not connected"));
+                          answer(*dp, *cp, *pending);
+                          pump.kick();
+                        });
+}
+
+void FakeBluez::State::abandonNotify(Device& d) {
+  auto pending = std::move(d.pendingNotify);
+  if (!pending) return;
+  cancel(d.notifyTimer);
+  ++d.counters.notifiesAbandoned;
+  d.notifyHeld = true;  // until RemoveDevice or a restart of bluetoothd
+  log::debug(kComponent, d.address +
+                             ": a Disconnect while AcquireNotify waited: its notifications stay "
+                             "held (BlueZ before 5.84)");
+  pending->returnError(failed("Not connected"));
 }
 
 void FakeBluez::State::watchNotifyIo(Device& d, Characteristic& ch) {

@@ -55,7 +55,8 @@ void scheduleFault(pitwall::testing::FakeBluez& fake, const std::string& text) {
                                                   {"writefail", Fault::WriteFail},
                                                   {"writehang", Fault::WriteHang},
                                                   {"connecthang", Fault::ConnectHang},
-                                                  {"notifyheld", Fault::NotifyHeld}};
+                                                  {"notifyheld", Fault::NotifyHeld},
+                                                  {"notifyslow", Fault::NotifySlow}};
   auto bad = [&] {
     return std::invalid_argument(
         "--fault '" + text +
@@ -117,12 +118,12 @@ int main(int argc, char** argv) {
   app.add_option("--drop", drop, "ADDR@SECONDS: the link drops, the car stays known (repeatable)");
   app.add_option("--vanish", vanish, "ADDR@SECONDS: the car disconnects and is gone for good");
   app.add_option("--garbage", garbage, "ADDR@SECONDS: the car sends malformed frames");
-  app.add_option(
-      "--fault", faults,
-      "KIND:ADDR@SECONDS[+LASTING]: KIND drop, burst, vanish, garbage, reboot, mute, "
-      "writefail, writehang, connecthang or notifyheld, seconds after that car's first connection; "
-      "unplug:hciN@SECONDS+LASTING and restart@SECONDS+LASTING, seconds from now "
-      "(repeatable)");
+  app.add_option("--fault", faults,
+                 "KIND:ADDR@SECONDS[+LASTING]: KIND drop, burst, vanish, garbage, reboot, mute, "
+                 "writefail, writehang, connecthang, notifyheld or notifyslow, seconds after that "
+                 "car's first connection; "
+                 "unplug:hciN@SECONDS+LASTING and restart@SECONDS+LASTING, seconds from now "
+                 "(repeatable)");
   app.add_option("--alphabots", options.alphabots,
                  "Number of Alphabot robots (BLE GATT service of alphabot.md §2; default 0)")
       ->check(CLI::Range(0, 64));

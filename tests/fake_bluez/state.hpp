@@ -272,6 +272,11 @@ struct Device {
   bool writesHang = false;    // WriteHang: the write socket is not read
   bool connectHangs = false;  // ConnectHang: a connection attempt pends
   bool notifyHeld = false;    // NotifyHeld: bluetoothd's leftover notify request refuses all
+  // NotifySlow: the next AcquireNotify is answered this late (zero: at once), and its answer
+  // while it waits.
+  Duration notifySlow{};
+  std::shared_ptr<sdbus::Result<sdbus::UnixFd, std::uint16_t>> pendingNotify;
+  Loop::TimerId notifyTimer = 0;
 
   FakeBluezCounters counters;
 
@@ -368,6 +373,9 @@ struct FakeBluez::State {
 
   // Links.
   void connect(Device& d, sdbus::Result<>&& result);
+  void acquireNotify(Device& d, Characteristic& ch,
+                     sdbus::Result<sdbus::UnixFd, std::uint16_t>&& result);
+  void abandonNotify(Device& d);  // a Disconnect while AcquireNotify waits (NotifySlow)
   void finishConnect(Device& d);
   void failConnect(Device& d, const std::string& why);
   void linkUp(Device& d);

@@ -567,3 +567,27 @@ TEST_CASE(
   }
   CHECK(named >= 1);  // each refused attempt says why, and what to do
 }
+
+TEST_CASE("ble: a car slow to enable its notifications is waited for, not left to BlueZ's hold") {
+  // The car confirms its notification setting later than the subscribe step's timeout. Giving
+  // up then would send Disconnect while bluetoothd's AcquireNotify still waits for the car, and
+  // BlueZ before 5.84 then holds the notifications until it restarts (the fake does the same:
+  // NotifySlow). pitwall waits for bluetoothd's answer instead, says so, and the car comes back.
+  ble::CentralOptions o = Rig::quick();
+  o.timeouts.subscribe = 300ms;
+  Rig rig(cars(1, 1), o);
+  REQUIRE(rig.start() == std::nullopt);
+  REQUIRE(rig.waitFor([&] { return rig.fleet.connectedCount() == 1; }));
+  std::vector<std::string> lines;
+  auto tap = log::addTap(
+      [&](log::Level, std::string_view, std::string_view message) { lines.emplace_back(message); });
+  rig.fake.schedule(FakeBluez::Fault::NotifySlow, kCar1, 0ms, 1200ms);
+  REQUIRE(rig.waitFor([&] { return rig.fleet.connectedCount() == 0; }));
+  CHECK(rig.waitFor([&] { return rig.fleet.connectedCount() == 1; }, 8s));
+  log::removeTap(tap);
+  CHECK(rig.fake.counters(kCar1).notifiesAbandoned == 0);
+  int waited = 0;
+  for (const auto& line : lines)
+    if (line.find("waiting for BlueZ's answer") != std::string::npos) ++waited;
+  CHECK(waited == 1);
+}
