@@ -139,7 +139,13 @@ int tostring(lua_State* L) {
 
 int gc(lua_State* L) {
   const auto& type = *static_cast<const TypeSpec*>(lua_touserdata(L, lua_upvalueindex(1)));
-  if (luaL_testudata(L, 1, type.metatable)) type.gc(L, 1);
+  if (!luaL_testudata(L, 1, type.metatable)) return 0;
+  type.gc(L, 1);
+  // What the box held is gone, but the object may be met again: a weak-keyed table keeps a
+  // finalized key until the next collection. Without its type it is a plain userdata there, which
+  // every check refuses ("expected a mindroad robot, got userdata").
+  lua_pushnil(L);
+  lua_setmetatable(L, 1);
   return 0;
 }
 

@@ -52,9 +52,10 @@ void GattClient::armStepTimer(Duration timeout, std::string what) {
   });
 }
 
-void GattClient::setupCallAnswered(std::uint64_t attempt) {
+void GattClient::setupCallAnswered() {
   --setupCalls_;
-  if (setupCalls_ == 0 && stepOverdue_ && current(attempt)) {
+  // (stepOverdue_ is the current attempt's: armStepTimer and fail() reset it)
+  if (setupCalls_ == 0 && stepOverdue_) {
     // the step goes on from here with its timeout anew (ready() or fail() cancel it)
     armStepTimer(stepTimeout_, stepWhat_);
   }
@@ -69,6 +70,7 @@ void GattClient::connect(Done done) {
   auto attempt = ++attempt_;
   done_ = std::move(done);
   disconnectRequested_ = false;
+  stepOverdue_ = false;
   step_ = Step::Connecting;
   std::weak_ptr<bool> alive = alive_;
   log::debug(label(), "connecting");
@@ -131,7 +133,6 @@ void GattClient::acquire(const std::string& path, const char* method,
                          std::function<void(const sdbus::Error*, int fd)> then) {
   auto attempt = attempt_;
   std::weak_ptr<bool> alive = alive_;
-  setupCallSent();
   bluez_.proxy(path)
       .callMethodAsync(method)
       .onInterface(kCharIface)
@@ -140,11 +141,12 @@ void GattClient::acquire(const std::string& path, const char* method,
       .uponReplyInvoke([this, alive, attempt, method, then](
                            const sdbus::Error* error, sdbus::UnixFd fd, std::uint16_t /*mtu*/) {
         if (alive.expired()) return;
-        setupCallAnswered(attempt);
+        setupCallAnswered();
         if (!current(attempt)) return;
         if (error) log::debug(label(), std::string(method) + " refused (" + error->getName() + ")");
         then(error, error ? -1 : fd.release());
       });
+  setupCallSent();  // (once sent: its answer comes through the loop, after this)
   bluez_.pump().kick();
 }
 
@@ -152,22 +154,23 @@ void GattClient::startNotify(const std::string& path,
                              std::function<void(const sdbus::Error*)> then) {
   auto attempt = attempt_;
   std::weak_ptr<bool> alive = alive_;
-  setupCallSent();
   bluez_.proxy(path)
       .callMethodAsync("StartNotify")
       .onInterface(kCharIface)
       .withTimeout(std::max(timeouts_.subscribe, kSetupCallLimit))
       .uponReplyInvoke([this, alive, attempt, then](const sdbus::Error* error) {
         if (alive.expired()) return;
-        setupCallAnswered(attempt);
+        setupCallAnswered();
         if (!current(attempt)) return;
         then(error);
       });
+  setupCallSent();
   bluez_.pump().kick();
 }
 
 void GattClient::ready() {
   bluez_.loop().cancel(stepTimer_);
+  stepOverdue_ = false;
   step_ = Step::Up;
   auto done = std::move(done_);
   done_ = nullptr;

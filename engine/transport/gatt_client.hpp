@@ -100,7 +100,7 @@ class GattClient {
   void resolved();
   void disconnectQuietly();  // Device1.Disconnect, nobody waiting for the answer
   void setupCallSent() { ++setupCalls_; }
-  void setupCallAnswered(std::uint64_t attempt);
+  void setupCallAnswered();
 
   Bluez& bluez_;
   // The loop itself, not through bluez_: a link may outlive the Bluez (the fleet that holds the

@@ -255,7 +255,8 @@ void FakeBluez::State::acquireNotify(Device& d, Characteristic& ch,
       pending.returnError(e);
     }
   };
-  if (d.notifySlow == Duration::zero() || !d.connected) return answer(d, ch, result);
+  if (d.notifySlow == Duration::zero() || !d.connected || d.pendingNotify)
+    return answer(d, ch, result);  // (one slow request at a time: a second is answered at once)
   log::debug(kComponent, d.address + ": AcquireNotify waits " +
                              std::to_string(toSeconds(d.notifySlow)) + " s for the car (fault)");
   auto pending = std::make_shared<sdbus::Result<sdbus::UnixFd, std::uint16_t>>(std::move(result));
@@ -471,6 +472,10 @@ void FakeBluez::State::linkDown(Device& d, bool tellCar) {
   ++d.generation;
   ++d.counters.disconnects;
   cancel(d.resolveTimer);
+  if (auto pending = std::move(d.pendingNotify)) {  // as bluetoothd answers it on a lost link
+    cancel(d.notifyTimer);
+    pending->returnError(failed("Not connected"));
+  }
   removeGatt(d);
   emit(d.object.get(), api::kDevice, {"ServicesResolved", "Connected"});
   if (tellCar && d.car) d.car->disconnect();  // the car stops, as on a lost link

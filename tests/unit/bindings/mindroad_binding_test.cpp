@@ -269,6 +269,32 @@ TEST_CASE_FIXTURE(RobotLua, "mindroad: a closed robot refuses commands and says 
         "test.lua:6: mindroad tcp 127.0.0.1:" + port() + " is closed; nothing sent");
 }
 
+TEST_CASE_FIXTURE(RobotLua,
+                  "mindroad: a robot met again after its finalizer is refused, not read") {
+  // Lua 5.4 keeps a finalized object as a weak table's key until the next collection: a script
+  // can reach it after its box was emptied. It must be refused like any wrong value.
+  start(R"(
+    seen = setmetatable({}, {__mode = "k"})
+    do
+      local robot = pitwall.mindroad{port = PORT}
+      robot:close()
+      seen[robot] = true
+    end
+    collectgarbage()
+    for robot in pairs(seen) do
+      met = true
+      readOk, readError = pcall(function() return robot.connected end)
+      label = tostring(robot)
+    end
+    done = true
+  )");
+  REQUIRE(waitFor("done"));
+  REQUIRE(global("met"));
+  CHECK_FALSE(global("readOk"));
+  CHECK(string("readError").find("attempt to index a userdata value") != std::string::npos);
+  CHECK(string("label").rfind("userdata: ", 0) == 0);  // a plain userdata, its label not read
+}
+
 TEST_CASE_FIXTURE(RobotLua, "mindroad: ready when made: in a task the next line can steer") {
   start(R"(
     robot = pitwall.mindroad{host = "127.0.0.1", port = PORT}
