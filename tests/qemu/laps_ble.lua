@@ -36,7 +36,10 @@ car.onDisconnect = function(_, ev)
   if laps < LAPS then pitwall.log("error", "the car disconnected: " .. tostring(ev.reason)) end
 end
 
-car:setSpeed(SPEED)
+-- A car whose first connection attempt failed is listed, not connected, and joins later
+-- (docs/bluetooth.md): it is driven when it connects.
+car.onConnect = function() car:setSpeed(SPEED) end
+if car.connected then car:setSpeed(SPEED) end
 if not pitwall.waitUntil(function() return laps >= LAPS end, TIMEOUT) then
   error(string.format("%d of %d laps in %d s (%d position updates, last piece %s)", laps, LAPS,
     TIMEOUT, positions, tostring(lastPiece)))

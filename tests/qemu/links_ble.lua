@@ -29,5 +29,7 @@ car.onPosition = function()
   end
 end
 
-car:setSpeed(SPEED)
+-- A car whose first connection attempt failed is listed, not connected, and joins later
+-- (docs/bluetooth.md): onConnect drives it then.
+if car.connected then car:setSpeed(SPEED) end
 pitwall.sleep(3600)
