@@ -135,7 +135,7 @@ void CarBinding::deliver(Proxy& p, CarEvent e, Fill&& fill) {
 
 void CarBinding::hookEvents(Proxy& p) {
   AnkiCar& car = *p.car;
-  car.onMessage = [this, &p](const Message& m) { dispatch(p, m); };
+  p.messages = car.messages.connect([this, &p](const Message& m) { dispatch(p, m); });
   // The fleet watches connections too (a car joins the run on its first one), and hears each
   // before the binding: it subscribed first.
   p.connection = car.connectionChanged.connect([this, &p](bool up, const std::string& reason) {
@@ -144,19 +144,20 @@ void CarBinding::hookEvents(Proxy& p) {
     else
       deliver(p, CarEvent::Disconnect, [&](EventTable& t) { t.string(kReason, reason); });
   });
-  car.onMalformed = [this, &p](const DecodeError& e, std::span<const std::uint8_t> bytes) {
-    std::string what = e.message();  // logged by the car, a count at a time in a flood
-    deliver(p, CarEvent::Malformed, [&](EventTable& t) {
-      t.string(kError, what);
-      t.string(kHex, toHex(bytes));
-    });
-  };
+  p.malformed =
+      car.malformed.connect([this, &p](const DecodeError& e, std::span<const std::uint8_t> bytes) {
+        std::string what = e.message();  // logged by the car, a count at a time in a flood
+        deliver(p, CarEvent::Malformed, [&](EventTable& t) {
+          t.string(kError, what);
+          t.string(kHex, toHex(bytes));
+        });
+      });
 }
 
 void CarBinding::unhookEvents(Proxy& p) {
-  p.car->onMessage = nullptr;
+  p.messages.disconnect();
   p.connection.disconnect();
-  p.car->onMalformed = nullptr;
+  p.malformed.disconnect();
 }
 
 void CarBinding::dispatch(Proxy& p, const Message& m) {

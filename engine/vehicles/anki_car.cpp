@@ -199,7 +199,7 @@ void AnkiCar::receive(std::span<const std::uint8_t> frame) {
   if (!decoded) {
     ++state_.malformed;
     malformedWarnings_.warn(label(), "malformed frame ignored: " + decoded.error().message());
-    if (onMalformed) onMalformed(decoded.error(), frame);
+    malformed.emit(decoded.error(), frame);
     return;
   }
   ++state_.frames_in;
@@ -208,7 +208,7 @@ void AnkiCar::receive(std::span<const std::uint8_t> frame) {
   apply(*decoded);
   silenceSpeed_ = movingSince_ >= 0 ? state_.speed_mm_s : 0;
   if (onFrame) onFrame(Direction::Rx, frame, *decoded);
-  if (onMessage) onMessage(*decoded);
+  messages.emit(*decoded);
 }
 
 // A frame longer than its layout is no error (anki-overdrive.md **Decision**): counted per message,

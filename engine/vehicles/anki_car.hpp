@@ -132,12 +132,14 @@ class AnkiCar {
   void resume() { paused_.clear(); }
   bool paused() const { return !paused_.empty(); }
 
-  // Events. Handlers are called on the loop; the message has already updated state().
-  std::function<void(const anki::Message&)> onMessage;
-  // Every connection change. Several listen (the fleet, which subscribes first, then the car's
-  // Lua object), each holding its subscription.
+  // Events, on the loop. Several listen, each holding its subscription: the car's Lua object in
+  // the run's world and in a driver world (docs/drivers.md). Every message, after it updated
+  // state():
+  Signal<const anki::Message&> messages;
+  // Every connection change (the fleet, which subscribes first, then the Lua objects).
   Signal<bool /*connected*/, const std::string& /*reason*/> connectionChanged;
-  std::function<void(const anki::DecodeError&, std::span<const std::uint8_t>)> onMalformed;
+  // Every frame that does not decode, with its bytes.
+  Signal<const anki::DecodeError&, std::span<const std::uint8_t>> malformed;
   // Round-trip time of the last ping, delivered with the ping response (seconds).
   std::optional<double> lastPingRtt() const { return lastPingRtt_; }
   // Every frame in and out, for recording.

@@ -86,8 +86,9 @@ TEST_CASE_FIXTURE(Log, "a car sending only malformed frames: every one counted, 
   testing::CaptureLink link;
   AnkiCar car{loop, link, CarIdentity{1, "skull", 9, 42}};
   link.setConnected(true);
-  int reported = 0;  // a script still hears every one (onMalformed)
-  car.onMalformed = [&](const anki::DecodeError&, std::span<const std::uint8_t>) { ++reported; };
+  int reported = 0;  // a script still hears every one (car.malformed)
+  Subscription heard = car.malformed.connect(
+      [&](const anki::DecodeError&, std::span<const std::uint8_t>) { ++reported; });
   // 100 000 bad frames over 10 s: 10 000 a second, a hostile peer's rate
   flood(100'000, 100us, [&](int) { link.carSendsBytes({0x10, 0x27, 0x01}); });
   loop.run();

@@ -196,9 +196,10 @@ TEST_CASE("ble: malformed notifications are counted and reported; the link carri
   AnkiCar* car = rig.car(kCar1);
   REQUIRE(rig.waitFor([&] { return car->state().connected; }));
   std::vector<std::string> errors;
-  car->onMalformed = [&](const anki::DecodeError& e, std::span<const std::uint8_t>) {
-    errors.push_back(e.message());
-  };
+  Subscription heard =
+      car->malformed.connect([&](const anki::DecodeError& e, std::span<const std::uint8_t>) {
+        errors.push_back(e.message());
+      });
   for (const auto& frame : FakeBluez::garbageFrames()) rig.fake.inject(kCar1, frame);
   CHECK(rig.waitFor([&] { return car->state().malformed >= 2; }));
   CHECK(errors.size() == car->state().malformed);

@@ -189,9 +189,9 @@ TEST_CASE("mqtt remote: another host's cars join as connected cars that follow t
 
   // B drives its car; A's car drives; A's frames come back as B's car's messages.
   int positions = 0;
-  p.b.car(0).onMessage = [&](const anki::Message& m) {
+  Subscription heard = p.b.car(0).messages.connect([&](const anki::Message& m) {
     positions += std::holds_alternative<anki::PositionUpdate>(m) ? 1 : 0;
-  };
+  });
   REQUIRE(p.reaches(
       0, [](AnkiCar& c) { return c.setSpeed(600, 1000); }, anki::SetSpeed{600, 1000, false}));
   AnkiCar& real = p.aOf(0);

@@ -57,10 +57,13 @@ TEST_CASE_FIXTURE(Fixture, "commands to a disconnected car fail with a sentence 
   CHECK(link.sent.empty());
 }
 
-TEST_CASE_FIXTURE(Fixture, "position updates update the state and reach onMessage") {
+TEST_CASE_FIXTURE(Fixture, "position updates update the state and reach every listener") {
   link.setConnected(true);
   int events = 0;
-  car.onMessage = [&](const Message& m) { events += std::holds_alternative<PositionUpdate>(m); };
+  Subscription heard = car.messages.connect(
+      [&](const Message& m) { events += std::holds_alternative<PositionUpdate>(m); });
+  int again = 0;  // a second listener (a driver world beside the run's) hears it too
+  Subscription second = car.messages.connect([&](const Message&) { ++again; });
   PositionUpdate p;
   p.piece_id = 34;
   p.location_id = 7;
@@ -69,6 +72,7 @@ TEST_CASE_FIXTURE(Fixture, "position updates update the state and reach onMessag
   p.parsing_flags = 0x20;
   link.carSends(p);
   CHECK(events == 1);
+  CHECK(again == 1);
   CHECK(car.state().piece == 34);
   CHECK(car.state().location == 7);
   CHECK(car.state().offset_mm == doctest::Approx(-23.0));
@@ -80,9 +84,8 @@ TEST_CASE_FIXTURE(Fixture, "position updates update the state and reach onMessag
 TEST_CASE_FIXTURE(Fixture, "a malformed frame is counted and reported, and the car carries on") {
   link.setConnected(true);
   std::string reported;
-  car.onMalformed = [&](const DecodeError& e, std::span<const std::uint8_t>) {
-    reported = e.message();
-  };
+  Subscription heard = car.malformed.connect(
+      [&](const DecodeError& e, std::span<const std::uint8_t>) { reported = e.message(); });
   link.carSendsBytes({0x10, 0x27, 0x01});
   CHECK(car.state().malformed == 1);
   CHECK(reported.find("0x27") != std::string::npos);
@@ -98,7 +101,8 @@ TEST_CASE_FIXTURE(Fixture,
   std::vector<std::string> logged;
   log::setSink([&](log::Level, std::string_view line) { logged.emplace_back(line); });
   int positions = 0;
-  car.onMessage = [&](const Message& m) { positions += std::holds_alternative<PositionUpdate>(m); };
+  Subscription heard = car.messages.connect(
+      [&](const Message& m) { positions += std::holds_alternative<PositionUpdate>(m); });
   // 0x27 (16) + 1 byte; 0x27 + 2 bytes; a battery response (3) + 1 byte.
   link.carSendsBytes({0x11, 0x27, 0x0e, 0x22, 0x00, 0x00, 0xb8, 0xc1, 0x58, 0x02, 0x47, 0x00, 0x00,
                       0x00, 0x00, 0x58, 0x02, 0xaa});
