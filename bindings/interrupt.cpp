@@ -11,6 +11,8 @@
 #include <optional>
 #include <thread>
 
+#include "bindings/protected_call.hpp"
+
 namespace pitwall::interrupt {
 
 namespace detail {
@@ -62,16 +64,28 @@ void hook(lua_State* L, lua_Debug*) {
   const bool task = lua_pushthread(L) == 0;
   lua_pop(L, 1);
   const int ms = static_cast<int>(g_budgetMs.load(std::memory_order_relaxed));
+  const char* raise = detail::g_ownCall ? "--driver-budget" : "--budget";
+  // Where it was running: the interrupted function (level 0 in a hook) when it is the script's,
+  // else the script's nearest line, as the engine's errors blame (lua::pushUserWhere).
+  lua_Debug ar;
+  if (lua_getstack(L, 0, &ar) && lua_getinfo(L, "Sl", &ar) && ar.currentline > 0 &&
+      !lua::isLibrarySource(L, ar.source))
+    luaL_where(L, 0);
+  else
+    lua::pushUserWhere(L);
   if (task)
-    luaL_error(L,
-               "still running after %d ms without a pause: interrupted (a task must give the "
-               "loop its turn: call pitwall.sleep or pitwall.waitUntil in its loop, or raise "
-               "--budget)",
-               ms);
-  luaL_error(L,
-             "still running after %d ms: interrupted (a callback must return quickly; run long "
-             "work in a task with pitwall.spawn and pitwall.sleep, or raise --budget)",
-             ms);
+    lua_pushfstring(L,
+                    "still running after %d ms without a pause: interrupted (a task must give the "
+                    "loop its turn: call pitwall.sleep or pitwall.waitUntil in its loop, or raise "
+                    "%s)",
+                    ms, raise);
+  else
+    lua_pushfstring(L,
+                    "still running after %d ms: interrupted (a callback must return quickly; run "
+                    "long work in a task with pitwall.spawn and pitwall.sleep, or raise %s)",
+                    ms, raise);
+  lua_concat(L, 2);
+  lua_error(L);
 }
 
 constexpr int kHookMask = LUA_MASKCALL | LUA_MASKRET | LUA_MASKLINE | LUA_MASKCOUNT;

@@ -31,24 +31,42 @@ namespace detail {
 extern std::atomic<lua_State*> g_running;  // the Lua thread running now, if any
 extern std::atomic<int> g_depth;           // scopes on the stack
 extern std::atomic<int> g_kind;            // Kind of the outermost scope
-extern std::atomic<std::uint64_t> g_call;  // numbers the outermost scopes
+extern std::atomic<std::uint64_t> g_call;  // the number of the call now counted (g_calls)
 extern std::atomic<int> g_reason;          // why the current call is being interrupted
 extern std::atomic<long long> g_budgetMs;  // the outermost call's budget (its world's); 0: none
+// Numbers every call, never the same twice (a call that resumes after an inner world's own call
+// is a new one to the watchdog): written on the loop's thread only.
+inline std::uint64_t g_calls = 0;
+// The call counted now is a driver world's (Scope's `own`): the budget's message names
+// --driver-budget. Written on the loop's thread only.
+inline bool g_ownCall = false;
 inline constexpr int kNoReason = 0;
 }  // namespace detail
 
 // Around every call from the engine into Lua (ScriptHost does this), with the budget of the world
 // called (its own: worlds side by side may differ; zero: none). Only the outermost scope on the
-// stack counts, with its budget; nested ones (a handler that triggers an event, a world that
-// calls another) are free.
+// stack counts, with its budget; nested ones (a handler that triggers an event) are free — except
+// a scope with `own` set: a world with a budget of its own called from inside another world's
+// call (a driver world called by the race director, docs/drivers.md) is a call of its own, with
+// its budget, counted from its start; when it returns, the call around it goes on as a fresh call
+// (its budget counts again from there: what the inner world used is not charged to it, and an
+// interrupt the outer call had not yet taken is dropped, to be asked again).
 class Scope {
  public:
-  Scope(lua_State* running, Kind kind, std::chrono::milliseconds budget)
+  Scope(lua_State* running, Kind kind, std::chrono::milliseconds budget, bool own = false)
       : outermost_(detail::g_depth.load(std::memory_order_relaxed) == 0),
+        own_(own && !outermost_),
         previous_(detail::g_running.load(std::memory_order_relaxed)) {
     using namespace detail;
-    if (outermost_) {
-      g_call.store(g_call.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+    if (own_) {
+      outerKind_ = g_kind.load(std::memory_order_relaxed);
+      outerBudgetMs_ = g_budgetMs.load(std::memory_order_relaxed);
+      g_reason.store(kNoReason, std::memory_order_relaxed);
+    }
+    if (outermost_ || own_) {
+      outerOwn_ = g_ownCall;
+      g_ownCall = own;
+      g_call.store(++g_calls, std::memory_order_relaxed);
       g_kind.store(static_cast<int>(kind), std::memory_order_relaxed);
       g_budgetMs.store(budget.count() > 0 ? budget.count() : 0, std::memory_order_relaxed);
     }
@@ -61,15 +79,26 @@ class Scope {
     g_depth.store(g_depth.load(std::memory_order_relaxed) - 1, std::memory_order_relaxed);
     std::atomic_signal_fence(std::memory_order_seq_cst);
     g_running.store(previous_, std::memory_order_relaxed);
-    if (outermost_)
+    if (outermost_ || own_) {
       g_reason.store(kNoReason, std::memory_order_relaxed);  // hooks remove themselves
+      g_ownCall = outerOwn_;
+    }
+    if (own_) {  // the outer call goes on as a fresh one
+      g_kind.store(outerKind_, std::memory_order_relaxed);
+      g_budgetMs.store(outerBudgetMs_, std::memory_order_relaxed);
+      g_call.store(++g_calls, std::memory_order_relaxed);
+    }
   }
   Scope(const Scope&) = delete;
   Scope& operator=(const Scope&) = delete;
 
  private:
   bool outermost_;
+  bool own_;
   lua_State* previous_;
+  int outerKind_ = 0;
+  long long outerBudgetMs_ = 0;
+  bool outerOwn_ = false;
 };
 
 // The Lua thread now running changes (a task's coroutine resumed inside a scope, or a coroutine

@@ -12,8 +12,9 @@ check "--duration: exit status" 0 $?
 expect_stopped "--duration" "$TMP/d.jsonl" 3
 # the script's hold on the library's last words: its command refused, its loop interrupted
 contains "last words: the command refused" "last words:	false" "$(cat "$TMP/d.out")"
-contains "last words: the loop interrupted" "the end of the run (pitwall._lastWords): still running" \
+contains "last words: the loop interrupted" "error in the end of the run (pitwall._lastWords): " \
   "$(cat "$TMP/d.err")"
+contains "last words: where it ran" "nagging.lua:32: still running after 100 ms" "$(cat "$TMP/d.err")"
 
 # the --fast safety cap: no --duration, and the script never ends the run
 MODE=none $PITWALL run "$NAGGING" --fast --fast-cap 5 --cars 3 --record "$TMP/c.jsonl" \
