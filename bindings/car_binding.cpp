@@ -91,7 +91,7 @@ int turn(lua_State* L) {
   return lua::raiseIfRefused(car.turn(type, trigger));
 }
 int lights(lua_State* L) {
-  AnkiCar& car = CarBinding::check(L, 1);
+  AnkiCar& car = CarBinding::order(L, 1);
   if (lua_istable(L, 2)) {
     // {headlights=true, brake=false, front=…, engine=…}: touched lights in the low nibble,
     // their values in the high nibble (anki-overdrive.md, set lights).
@@ -126,7 +126,7 @@ constexpr std::pair<const char*, int> kChannels[] = {
 constexpr std::pair<const char*, int> kEffects[] = {
     {"steady", 0}, {"fade", 1}, {"throb", 2}, {"flash", 3}, {"random", 4}};
 int lightsPattern(lua_State* L) {
-  AnkiCar& car = CarBinding::check(L, 1);
+  AnkiCar& car = CarBinding::order(L, 1);
   if (!lua_istable(L, 2))
     throw LuaError(
         "lightsPattern takes a list of up to 3 channels, e.g. "
@@ -291,7 +291,7 @@ namespace {
 const lua::TypeSpec& carType() {
   static const luaL_Reg methods[] = {
       {"setSpeed", lua::guarded<setSpeed>},
-      {"stop", lua::guarded<lua::command<CarBinding::check, &AnkiCar::stop>>},
+      {"stop", lua::guarded<lua::command<CarBinding::order, &AnkiCar::stop>>},
       {"changeLane", lua::guarded<changeLane>},
       {"setOffset", lua::guarded<setOffset>},
       {"cancelLaneChange",
@@ -300,10 +300,10 @@ const lua::TypeSpec& carType() {
       {"turn", lua::guarded<turn>},
       {"lights", lua::guarded<lights>},
       {"lightsPattern", lua::guarded<lightsPattern>},
-      {"ping", lua::guarded<lua::command<CarBinding::check, &AnkiCar::ping>>},
-      {"battery", lua::guarded<lua::command<CarBinding::check, &AnkiCar::requestBattery>>},
-      {"version", lua::guarded<lua::command<CarBinding::check, &AnkiCar::requestVersion>>},
-      {"disconnect", lua::guarded<lua::command<CarBinding::check, &AnkiCar::disconnect>>},
+      {"ping", lua::guarded<lua::command<CarBinding::order, &AnkiCar::ping>>},
+      {"battery", lua::guarded<lua::command<CarBinding::order, &AnkiCar::requestBattery>>},
+      {"version", lua::guarded<lua::command<CarBinding::order, &AnkiCar::requestVersion>>},
+      {"disconnect", lua::guarded<lua::command<CarBinding::disconnecting, &AnkiCar::disconnect>>},
       {nullptr, nullptr}};
   static const lua::TypeSpec type{
       .metatable = kMetatable,
@@ -328,8 +328,24 @@ AnkiCar& CarBinding::check(lua_State* L, int idx) {
   return *proxyAt(L, idx).car;
 }
 
+AnkiCar& CarBinding::order(lua_State* L, int idx) {
+  Proxy& p = proxyAt(L, idx);
+  if (AnkiCar* own = ScriptHost::from(L).driverCar(); own && own != p.car)
+    throw LuaError(p.label + " is not this driver's car: a driver commands only its own (" +
+                   own->label() + "); the others are there to be read (speed, offset, piece)");
+  return *p.car;
+}
+
+AnkiCar& CarBinding::disconnecting(lua_State* L, int idx) {
+  AnkiCar& car = order(L, idx);
+  if (ScriptHost::from(L).driverCar())
+    throw LuaError("a driver cannot disconnect its car: the race director keeps the links");
+  return car;
+}
+
 AnkiCar& CarBinding::command(lua_State* L, int idx) {
   Proxy& p = proxyAt(L, idx);
+  order(L, idx);
   if (!p.stopped.empty())
     throw LuaError(p.stopped +
                    "; it takes no command from this script until the script is reloaded (save "

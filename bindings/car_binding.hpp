@@ -51,6 +51,11 @@ class CarBinding {
   bool attached() const { return attached_; }
   void push(lua_State* L, AnkiCar& car);
   static AnkiCar& check(lua_State* L, int idx);
+  // The car at idx for any command (stop, ping, lights, …): in a driver world, refused for any
+  // car but the driver's own (HostOptions::driverCar). `disconnecting`: the same for
+  // disconnect, which a driver world may not send at all.
+  static AnkiCar& order(lua_State* L, int idx);
+  static AnkiCar& disconnecting(lua_State* L, int idx);
   // The car at idx for a command that moves it (setSpeed, changeLane, turn, …): refused once
   // the car was stopped for a handler that kept failing (handlerFailed).
   static AnkiCar& command(lua_State* L, int idx);

@@ -13,6 +13,7 @@ ErrorReport::ErrorReport(ScriptHost& host) : host_(host), flood_(host.loop(), "s
 void ErrorReport::checkMemory() {
   if (!host_.memory().exceeded || memoryReported_) return;
   memoryReported_ = true;
+  if (host_.ownBudget()) return host_.driverFailed(sandbox::memoryMessage(host_.memory()));
   std::string text = "error: " + sandbox::memoryMessage(host_.memory());
   if (host_.options().test_mode && !failure_) failure_ = text;
   log::error("script", text);
@@ -22,6 +23,15 @@ void ErrorReport::checkMemory() {
 void ErrorReport::report(const std::string& where, const std::string& message) {
   if (host_.exitStatus()) return;  // os.exit or the memory limit: the run is ending, and said why
   ++count_;
+  // A driver world's first error puts its car out (the race director says why): no handler,
+  // no log line of its own.
+  if (host_.ownBudget()) {
+    // Lua's own "not enough memory" (a refusal its emergency collection could not retry) is
+    // the cap too: said as the cap.
+    const bool capped = message == "not enough memory" && host_.memory().limit != 0;
+    return host_.driverFailed("error in " + where + ": " +
+                              (capped ? sandbox::memoryMessage(host_.memory()) : message));
+  }
   // An error in a car's handler or listeners ("onPosition handler of car 1 (skull)") counts
   // towards stopping that car (CarBinding::handlerFailed), after the error itself is reported.
   struct CountAfter {

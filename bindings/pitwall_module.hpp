@@ -18,4 +18,7 @@ void openAlphabotModule(ScriptHost& host);
 void openViewModule(ScriptHost& host);
 // pitwall.seats, pitwall.seat and sim.openSeats (seat_binding.cpp): human drivers' seats.
 void openSeatModule(ScriptHost& host);
+// pitwall.driverFiles and pitwall._driverWorld (driver_world_binding.cpp): driver files, each in
+// a Lua world of its own (docs/drivers.md).
+void openDriverWorlds(ScriptHost& host);
 }  // namespace pitwall

@@ -238,7 +238,10 @@ int searchLuaText(lua_State* L) {
   const char* name = luaL_checkstring(L, 1);
   lua_getfield(L, lua_upvalueindex(1), "searchpath");
   lua_pushstring(L, name);
-  lua_getfield(L, lua_upvalueindex(1), "path");
+  if (lua_isstring(L, lua_upvalueindex(2)))  // a driver world's: fixed when it opened
+    lua_pushvalue(L, lua_upvalueindex(2));
+  else
+    lua_getfield(L, lua_upvalueindex(1), "path");
   if (!lua_isstring(L, -1)) luaL_error(L, "'package.path' must be a string");
   lua_call(L, 2, 2);
   if (lua_isnil(L, -2)) return 1;  // the "no file …" lines
@@ -302,6 +305,10 @@ int linesOfFile(lua_State* L) {
 }  // namespace
 
 std::string memoryMessage(const Memory& memory) {
+  if (memory.driver)
+    return "driver memory limit of " + std::to_string(memory.limit >> 20) +
+           " MB reached (the driver keeps too much: drop what it no longer needs, or raise the "
+           "limit with --driver-memory MB)";
   return "script memory limit of " + std::to_string(memory.limit >> 20) +
          " MB reached (the script keeps too much: drop what it no longer needs, or raise the "
          "limit with --lua-memory MB)";
@@ -388,6 +395,47 @@ void restrict(lua_State* L) {
     lua_setfield(L, -2, "lines");
   }
   lua_pop(L, 1);
+}
+
+void restrictToLibrary(lua_State* L, const std::string& path) {
+  constexpr const char* kNoFiles =
+      "a driver reads and writes no file (docs/drivers.md); what it needs comes from its car, "
+      "its ctx and the shipped library (require \"pitwall.drivers\")";
+  for (const char* name : {"open", "lines", "input", "output", "close", "tmpfile", "popen"})
+    refuse(L, "io", name, kNoFiles);
+  for (const char* name : {"remove", "rename", "tmpname", "getenv", "setlocale"})
+    refuse(L, "os", name, kNoFiles);
+  lua_getglobal(L, "io");
+  for (const char* name : {"stdin", "stdout", "stderr"}) {
+    lua_pushnil(L);
+    lua_setfield(L, -2, name);
+  }
+  lua_pop(L, 1);
+  lua_pushliteral(L, "loadfile");
+  lua_pushstring(L, kNoFiles);
+  lua_pushcclosure(L, refused, 2);
+  lua_setglobal(L, "loadfile");
+  lua_pushliteral(L, "dofile");
+  lua_pushstring(L, kNoFiles);
+  lua_pushcclosure(L, refused, 2);
+  lua_setglobal(L, "dofile");
+  // require: the shipped library only, from a path fixed now (package.path does not move it);
+  // no C searchers (Lua's own package.cpath and all-in-one loaders).
+  lua_getglobal(L, "package");
+  lua_pushstring(L, path.c_str());
+  lua_setfield(L, -2, "path");
+  lua_pushliteral(L, "");
+  lua_setfield(L, -2, "cpath");
+  lua_getfield(L, -1, "searchers");
+  lua_pushvalue(L, -2);
+  lua_pushstring(L, path.c_str());
+  lua_pushcclosure(L, searchLuaText, 2);
+  lua_rawseti(L, -2, 2);
+  for (lua_Integer i = luaL_len(L, -1); i > 2; --i) {
+    lua_pushnil(L);
+    lua_rawseti(L, -2, i);
+  }
+  lua_pop(L, 2);
 }
 
 }  // namespace pitwall::sandbox

@@ -43,6 +43,7 @@ struct Memory {
   const void* refusedPtr = nullptr;
   std::size_t refusedOld = 0, refusedNew = 0;
   int refusals = 0;
+  bool driver = false;  // a driver world's: its cap is --driver-memory (docs/drivers.md)
 };
 
 // "script memory limit of 512 MB reached (…what to do…)"
@@ -54,5 +55,9 @@ lua_State* newState(Memory& memory);
 
 // After luaL_openlibs: the restrictions above (os.exit is the host's, see ScriptHost).
 void restrict(lua_State* L);
+// After restrict, for a driver world (docs/drivers.md): no file is read or written (io's files,
+// loadfile, dofile, os.remove, … refused with a sentence; os.getenv too), and require finds only
+// what `path` (Lua's "DIR/?.lua;…" form) finds — fixed now: changing package.path moves nothing.
+void restrictToLibrary(lua_State* L, const std::string& path);
 
 }  // namespace pitwall::sandbox

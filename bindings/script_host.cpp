@@ -19,6 +19,7 @@ namespace pitwall {
 ScriptHost::ScriptHost(Loop& loop, Fleet& fleet, SimSession* sim, HostOptions options)
     : loop_(loop), fleet_(fleet), sim_(sim), options_(std::move(options)) {
   memory_.limit = options_.memory_limit;
+  memory_.driver = options_.driverCar != nullptr;
   L_ = sandbox::newState(memory_);
   if (!L_) throw std::runtime_error("cannot create a Lua state (out of memory)");
   interrupt::watchThisThread(options_.budget.count() > 0);
@@ -96,7 +97,8 @@ int ScriptHost::tracedCall(int nargs, int nresults, interrupt::Kind kind) {
   const int base = lua_gettop(L_) - nargs;  // the function's slot
   lua_pushcfunction(L_, lua::traceback);
   lua_insert(L_, base);
-  const int status = lua::protectedCall(L_, nargs, nresults, base, kind, options_.budget);
+  const int status =
+      lua::protectedCall(L_, nargs, nresults, base, kind, options_.budget, ownBudget());
   lua_remove(L_, base);
   return status;
 }
@@ -140,6 +142,9 @@ bool ScriptHost::finishCall(int status, const char* what, std::string_view who) 
 }
 
 void ScriptHost::requestExit(int status) {
+  if (ownBudget())
+    return driverFailed("it called os.exit(" + std::to_string(status) +
+                        "): a driver cannot end the run");
   if (!exitStatus_) exitStatus_ = status;
   if (!stopRequested_) return requestStop();
   // pitwall.stop() came first: the stop path is under way, and takes the exit status from here
@@ -182,6 +187,13 @@ void ScriptHost::atShutDown(std::function<void()> fn) {
 }
 
 void ScriptHost::requestStop() {
+  if (ownBudget()) {
+    if (driverFailure_.empty())
+      driverFailed(
+          "it called pitwall.stop: a driver cannot end the race (its `update` decides "
+          "its car's speed; the race director ends the race)");
+    return;
+  }
   if (stopRequested_) return;
   stopRequested_ = true;
   if (onStopRequested) onStopRequested();
@@ -197,8 +209,9 @@ Result<bool, std::string> ScriptHost::loadFile(const std::string& path) {
   std::error_code ec;
   // The script's own folder joins the front of the require path (as messages show it: its
   // modules are named relative to the current folder too).
+  // (Not a driver world's: it requires the shipped library only, docs/drivers.md.)
   fs::path folder = fs::path(script_file::shownPath(path)).parent_path();
-  prependRequirePath(L_, {folder.empty() ? std::string(".") : folder.string()});
+  if (!ownBudget()) prependRequirePath(L_, {folder.empty() ? std::string(".") : folder.string()});
   if (auto loaded = script_file::load(L_, path); !loaded) return loaded;
   loadedFiles_.push_back(fs::absolute(path, ec).lexically_normal().string());
   return true;
@@ -247,6 +260,15 @@ void ScriptHost::mainEnded(const std::string& where, const std::string& error) {
     requestStop();
   }
   if (options_.test_mode) requestStop();  // a scenario ends with its main chunk
+}
+
+void ScriptHost::driverFailed(const std::string& why) {
+  if (!driverFailure_.empty() || !options_.driverCar) return;
+  driverFailure_ = why;
+  // Its car first: the stop goes out before anything else runs (AnkiCar::stop, as any stop).
+  (void)options_.driverCar->stop();
+  shutDown();
+  if (options_.driverFailed) options_.driverFailed(why);
 }
 
 }  // namespace pitwall

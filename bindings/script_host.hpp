@@ -11,6 +11,7 @@
 
 #include <chrono>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -54,6 +55,19 @@ struct HandlerErrorLimit {
   double window = 10.0;
 };
 
+// What each driver world may use (docs/drivers.md): its memory cap in bytes, the CPU time of
+// one call (its own budget, not the race director's), and in real time its share of the loop —
+// the CPU time its last `shareCalls` calls may take on average, as a fraction of the budget (0:
+// no share): a call may take up to the budget now and then, not every time — and whether its
+// file is watched for saves (--watch).
+struct DriverLimits {
+  std::size_t memory = std::size_t{64} << 20;
+  std::chrono::milliseconds budget{50};
+  double share = 0.5;
+  int shareCalls = 10;
+  bool watch = false;
+};
+
 struct HostOptions {
   bool test_mode = false;      // callback errors fail the run; `expect` helpers loaded
   bool library_frames = true;  // tracebacks list the library's frames (lua::Frames)
@@ -78,6 +92,18 @@ struct HostOptions {
   // --record: the race as pitwall.view.race reports it, into the record (for a replay's view);
   // unset: not recorded. pitwall.view.recording says whether it is set.
   std::function<void(const nlohmann::json& race)> recordRace;
+  // A driver world (docs/drivers.md, bindings/driver_world.hpp): `driverCar` is the one car it
+  // may command (every other car's commands are refused, and its own cannot be disconnected);
+  // its library reaches no file, robot, simulator control or the run's results; its budget is
+  // its own even when the race director calls it; and its first failure — an error, its budget,
+  // its memory cap, os.exit, pitwall.stop — goes to `driverFailed` (once) and shuts the world
+  // down instead of ending the run. nullptr: a run's world.
+  AnkiCar* driverCar = nullptr;
+  std::function<void(const std::string& why)> driverFailed;
+  // --driver CAR=FILE (pitwall.driverFiles: a race's driver of car number CAR is FILE, in a world
+  // of its own) and those worlds' limits (--driver-memory, --driver-budget, --watch).
+  std::map<int, std::string> driverFiles;
+  DriverLimits driverLimits;
 };
 
 class ScriptHost {
@@ -131,8 +157,8 @@ class ScriptHost {
       lua_pop(L_, nargs + 2);
       return false;
     }
-    const int status =
-        lua::protectedCall(L_, nargs, 0, -(nargs + 2), interrupt::Kind::Callback, options_.budget);
+    const int status = lua::protectedCall(L_, nargs, 0, -(nargs + 2), interrupt::Kind::Callback,
+                                          options_.budget, ownBudget());
     if (status == LUA_OK) {
       lua_pop(L_, 1);  // the handler
       return true;
@@ -203,6 +229,14 @@ class ScriptHost {
 
   static ScriptHost& from(lua_State* L);
 
+  // A driver world (HostOptions::driverCar): its car, and whether it failed (why, once).
+  AnkiCar* driverCar() const { return options_.driverCar; }
+  bool ownBudget() const { return options_.driverCar != nullptr; }
+  const std::string& driverFailure() const { return driverFailure_; }
+  // A driver world's failure: said once to HostOptions::driverFailed, its car stopped, the world
+  // shut down. The run goes on.
+  void driverFailed(const std::string& why);
+
  private:
   friend class ErrorReport;  // counts a car's handler errors towards its stop (cars_)
   void carJoined(AnkiCar& car);
@@ -239,6 +273,7 @@ class ScriptHost {
   std::vector<std::string> loadedFiles_;
   std::vector<std::function<void()>> atShutDown_;
   std::unique_ptr<drive::Seats> ownSeats_;  // sim.openSeats: after L_, which reads them
+  std::string driverFailure_;               // a driver world's first failure (driverFailed)
 };
 
 }  // namespace pitwall

@@ -79,7 +79,7 @@ std::string Tasks::cancel(lua_State* co) {
   tasks_.erase(it);
   {
     // Closing runs the chunk's to-be-closed variables: Lua code, which Ctrl-C must reach too.
-    interrupt::Scope scope(co, task.kind, host_.options().budget);
+    interrupt::Scope scope(co, task.kind, host_.options().budget, host_.ownBudget());
     closeThread(co);
   }
   luaL_unref(L, LUA_REGISTRYINDEX, task.threadRef);
@@ -138,7 +138,7 @@ void Tasks::resume(lua_State* co, int nargs) {
   int nres = 0;
   int status;
   {
-    interrupt::Scope scope(co, tasks_.at(co).kind, host_.options().budget);
+    interrupt::Scope scope(co, tasks_.at(co).kind, host_.options().budget, host_.ownBudget());
     status = lua_resume(co, L, nargs, &nres);
   }
   std::string error;

@@ -36,6 +36,10 @@
 //   pitwall.mindroad, .alphabot  the robots (bindings/mindroad_binding.cpp, alphabot_binding.cpp)
 //   pitwall.view               what the race view shows (bindings/view_binding.cpp)
 //   pitwall.seats, .seat       human drivers' seats (bindings/seat_binding.cpp); sim.openSeats
+//   pitwall.driverFiles, _driverWorld  driver files in worlds of their own
+//                              (bindings/driver_world_binding.cpp)
+//   (a driver world: none of the six above, and no pitwall.writeResults; its Lua libraries
+//   read no file and require finds the shipped library only: sandbox::restrictToLibrary)
 //   the cars                   every car the fleet knows gets its Lua object now (later ones as
 //                              they join: ScriptHost::carJoined)
 //   the Lua library            require "pitwall.core" (scripts/pitwall/core.lua); in test mode
@@ -184,6 +188,14 @@ void openStdout(lua_State* L) {
 }
 
 // The Lua half of the module (waitUntil, copy, …) and, in tests, the expectations.
+// A driver world's `pitwall` (docs/drivers.md): no results file; the rest reads or is its own.
+void closeForDrivers(lua_State* L) {
+  lua_getglobal(L, "pitwall");
+  lua_pushnil(L);
+  lua_setfield(L, -2, "writeResults");
+  lua_pop(L, 1);
+}
+
 void openLuaLibrary(ScriptHost& host, const std::string& lib) {
   lua_State* L = host.state();
   const char* prelude = host.options().test_mode
@@ -224,16 +236,23 @@ void openWorld(ScriptHost& host) {
   std::vector<std::string> dirs = host.options().library_paths;
   dirs.push_back(lib);
   prependRequirePath(L, dirs);
+  const bool driver = host.driverCar() != nullptr;
+  if (driver) sandbox::restrictToLibrary(L, lib + "/?.lua;" + lib + "/?/init.lua");
   host.setLibrary(lib);  // its chunks' names, for the blame (lua::Frames)
   seedRandom(L, host.options().seed);
   host.cars().registerType(L);
   openPitwallModule(host);
   openStdout(L);
-  if (host.sim()) openSimModule(host);
-  openMindroadModule(host);
-  openAlphabotModule(host);
-  openViewModule(host);
-  openSeatModule(host);
+  if (driver) {
+    closeForDrivers(L);
+  } else {
+    if (host.sim()) openSimModule(host);
+    openMindroadModule(host);
+    openAlphabotModule(host);
+    openViewModule(host);
+    openSeatModule(host);
+    openDriverWorlds(host);
+  }
   for (AnkiCar* car : host.fleet().cars()) host.cars().bind(*car);
   openLuaLibrary(host, lib);
 }

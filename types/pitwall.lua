@@ -54,6 +54,7 @@ function Stdout:flush() end
 
 ---The engine: cars, timers, tasks, the clock (docs/lua-api.md).
 ---@class pitwall
+---@field driverFiles table<integer, string> the run's --driver CAR=FILE: car number → driver file, each raced in a Lua world of its own (docs/drivers.md)
 ---@field persist table survives hot reloads: plain data and cars, copied into each new version
 ---@field reloads integer how many times the script was reloaded: 0 in the first version
 ---@field resultsFile string? the --results FILE of the run, or nil
@@ -172,6 +173,24 @@ function pitwall.waitUntil(cond, timeout, step) end
 ---@param path? string
 ---@return string path
 function pitwall.writeResults(rows, columns, path) end
+
+---A driver file's Lua world of its own, as drivers.world makes it (docs/drivers.md): it drives one car, reads no file, and is out at its first failure.
+---@class pitwall.DriverWorld
+---@field cpu number seconds of CPU time its calls used
+---@field failure string? why it is out (its car stopped), nil while it drives
+---@field file string the driver file, absolute
+---@field version integer 1 for its first world, +1 for each reload
+local DriverWorld = {}
+
+---Calls the driver's `method` with `data` copied in (what drivers.world sends); false once the world has failed.
+---@param method "start"|"update"|"finish"|"waiting"
+---@param data table
+---@return boolean ok
+function DriverWorld:call(method, data) end
+
+---Loads the file again into a new world, as a save does with --watch; false when the new one fails (the car is out).
+---@return boolean loaded
+function DriverWorld:reload() end
 
 ---A human driver's seat (docs/racing.md "Human drivers"): --humans N opens cars 1..N; a phone (/drive), a gamepad, the keyboard or a script holds it.
 ---@class pitwall.Seat

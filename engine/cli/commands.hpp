@@ -69,6 +69,12 @@ struct RunOptions : CarSource {
   // --fast-cap S: with --fast and no --duration, the simulated seconds after which a script that
   // has not ended the run is stopped and the run ends with kExitCapped; none: the default cap
   std::optional<double> fastCap;
+  // --driver CAR=FILE (repeatable): the race's driver of car number CAR is FILE, in a Lua world of
+  // its own; --driver-memory MB and --driver-budget S are each such world's limits
+  // (docs/drivers.md).
+  std::vector<std::string> drivers;
+  int driverMemory = 64;
+  double driverBudget = 0.05;
 };
 int run(const RunOptions& options);
 // The exit status of a --fast run that its safety cap ended (docs/cli.md).

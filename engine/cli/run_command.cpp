@@ -1,8 +1,11 @@
 // pitwall run SCRIPT: a script driving simulated cars (real or virtual time), or real cars over
 // Bluetooth LE with --ble.
+#include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <memory>
 
 #include "bindings/script_file.hpp"
@@ -24,6 +27,34 @@ namespace pitwall::cli {
 constexpr double kFastCap = 24 * 3600;
 
 namespace {
+// --driver CAR=FILE, each read and checked now (before any car is connected): the number, a file
+// that exists and compiles, one file per car.
+Result<std::map<int, std::string>, std::string> driverFiles(const std::vector<std::string>& given) {
+  std::map<int, std::string> files;
+  for (const auto& g : given) {
+    const auto eq = g.find('=');
+    int number = 0;
+    const auto* end = eq == std::string::npos ? nullptr : g.data() + eq;
+    auto [ptr, ec] = std::from_chars(g.data(), end ? end : g.data(), number);
+    if (!end || ec != std::errc() || ptr != end || number < 1 || number > 64)
+      return Unexpected{"--driver " + g +
+                        ": expected CAR=FILE, the car's number (1..64) and a driver file, as in "
+                        "--driver 2=alice.lua"};
+    const std::string file = g.substr(eq + 1);
+    std::error_code fsError;
+    if (!std::filesystem::is_regular_file(file, fsError))
+      return Unexpected{"--driver " + g + ": no such file " + file};
+    if (auto problem = script_file::check(file))
+      return Unexpected{"--driver " + g + ": " + *problem};
+    if (files.count(number))
+      return Unexpected{"--driver " + g + ": car " + std::to_string(number) +
+                        " has a driver already (--driver " + std::to_string(number) + "=" +
+                        files[number] + ")"};
+    files[number] = std::filesystem::absolute(file, fsError).lexically_normal().string();
+  }
+  return files;
+}
+
 std::string simulatedTime(double seconds) {
   std::string text = formatNumber(seconds, 6) + " s";
   if (seconds >= 3600) text += " (" + formatNumber(seconds / 3600, 6) + " h)";
@@ -49,6 +80,8 @@ int run(const RunOptions& options) {
       return fail("run", checked.error());
     }
   }
+  auto drivers = driverFiles(options.drivers);
+  if (!drivers) return fail("run", drivers.error());
   if (options.humans > 0 && options.fast && options.view) {  // phones live in real time
     return fail("run",
                 "phones drive in real time: --humans with --view needs no --fast (a phone's "
@@ -93,6 +126,10 @@ int run(const RunOptions& options) {
   host.results = options.results;
   host.view = session.viewFeed();
   host.seats = session.seats();
+  host.driverFiles = *drivers;
+  host.driverLimits.memory = static_cast<std::size_t>(options.driverMemory) << 20;
+  host.driverLimits.budget = std::chrono::milliseconds(std::llround(options.driverBudget * 1000));
+  host.driverLimits.watch = options.watch;
   try {
     session.startHost(host);
   } catch (const std::exception& e) {
@@ -193,6 +230,16 @@ Command addRunCommand(CLI::App& app) {
   cmd->add_flag("--watch", run->watch,
                 "Reload the script when one of its files is saved (docs/hot-reload.md)");
   cmd->add_option("--history", run->history, "With --repl: the history file")->needs(replFlag);
+  cmd->add_option("--driver", run->drivers,
+                  "CAR=FILE: the race's driver of car number CAR is FILE, in a Lua world of its "
+                  "own that commands that car only (repeatable; docs/drivers.md)");
+  cmd->add_option("--driver-memory", run->driverMemory,
+                  "MB each driver world may hold (default 64); past it the driver is out")
+      ->check(CLI::Range(1, 4096));
+  cmd->add_option("--driver-budget", run->driverBudget,
+                  "Seconds of CPU one call into a driver world may take (default 0.05); past it "
+                  "the driver is out")
+      ->check(CLI::Range(0.001, 10.0));
   // A prompt needs the real clock: virtual time would race ahead while the operator types.
   replFlag->excludes(fastFlag);
   // Hands on a gamepad or the keys drive in real time; the keys are the prompt's with --repl.

@@ -267,6 +267,54 @@ local function call(driver, method, car, ctx)
 end
 drivers.call = call
 
+-- ---- a driver in a world of its own ----
+
+-- What a race director holds for a driver file in a Lua world of its own (docs/drivers.md): a
+-- driver like any other, whose methods hand the call to the world with a copy of what it may
+-- read. `world.failure` says why it is out (its car stopped); after a good save (a new world
+-- version) a car that had started is started again in the new world.
+local World = { __name = "driver world" }
+World.__index = World
+
+local function send(self, method, car, ctx)
+  local w = self.world
+  if w.failure then return end
+  local data = { car = car, limit = ctx and ctx.limit, pieceLimits = ctx and ctx.pieceLimits,
+    period = ctx and ctx.period, race = ctx and ctx.race }
+  if self.version ~= w.version then
+    self.version = w.version
+    data.map = ctx and ctx.map
+    if self.started and method ~= "start" and method ~= "finish" then
+      if not w:call("start", data) then return end
+      data.map = nil
+    end
+  end
+  if method == "start" then self.started = true end
+  w:call(method, data)
+end
+
+for _, method in ipairs { "start", "update", "finish", "waiting" } do
+  World[method] = function(self, car, ctx) send(self, method, car, ctx) end
+end
+
+--- A driver for `car` from the Lua file `file`, run in a world of its own: the file returns a
+--- driver class or a driver, as pitwall/drivers/*.lua do; the world commands `car` only, reads
+--- no file, and its failure (an error, its budget, its memory cap) stops `car` and shows in
+--- `driver.world.failure`. Limits: --driver-memory, --driver-budget.
+function drivers.world(file, car)
+  if type(file) ~= "string" then
+    pitwall._raise("drivers.world: give the driver's file name, got " .. type(file))
+  end
+  local w = pitwall._driverWorld(file, car)
+  local name = (file:match("([^/]+)$") or file):gsub("%.lua$", "")
+  return setmetatable({ name = name, file = file, world = w, version = 0 }, World)
+end
+
+--- True for a driver given as a file (a string ending in .lua): drivers.world makes it.
+function drivers.isFile(spec)
+  return type(spec) == "string" and spec:match("%.lua$") ~= nil
+end
+
 --- Drives `car` with `driver` in a task of its own: start, then update every ctx.period s
 --- until handle:stop() (which calls finish; it does not stop the car). An error in a method
 --- is reported (pitwall.onError or the log) and the driver keeps being called.

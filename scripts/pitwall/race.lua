@@ -25,7 +25,7 @@ local race = {}
 race.onLap, race.onFinish, race.onPositionChange, race.onFalseStart = nil, nil, nil, nil
 
 race.columns = { "position", "car", "number", "laps", "totalTime", "bestLap", "lastLap",
-  "finished", "falseStart", "driver", "player", "status" }
+  "finished", "falseStart", "driver", "player", "status", "reason" }
 
 -- A driver that holds one speed (under ctx.limit): the default when no driver is given and
 -- pitwall.drivers has no "cruiser".
@@ -138,6 +138,7 @@ local function makeDriver(spec, car, i)
     local ok, cls = pcall(drivers.load, "cruiser")
     spec = ok and cls or Steady
   end
+  if drivers.isFile(spec) then return drivers.world(spec, car) end -- a world of its own
   if type(spec) == "string" then spec = drivers.load(spec) end
   if type(spec) == "table" and type(spec.update) ~= "function" and type(spec.new) == "function" then
     spec = spec.new {}
@@ -258,6 +259,35 @@ for name, fn in pairs(require "pitwall.race_marshal") do Race[name] = fn end
 function Race:_start(e)
   e.started = true
   drivers.call(e.driver, "start", e.car, e.ctx)
+  self:_checkWorld(e)
+end
+
+-- A driver in a world of its own (drivers.world) that failed puts its car out: stopped, DNF with
+-- the reason; a good save brings it back while the race is on and the car has not finished.
+function Race:_checkWorld(e)
+  local w = type(e.driver) == "table" and rawget(e.driver, "world")
+  if not w then return end
+  local why = w.failure
+  if why and not e.out then
+    e.out = why -- (its world stopped the car as it failed: bindings/driver_world.cpp)
+    pitwall.log("info", "race: " .. tostring(e.car) .. " is out (DNF): its driver failed")
+  elseif not why and e.out and not e.finished and not self.done then
+    e.out = nil
+    pitwall.log("info", "race: " .. tostring(e.car) .. " is back (driver " .. tostring(w.file)
+      .. ", version " .. tostring(w.version) .. ")")
+  end
+end
+
+-- What a driver in a world of its own reads of the race (ctx.race, a copy): the phase and every
+-- car's place, laps and best lap.
+function Race:_view()
+  local standings = {}
+  for k, e in ipairs(self.order) do
+    local t = e.finished and e.final or e.timer
+    standings[k] = { car = e.car, position = k, laps = t.count,
+      bestLap = t.best and t.best.time, finished = e.finished or false, out = e.out ~= nil }
+  end
+  return { phase = self.phase, mode = self.mode, laps = self.laps, standings = standings }
 end
 
 function Race:_finish(e, t)
@@ -416,12 +446,19 @@ function Race:_tick()
   self.ticks = self.ticks + 1
   self:_safety(now)
   self:_marshal(now)
+  local view
   for _, e in ipairs(self.order) do
     local car = e.car
-    if not e.started and now >= e.releaseAt then self:_start(e) end
-    if e.started and not e.finished and car.connected then
+    self:_checkWorld(e)
+    if not e.started and now >= e.releaseAt and not e.out then self:_start(e) end
+    if e.started and not e.finished and car.connected and not e.out then
       if e.ctx then e.ctx.limit, e.ctx.pieceLimits = e.limit, e.pieceLimits end
+      if rawget(e.driver, "world") then
+        view = view or self:_view()
+        e.ctx.race = view
+      end
       drivers.call(e.driver, "update", car, e.ctx)
+      self:_checkWorld(e)
       self:_applyFloor(e, now)
       if e.limit and (car.targetSpeed or 0) > e.limit then pcall(car.setSpeed, car, e.limit, 2000) end
     elseif e.finished and car.connected and e.limit and (car.targetSpeed or 0) > e.limit then
@@ -449,7 +486,9 @@ function Race:_tick()
     else
       e.awaySince = e.awaySince or now
     end
-    if not e.finished and (e.car.connected or now - e.awaySince < away) then all = false end
+    if not e.finished and not e.out and (e.car.connected or now - e.awaySince < away) then
+      all = false
+    end
   end
   local grace = self.options.finishTimeout or 60
   local since = self.leaderFinished or self.timeUp
@@ -495,6 +534,7 @@ end
 -- "finished", "running" (racing, or the run ended first), "DNF" or "DNF (disconnected)".
 function Race:_statusOf(e)
   if e.finished then return "finished" end
+  if e.out then return "DNF" end -- its driver's world failed (row.reason says why)
   if self.state ~= "done" or self.cut then return "running" end
   return e.car.connected and "DNF" or "DNF (disconnected)"
 end
@@ -517,6 +557,7 @@ function Race:_rows()
       bestLap = t.best and t.best.time, lastLap = t.last and t.last.time,
       gap = gap, lapsBehind = behind,
       finished = e.finished or false, falseStart = e.falseStart or false,
+      reason = not e.finished and e.out or nil,
     }
   end
   return rows
@@ -575,6 +616,8 @@ function Race:_drivers()
     if type(driverSpec) == "table" and not driverSpec.update and not driverSpec.new then
       spec = driverSpec[car] or driverSpec[car.name] or driverSpec[i]
     end
+    -- the command line's --driver CAR=FILE comes first (docs/drivers.md)
+    spec = pitwall.driverFiles and pitwall.driverFiles[car.number] or spec
     e.driver = makeDriver(spec, car, i)
     e.ctx = drivers.context(car, self.map, field, { period = self.period })
     local h = e.handover

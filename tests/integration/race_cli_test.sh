@@ -43,7 +43,7 @@ out=$(LAPS=3 $PITWALL run "$SRC/examples/grand_prix.lua" --fast --cars 4 \
 check "grand prix on a custom track: exit status" 0 "$rc"
 contains "grand prix on a custom track: the winner" "Winner: " "$out"
 if grep -q "error " "$TMP/err"; then fail "custom track reported an error: $(cat "$TMP/err")"; fi
-check "grand prix on a custom track: every car finished" 4 "$(grep -c ',true,false,[a-z]*,[^,]*,finished$' "$TMP/hairpin.csv")"
+check "grand prix on a custom track: every car finished" 4 "$(grep -c ',true,false,[a-z]*,[^,]*,finished,$' "$TMP/hairpin.csv")"
 
 out=$(LAPS=2 $PITWALL run "$SRC/examples/time_trial.lua" --fast --cars 3 --results "$TMP/tt.csv" 2>/dev/null); rc=$?
 check "time trial exit status" 0 "$rc"
@@ -72,7 +72,7 @@ check "grand prix over --ble: exit status" 0 "$rc"
 contains "grand prix over --ble: the winner" "Winner: " "$out"
 if grep -q "error " "$TMP/ble.err"; then fail "grand prix over --ble reported an error: $(cat "$TMP/ble.err")"; fi
 check "grand prix over --ble: a row per car" 5 "$(wc -l < "$TMP/ble.csv" | tr -d ' ')"
-check "grand prix over --ble: every car finished its lap" 4 "$(grep -c ',1,[0-9.]*,[0-9.]*,[0-9.]*,true,false,[a-z]*,[^,]*,finished$' "$TMP/ble.csv")"
+check "grand prix over --ble: every car finished its lap" 4 "$(grep -c ',1,[0-9.]*,[0-9.]*,[0-9.]*,true,false,[a-z]*,[^,]*,finished,$' "$TMP/ble.csv")"
 stop_fake
 check "grand prix over --ble: every car stopped" 4 "$(grep -c 'connected=false target=0 ' "$TMP/fake.out")"
 
@@ -85,7 +85,7 @@ out=$(LAPS=1 $PITWALL run "$SRC/examples/grand_prix.lua" --ble --scan-timeout 1 
 check "custom track over --ble: exit status" 0 "$rc"
 contains "custom track over --ble: the winner" "Winner: " "$out"
 if grep -q "error " "$TMP/ble-hairpin.err"; then fail "custom track over --ble reported an error: $(cat "$TMP/ble-hairpin.err")"; fi
-check "custom track over --ble: every car finished its lap" 2 "$(grep -c ',1,[0-9.]*,[0-9.]*,[0-9.]*,true,false,[a-z]*,[^,]*,finished$' "$TMP/ble-hairpin.csv")"
+check "custom track over --ble: every car finished its lap" 2 "$(grep -c ',1,[0-9.]*,[0-9.]*,[0-9.]*,true,false,[a-z]*,[^,]*,finished,$' "$TMP/ble-hairpin.csv")"
 # People: two seats the script holds (as phones would) race two cruisers; then input loss.
 human_race() {  # $1: what runs the cars; the rest: options
   local what=$1; shift

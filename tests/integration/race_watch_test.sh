@@ -55,7 +55,7 @@ gp_watch() {
   contains "$name: the refusal names file and line" "grand_prix.lua:3:" "$(grep 'not started' "$err")"
   check "$name: no other error" "" "$(grep -E '\] error ' "$err" | grep -v 'not started')"
   check "$name: a row per car" 5 "$(wc -l <"$TMP/$name.csv" | tr -d ' ')"
-  check "$name: every car finished" 4 "$(grep -c ',true,false,[a-z]*,[^,]*,finished$' "$TMP/$name.csv")"
+  check "$name: every car finished" 4 "$(grep -c ',true,false,[a-z]*,[^,]*,finished,$' "$TMP/$name.csv")"
   check "$name: the winner's 2 laps" 2 "$(sed -n 2p "$TMP/$name.csv" | cut -d, -f4)"
   python3 - "$TMP/$name.rec" "$(stamp "$err" 'race: green')" "$(stamp "$err" 'version 2 took over')" \
     "$(stamp "$err" 'race: .* finished \(')" <<'PY' || fail "$name: commands in the record"

@@ -128,6 +128,11 @@ function drivers.checkOptions(name, options, known) end
 ---@return pitwall.drivers.Context
 function drivers.context(car, map, field, options) end
 
+---True for a driver given as a file name (a string ending in .lua), which a race runs with drivers.world.
+---@param spec any
+---@return boolean
+function drivers.isFile(spec) end
+
 ---The driver class named `x` (pitwall.drivers.<x>: "cruiser", "follower", "human", "lanekeeper", "overtaker"), or `x` itself when it is a table.
 ---@param x string|pitwall.drivers.Class
 ---@return pitwall.drivers.Class
@@ -168,5 +173,11 @@ function drivers.run(car, driver, ctx) end
 ---@param step? number mm/s
 ---@return boolean sent
 function drivers.setSpeed(car, speed, accel, step) end
+
+---A driver for `car` from the Lua file `file`, in a world of its own (docs/drivers.md): the file returns a driver class or a driver; the world commands `car` only and reads no file; its failure stops `car` and shows in `driver.world.failure`.
+---@param file string
+---@param car pitwall.Car
+---@return pitwall.drivers.Driver
+function drivers.world(file, car) end
 
 return drivers

@@ -72,6 +72,7 @@ function Stdout:flush() end
       stdout = { "pitwall.Stdout", "a file-like object (:write, :flush) for the console" },
       sim = { "pitwall.sim?", "the simulator's API: present when the run uses the built-in simulator" },
       view = { "pitwall.view", "what the race view shows (docs/view.md)" },
+      driverFiles = { "table<integer, string>", "the run's --driver CAR=FILE: car number → driver file, each raced in a Lua world of its own (docs/drivers.md)" },
     },
     settable = {
       onCar = { "fun(car: pitwall.Car)", "called when a car joins after the script started" },
@@ -146,6 +147,26 @@ function Stdout:flush() end
       alphabot = [[An Alphabot over WLAN (TCP) or Bluetooth LE (docs/robots.md); in a task it waits until connected.
 @param options pitwall.AlphabotOptions
 @return pitwall.Alphabot]],
+    },
+  },
+  {
+    metatable = "pitwall.driverworld",
+    class = "pitwall.DriverWorld",
+    localName = "DriverWorld",
+    doc = [[A driver file's Lua world of its own, as drivers.world makes it (docs/drivers.md): it drives one car, reads no file, and is out at its first failure.]],
+    fields = {
+      failure = { "string?", "why it is out (its car stopped), nil while it drives" },
+      file = { "string", "the driver file, absolute" },
+      version = { "integer", "1 for its first world, +1 for each reload" },
+      cpu = { "number", "seconds of CPU time its calls used" },
+    },
+    methods = {
+      call = [[Calls the driver's `method` with `data` copied in (what drivers.world sends); false once the world has failed.
+@param method "start"|"update"|"finish"|"waiting"
+@param data table
+@return boolean ok]],
+      reload = [[Loads the file again into a new world, as a save does with --watch; false when the new one fails (the car is out).
+@return boolean loaded]],
     },
   },
   {

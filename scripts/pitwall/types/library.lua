@@ -358,6 +358,13 @@ function Handle:stop() end]],
 @param driver pitwall.drivers.Driver
 @param ctx pitwall.drivers.Context
 @return pitwall.drivers.Handle]],
+      world = [[A driver for `car` from the Lua file `file`, in a world of its own (docs/drivers.md): the file returns a driver class or a driver; the world commands `car` only and reads no file; its failure stops `car` and shows in `driver.world.failure`.
+@param file string
+@param car pitwall.Car
+@return pitwall.drivers.Driver]],
+      isFile = [[True for a driver given as a file name (a string ending in .lua), which a race runs with drivers.world.
+@param spec any
+@return boolean]],
       call = [[Calls driver[method] if it has one, reporting an error like drivers.run does.
 @param driver pitwall.drivers.Driver
 @param method string

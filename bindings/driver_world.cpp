@@ -1,0 +1,200 @@
+#include "bindings/driver_world.hpp"
+
+#include <time.h>
+
+#include <cstdio>
+#include <filesystem>
+
+#include "bindings/world_copy.hpp"
+#include "engine/core/log.hpp"
+
+namespace pitwall {
+
+namespace {
+
+double threadCpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
+}
+
+std::string fileName(const std::string& file) {
+  return std::filesystem::path(file).filename().string();
+}
+
+// What runs inside the driver world's protected call: the director's data copied in (an
+// allocation past the world's cap fails there, as a call, not as a panic), then
+// pitwall._driverCall(method, data) (scripts/pitwall/driver_world.lua).
+struct CallIn {
+  lua_State* from;
+  int data;
+  const char* method;
+};
+
+int callIn(lua_State* L) {
+  const auto* in = static_cast<const CallIn*>(lua_touserdata(L, 1));
+  lua_settop(L, 0);
+  lua_getglobal(L, "pitwall");
+  lua_getfield(L, -1, "_driverCall");
+  lua_remove(L, -2);
+  lua_pushstring(L, in->method);
+  std::vector<std::string> dropped;  // (quiet: what cannot cross is the director's own)
+  lua::WorldCopy copy(in->from, L, dropped, true);
+  copy.openMemo();
+  if (!copy.copy(in->data, "data", 0)) lua_pushnil(L);
+  copy.closeMemo();
+  lua_call(L, 2, 0);
+  return 0;
+}
+
+// The same for the driver the file returned: pitwall._driverSetup(value, name).
+int setupIn(lua_State* L) {
+  lua_getglobal(L, "require");
+  lua_pushliteral(L, "pitwall.driver_world");
+  lua_call(L, 1, 1);
+  lua_getfield(L, -1, "setup");
+  lua_rotate(L, 1, 1);  // setup, value, name, module
+  lua_pop(L, 1);
+  lua_call(L, 2, 0);
+  return 0;
+}
+
+}  // namespace
+
+DriverWorld::DriverWorld(ScriptHost& race, AnkiCar& car, std::string file, DriverLimits limits)
+    : race_(race), car_(car), file_(std::move(file)), limits_(limits) {
+  std::weak_ptr<bool> alive = alive_;
+  // The run's world shuts down (the run ends): so does every driver world it made.
+  race_.atShutDown([this, alive] {
+    if (alive.expired()) return;
+    watch_.reset();
+    if (host_) host_->shutDown();
+  });
+  reload();
+  if (limits_.watch) watch();
+}
+
+DriverWorld::~DriverWorld() {
+  *alive_ = false;
+  if (sweep_) race_.loop().cancel(sweep_);
+}
+
+bool DriverWorld::reload() {
+  if (host_) {
+    host_->detach();
+    host_->shutDown();
+    retired_.push_back(std::move(host_));
+  }
+  if (!retired_.empty() && !sweep_) {
+    std::weak_ptr<bool> alive = alive_;
+    sweep_ = race_.loop().after(Duration::zero(), [this, alive] {
+      if (alive.expired()) return;
+      sweep_ = 0;
+      retired_.clear();
+    });
+  }
+  failure_.clear();
+  spent_.clear();
+  spentSum_ = 0;
+  ++version_;
+  if (race_.isShutDown()) return false;
+  HostOptions o;
+  o.memory_limit = limits_.memory;
+  o.budget = limits_.budget;
+  o.seed = race_.options().seed;
+  o.library_frames = race_.options().library_frames;
+  o.driverCar = &car_;
+  std::weak_ptr<bool> alive = alive_;
+  o.driverFailed = [this, alive](const std::string& why) {
+    if (!alive.expired()) fail(why);
+  };
+  try {
+    host_ = std::make_unique<ScriptHost>(race_.loop(), race_.fleet(), nullptr, std::move(o));
+  } catch (const std::exception& e) {
+    fail(std::string("its world did not open: ") + e.what());
+    return false;
+  }
+  if (!failure_.empty()) return false;  // its library failed (its memory cap, say)
+  if (auto loaded = host_->loadFile(file_); !loaded) {
+    fail("its file does not load: " + loaded.error());
+    return false;
+  }
+  lua_State* L = host_->state();
+  // The main chunk: what it returns is the driver (a class or an instance).
+  if (!host_->call(0, 1, "main chunk", fileName(file_))) return false;
+  lua_pushcfunction(L, setupIn);
+  lua_insert(L, -2);
+  lua_pushstring(L, fileName(file_).c_str());
+  if (!host_->call(2, 0, "driver", fileName(file_))) return false;
+  return failure_.empty();
+}
+
+bool DriverWorld::call(lua_State* from, const char* method, int data) {
+  if (!failure_.empty() || !host_ || host_->isShutDown()) return false;
+  const int top = lua_gettop(from);
+  CallIn in{from, lua_absindex(from, data), method};
+  lua_State* L = host_->state();
+  lua_pushcfunction(L, callIn);
+  lua_pushlightuserdata(L, &in);
+  const double cpu = threadCpuSeconds();
+  // "update of driver alice.lua" of "car 2 (skull)"
+  const std::string what = std::string(method) + " of driver " + fileName(file_);
+  host_->call(1, 0, what.c_str(), car_.label());
+  lua_settop(from, top);  // a copy cut short by an error leaves the director's stack as it was
+  if (failure_.empty()) charge(threadCpuSeconds() - cpu);
+  return failure_.empty();
+}
+
+void DriverWorld::fail(const std::string& why) {
+  if (!failure_.empty()) return;
+  failure_ = why.substr(0, why.find('\n'));  // the sentence; the log keeps the traceback
+  (void)car_.stop();  // (a world that failed stopped it already: this one may never have run)
+  if (host_ && !host_->isShutDown()) host_->shutDown();
+  log::error("driver", "driver " + fileName(file_) + " of " + car_.label() +
+                           " is out, its car stopped: " + why);
+}
+
+void DriverWorld::charge(double cpu) {
+  cpuTotal_ += cpu;
+  // Real time only: in virtual time the CPU a call takes delays no one, and a race's result
+  // must not depend on the machine.
+  if (limits_.share <= 0 || limits_.shareCalls <= 0 || race_.loop().clockKind() != ClockKind::Real)
+    return;
+  spent_.push_back(cpu);
+  spentSum_ += cpu;
+  if (static_cast<int>(spent_.size()) > limits_.shareCalls) {
+    spentSum_ -= spent_.front();
+    spent_.pop_front();
+  }
+  const double budget = static_cast<double>(limits_.budget.count()) / 1000;
+  const double average = spentSum_ / static_cast<double>(spent_.size());
+  if (static_cast<int>(spent_.size()) < limits_.shareCalls || average <= limits_.share * budget)
+    return;
+  char text[300];
+  std::snprintf(text, sizeof text,
+                "its last %d calls took %.0f ms of CPU time on average, more than its share of "
+                "the loop (%g %% of its budget of %.0f ms): a call may use the budget now and "
+                "then, not every time (docs/drivers.md)",
+                limits_.shareCalls, average * 1000, limits_.share * 100, budget * 1000);
+  fail(text);
+}
+
+void DriverWorld::watch() {
+  try {
+    watch_ = std::make_unique<FileWatch>(race_.loop());
+  } catch (const std::exception& e) {
+    log::warn("driver", "cannot watch " + file_ + " for saves: " + e.what());
+    return;
+  }
+  if (auto added = watch_->add(file_); !added) {
+    log::warn("driver", "cannot watch " + file_ + " for saves: " + added.error());
+    watch_.reset();
+    return;
+  }
+  watch_->onChange = [this](const std::vector<std::string>&) {
+    if (reload())
+      log::info("driver", "driver " + fileName(file_) + " of " + car_.label() + " reloaded");
+  };
+}
+
+}  // namespace pitwall

@@ -1,0 +1,73 @@
+#pragma once
+// A driver world (docs/drivers.md): one driver file, in a Lua world of its own, driving one car
+// for the race director of the run's world. The file returns a driver — a class ({new}) or a
+// driver ({update}), the race library's shape — and the director calls its methods through
+// call(): the race's state copied in as plain data, the method run under the world's own budget.
+//
+// The world is a ScriptHost made with HostOptions::driverCar: it commands only its car, reads
+// no file, requires the shipped library only, and its first failure (an error, its budget, its
+// memory cap, os.exit, pitwall.stop, a file that does not load) stops its car and shuts it down
+// — failure() says why; the run goes on. In real time it also fails when its calls take more
+// than its share of the loop (DriverLimits::share: on average, half its budget), so a driver that
+// uses most of its budget in every call cannot starve the others. A good save (reload(), or
+// --watch) makes a new world; the director then takes the car back (scripts/pitwall/drivers.lua,
+// drivers.world).
+#include <lua.hpp>
+
+#include <deque>
+#include <memory>
+#include <string>
+
+#include "bindings/script_host.hpp"
+#include "engine/core/file_watch.hpp"
+
+namespace pitwall {
+
+class DriverWorld {
+ public:
+  // `race` is the director's world (its loop, fleet, seed and traceback style are the world's
+  // too); `file` the driver file. Loads it (failure() says whether it did).
+  DriverWorld(ScriptHost& race, AnkiCar& car, std::string file, DriverLimits limits);
+  ~DriverWorld();
+  DriverWorld(const DriverWorld&) = delete;
+  DriverWorld& operator=(const DriverWorld&) = delete;
+
+  // Calls the driver's `method` (start, update, finish, waiting) in the world with the value at
+  // index `data` of `from` (a thread of the director's world) copied in (what drivers.world sends:
+  // the limits, the race's phase and standings, the map once). False when the world has failed, now
+  // or before.
+  bool call(lua_State* from, const char* method, int data);
+  // Loads the file again into a new world: the old one goes (its car keeps its last speed until
+  // the director calls the new one). False, and failure() set, when the new one fails.
+  bool reload();
+
+  const std::string& failure() const { return failure_; }
+  const std::string& file() const { return file_; }
+  AnkiCar& car() { return car_; }
+  int version() const { return version_; }         // 1 for the first world, +1 for each reload
+  double cpuSeconds() const { return cpuTotal_; }  // what its calls used, every version's
+
+ private:
+  void fail(const std::string& why);
+  // The CPU time a call used: failed past its share (real time, DriverLimits::share).
+  void charge(double cpu);
+  void watch();
+
+  ScriptHost& race_;
+  AnkiCar& car_;
+  std::string file_;
+  DriverLimits limits_;
+  std::unique_ptr<ScriptHost> host_;
+  // Worlds replaced or failed: a world may be on the stack when it goes (it failed inside its
+  // own call), so it is freed on a later turn of the loop.
+  std::vector<std::unique_ptr<ScriptHost>> retired_;
+  Loop::TimerId sweep_ = 0;
+  std::string failure_;
+  int version_ = 0;
+  std::deque<double> spent_;  // the CPU time of its last calls (DriverLimits::shareCalls)
+  double spentSum_ = 0, cpuTotal_ = 0;
+  std::unique_ptr<FileWatch> watch_;
+  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
+};
+
+}  // namespace pitwall

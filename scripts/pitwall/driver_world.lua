@@ -1,0 +1,44 @@
+-- In a driver world (docs/drivers.md): the driver its file returned, the context it drives by,
+-- and the race director's calls, which come through bindings/driver_world.cpp as
+-- pitwall._driverCall(method, data). `data` is what drivers.world in the run's world sends, a
+-- copy: the car (this world's own object of it), ctx's limits, the race (phase, standings) and,
+-- on the first call of each world, the map.
+local drivers = require "pitwall.drivers"
+local track = require "pitwall.track"
+
+local M = {}
+local driver, ctx
+
+local METHODS = { start = true, update = true, finish = true, waiting = true }
+
+local function call(method, data)
+  if not METHODS[method] then error("no driver method " .. tostring(method), 0) end
+  local car = data.car
+  if not ctx then
+    local field = {}
+    for _, c in ipairs(pitwall.cars()) do field[#field + 1] = c end
+    local map = data.map and track._adopt(data.map)
+    if not map then error("the race director sent no map", 0) end
+    ctx = drivers.context(car, map, field, { period = data.period })
+  end
+  ctx.limit, ctx.pieceLimits, ctx.race = data.limit, data.pieceLimits, data.race
+  local fn = driver[method]
+  if fn then fn(driver, car, ctx) end
+end
+
+--- The value the driver file returned, `file` its name: a class ({new}, made with no options)
+--- or a driver ({update}). Anything else is this world's failure.
+function M.setup(value, file)
+  if type(value) == "table" and type(value.update) ~= "function" and type(value.new) == "function" then
+    value = value.new {}
+  end
+  if type(value) ~= "table" or type(value.update) ~= "function" then
+    error(string.format("%s must return a driver: a class with `new` (as the shipped "
+      .. "pitwall/drivers/cruiser.lua does) or a table with an `update` method; it returned %s",
+      file, value == nil and "nothing" or "a " .. type(value)), 0)
+  end
+  driver = value
+  pitwall._driverCall = call
+end
+
+return M

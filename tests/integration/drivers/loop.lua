@@ -1,0 +1,2 @@
+-- Never returns from its update: past its budget (--driver-budget), out.
+return { update = function() while true do end end }
