@@ -11,6 +11,7 @@
 
 #include "bindings/copy_budget.hpp"
 #include "bindings/lua_args.hpp"
+#include "bindings/lua_json.hpp"
 #include "bindings/lua_options.hpp"
 #include "bindings/pitwall_module.hpp"
 #include "bindings/script_host.hpp"
@@ -35,84 +36,6 @@ view::Feed* feedOf(lua_State* L) {
   return ScriptHost::from(L).options().view;
 }
 
-// A Lua value as JSON: tables with keys 1..n are arrays, others objects with string keys
-// (numbers become their text); functions and other non-data are refused with where they are.
-nlohmann::json toJson(lua_State* L, int idx, int depth, std::size_t& count, lua::CopyBudget& budget,
-                      const std::string& where) {
-  budget.add(kValueBytes, where);
-  if (++count > kMaxEntries)
-    throw LuaError("pitwall.view.race: the table holds more than " + std::to_string(kMaxEntries) +
-                   " values");
-  switch (lua_type(L, idx)) {
-    case LUA_TNIL:
-      return nullptr;
-    case LUA_TBOOLEAN:
-      return lua_toboolean(L, idx) != 0;
-    case LUA_TNUMBER:
-      if (lua_isinteger(L, idx)) return static_cast<long long>(lua_tointeger(L, idx));
-      {
-        double d = lua_tonumber(L, idx);
-        return std::isfinite(d) ? nlohmann::json(d) : nlohmann::json(nullptr);
-      }
-    case LUA_TSTRING: {
-      std::size_t n = 0;
-      const char* s = lua_tolstring(L, idx, &n);
-      budget.add(n, where);
-      return std::string(s, n);  // invalid UTF-8 is replaced when the feed is written
-    }
-    case LUA_TTABLE:
-      break;
-    default:
-      throw LuaError("pitwall.view.race: " + where + " is a " + luaL_typename(L, idx) +
-                     "; only data (tables, strings, numbers, booleans) goes to the view");
-  }
-  if (depth >= kMaxDepth)
-    throw LuaError("pitwall.view.race: " + where + " is nested deeper than " +
-                   std::to_string(kMaxDepth) + " tables");
-  idx = lua_absindex(L, idx);
-  luaL_checkstack(L, 4, "pitwall.view.race");
-  const lua_Integer n = static_cast<lua_Integer>(lua_rawlen(L, idx));
-  std::size_t keys = 0;
-  lua_pushnil(L);
-  while (lua_next(L, idx)) {
-    if (count + ++keys > kMaxEntries)  // before the copy: counting a huge table is work too
-      throw LuaError("pitwall.view.race: the table holds more than " + std::to_string(kMaxEntries) +
-                     " values");
-    lua_pop(L, 1);
-  }
-  if (keys == static_cast<std::size_t>(n)) {  // an empty table is an empty list
-    nlohmann::json a = nlohmann::json::array();
-    for (lua_Integer i = 1; i <= n; ++i) {
-      lua_rawgeti(L, idx, i);
-      a.push_back(toJson(L, -1, depth + 1, count, budget, where + "[" + std::to_string(i) + "]"));
-      lua_pop(L, 1);
-    }
-    return a;
-  }
-  nlohmann::json o = nlohmann::json::object();
-  lua_pushnil(L);
-  while (lua_next(L, idx)) {
-    std::string key;
-    if (lua_type(L, -2) == LUA_TSTRING) {
-      key = lua_tostring(L, -2);
-    } else if (lua_type(L, -2) == LUA_TNUMBER) {
-      lua_pushvalue(L, -2);
-      key = lua_tostring(L, -1);
-      lua_pop(L, 1);
-    } else {
-      throw LuaError("pitwall.view.race: " + where + " has a " + luaL_typename(L, -2) +
-                     " key; keys are strings or numbers");
-    }
-    // the path names at most 40 bytes of a key: a 1 MiB key over 100 000 values would otherwise
-    // be copied into the path of each of them (work no budget counts)
-    const std::string path = where + "." + printable(key, 40);
-    budget.add(key.size(), path);
-    o[key] = toJson(L, -1, depth + 1, count, budget, path);
-    lua_pop(L, 1);
-  }
-  return o;
-}
-
 int race(lua_State* L) {
   view::Feed* feed = feedOf(L);
   ScriptHost& host = ScriptHost::from(L);
@@ -125,9 +48,9 @@ int race(lua_State* L) {
     return 0;
   }
   luaL_checktype(L, 1, LUA_TTABLE);
-  std::size_t count = 0;
   lua::CopyBudget budget(L, "pitwall.view.race", kMaxBytes, host.memory().outside);
-  nlohmann::json race = toJson(L, 1, 0, count, budget, "race");
+  nlohmann::json race = lua::toJson(
+      L, 1, {"pitwall.view.race", "the view", kMaxDepth, kMaxEntries, kValueBytes}, budget, "race");
   if (record) record(race);
   if (feed) feed->setRace(std::move(race));
   host.chargeOutside(budget.bytes());  // the feed keeps it until the next race table

@@ -29,6 +29,7 @@ struct ScenarioResult {
   double wall = 0;                     // seconds of real time
   std::uint64_t seed = 1;
   std::string output;  // what it printed, when run in a process of its own
+  std::string data;    // what a job hands its parent besides (a league heat's results as JSON)
 
   bool passed() const { return status == Status::Passed; }
 };

@@ -76,6 +76,7 @@ void save(std::FILE* f, const ScenarioResult& r) {
   w.number(r.simulated);
   w.number(r.wall);
   w.text(std::to_string(r.seed));
+  w.text(r.data);
 }
 
 std::optional<ScenarioResult> load(std::FILE* f) {
@@ -92,6 +93,7 @@ std::optional<ScenarioResult> load(std::FILE* f) {
   r.simulated = rd.number();
   r.wall = rd.number();
   std::string seed = rd.text();
+  r.data = rd.text();
   if (!rd.ok() || status < 0 || status > static_cast<int>(ScenarioResult::Status::Crashed))
     return std::nullopt;
   r.status = static_cast<ScenarioResult::Status>(status);

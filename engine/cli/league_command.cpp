@@ -1,0 +1,327 @@
+// pitwall league DIR|FILES…: a tournament of driver files in the simulator (docs/league.md).
+// Each driver qualifies alone (its best lap sets its place on every grid), then the heats drawn so
+// that every driver meets every other (engine/league/schedule.hpp) are raced, each in a process
+// of its own (-j), each driver in a world of its own (docs/drivers.md); points per place and the
+// tie rule make the standings (engine/league/scoring.hpp). Results as JSON or CSV (--results) and
+// an HTML report (--report) that opens from the file.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <memory>
+
+#include <nlohmann/json.hpp>
+
+#include "bindings/script_file.hpp"
+#include "engine/cli/fail.hpp"
+#include "engine/cli/league_heat.hpp"
+#include "engine/cli/options.hpp"
+#include "engine/cli/test_pool.hpp"
+#include "engine/core/numbers.hpp"
+#include "engine/league/report.hpp"
+#include "engine/league/schedule.hpp"
+#include "engine/league/scoring.hpp"
+#include "engine/record/results.hpp"
+#include "engine/sim/sensor.hpp"
+#include "engine/sim/track.hpp"
+
+namespace pitwall::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct LeagueOptions {
+  std::vector<std::string> paths;
+  int rounds = 1;
+  int cars = 4;
+  int laps = 5;
+  int qualifyingLaps = 2;
+  std::string track = "oval";
+  std::string sensor = "real";
+  int jobs = 1;
+  std::uint64_t seed = 1;
+  std::string results;
+  std::string report;
+  int driverMemory = 64;
+  double driverBudget = 0.05;
+};
+
+struct Driver {
+  std::string name;  // the file's name without .lua
+  std::string file;  // absolute
+};
+
+// The drivers of DIR (its *.lua files) and FILES, sorted by name; a name given twice or a
+// missing file is refused.
+Result<std::vector<Driver>, std::string> collect(const std::vector<std::string>& paths) {
+  std::vector<Driver> drivers;
+  std::map<std::string, std::string> seen;
+  auto add = [&](const fs::path& p) -> std::optional<std::string> {
+    std::error_code ec;
+    Driver d{p.stem().string(), fs::absolute(p, ec).lexically_normal().string()};
+    // A file that does not compile still enters: it is out at the start of each of its heats,
+    // with the reason in the results (a class's league goes on without it)
+    if (auto problem = script_file::check(p.string()))
+      std::cerr << "league: " << *problem << ": " << d.name
+                << " enters, and is out at the start of each heat\n";
+    if (auto it = seen.find(d.name); it != seen.end())
+      return "two drivers are named " + d.name + ": " + it->second + " and " + d.file +
+             " (a driver's name is its file's: rename one)";
+    seen[d.name] = d.file;
+    drivers.push_back(std::move(d));
+    return std::nullopt;
+  };
+  for (const auto& given : paths) {
+    std::error_code ec;
+    if (fs::is_directory(given, ec)) {
+      std::vector<fs::path> files;
+      for (const auto& e : fs::directory_iterator(given, ec))
+        if (e.is_regular_file(ec) && e.path().extension() == ".lua") files.push_back(e.path());
+      if (files.empty()) return Unexpected{given + ": no driver files (*.lua) in this folder"};
+      std::sort(files.begin(), files.end());
+      for (const auto& f : files)
+        if (auto problem = add(f)) return Unexpected{*problem};
+    } else if (fs::is_regular_file(given, ec)) {
+      if (auto problem = add(given)) return Unexpected{*problem};
+    } else {
+      return Unexpected{given + ": no such file or folder"};
+    }
+  }
+  if (drivers.size() < 2)
+    return Unexpected{"a league needs at least 2 drivers, got " + std::to_string(drivers.size())};
+  std::sort(drivers.begin(), drivers.end(),
+            [](const Driver& a, const Driver& b) { return a.name < b.name; });
+  return drivers;
+}
+
+std::optional<double> numberAt(const nlohmann::json& row, const char* key) {
+  auto it = row.find(key);
+  if (it == row.end() || !it->is_number()) return std::nullopt;
+  return it->get<double>();
+}
+
+nlohmann::json orNull(const std::optional<double>& v) {
+  return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
+}
+
+std::string lapText(const std::optional<double>& v) {
+  return v ? formatNumber(*v, 3) + " s" : "no time";
+}
+
+int league(const LeagueOptions& o) {
+  auto drivers = collect(o.paths);
+  if (!drivers) return fail("league", drivers.error());
+  if (auto track = sim::loadLayout(o.track); !track) return fail("league", track.error());
+  if (!o.results.empty()) {
+    if (auto checked = results::writable(o.results); !checked)
+      return fail("league", checked.error());
+  }
+  const int n = static_cast<int>(drivers->size());
+  const int perHeat = std::min(o.cars, n);
+  const int jobs = std::max(1, o.jobs);
+  DriverLimits limits;
+  limits.memory = static_cast<std::size_t>(o.driverMemory) << 20;
+  limits.budget = std::chrono::milliseconds(std::llround(o.driverBudget * 1000));
+  auto spec = [&](std::vector<std::string> files, bool qualifying, std::uint64_t seed,
+                  std::string title) {
+    HeatSpec s;
+    s.files = std::move(files);
+    s.qualifying = qualifying;
+    s.laps = qualifying ? o.qualifyingLaps : o.laps;
+    s.track = o.track;
+    s.sensor = o.sensor;
+    s.seed = seed;
+    s.title = std::move(title);
+    s.limits = limits;
+    return s;
+  };
+  int errors = 0;
+
+  // Qualifying: each driver alone, its best lap
+  std::vector<std::optional<double>> qualifying(static_cast<std::size_t>(n));
+  nlohmann::json qualifyingRows = nlohmann::json::array();
+  std::cerr << "league: " << n << " drivers; qualifying (" << o.qualifyingLaps
+            << (o.qualifyingLaps == 1 ? " lap" : " laps") << " each)\n";
+  runInProcesses(
+      static_cast<std::size_t>(n), jobs,
+      [&](std::size_t d) {
+        return runHeat(spec({(*drivers)[d].file}, true, o.seed * 1000003 + 500000 + d,
+                            "Qualifying: " + (*drivers)[d].name));
+      },
+      [&](std::size_t d, ScenarioResult r) {
+        nlohmann::json row = {{"driver", (*drivers)[d].name}};
+        if (!r.passed()) {
+          ++errors;
+          row["status"] = "error";
+          row["reason"] = r.message;
+        } else {
+          auto rows = nlohmann::json::parse(r.data, nullptr, false);
+          const nlohmann::json first =
+              rows.is_array() && !rows.empty() ? rows[0] : nlohmann::json::object();
+          qualifying[d] = numberAt(first, "bestLap");
+          row["status"] = first.value("status", "error");
+          if (first.contains("reason")) row["reason"] = first["reason"];
+        }
+        row["bestLap"] = orNull(qualifying[d]);
+        std::cerr << "qualifying " << d + 1 << "/" << n << ": " << (*drivers)[d].name << " "
+                  << lapText(qualifying[d])
+                  << (row.contains("reason") ? " (" + row["reason"].get<std::string>() + ")" : "")
+                  << "\n";
+        qualifyingRows.push_back(std::move(row));
+      });
+
+  // The heats, each grid by qualifying
+  const auto heats = league::drawHeats(n, perHeat, o.rounds, o.seed);
+  std::vector<std::vector<int>> grids;
+  for (const auto& h : heats) grids.push_back(league::gridOrder(h, qualifying));
+  std::vector<std::vector<league::Place>> places(heats.size());
+  nlohmann::json heatRows = nlohmann::json::array();
+  std::cerr << "league: " << heats.size() << " heats of " << perHeat << " cars, " << o.laps
+            << (o.laps == 1 ? " lap\n" : " laps\n");
+  runInProcesses(
+      heats.size(), jobs,
+      [&](std::size_t h) {
+        std::vector<std::string> files;
+        for (int d : grids[h]) files.push_back((*drivers)[static_cast<std::size_t>(d)].file);
+        return runHeat(spec(files, false, o.seed * 1000003 + h, "Heat " + std::to_string(h + 1)));
+      },
+      [&](std::size_t h, ScenarioResult r) {
+        nlohmann::json heat = {{"heat", h + 1}};
+        nlohmann::json names = nlohmann::json::array();
+        for (int d : grids[h]) names.push_back((*drivers)[static_cast<std::size_t>(d)].name);
+        heat["grid"] = names;
+        std::string line = "heat " + std::to_string(h + 1) + "/" + std::to_string(heats.size());
+        auto rows = r.passed() ? nlohmann::json::parse(r.data, nullptr, false) : nlohmann::json();
+        if (!rows.is_array()) {
+          ++errors;
+          heat["error"] = r.passed() ? "the heat's results could not be read" : r.message;
+          std::cerr << line << ": " << heat["error"].get<std::string>() << "\n";
+          heatRows.push_back(std::move(heat));
+          return;
+        }
+        nlohmann::json results = nlohmann::json::array();
+        for (auto& row : rows) {
+          const int number = row.value("number", 0);
+          if (number < 1 || number > static_cast<int>(grids[h].size())) continue;
+          league::Place p;
+          p.driver = grids[h][static_cast<std::size_t>(number - 1)];
+          p.position = row.value("position", 0);
+          p.finished = row.value("finished", false);
+          p.bestLap = numberAt(row, "bestLap");
+          places[h].push_back(p);
+          row["driver"] = (*drivers)[static_cast<std::size_t>(p.driver)].name;
+          row["points"] = league::pointsFor(p.position, p.finished);
+          line += (results.empty() ? ": " : ", ") + std::to_string(p.position) + ". " +
+                  row["driver"].get<std::string>() +
+                  (p.finished ? "" : " " + row.value("status", std::string("DNF")));
+          results.push_back(row);
+        }
+        heat["results"] = results;
+        std::cerr << line << "\n";
+        heatRows.push_back(std::move(heat));
+      });
+
+  // The standings
+  const auto table = league::standings(n, places, qualifying);
+  nlohmann::json standingRows = nlohmann::json::array();
+  std::cout << "League: " << n << " drivers, " << heats.size() << " heats\n";
+  std::cout << "POS  DRIVER               POINTS  HEATS  WINS  QUALIFYING\n";
+  int position = 0;
+  for (const auto& s : table) {
+    ++position;
+    const auto& d = (*drivers)[static_cast<std::size_t>(s.driver)];
+    const int wins = s.places.empty() ? 0 : s.places[0];
+    standingRows.push_back({{"position", position},
+                            {"driver", d.name},
+                            {"file", d.file},
+                            {"points", s.points},
+                            {"heats", s.heats},
+                            {"wins", wins},
+                            {"finishes", s.finishes},
+                            {"places", s.places},
+                            {"bestLap", orNull(s.bestLap)},
+                            {"qualifying", orNull(s.qualifying)}});
+    char row[160];
+    std::snprintf(row, sizeof row, "%3d  %-20s %6d  %5d  %4d  %s\n", position,
+                  d.name.substr(0, 20).c_str(), s.points, s.heats, wins,
+                  lapText(s.qualifying).c_str());
+    std::cout << row;
+  }
+  nlohmann::json all = {{"league",
+                         {{"title", fs::path(o.paths.front()).filename().string()},
+                          {"drivers", n},
+                          {"heats", heats.size()},
+                          {"cars", perHeat},
+                          {"laps", o.laps},
+                          {"qualifyingLaps", o.qualifyingLaps},
+                          {"rounds", o.rounds},
+                          {"track", o.track},
+                          {"seed", o.seed}}},
+                        {"qualifying", qualifyingRows},
+                        {"heats", heatRows},
+                        {"standings", standingRows}};
+  if (!o.results.empty()) {
+    const bool csv =
+        o.results.size() >= 4 && o.results.compare(o.results.size() - 4, 4, ".csv") == 0;
+    std::ofstream out(o.results);
+    if (csv) {
+      out << "position,driver,points,heats,wins,finishes,bestLap,qualifying\n";
+      for (const auto& s : standingRows) {
+        auto cell = [](const nlohmann::json& v) { return v.is_null() ? std::string() : v.dump(); };
+        out << s["position"] << ',' << s["driver"].get<std::string>() << ',' << s["points"] << ','
+            << s["heats"] << ',' << s["wins"] << ',' << s["finishes"] << ',' << cell(s["bestLap"])
+            << ',' << cell(s["qualifying"]) << '\n';
+      }
+    } else {
+      out << all.dump(2) << '\n';
+    }
+    if (!out) return fail("league", o.results + ": the results could not be written");
+  }
+  if (!o.report.empty()) {
+    std::ofstream out(o.report);
+    out << league::htmlReport(all);
+    if (!out) return fail("league", o.report + ": the report could not be written");
+    std::cerr << "league: report " << o.report << "\n";
+  }
+  return errors ? 1 : 0;
+}
+
+}  // namespace
+
+Command addLeagueCommand(CLI::App& app) {
+  auto o = std::make_shared<LeagueOptions>();
+  auto* cmd = app.add_subcommand(
+      "league",
+      "Score driver files in the simulator: qualifying, heats where every driver meets "
+      "every other, standings (docs/league.md)");
+  cmd->add_option("drivers", o->paths, "Driver files, or folders of them (*.lua)")->required();
+  cmd->add_option("--races", o->rounds,
+                  "Rounds: in each, every driver meets every other in a heat (default 1)")
+      ->check(CLI::Range(1, 100));
+  cmd->add_option("--cars", o->cars, "Cars in a heat (default 4)")->check(CLI::Range(1, 16));
+  cmd->add_option("--laps", o->laps, "Laps of a heat (default 5)")->check(CLI::Range(1, 100));
+  cmd->add_option("--qualifying-laps", o->qualifyingLaps,
+                  "Laps each driver drives alone to qualify (default 2)")
+      ->check(CLI::Range(1, 20));
+  cmd->add_option("--track", o->track, "The layout: a name (oval, …) or a layout file");
+  cmd->add_option("--sensor", o->sensor,
+                  "The simulated cars' sensors: real (default, as real cars report) or ideal")
+      ->check(CLI::IsMember({"real", "ideal"}));
+  cmd->add_option("-j,--jobs", o->jobs, "Heats raced at once, each in a process of its own")
+      ->check(CLI::Range(1, 256));
+  cmd->add_option("--seed", o->seed, "The draw's and the simulator's seed (default 1)");
+  cmd->add_option("--results", o->results,
+                  "Write the league as JSON (everything) or CSV (the standings) to FILE");
+  cmd->add_option("--report", o->report, "Write an HTML report (standings, heats, charts)");
+  cmd->add_option("--driver-memory", o->driverMemory, "MB each driver world may hold (default 64)")
+      ->check(CLI::Range(1, 4096));
+  cmd->add_option("--driver-budget", o->driverBudget,
+                  "Seconds of CPU one call into a driver world may take (default 0.05)")
+      ->check(CLI::Range(0.001, 10.0));
+  return {cmd, [o] { return league(*o); }};
+}
+
+}  // namespace pitwall::cli

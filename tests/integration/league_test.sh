@@ -1,0 +1,110 @@
+# pitwall league (docs/league.md): submitted drivers — good ones and adversaries — qualify and race
+# heats in the simulator. The draw covers every pair; the league is the same twice for a seed and
+# with -j 2 as with -j 1; every adversary is DNF with its reason in each of its heats and scores
+# nothing while the good ones finish; the results come as JSON and CSV; the HTML report loads in
+# Chromium with a lap-time chart per heat (its screenshot is kept in test-results/). Bad
+# invocations are sentences.
+source "$(dirname "$0")/lib.sh"
+D="$SRC/tests/integration/drivers"
+SHOTS="$(cd "$(dirname "$PITWALL")" && pwd)/test-results"
+mkdir -p "$SHOTS" "$TMP/class"
+
+cp "$D/good.lua" "$TMP/class/alice.lua"
+cat > "$TMP/class/bob.lua" <<'LUA'
+local cruiser = require "pitwall.drivers.cruiser"
+return { name = "bob", new = function() return cruiser.new { speed = 1100 } end }
+LUA
+printf 'return require "pitwall.drivers.overtaker"\n' > "$TMP/class/carol.lua"
+printf 'return require "pitwall.drivers.follower"\n' > "$TMP/class/dave.lua"
+cp "$D/loop.lua" "$TMP/class/eve.lua"
+cp "$D/errors.lua" "$TMP/class/frank.lua"
+cp "$D/other_car.lua" "$TMP/class/gina.lua"
+cp "$D/broken_save.lua" "$TMP/class/hank.lua"  # does not compile: enters, and is out
+cp "$D/require_other.lua" "$TMP/class/ivan.lua"
+
+league() {
+  $PITWALL league "$TMP/class" --laps 2 --qualifying-laps 1 --seed 3 "$@"
+}
+
+league --results "$TMP/a.json" --report "$TMP/report.html" >"$TMP/a.out" 2>"$TMP/a.err"
+check "a league: exit status" 0 "$?"
+contains "live progress: qualifying" "qualifying 9/9: ivan" "$(cat "$TMP/a.err")"
+contains "live progress: the heats" "heat 1/" "$(cat "$TMP/a.err")"
+contains "the file that does not compile is named" "hank enters, and is out" "$(cat "$TMP/a.err")"
+contains "the standings printed" "POS  DRIVER" "$(cat "$TMP/a.out")"
+
+python3 - "$TMP/a.json" <<'PY' >"$TMP/checks.txt"
+import itertools, json, sys
+league = json.load(open(sys.argv[1]))
+names = [q["driver"] for q in league["qualifying"]]
+print("drivers", len(names))
+met = set()
+for h in league["heats"]:
+    met.update(itertools.combinations(sorted(h["grid"]), 2))
+print("pairs", len(met), "of", len(names) * (len(names) - 1) // 2)
+bad = {"eve": "still running after 50 ms", "frank": "this driver is broken",
+       "gina": "is not this driver's car", "hank": "its file does not load",
+       "ivan": "module 'good' not found"}
+for h in league["heats"]:
+    for r in h["results"]:
+        d = r["driver"]
+        if d in bad:
+            ok = r["status"] == "DNF" and bad[d] in r.get("reason", "") and r["points"] == 0
+            print("adversary", d, "ok" if ok else "WRONG %s" % r)
+        else:
+            print("good", d, "ok" if r["status"] == "finished" else "WRONG %s" % r)
+standings = league["standings"]
+print("leader", standings[0]["driver"], standings[0]["points"])
+print("nothing for adversaries", all(s["points"] == 0 for s in standings if s["driver"] in bad))
+print("points add up", all(s["points"] == sum(r["points"] for h in league["heats"]
+      for r in h["results"] if r["driver"] == s["driver"]) for s in standings))
+PY
+checks=$(cat "$TMP/checks.txt")
+contains "nine drivers" "drivers 9" "$checks"
+contains "the heats cover every pair" "pairs 36 of 36" "$checks"
+case "$checks" in *WRONG*) fail "a driver's row: $(grep WRONG "$TMP/checks.txt")" ;; *) echo "ok: every row as expected" ;; esac
+check "every adversary seen" 5 "$(grep '^adversary' "$TMP/checks.txt" | cut -d' ' -f2 | sort -u | wc -l)"
+contains "the adversaries score nothing" "nothing for adversaries True" "$checks"
+contains "the standings are the heats' points" "points add up True" "$checks"
+
+league --results "$TMP/b.json" >/dev/null 2>&1
+check "the same seed: the same league" "" "$(cmp "$TMP/a.json" "$TMP/b.json" 2>&1)"
+league --results "$TMP/j2.json" -j 2 >/dev/null 2>&1
+check "-j 2: the same league as -j 1" "" "$(cmp "$TMP/a.json" "$TMP/j2.json" 2>&1)"
+
+league --results "$TMP/c.csv" >/dev/null 2>&1
+check "CSV: the standings' header" "position,driver,points,heats,wins,finishes,bestLap,qualifying" \
+  "$(head -1 "$TMP/c.csv")"
+check "CSV: a row per driver" 9 "$(tail -n +2 "$TMP/c.csv" | wc -l)"
+
+# The report in Chromium: its tables and a chart per heat, drawn
+CHROMIUM=${CHROMIUM:-/usr/bin/chromium}
+heats=$(python3 -c "import json,sys; print(len(json.load(open(sys.argv[1]))['heats']))" "$TMP/a.json")
+dom=$(timeout 60 "$CHROMIUM" --headless=new --no-sandbox --disable-gpu --dump-dom \
+  "file://$TMP/report.html" 2>/dev/null)
+check "the report: a standings row per driver" 9 \
+  "$(echo "$dom" | python3 -c "import re,sys; t=sys.stdin.read(); s=t[t.find('id=\"standings\"'):]; print(s[:s.find('</table>')].count('<tr>') - 1)")"
+check "the report: a chart per heat" "$heats" "$(echo "$dom" | grep -o '<svg class="laps"' | wc -l)"
+lines=$(echo "$dom" | grep -o '<polyline class="driver"' | wc -l)
+[ "$lines" -ge "$heats" ] && echo "ok: the report: lap-time lines drawn ($lines)" ||
+  fail "the report: $lines lines for $heats heats"
+timeout 60 "$CHROMIUM" --headless=new --no-sandbox --disable-gpu --hide-scrollbars \
+  --window-size=1000,1800 --screenshot="$SHOTS/league-report.png" "file://$TMP/report.html" \
+  >/dev/null 2>&1
+[ -s "$SHOTS/league-report.png" ] && echo "ok: the report's screenshot: $SHOTS/league-report.png" ||
+  fail "no screenshot of the report"
+
+# Sentences for what cannot be a league
+err=$($PITWALL league "$TMP/class/alice.lua" 2>&1); rc=$?
+check "one driver: status 2" 2 "$rc"
+contains "one driver: says why" "a league needs at least 2 drivers, got 1" "$err"
+err=$($PITWALL league "$TMP/class" "$TMP/nowhere" 2>&1)
+contains "a missing folder is named" "$TMP/nowhere: no such file or folder" "$err"
+mkdir -p "$TMP/other" && cp "$D/good.lua" "$TMP/other/alice.lua"
+err=$($PITWALL league "$TMP/class" "$TMP/other" 2>&1)
+contains "two drivers of one name" "two drivers are named alice" "$err"
+mkdir -p "$TMP/empty"
+err=$($PITWALL league "$TMP/empty" 2>&1)
+contains "a folder without drivers" "no driver files (*.lua) in this folder" "$err"
+
+finish
