@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <map>
 #include <memory>
@@ -118,6 +117,12 @@ int league(const LeagueOptions& o) {
   if (!o.results.empty()) {
     if (auto checked = results::writable(o.results); !checked)
       return fail("league", checked.error());
+  }
+  if (!o.report.empty()) {  // refused now, not after the league
+    std::error_code ec;
+    const fs::path folder = fs::absolute(o.report, ec).parent_path();
+    if (!fs::is_directory(folder, ec))
+      return fail("league", "--report " + o.report + ": no folder " + folder.string());
   }
   const int n = static_cast<int>(drivers->size());
   const int perHeat = std::min(o.cars, n);
@@ -263,27 +268,32 @@ int league(const LeagueOptions& o) {
                         {"qualifying", qualifyingRows},
                         {"heats", heatRows},
                         {"standings", standingRows}};
+  constexpr auto kReplace = nlohmann::json::error_handler_t::replace;  // a reason's bad bytes
   if (!o.results.empty()) {
-    const bool csv =
-        o.results.size() >= 4 && o.results.compare(o.results.size() - 4, 4, ".csv") == 0;
-    std::ofstream out(o.results);
-    if (csv) {
-      out << "position,driver,points,heats,wins,finishes,bestLap,qualifying\n";
-      for (const auto& s : standingRows) {
-        auto cell = [](const nlohmann::json& v) { return v.is_null() ? std::string() : v.dump(); };
-        out << s["position"] << ',' << s["driver"].get<std::string>() << ',' << s["points"] << ','
-            << s["heats"] << ',' << s["wins"] << ',' << s["finishes"] << ',' << cell(s["bestLap"])
-            << ',' << cell(s["qualifying"]) << '\n';
-      }
+    Result<bool, std::string> written = true;
+    if (auto format = results::formatOf(o.results); format && *format == results::Format::Csv) {
+      results::Table t{
+          {"position", "driver", "points", "heats", "wins", "finishes", "bestLap", "qualifying"},
+          {}};
+      auto time = [](const nlohmann::json& v) -> results::Cell {
+        if (v.is_number()) return v.get<double>();
+        return std::monostate{};
+      };
+      for (const auto& s : standingRows)
+        t.rows.push_back({s["position"].get<double>(), s["driver"].get<std::string>(),
+                          s["points"].get<double>(), s["heats"].get<double>(),
+                          s["wins"].get<double>(), s["finishes"].get<double>(), time(s["bestLap"]),
+                          time(s["qualifying"])});
+      written = results::write(o.results, t);
     } else {
-      out << all.dump(2) << '\n';
+      written = results::writeText(o.results, all.dump(2, ' ', false, kReplace) + "\n", "results");
     }
-    if (!out) return fail("league", o.results + ": the results could not be written");
+    if (!written) return fail("league", written.error());
   }
   if (!o.report.empty()) {
-    std::ofstream out(o.report);
-    out << league::htmlReport(all);
-    if (!out) return fail("league", o.report + ": the report could not be written");
+    if (auto written = results::writeText(o.report, league::htmlReport(all), "the report");
+        !written)
+      return fail("league", written.error());
     std::cerr << "league: report " << o.report << "\n";
   }
   return errors ? 1 : 0;

@@ -117,7 +117,9 @@ ScenarioResult runHeat(const HeatSpec& spec) {
   }
   lua::CopyBudget budget(L, "league heat", std::size_t{64} << 20);
   try {
-    out.data = lua::toJson(L, -1, {"league heat", "the league"}, budget, "results").dump();
+    // (a driver's error may hold any byte: its reason keeps the rest)
+    out.data = lua::toJson(L, -1, {"league heat", "the league"}, budget, "results")
+                   .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   } catch (const std::exception& e) {
     out.status = ScenarioResult::Status::Errored;
     out.message = e.what();

@@ -99,27 +99,7 @@ std::string xml(std::string_view text) {
     for (std::string_view bad : {"\xEF\xBF\xBE", "\xEF\xBF\xBF"})
       for (auto at = shown.find(bad); at != std::string::npos; at = shown.find(bad, at))
         shown.replace(at, bad.size(), bad.back() == '\xBE' ? "\\uFFFE" : "\\uFFFF");
-    for (char c : shown) {
-      switch (c) {
-        case '&':
-          out += "&amp;";
-          break;
-        case '<':
-          out += "&lt;";
-          break;
-        case '>':
-          out += "&gt;";
-          break;
-        case '"':
-          out += "&quot;";
-          break;
-        case '\'':
-          out += "&apos;";
-          break;
-        default:
-          out += c;
-      }
-    }
+    out += markupEscaped(shown);
     out += '\n';
   }
   if (!out.empty()) out.pop_back();

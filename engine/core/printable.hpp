@@ -16,4 +16,8 @@ std::size_t utf8Length(std::string_view s);
 // stays short however hostile the text), then "…" when some of the text was left out.
 std::string printable(std::string_view text, std::size_t maxBytes = std::string_view::npos);
 
+// Text for XML or HTML character data and attribute values: & < > " ' as entities, the rest as
+// it is (give it printable() text: markup takes no control characters).
+std::string markupEscaped(std::string_view text);
+
 }  // namespace pitwall

@@ -5,41 +5,17 @@
 #include <cstdio>
 #include <sstream>
 
+#include "engine/core/printable.hpp"
+
 namespace pitwall::league {
 
 namespace {
 
-std::string escape(const std::string& s) {
-  std::string out;
-  out.reserve(s.size());
-  for (char c : s) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      case '\'':
-        out += "&#39;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
-
+// A value as HTML text: a string as printable() shows it (a driver's error may hold any byte).
 std::string text(const nlohmann::json& v) {
-  if (v.is_string()) return escape(v.get<std::string>());
+  if (v.is_string()) return markupEscaped(printable(v.get<std::string>()));
   if (v.is_null()) return "–";
-  return escape(v.dump());
+  return markupEscaped(v.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
 }
 
 std::string seconds(const nlohmann::json& v) {

@@ -119,16 +119,21 @@ Result<bool, std::string> writable(const std::string& path) {
 Result<bool, std::string> write(const std::string& path, const Table& table) {
   auto format = formatOf(path);
   if (!format) return Unexpected{format.error()};
+  return writeText(path, render(table, *format), "results");
+}
+
+Result<bool, std::string> writeText(const std::string& path, const std::string& text,
+                                    const std::string& what) {
   std::string tmp = path + ".tmp";
   {
     std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    if (!f) return Unexpected{"cannot write results to '" + path + "': cannot create " + tmp};
-    f << render(table, *format);
-    if (!f.flush()) return Unexpected{"cannot write results to '" + path + "'"};
+    if (!f) return Unexpected{"cannot write " + what + " to '" + path + "': cannot create " + tmp};
+    f << text;
+    if (!f.flush()) return Unexpected{"cannot write " + what + " to '" + path + "'"};
   }
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
     std::remove(tmp.c_str());
-    return Unexpected{"cannot write results to '" + path + "': rename failed"};
+    return Unexpected{"cannot write " + what + " to '" + path + "': rename failed"};
   }
   return true;
 }

@@ -30,5 +30,8 @@ std::string render(const Table& table, Format format);
 Result<bool, std::string> writable(const std::string& path);
 // Writes atomically enough for a results file: the whole text, then a rename over the path.
 Result<bool, std::string> write(const std::string& path, const Table& table);
+// The same for any text (a league's JSON, its HTML report); `what` names it in the sentence.
+Result<bool, std::string> writeText(const std::string& path, const std::string& text,
+                                    const std::string& what);
 
 }  // namespace pitwall::results

@@ -143,6 +143,37 @@ contains "the good save brought it back" "car 2 (skull) is back (driver $TMP/rep
 contains "it raced to the flag" "finished | None" "$(second "$TMP/repaired.json")"
 expect_stopped "a repaired driver" "$TMP/repaired.jsonl" 4
 
+# --watch, in real time: a save of a driver file reloads its world — a broken save puts it out,
+# a good one brings it back (an editor's atomic save: write a copy, rename it over the file)
+cp "$D/good.lua" "$TMP/watched.lua"
+cat > "$TMP/watch_race.lua" <<'LUA'
+local race = require "pitwall.race"
+race.laps { laps = 2, onLap = function(car, lap)
+  if car.number == 1 then pitwall.log("info", "leader's lap " .. lap.number) end
+end }
+pitwall.stop()
+LUA
+$PITWALL run "$TMP/watch_race.lua" --watch --driver 2="$TMP/watched.lua" \
+  --results "$TMP/watched.json" --record "$TMP/watched.jsonl" >/dev/null 2>"$TMP/watch.err" &
+pid=$!
+saved() { cp "$1" "$TMP/watched.lua.swp" && mv "$TMP/watched.lua.swp" "$TMP/watched.lua"; }
+if wait_for "$TMP/watch.err" "leader's lap 1" 40; then
+  saved "$D/broken_save.lua"
+  wait_for "$TMP/watch.err" "car 2 \(skull\) is out \(DNF\)" 20 ||
+    fail "--watch: a broken save did not put the driver out: $(tail -3 "$TMP/watch.err")"
+  saved "$D/good.lua"
+  wait_for "$TMP/watch.err" "car 2 \(skull\) is back" 20 ||
+    fail "--watch: a good save did not bring it back: $(tail -3 "$TMP/watch.err")"
+else
+  fail "--watch: the race never reached its first lap: $(tail -3 "$TMP/watch.err")"
+fi
+wait_bounded $pid
+check "--watch: exit status" 0 "$?"
+contains "--watch: the save's reload is said" "driver watched.lua of car 2 (skull) reloaded" \
+  "$(cat "$TMP/watch.err")"
+contains "--watch: car 2 raced to the flag" "finished | None" "$(second "$TMP/watched.json")"
+expect_stopped "--watch" "$TMP/watched.jsonl" 4
+
 # Good drivers race as any other: two worlds, and the script's own form of the same
 out=$($PITWALL run "$TMP/race.lua" --fast --driver 2="$D/good.lua" --driver 4="$D/good.lua" \
   --results "$TMP/good.json" 2>&1)

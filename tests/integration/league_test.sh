@@ -21,6 +21,7 @@ cp "$D/errors.lua" "$TMP/class/frank.lua"
 cp "$D/other_car.lua" "$TMP/class/gina.lua"
 cp "$D/broken_save.lua" "$TMP/class/hank.lua"  # does not compile: enters, and is out
 cp "$D/require_other.lua" "$TMP/class/ivan.lua"
+cp "$D/bad_bytes.lua" "$TMP/class/jack.lua"  # fails with bytes that are not UTF-8, and markup
 
 league() {
   $PITWALL league "$TMP/class" --laps 2 --qualifying-laps 1 --seed 3 "$@"
@@ -28,7 +29,7 @@ league() {
 
 league --results "$TMP/a.json" --report "$TMP/report.html" >"$TMP/a.out" 2>"$TMP/a.err"
 check "a league: exit status" 0 "$?"
-contains "live progress: qualifying" "qualifying 9/9: ivan" "$(cat "$TMP/a.err")"
+contains "live progress: qualifying" "qualifying 10/10: jack" "$(cat "$TMP/a.err")"
 contains "live progress: the heats" "heat 1/" "$(cat "$TMP/a.err")"
 contains "the file that does not compile is named" "hank enters, and is out" "$(cat "$TMP/a.err")"
 contains "the standings printed" "POS  DRIVER" "$(cat "$TMP/a.out")"
@@ -44,7 +45,7 @@ for h in league["heats"]:
 print("pairs", len(met), "of", len(names) * (len(names) - 1) // 2)
 bad = {"eve": "still running after 50 ms", "frank": "this driver is broken",
        "gina": "is not this driver's car", "hank": "its file does not load",
-       "ivan": "module 'good' not found"}
+       "ivan": "module 'good' not found", "jack": "bytes, <b>and markup</b>"}
 for h in league["heats"]:
     for r in h["results"]:
         d = r["driver"]
@@ -60,10 +61,10 @@ print("points add up", all(s["points"] == sum(r["points"] for h in league["heats
       for r in h["results"] if r["driver"] == s["driver"]) for s in standings))
 PY
 checks=$(cat "$TMP/checks.txt")
-contains "nine drivers" "drivers 9" "$checks"
-contains "the heats cover every pair" "pairs 36 of 36" "$checks"
+contains "ten drivers" "drivers 10" "$checks"
+contains "the heats cover every pair" "pairs 45 of 45" "$checks"
 case "$checks" in *WRONG*) fail "a driver's row: $(grep WRONG "$TMP/checks.txt")" ;; *) echo "ok: every row as expected" ;; esac
-check "every adversary seen" 5 "$(grep '^adversary' "$TMP/checks.txt" | cut -d' ' -f2 | sort -u | wc -l)"
+check "every adversary seen" 6 "$(grep '^adversary' "$TMP/checks.txt" | cut -d' ' -f2 | sort -u | wc -l)"
 contains "the adversaries score nothing" "nothing for adversaries True" "$checks"
 contains "the standings are the heats' points" "points add up True" "$checks"
 
@@ -75,19 +76,21 @@ check "-j 2: the same league as -j 1" "" "$(cmp "$TMP/a.json" "$TMP/j2.json" 2>&
 league --results "$TMP/c.csv" >/dev/null 2>&1
 check "CSV: the standings' header" "position,driver,points,heats,wins,finishes,bestLap,qualifying" \
   "$(head -1 "$TMP/c.csv")"
-check "CSV: a row per driver" 9 "$(tail -n +2 "$TMP/c.csv" | wc -l)"
+check "CSV: a row per driver" 10 "$(tail -n +2 "$TMP/c.csv" | wc -l)"
 
 # The report in Chromium: its tables and a chart per heat, drawn
 CHROMIUM=${CHROMIUM:-/usr/bin/chromium}
 heats=$(python3 -c "import json,sys; print(len(json.load(open(sys.argv[1]))['heats']))" "$TMP/a.json")
 dom=$(timeout 60 "$CHROMIUM" --headless=new --no-sandbox --disable-gpu --dump-dom \
   "file://$TMP/report.html" 2>/dev/null)
-check "the report: a standings row per driver" 9 \
+check "the report: a standings row per driver" 10 \
   "$(echo "$dom" | python3 -c "import re,sys; t=sys.stdin.read(); s=t[t.find('id=\"standings\"'):]; print(s[:s.find('</table>')].count('<tr>') - 1)")"
 check "the report: a chart per heat" "$heats" "$(echo "$dom" | grep -o '<svg class="laps"' | wc -l)"
 lines=$(echo "$dom" | grep -o '<polyline class="driver"' | wc -l)
 [ "$lines" -ge "$heats" ] && echo "ok: the report: lap-time lines drawn ($lines)" ||
   fail "the report: $lines lines for $heats heats"
+contains "the report: a driver's markup is text" "bytes, &lt;b&gt;and markup&lt;/b&gt;" "$dom"
+case "$dom" in *"<b>and markup"*) fail "the report: a driver's markup became markup" ;; esac
 timeout 60 "$CHROMIUM" --headless=new --no-sandbox --disable-gpu --hide-scrollbars \
   --window-size=1000,1800 --screenshot="$SHOTS/league-report.png" "file://$TMP/report.html" \
   >/dev/null 2>&1
