@@ -7,9 +7,12 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <map>
 #include <memory>
+#include <set>
+#include <tuple>
 
 #include <nlohmann/json.hpp>
 
@@ -46,6 +49,9 @@ struct LeagueOptions {
   std::string report;
   int driverMemory = 64;
   double driverBudget = 0.05;
+  std::string shard;  // K/N: the heats of shard K of N only
+  // pitwall league merge FILE…: the shards' results, as one league
+  std::vector<std::string> merge;
 };
 
 struct Driver {
@@ -110,20 +116,187 @@ std::string lapText(const std::optional<double>& v) {
   return v ? formatNumber(*v, 3) + " s" : "no time";
 }
 
-int league(const LeagueOptions& o) {
-  auto drivers = collect(o.paths);
-  if (!drivers) return fail("league", drivers.error());
-  if (auto track = sim::loadLayout(o.track); !track) return fail("league", track.error());
+// K/N with 1 <= K <= N <= 1000.
+Result<std::pair<int, int>, std::string> parseShard(const std::string& text) {
+  int k = 0, n = 0;
+  char slash = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%d%c%d%c", &k, &slash, &n, &extra) != 3 || slash != '/' || n < 1 ||
+      n > 1000 || k < 1 || k > n)
+    return Unexpected{"--shard " + text +
+                      ": expected K/N, shard K of N (1 <= K <= N), as in "
+                      "--shard 2/3"};
+  return std::pair{k, n};
+}
+
+// The standings from the qualifying and heat rows (each row names its driver), printed; the
+// league as --results writes it. One way for a run and for a merge of shards.
+nlohmann::json complete(nlohmann::json about, const std::vector<Driver>& drivers,
+                        nlohmann::json qualifyingRows, nlohmann::json heatRows) {
+  const int n = static_cast<int>(drivers.size());
+  std::map<std::string, int> index;
+  for (int d = 0; d < n; ++d) index[drivers[static_cast<std::size_t>(d)].name] = d;
+  std::vector<std::optional<double>> qualifying(static_cast<std::size_t>(n));
+  for (const auto& q : qualifyingRows)
+    if (auto it = index.find(q.value("driver", std::string())); it != index.end())
+      qualifying[static_cast<std::size_t>(it->second)] = numberAt(q, "bestLap");
+  std::vector<std::vector<league::Place>> places;
+  for (const auto& heat : heatRows) {
+    auto& ps = places.emplace_back();
+    if (!heat.contains("results")) continue;
+    for (const auto& row : heat["results"]) {
+      auto it = index.find(row.value("driver", std::string()));
+      if (it == index.end()) continue;
+      ps.push_back({it->second, row.value("position", 0), row.value("finished", false),
+                    numberAt(row, "bestLap")});
+    }
+  }
+  const auto table = league::standings(n, places, qualifying);
+  nlohmann::json standingRows = nlohmann::json::array();
+  std::cout << "League: " << n << " drivers, " << heatRows.size() << " heats"
+            << (about.contains("shard") ? " (shard " + about["shard"].get<std::string>() + ")"
+                                        : std::string())
+            << "\n";
+  std::cout << "POS  DRIVER               POINTS  HEATS  WINS  QUALIFYING\n";
+  int position = 0;
+  for (const auto& s : table) {
+    ++position;
+    const auto& d = drivers[static_cast<std::size_t>(s.driver)];
+    const int wins = s.places.empty() ? 0 : s.places[0];
+    standingRows.push_back({{"position", position},
+                            {"driver", d.name},
+                            {"file", d.file},
+                            {"points", s.points},
+                            {"heats", s.heats},
+                            {"wins", wins},
+                            {"finishes", s.finishes},
+                            {"places", s.places},
+                            {"bestLap", orNull(s.bestLap)},
+                            {"qualifying", orNull(s.qualifying)}});
+    char row[160];
+    std::snprintf(row, sizeof row, "%3d  %-20s %6d  %5d  %4d  %s\n", position,
+                  d.name.substr(0, 20).c_str(), s.points, s.heats, wins,
+                  lapText(s.qualifying).c_str());
+    std::cout << row;
+  }
+  return {{"league", std::move(about)},
+          {"qualifying", std::move(qualifyingRows)},
+          {"heats", std::move(heatRows)},
+          {"standings", std::move(standingRows)}};
+}
+
+// --results (JSON: everything; CSV: the standings) and --report.
+int writeOutputs(const nlohmann::json& all, const LeagueOptions& o) {
+  constexpr auto kReplace = nlohmann::json::error_handler_t::replace;  // a reason's bad bytes
+  if (!o.results.empty()) {
+    Result<bool, std::string> written = true;
+    if (auto format = results::formatOf(o.results); format && *format == results::Format::Csv) {
+      results::Table t{
+          {"position", "driver", "points", "heats", "wins", "finishes", "bestLap", "qualifying"},
+          {}};
+      auto time = [](const nlohmann::json& v) -> results::Cell {
+        if (v.is_number()) return v.get<double>();
+        return std::monostate{};
+      };
+      for (const auto& s : all["standings"])
+        t.rows.push_back({s["position"].get<double>(), s["driver"].get<std::string>(),
+                          s["points"].get<double>(), s["heats"].get<double>(),
+                          s["wins"].get<double>(), s["finishes"].get<double>(), time(s["bestLap"]),
+                          time(s["qualifying"])});
+      written = results::write(o.results, t);
+    } else {
+      written = results::writeText(o.results, all.dump(2, ' ', false, kReplace) + "\n", "results");
+    }
+    if (!written) return fail("league", written.error());
+  }
+  if (!o.report.empty()) {
+    if (auto written = results::writeText(o.report, league::htmlReport(all), "the report");
+        !written)
+      return fail("league", written.error());
+    std::cerr << "league: report " << o.report << "\n";
+  }
+  return 0;
+}
+
+// Checks --results and --report before anything runs: a typo does not cost the league.
+int checkOutputs(const LeagueOptions& o) {
   if (!o.results.empty()) {
     if (auto checked = results::writable(o.results); !checked)
       return fail("league", checked.error());
   }
-  if (!o.report.empty()) {  // refused now, not after the league
+  if (!o.report.empty()) {
     std::error_code ec;
     const fs::path folder = fs::absolute(o.report, ec).parent_path();
     if (!fs::is_directory(folder, ec))
       return fail("league", "--report " + o.report + ": no folder " + folder.string());
   }
+  return 0;
+}
+
+// pitwall league merge FILE…: the shards' JSON results as the one league they split. Every
+// shard of the same league (the same `league` but its shard, the same qualifying), each heat in
+// exactly one of them.
+int merge(const LeagueOptions& o) {
+  if (int status = checkOutputs(o); status != 0) return status;
+  nlohmann::json about, qualifying;
+  std::map<int, nlohmann::json> heats;
+  std::map<std::string, std::string> files;  // driver → file
+  std::set<std::string> shardsSeen;
+  for (const auto& path : o.merge) {
+    std::ifstream in(path);
+    auto part = in ? nlohmann::json::parse(in, nullptr, false) : nlohmann::json();
+    if (!part.is_object() || !part.contains("league") || !part.contains("heats") ||
+        !part.contains("qualifying") || !part.contains("standings"))
+      return fail("league", path +
+                                ": not the JSON results of a league (pitwall league "
+                                "--shard K/N --results FILE.json writes them)");
+    nlohmann::json league = part["league"];
+    const std::string shard = league.value("shard", std::string("1/1"));
+    league.erase("shard");
+    if (about.is_null()) {
+      about = league;
+      qualifying = part["qualifying"];
+    } else if (league != about || part["qualifying"] != qualifying) {
+      return fail("league", path + ": another league than " + o.merge.front() +
+                                " (its drivers, options, seed or qualifying differ)");
+    }
+    if (!shardsSeen.insert(shard).second)
+      return fail("league", path + ": shard " + shard + " is given twice");
+    for (const auto& s : part["standings"])
+      files[s.value("driver", std::string())] = s.value("file", std::string());
+    for (const auto& h : part["heats"]) {
+      const int number = h.value("heat", 0);
+      if (heats.count(number))
+        return fail("league", path + ": heat " + std::to_string(number) + " is in two shards");
+      heats[number] = h;
+    }
+  }
+  const int total = about.value("heats", 0);
+  for (int h = 1; h <= total; ++h)
+    if (!heats.count(h))
+      return fail("league", "heat " + std::to_string(h) + " of " + std::to_string(total) +
+                                " is in none of the files: merge every shard's results");
+  std::vector<Driver> drivers;
+  for (const auto& [name, file] : files) drivers.push_back({name, file});
+  nlohmann::json heatRows = nlohmann::json::array();
+  for (auto& [number, h] : heats) heatRows.push_back(std::move(h));
+  auto all = complete(std::move(about), drivers, std::move(qualifying), std::move(heatRows));
+  return writeOutputs(all, o);
+}
+
+int league(const LeagueOptions& o) {
+  if (!o.merge.empty()) return merge(o);
+  if (o.paths.empty())
+    return fail("league", "give the drivers: files, or folders of them (pitwall league DIR)");
+  int shard = 1, shards = 1;
+  if (!o.shard.empty()) {
+    auto parsed = parseShard(o.shard);
+    if (!parsed) return fail("league", parsed.error());
+    std::tie(shard, shards) = *parsed;
+  }
+  auto drivers = collect(o.paths);
+  if (!drivers) return fail("league", drivers.error());
+  if (auto track = sim::loadLayout(o.track); !track) return fail("league", track.error());
+  if (int status = checkOutputs(o); status != 0) return status;
   const int n = static_cast<int>(drivers->size());
   const int perHeat = std::min(o.cars, n);
   const int jobs = std::max(1, o.jobs);
@@ -178,22 +351,30 @@ int league(const LeagueOptions& o) {
         qualifyingRows.push_back(std::move(row));
       });
 
-  // The heats, each grid by qualifying
+  // The heats (this shard's), each grid by qualifying
   const auto heats = league::drawHeats(n, perHeat, o.rounds, o.seed);
+  std::vector<std::size_t> mine;
+  for (std::size_t h = 0; h < heats.size(); ++h)
+    if (league::inShard(h, shard, shards)) mine.push_back(h);
   std::vector<std::vector<int>> grids;
   for (const auto& h : heats) grids.push_back(league::gridOrder(h, qualifying));
-  std::vector<std::vector<league::Place>> places(heats.size());
   nlohmann::json heatRows = nlohmann::json::array();
   std::cerr << "league: " << heats.size() << " heats of " << perHeat << " cars, " << o.laps
-            << (o.laps == 1 ? " lap\n" : " laps\n");
+            << (o.laps == 1 ? " lap" : " laps")
+            << (shards > 1 ? "; shard " + std::to_string(shard) + "/" + std::to_string(shards) +
+                                 " races " + std::to_string(mine.size()) + " of them"
+                           : std::string())
+            << "\n";
   runInProcesses(
-      heats.size(), jobs,
-      [&](std::size_t h) {
+      mine.size(), jobs,
+      [&](std::size_t i) {
+        const std::size_t h = mine[i];
         std::vector<std::string> files;
         for (int d : grids[h]) files.push_back((*drivers)[static_cast<std::size_t>(d)].file);
         return runHeat(spec(files, false, o.seed * 1000003 + h, "Heat " + std::to_string(h + 1)));
       },
-      [&](std::size_t h, ScenarioResult r) {
+      [&](std::size_t i, ScenarioResult r) {
+        const std::size_t h = mine[i];
         nlohmann::json heat = {{"heat", h + 1}};
         nlohmann::json names = nlohmann::json::array();
         for (int d : grids[h]) names.push_back((*drivers)[static_cast<std::size_t>(d)].name);
@@ -211,17 +392,14 @@ int league(const LeagueOptions& o) {
         for (auto& row : rows) {
           const int number = row.value("number", 0);
           if (number < 1 || number > static_cast<int>(grids[h].size())) continue;
-          league::Place p;
-          p.driver = grids[h][static_cast<std::size_t>(number - 1)];
-          p.position = row.value("position", 0);
-          p.finished = row.value("finished", false);
-          p.bestLap = numberAt(row, "bestLap");
-          places[h].push_back(p);
-          row["driver"] = (*drivers)[static_cast<std::size_t>(p.driver)].name;
-          row["points"] = league::pointsFor(p.position, p.finished);
-          line += (results.empty() ? ": " : ", ") + std::to_string(p.position) + ". " +
+          const int driver = grids[h][static_cast<std::size_t>(number - 1)];
+          const int position = row.value("position", 0);
+          const bool finished = row.value("finished", false);
+          row["driver"] = (*drivers)[static_cast<std::size_t>(driver)].name;
+          row["points"] = league::pointsFor(position, finished);
+          line += (results.empty() ? ": " : ", ") + std::to_string(position) + ". " +
                   row["driver"].get<std::string>() +
-                  (p.finished ? "" : " " + row.value("status", std::string("DNF")));
+                  (finished ? "" : " " + row.value("status", std::string("DNF")));
           results.push_back(row);
         }
         heat["results"] = results;
@@ -229,34 +407,7 @@ int league(const LeagueOptions& o) {
         heatRows.push_back(std::move(heat));
       });
 
-  // The standings
-  const auto table = league::standings(n, places, qualifying);
-  nlohmann::json standingRows = nlohmann::json::array();
-  std::cout << "League: " << n << " drivers, " << heats.size() << " heats\n";
-  std::cout << "POS  DRIVER               POINTS  HEATS  WINS  QUALIFYING\n";
-  int position = 0;
-  for (const auto& s : table) {
-    ++position;
-    const auto& d = (*drivers)[static_cast<std::size_t>(s.driver)];
-    const int wins = s.places.empty() ? 0 : s.places[0];
-    standingRows.push_back({{"position", position},
-                            {"driver", d.name},
-                            {"file", d.file},
-                            {"points", s.points},
-                            {"heats", s.heats},
-                            {"wins", wins},
-                            {"finishes", s.finishes},
-                            {"places", s.places},
-                            {"bestLap", orNull(s.bestLap)},
-                            {"qualifying", orNull(s.qualifying)}});
-    char row[160];
-    std::snprintf(row, sizeof row, "%3d  %-20s %6d  %5d  %4d  %s\n", position,
-                  d.name.substr(0, 20).c_str(), s.points, s.heats, wins,
-                  lapText(s.qualifying).c_str());
-    std::cout << row;
-  }
-  nlohmann::json all = {{"league",
-                         {{"title", fs::path(o.paths.front()).filename().string()},
+  nlohmann::json about = {{"title", fs::path(o.paths.front()).filename().string()},
                           {"drivers", n},
                           {"heats", heats.size()},
                           {"cars", perHeat},
@@ -264,38 +415,10 @@ int league(const LeagueOptions& o) {
                           {"qualifyingLaps", o.qualifyingLaps},
                           {"rounds", o.rounds},
                           {"track", o.track},
-                          {"seed", o.seed}}},
-                        {"qualifying", qualifyingRows},
-                        {"heats", heatRows},
-                        {"standings", standingRows}};
-  constexpr auto kReplace = nlohmann::json::error_handler_t::replace;  // a reason's bad bytes
-  if (!o.results.empty()) {
-    Result<bool, std::string> written = true;
-    if (auto format = results::formatOf(o.results); format && *format == results::Format::Csv) {
-      results::Table t{
-          {"position", "driver", "points", "heats", "wins", "finishes", "bestLap", "qualifying"},
-          {}};
-      auto time = [](const nlohmann::json& v) -> results::Cell {
-        if (v.is_number()) return v.get<double>();
-        return std::monostate{};
-      };
-      for (const auto& s : standingRows)
-        t.rows.push_back({s["position"].get<double>(), s["driver"].get<std::string>(),
-                          s["points"].get<double>(), s["heats"].get<double>(),
-                          s["wins"].get<double>(), s["finishes"].get<double>(), time(s["bestLap"]),
-                          time(s["qualifying"])});
-      written = results::write(o.results, t);
-    } else {
-      written = results::writeText(o.results, all.dump(2, ' ', false, kReplace) + "\n", "results");
-    }
-    if (!written) return fail("league", written.error());
-  }
-  if (!o.report.empty()) {
-    if (auto written = results::writeText(o.report, league::htmlReport(all), "the report");
-        !written)
-      return fail("league", written.error());
-    std::cerr << "league: report " << o.report << "\n";
-  }
+                          {"seed", o.seed}};
+  if (shards > 1) about["shard"] = std::to_string(shard) + "/" + std::to_string(shards);
+  auto all = complete(std::move(about), *drivers, std::move(qualifyingRows), std::move(heatRows));
+  if (int status = writeOutputs(all, o); status != 0) return status;
   return errors ? 1 : 0;
 }
 
@@ -307,7 +430,15 @@ Command addLeagueCommand(CLI::App& app) {
       "league",
       "Score driver files in the simulator: qualifying, heats where every driver meets "
       "every other, standings (docs/league.md)");
-  cmd->add_option("drivers", o->paths, "Driver files, or folders of them (*.lua)")->required();
+  cmd->add_option("drivers", o->paths, "Driver files, or folders of them (*.lua)");
+  cmd->add_option("--shard", o->shard,
+                  "K/N: race only shard K of N of the heats (merge the shards' --results with "
+                  "pitwall league merge)");
+  auto* merge = cmd->add_subcommand(
+      "merge", "Merge the JSON results of a league's shards into the one league they split");
+  merge->add_option("files", o->merge, "Each shard's --results FILE.json")->required();
+  merge->add_option("--results", o->results, "Write the league as JSON or CSV to FILE");
+  merge->add_option("--report", o->report, "Write the HTML report to FILE.html");
   cmd->add_option("--races", o->rounds,
                   "Rounds: in each, every driver meets every other in a heat (default 1)")
       ->check(CLI::Range(1, 100));

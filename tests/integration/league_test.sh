@@ -73,6 +73,32 @@ check "the same seed: the same league" "" "$(cmp "$TMP/a.json" "$TMP/b.json" 2>&
 league --results "$TMP/j2.json" -j 2 >/dev/null 2>&1
 check "-j 2: the same league as -j 1" "" "$(cmp "$TMP/a.json" "$TMP/j2.json" 2>&1)"
 
+# Beyond one machine: three shards, merged, are the one league
+for k in 1 2 3; do
+  league --shard "$k/3" --results "$TMP/shard$k.json" >/dev/null 2>"$TMP/shard$k.err"
+  check "shard $k/3: exit status" 0 "$?"
+done
+contains "a shard says which heats it races" "shard 2/3 races" "$(cat "$TMP/shard2.err")"
+$PITWALL league merge "$TMP/shard3.json" "$TMP/shard1.json" "$TMP/shard2.json" \
+  --results "$TMP/merged.json" --report "$TMP/merged.html" >/dev/null 2>&1
+check "merge: exit status" 0 "$?"
+check "3 shards merged = one run" "" "$(cmp "$TMP/a.json" "$TMP/merged.json" 2>&1)"
+[ -s "$TMP/merged.html" ] && echo "ok: merge: the report" || fail "merge: no report"
+err=$($PITWALL league merge "$TMP/shard1.json" "$TMP/shard2.json" 2>&1); rc=$?
+check "merge: a missing shard is refused (status 2)" 2 "$rc"
+contains "merge: the missing heat is named" "is in none of the files: merge every shard's results" "$err"
+err=$($PITWALL league merge "$TMP/shard1.json" "$TMP/shard1.json" "$TMP/shard2.json" "$TMP/shard3.json" 2>&1)
+contains "merge: a shard twice" "shard 1/3 is given twice" "$err"
+$PITWALL league "$TMP/class" --laps 1 --qualifying-laps 1 --seed 4 --shard 1/3 \
+  --results "$TMP/other1.json" >/dev/null 2>&1
+err=$($PITWALL league merge "$TMP/other1.json" "$TMP/shard2.json" "$TMP/shard3.json" 2>&1)
+contains "merge: another league's shard" "another league than" "$err"
+echo '{"not": "a league"}' >"$TMP/junk.json"
+err=$($PITWALL league merge "$TMP/junk.json" 2>&1)
+contains "merge: a file that is no league's results" "not the JSON results of a league" "$err"
+err=$($PITWALL league "$TMP/class" --shard 3/2 2>&1)
+contains "--shard K/N checked" "expected K/N, shard K of N" "$err"
+
 league --results "$TMP/c.csv" >/dev/null 2>&1
 check "CSV: the standings' header" "position,driver,points,heats,wins,finishes,bestLap,qualifying" \
   "$(head -1 "$TMP/c.csv")"
