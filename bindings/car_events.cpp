@@ -135,7 +135,11 @@ void CarBinding::deliver(Proxy& p, CarEvent e, Fill&& fill) {
 
 void CarBinding::hookEvents(Proxy& p) {
   AnkiCar& car = *p.car;
-  p.messages = car.messages.connect([this, &p](const Message& m) { dispatch(p, m); });
+  // The run's world holds the car's one message slot (the hot path); a driver world listens
+  if (host_.driverCar())
+    p.messages = car.messages.connect([this, &p](const Message& m) { dispatch(p, m); });
+  else
+    car.onMessage = [this, &p](const Message& m) { dispatch(p, m); };
   // The fleet watches connections too (a car joins the run on its first one), and hears each
   // before the binding: it subscribed first.
   p.connection = car.connectionChanged.connect([this, &p](bool up, const std::string& reason) {
@@ -155,7 +159,10 @@ void CarBinding::hookEvents(Proxy& p) {
 }
 
 void CarBinding::unhookEvents(Proxy& p) {
-  p.messages.disconnect();
+  if (host_.driverCar())
+    p.messages.disconnect();
+  else
+    p.car->onMessage = nullptr;
   p.connection.disconnect();
   p.malformed.disconnect();
 }

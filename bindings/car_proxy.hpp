@@ -32,7 +32,9 @@ struct CarBinding::Proxy {
   // The binding's slot of the car's connection signal while attached (after the fleet's, which
   // subscribed when the car joined the fleet).
   Subscription connection;
-  Subscription messages, malformed;  // the car's messages and malformed frames, while attached
+  // A driver world's subscription to the car's messages (the run's world holds its one slot),
+  // and every world's to its malformed frames, while attached.
+  Subscription messages, malformed;
   // Errors of each failing handler in the current window (CarBinding::handlerFailed), and why
   // the car was stopped for them (empty: it was not; then commands are refused).
   struct Failing {

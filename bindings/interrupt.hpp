@@ -37,7 +37,7 @@ extern std::atomic<long long> g_budgetMs;  // the outermost call's budget (its w
 // Numbers every call, never the same twice (a call that resumes after an inner world's own call
 // is a new one to the watchdog): written on the loop's thread only.
 inline std::uint64_t g_calls = 0;
-// The call counted now is a driver world's (Scope's `own`): the budget's message names
+// The call counted now is a driver world's (OwnScope): the budget's message names
 // --driver-budget. Written on the loop's thread only.
 inline bool g_ownCall = false;
 inline constexpr int kNoReason = 0;
@@ -45,27 +45,14 @@ inline constexpr int kNoReason = 0;
 
 // Around every call from the engine into Lua (ScriptHost does this), with the budget of the world
 // called (its own: worlds side by side may differ; zero: none). Only the outermost scope on the
-// stack counts, with its budget; nested ones (a handler that triggers an event) are free — except
-// a scope with `own` set: a world with a budget of its own called from inside another world's
-// call (a driver world called by the race director, docs/drivers.md) is a call of its own, with
-// its budget, counted from its start; when it returns, the call around it goes on as a fresh call
-// (its budget counts again from there: what the inner world used is not charged to it, and an
-// interrupt the outer call had not yet taken is dropped, to be asked again).
+// stack counts, with its budget; nested ones (a handler that triggers an event) are free.
 class Scope {
  public:
-  Scope(lua_State* running, Kind kind, std::chrono::milliseconds budget, bool own = false)
+  Scope(lua_State* running, Kind kind, std::chrono::milliseconds budget)
       : outermost_(detail::g_depth.load(std::memory_order_relaxed) == 0),
-        own_(own && !outermost_),
         previous_(detail::g_running.load(std::memory_order_relaxed)) {
     using namespace detail;
-    if (own_) {
-      outerKind_ = g_kind.load(std::memory_order_relaxed);
-      outerBudgetMs_ = g_budgetMs.load(std::memory_order_relaxed);
-      g_reason.store(kNoReason, std::memory_order_relaxed);
-    }
-    if (outermost_ || own_) {
-      outerOwn_ = g_ownCall;
-      g_ownCall = own;
+    if (outermost_) {
       g_call.store(++g_calls, std::memory_order_relaxed);
       g_kind.store(static_cast<int>(kind), std::memory_order_relaxed);
       g_budgetMs.store(budget.count() > 0 ? budget.count() : 0, std::memory_order_relaxed);
@@ -79,26 +66,63 @@ class Scope {
     g_depth.store(g_depth.load(std::memory_order_relaxed) - 1, std::memory_order_relaxed);
     std::atomic_signal_fence(std::memory_order_seq_cst);
     g_running.store(previous_, std::memory_order_relaxed);
-    if (outermost_ || own_) {
+    if (outermost_)
       g_reason.store(kNoReason, std::memory_order_relaxed);  // hooks remove themselves
-      g_ownCall = outerOwn_;
-    }
-    if (own_) {  // the outer call goes on as a fresh one
-      g_kind.store(outerKind_, std::memory_order_relaxed);
-      g_budgetMs.store(outerBudgetMs_, std::memory_order_relaxed);
-      g_call.store(++g_calls, std::memory_order_relaxed);
-    }
   }
   Scope(const Scope&) = delete;
   Scope& operator=(const Scope&) = delete;
 
  private:
   bool outermost_;
-  bool own_;
   lua_State* previous_;
-  int outerKind_ = 0;
-  long long outerBudgetMs_ = 0;
-  bool outerOwn_ = false;
+};
+
+// A call into a world with a budget of its own (a driver world, docs/drivers.md), even inside
+// another world's call (the race director's): a call of its own, with its budget, counted from
+// its start. When it returns, the call around it goes on as a fresh call (its budget counts again
+// from there: what the inner world used is not charged to it, and an interrupt the outer call had
+// not yet taken is dropped, to be asked again). Its runaway's message names --driver-budget.
+// Kept apart from Scope, which is on every event's path and pays nothing for it.
+class OwnScope {
+ public:
+  OwnScope(lua_State* running, Kind kind, std::chrono::milliseconds budget)
+      : outerKind_(detail::g_kind.load(std::memory_order_relaxed)),
+        outerBudgetMs_(detail::g_budgetMs.load(std::memory_order_relaxed)),
+        outerOwn_(detail::g_ownCall),
+        nested_(detail::g_depth.load(std::memory_order_relaxed) > 0) {
+    using namespace detail;
+    g_reason.store(kNoReason, std::memory_order_relaxed);
+    g_ownCall = true;
+    g_call.store(++g_calls, std::memory_order_relaxed);
+    g_kind.store(static_cast<int>(kind), std::memory_order_relaxed);
+    g_budgetMs.store(budget.count() > 0 ? budget.count() : 0, std::memory_order_relaxed);
+    previous_ = g_running.load(std::memory_order_relaxed);
+    g_running.store(running, std::memory_order_relaxed);
+    std::atomic_signal_fence(std::memory_order_seq_cst);
+    g_depth.store(g_depth.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+  }
+  ~OwnScope() {
+    using namespace detail;
+    g_depth.store(g_depth.load(std::memory_order_relaxed) - 1, std::memory_order_relaxed);
+    std::atomic_signal_fence(std::memory_order_seq_cst);
+    g_running.store(previous_, std::memory_order_relaxed);
+    g_reason.store(kNoReason, std::memory_order_relaxed);  // hooks remove themselves
+    g_ownCall = outerOwn_;
+    if (nested_) {  // the outer call goes on as a fresh one
+      g_kind.store(outerKind_, std::memory_order_relaxed);
+      g_budgetMs.store(outerBudgetMs_, std::memory_order_relaxed);
+      g_call.store(++g_calls, std::memory_order_relaxed);
+    }
+  }
+  OwnScope(const OwnScope&) = delete;
+  OwnScope& operator=(const OwnScope&) = delete;
+
+ private:
+  int outerKind_;
+  long long outerBudgetMs_;
+  bool outerOwn_;
+  bool nested_;
+  lua_State* previous_ = nullptr;
 };
 
 // The Lua thread now running changes (a task's coroutine resumed inside a scope, or a coroutine

@@ -107,12 +107,18 @@ class StackCheck {
 #endif
 
 // Calls the function under the top `nargs` values, as lua_pcall(L, nargs, nresults, handler)
-// does, inside an interrupt::Scope of `kind` with the world's `budget` (its own, counted from
-// here even inside another world's call, with `ownBudget`: a driver world's). Returns lua_pcall's
+// does, inside an interrupt::Scope of `kind` with the world's `budget`. Returns lua_pcall's
 // status; on success the results are left (nresults of them), on failure the error.
 inline int protectedCall(lua_State* L, int nargs, int nresults, int handler, interrupt::Kind kind,
-                         std::chrono::milliseconds budget, bool ownBudget = false) {
-  interrupt::Scope scope(L, kind, budget, ownBudget);
+                         std::chrono::milliseconds budget) {
+  interrupt::Scope scope(L, kind, budget);
+  return lua_pcall(L, nargs, nresults, handler);
+}
+// The same in a world whose budget is its own (a driver world's, interrupt::OwnScope); its
+// callers are out of line, off the event hot path of the run's world.
+inline int protectedOwnCall(lua_State* L, int nargs, int nresults, int handler,
+                            interrupt::Kind kind, std::chrono::milliseconds budget) {
+  interrupt::OwnScope scope(L, kind, budget);
   return lua_pcall(L, nargs, nresults, handler);
 }
 

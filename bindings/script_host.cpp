@@ -97,8 +97,9 @@ int ScriptHost::tracedCall(int nargs, int nresults, interrupt::Kind kind) {
   const int base = lua_gettop(L_) - nargs;  // the function's slot
   lua_pushcfunction(L_, lua::traceback);
   lua_insert(L_, base);
-  const int status =
-      lua::protectedCall(L_, nargs, nresults, base, kind, options_.budget, ownBudget());
+  const int status = ownBudget()
+                         ? lua::protectedOwnCall(L_, nargs, nresults, base, kind, options_.budget)
+                         : lua::protectedCall(L_, nargs, nresults, base, kind, options_.budget);
   lua_remove(L_, base);
   return status;
 }
@@ -120,6 +121,16 @@ bool ScriptHost::protectedCall(int nargs, int nresults, std::string& error, bool
   if (memory_.exceeded) error = sandbox::memoryMessage(memory_);
   checkMemory();
   return false;
+}
+
+bool ScriptHost::ownCallAboveHandler(int nargs, const char* what, std::string_view who) {
+  const int status =
+      lua::protectedOwnCall(L_, nargs, 0, -(nargs + 2), interrupt::Kind::Callback, options_.budget);
+  if (status == LUA_OK) {
+    lua_pop(L_, 1);  // the handler
+    return true;
+  }
+  return failedAboveHandler(status, what, who);
 }
 
 bool ScriptHost::failedAboveHandler(int status, const char* what, std::string_view who) {

@@ -157,8 +157,10 @@ class ScriptHost {
       lua_pop(L_, nargs + 2);
       return false;
     }
-    const int status = lua::protectedCall(L_, nargs, 0, -(nargs + 2), interrupt::Kind::Callback,
-                                          options_.budget, ownBudget());
+    if (ownBudget()) [[unlikely]]
+      return ownCallAboveHandler(nargs, what, who);
+    const int status =
+        lua::protectedCall(L_, nargs, 0, -(nargs + 2), interrupt::Kind::Callback, options_.budget);
     if (status == LUA_OK) {
       lua_pop(L_, 1);  // the handler
       return true;
@@ -244,6 +246,8 @@ class ScriptHost {
   bool finishCall(int status, const char* what, std::string_view who);
   // callAboveHandler's error path, out of line: the error over the handler.
   bool failedAboveHandler(int status, const char* what, std::string_view who);
+  // callAboveHandler in a driver world (its budget its own), out of line.
+  bool ownCallAboveHandler(int nargs, const char* what, std::string_view who);
   Result<bool, std::string> startLoaded();
   // Calls the function under the top `nargs` values with the traceback handler under it (gone
   // after): lua::protectedCall's status, the error or the results on the stack.

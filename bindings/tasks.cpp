@@ -6,6 +6,7 @@
 #include "bindings/script_host.hpp"
 
 #include <algorithm>
+#include <optional>
 
 namespace pitwall {
 
@@ -79,7 +80,12 @@ std::string Tasks::cancel(lua_State* co) {
   tasks_.erase(it);
   {
     // Closing runs the chunk's to-be-closed variables: Lua code, which Ctrl-C must reach too.
-    interrupt::Scope scope(co, task.kind, host_.options().budget, host_.ownBudget());
+    std::optional<interrupt::Scope> scope;
+    std::optional<interrupt::OwnScope> own;  // a driver world's: its budget its own
+    if (host_.ownBudget())
+      own.emplace(co, task.kind, host_.options().budget);
+    else
+      scope.emplace(co, task.kind, host_.options().budget);
     closeThread(co);
   }
   luaL_unref(L, LUA_REGISTRYINDEX, task.threadRef);
@@ -138,7 +144,12 @@ void Tasks::resume(lua_State* co, int nargs) {
   int nres = 0;
   int status;
   {
-    interrupt::Scope scope(co, tasks_.at(co).kind, host_.options().budget, host_.ownBudget());
+    std::optional<interrupt::Scope> scope;
+    std::optional<interrupt::OwnScope> own;  // a driver world's: its budget its own
+    if (host_.ownBudget())
+      own.emplace(co, tasks_.at(co).kind, host_.options().budget);
+    else
+      scope.emplace(co, tasks_.at(co).kind, host_.options().budget);
     status = lua_resume(co, L, nargs, &nres);
   }
   std::string error;

@@ -95,6 +95,13 @@ std::optional<std::string> explainRefusal(const CLI::App& app, int argc, const c
       cur = *found;
       continue;
     }
+    // a command with subcommands that takes arguments too (league DIR, league merge FILE)
+    const auto options = cur->get_options();
+    if (std::any_of(options.begin(), options.end(),
+                    [](const CLI::Option* o) { return o->get_positional(); })) {
+      commandTaken = true;
+      continue;
+    }
     std::vector<std::string> names;
     for (const CLI::App* s : subs) names.push_back(s->get_name());
     const std::string path = pathOf(*cur);

@@ -208,6 +208,7 @@ void AnkiCar::receive(std::span<const std::uint8_t> frame) {
   apply(*decoded);
   silenceSpeed_ = movingSince_ >= 0 ? state_.speed_mm_s : 0;
   if (onFrame) onFrame(Direction::Rx, frame, *decoded);
+  if (onMessage) onMessage(*decoded);
   messages.emit(*decoded);
 }
 

@@ -132,9 +132,11 @@ class AnkiCar {
   void resume() { paused_.clear(); }
   bool paused() const { return !paused_.empty(); }
 
-  // Events, on the loop. Several listen, each holding its subscription: the car's Lua object in
-  // the run's world and in a driver world (docs/drivers.md). Every message, after it updated
-  // state():
+  // Events, on the loop. Every message, after it updated state(): to the run's Lua world, whose
+  // one slot this is (the hot path of every frame, docs/performance.md: a plain call), then to
+  // every other listener — a driver world's car objects (docs/drivers.md) — each holding its
+  // subscription.
+  std::function<void(const anki::Message&)> onMessage;
   Signal<const anki::Message&> messages;
   // Every connection change (the fleet, which subscribes first, then the Lua objects).
   Signal<bool /*connected*/, const std::string& /*reason*/> connectionChanged;
