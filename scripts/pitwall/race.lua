@@ -255,39 +255,13 @@ for name, fn in pairs(require "pitwall.race_start") do Race[name] = fn end
 for name, fn in pairs(require "pitwall.race_view") do Race[name] = fn end
 -- Slow laps seen and contacts freed (race_marshal.lua).
 for name, fn in pairs(require "pitwall.race_marshal") do Race[name] = fn end
+-- Drivers in worlds of their own: out, back, what they read of the race (race_worlds.lua).
+for name, fn in pairs(require "pitwall.race_worlds") do Race[name] = fn end
 
 function Race:_start(e)
   e.started = true
   drivers.call(e.driver, "start", e.car, e.ctx)
   self:_checkWorld(e)
-end
-
--- A driver in a world of its own (drivers.world) that failed puts its car out: stopped, DNF with
--- the reason; a good save brings it back while the race is on and the car has not finished.
-function Race:_checkWorld(e)
-  local w = type(e.driver) == "table" and rawget(e.driver, "world")
-  if not w then return end
-  local why = w.failure
-  if why and not e.out then
-    e.out = why -- (its world stopped the car as it failed: bindings/driver_world.cpp)
-    pitwall.log("info", "race: " .. tostring(e.car) .. " is out (DNF): its driver failed")
-  elseif not why and e.out and not e.finished and not self.done then
-    e.out = nil
-    pitwall.log("info", "race: " .. tostring(e.car) .. " is back (driver " .. tostring(w.file)
-      .. ", version " .. tostring(w.version) .. ")")
-  end
-end
-
--- What a driver in a world of its own reads of the race (ctx.race, a copy): the phase and every
--- car's place, laps and best lap.
-function Race:_view()
-  local standings = {}
-  for k, e in ipairs(self.order) do
-    local t = e.finished and e.final or e.timer
-    standings[k] = { car = e.car, position = k, laps = t.count,
-      bestLap = t.best and t.best.time, finished = e.finished or false, out = e.out ~= nil }
-  end
-  return { phase = self.phase, mode = self.mode, laps = self.laps, standings = standings }
 end
 
 function Race:_finish(e, t)
@@ -453,10 +427,7 @@ function Race:_tick()
     if not e.started and now >= e.releaseAt and not e.out then self:_start(e) end
     if e.started and not e.finished and car.connected and not e.out then
       if e.ctx then e.ctx.limit, e.ctx.pieceLimits = e.limit, e.pieceLimits end
-      if rawget(e.driver, "world") then
-        view = view or self:_view()
-        e.ctx.race = view
-      end
+      view = self:_tellWorld(e, view)
       drivers.call(e.driver, "update", car, e.ctx)
       self:_checkWorld(e)
       self:_applyFloor(e, now)

@@ -189,6 +189,18 @@ out=$($PITWALL run "$TMP/script_form.lua" --fast --results "$TMP/form.json" 2>&1
 check "race.laps{drivers = {[3] = FILE}}: exit status" 0 "$?"
 contains "the script's form makes a world too" "driver loop.lua of car 3 (thermo) is out" "$out"
 
+cat > "$TMP/missing_form.lua" <<LUA
+local race = require "pitwall.race"
+race.laps { laps = 1, drivers = { [2] = "$TMP/nobody.lua" } }
+LUA
+out=$($PITWALL run "$TMP/missing_form.lua" --fast --record "$TMP/missing.jsonl" 2>&1)
+check "the script's form, a missing file: exit status 1" 1 "$?"
+contains "the script's form, a missing file: named, with what a driver is" \
+  "driver file $TMP/nobody.lua: no such file (a driver is a Lua file that returns a driver" "$out"
+expect_stopped "the script's form, a missing file" "$TMP/missing.jsonl" 4
+err=$($PITWALL run "$TMP/race.lua" --fast --driver 2="$D/good.lua" --driver-memory 0 2>&1)
+contains "--driver-memory 0 is refused" "--driver-memory" "$err"
+
 # The command line refuses what cannot be a driver before any car is connected
 for bad in "x=$D/good.lua" "2" "0=$D/good.lua" "2=$TMP/missing.lua" "2=$D/broken_save.lua"; do
   err=$($PITWALL run "$TMP/race.lua" --fast --driver "$bad" 2>&1); rc=$?

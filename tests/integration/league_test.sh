@@ -132,6 +132,10 @@ contains "a missing folder is named" "$TMP/nowhere: no such file or folder" "$er
 mkdir -p "$TMP/other" && cp "$D/good.lua" "$TMP/other/alice.lua"
 err=$($PITWALL league "$TMP/class" "$TMP/other" 2>&1)
 contains "two drivers of one name" "two drivers are named alice" "$err"
+err=$($PITWALL league "$TMP/class" --report "$TMP/nowhere/r.html" 2>&1); rc=$?
+check "a report into no folder: refused first (status 2)" 2 "$rc"
+contains "a report into no folder: named" "--report $TMP/nowhere/r.html: no folder $TMP/nowhere" "$err"
+case "$err" in *qualifying*) fail "the league ran before its report was refused" ;; esac
 mkdir -p "$TMP/empty"
 err=$($PITWALL league "$TMP/empty" 2>&1)
 contains "a folder without drivers" "no driver files (*.lua) in this folder" "$err"
