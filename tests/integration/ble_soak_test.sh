@@ -76,10 +76,15 @@ contains "soak: car.link: connected again after each drop" "connects=$((d + 1))"
 # needs, and no longer than the mute's 3 s (and a tick). It may be shorter than the mute: a silence
 # counts until the car speaks or is told to stop (engine/vehicles/anki_car.cpp, noteSilence), and
 # its driver may tell it to stand within the mute (a follower closing on the car ahead: in clean
-# clone run 18, under a CPU quota, 2.1 s).
+# clone run 18, under a CPU quota, 2.1 s). A car stuck in a contact later in the race (behind the
+# vanished car's body, which stands on the track) reads no track code and sends nothing either, as
+# a real car would: that silence is the car's, not the mute's (clean clone run 37: 7.2 s), so the
+# cap holds only when the log shows no contact of that car.
 muted=$(echo "$out" | grep "^car $(nth 4) ")
 sil=$(echo "$muted" | sed -n 's/.* silences=\([0-9]*\) longestSilence=\([0-9.]*\).*/\1 \2/p')
-awk -v s="$sil" 'BEGIN { split(s, a, " "); exit !(a[1] >= 1 && a[2] >= 1.0 && a[2] <= 3.5) }' &&
+cap=3.5
+grep -q "car $(nth 4) ([a-z]*) is slow: .*stuck in a contact" "$TMP/run.err" && cap=$S
+awk -v s="$sil" -v cap="$cap" 'BEGIN { split(s, a, " "); exit !(a[1] >= 1 && a[2] >= 1.0 && a[2] <= cap) }' &&
   echo "ok: soak: car.link shows car $(nth 4)'s lost notifications (silences, longest: $sil)" ||
   fail "soak: car $(nth 4) was muted for 3 s, car.link says silences/longest [$sil]: $muted"
 # (a number as Lua prints it: 0.0123, or 9.7e-05 for a round trip under 0.1 ms)
