@@ -1,4 +1,5 @@
-// Driver worlds as the run's world sees them (docs/drivers.md): pitwall.driverFiles, the
+// Driver worlds as the run's world sees them (docs/drivers.md): pitwall.driverFiles (and a
+// league final's pitwall.final, docs/league.md), the
 // --driver CAR=FILE of the command line, and pitwall._driverWorld(file, car), the engine's half
 // of drivers.world (scripts/pitwall/drivers.lua), which a race director calls like any driver.
 // A driver world object: world:call(method, data) → true, or false once the world has failed;
@@ -116,6 +117,22 @@ void openDriverWorlds(ScriptHost& host) {
     lua_rawseti(L, -2, number);
   }
   lua_setfield(L, -2, "driverFiles");
+  if (const auto& final = host.options().leagueFinal) {
+    lua_createtable(L, 0, 4);
+    pushText(L, final->title);
+    lua_setfield(L, -2, "title");
+    lua_pushinteger(L, final->laps);
+    lua_setfield(L, -2, "laps");
+    lua_pushinteger(L, static_cast<lua_Integer>(final->league));
+    lua_setfield(L, -2, "league");
+    lua_createtable(L, static_cast<int>(final->drivers.size()), 0);
+    for (std::size_t i = 0; i < final->drivers.size(); ++i) {
+      pushText(L, final->drivers[i]);
+      lua_rawseti(L, -2, static_cast<lua_Integer>(i + 1));
+    }
+    lua_setfield(L, -2, "drivers");
+    lua_setfield(L, -2, "final");
+  }
   lua_pop(L, 1);
 }
 

@@ -17,6 +17,7 @@
 #include "bindings/car_lists.hpp"
 #include "bindings/copy_budget.hpp"
 #include "bindings/lua_args.hpp"
+#include "bindings/lua_json.hpp"
 #include "bindings/lua_object.hpp"
 #include "bindings/lua_options.hpp"
 #include "bindings/metatables.hpp"
@@ -390,6 +391,26 @@ int writeResults(lua_State* L) {
   return 1;
 }
 
+// pitwall.keepResults(race): a race's results ({kind, number, track, laps, entries}) into the
+// standings database of the run (--db); true when written, false when the run keeps none, or
+// false and the sentence when they were held or saved beside it (the race goes on either way).
+int keepResults(lua_State* L) {
+  luaL_checktype(L, 1, LUA_TTABLE);
+  const auto& keep = ScriptHost::from(L).options().keepRace;
+  if (!keep) {
+    lua_pushboolean(L, 0);
+    return 1;
+  }
+  lua::CopyBudget budget(L, "pitwall.keepResults", std::size_t{16} << 20);
+  const nlohmann::json race =
+      lua::toJson(L, 1, {"pitwall.keepResults", "the standings"}, budget, "race");
+  const auto problem = keep(race);
+  lua_pushboolean(L, problem ? 0 : 1);
+  if (!problem) return 1;
+  lua_pushlstring(L, problem->data(), problem->size());
+  return 2;
+}
+
 // pitwall.terminal(): {tty = stdout is a terminal that a script may redraw (not while a REPL
 // prompt is on it), columns = its width (COLUMNS, else 80)}.
 int terminal(lua_State* L) {
@@ -440,6 +461,7 @@ void openPitwallModule(ScriptHost& host) {
                                        {"piece", lua::guarded<piece>},
                                        {"layout", lua::guarded<layout>},
                                        {"writeResults", lua::guarded<writeResults>},
+                                       {"keepResults", lua::guarded<keepResults>},
                                        {"terminal", terminal},
                                        {"_setHub", lua::guarded<&lua::setHub>},
                                        {"_reportError", lua::guarded<reportError>},

@@ -92,6 +92,10 @@ struct HostOptions {
   // --record: the race as pitwall.view.race reports it, into the record (for a replay's view);
   // unset: not recorded. pitwall.view.recording says whether it is set.
   std::function<void(const nlohmann::json& race)> recordRace;
+  // The standings database of the run (--db; docs/league.md "Standings"): a race's results as
+  // pitwall.keepResults hands them (engine/standings/race_json.hpp), kept; returns the sentence
+  // when they were not written now (held, or saved beside the database). Unset: nothing is kept.
+  std::function<std::optional<std::string>(const nlohmann::json& race)> keepRace;
   // A driver world (docs/drivers.md, bindings/driver_world.hpp): `driverCar` is the one car it
   // may command (every other car's commands are refused, and its own cannot be disconnected);
   // its library reaches no file, robot, simulator control or the run's results; its budget is
@@ -104,6 +108,15 @@ struct HostOptions {
   // of its own) and those worlds' limits (--driver-memory, --driver-budget, --watch).
   std::map<int, std::string> driverFiles;
   DriverLimits driverLimits;
+  // --league-final: the league's final this run races (pitwall.final, read by the shipped
+  // scripts/pitwall/league_final.lua; docs/league.md "The final"); driverFiles holds its files.
+  struct LeagueFinal {
+    std::string title;
+    int laps = 5;
+    std::int64_t league = 0;
+    std::vector<std::string> drivers;  // pole first: car 1's, car 2's, …
+  };
+  std::optional<LeagueFinal> leagueFinal;
 };
 
 class ScriptHost {

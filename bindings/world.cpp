@@ -38,7 +38,7 @@
 //   pitwall.seats, .seat       human drivers' seats (bindings/seat_binding.cpp); sim.openSeats
 //   pitwall.driverFiles, _driverWorld  driver files in worlds of their own
 //                              (bindings/driver_world_binding.cpp)
-//   (a driver world: none of the six above, and no pitwall.writeResults; its Lua libraries
+//   (a driver world: none of the six above, and no pitwall.writeResults or keepResults; its Lua libraries
 //   read no file and require finds the shipped library only: sandbox::restrictToLibrary)
 //   the cars                   every car the fleet knows gets its Lua object now (later ones as
 //                              they join: ScriptHost::carJoined)
@@ -193,6 +193,8 @@ void closeForDrivers(lua_State* L) {
   lua_getglobal(L, "pitwall");
   lua_pushnil(L);
   lua_setfield(L, -2, "writeResults");
+  lua_pushnil(L);
+  lua_setfield(L, -2, "keepResults");
   lua_pop(L, 1);
 }
 

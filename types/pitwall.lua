@@ -106,6 +106,12 @@ function pitwall.copy(t) end
 ---@return pitwall.Timer
 function pitwall.every(period, fn) end
 
+---Keeps a race's results in the run's standings database (--db; docs/league.md "Standings"): {kind, number, track, laps, entries = {{number, driver, car, file?, position, finished, status, reason?, laps, bestLap, totalTime, lapTimes}}}. The race library calls it when a race ends.
+---@param race table
+---@return boolean kept false when the run keeps no standings, or when they were held or saved beside the database
+---@return string? why not now
+function pitwall.keepResults(race) end
+
 ---The layout the cars are on, as sim.track() gives it: the simulator's track, or with --ble the layout given with --track; nil when none is known.
 ---@return pitwall.sim.Track?
 function pitwall.layout() end

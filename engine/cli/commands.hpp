@@ -75,6 +75,14 @@ struct RunOptions : CarSource {
   std::vector<std::string> drivers;
   int driverMemory = 64;
   double driverBudget = 0.05;
+  // --db FILE: the standings database its races are kept in (default: standings::defaultPath());
+  // --no-db: none (docs/league.md "Standings")
+  std::string db;
+  bool noDb = false;
+  // --league-final DB[:EVENT]: the top drivers of a league kept in DB race a final, the script
+  // optional (docs/league.md "The final"); --final-cars K of them (default: as many as the cars)
+  std::string leagueFinal;
+  int finalCars = 0;
 };
 int run(const RunOptions& options);
 // The exit status of a --fast run that its safety cap ended (docs/cli.md).

@@ -28,6 +28,7 @@
 #include "engine/record/results.hpp"
 #include "engine/sim/sensor.hpp"
 #include "engine/sim/track.hpp"
+#include "engine/standings/keeper.hpp"
 
 namespace pitwall::cli {
 
@@ -49,6 +50,8 @@ struct LeagueOptions {
   std::string report;
   int driverMemory = 64;
   double driverBudget = 0.05;
+  std::string db;     // --db FILE: the standings database (default: standings::defaultPath())
+  bool noDb = false;  // --no-db: keep nothing
   std::string shard;  // K/N: the heats of shard K of N only
   // pitwall league merge FILE…: the shards' results, as one league
   std::vector<std::string> merge;
@@ -114,6 +117,84 @@ nlohmann::json orNull(const std::optional<double>& v) {
 
 std::string lapText(const std::optional<double>& v) {
   return v ? formatNumber(*v, 3) + " s" : "no time";
+}
+
+// A qualifying row and a heat (as --results has them) as races of the standings.
+standings::Race qualifyingRace(const nlohmann::json& row, int number, const std::string& file,
+                               const nlohmann::json& about) {
+  standings::Entry e;
+  e.number = 1;
+  e.driver = row.value("driver", std::string());
+  e.car = row.value("car", std::string());
+  e.file = file;
+  e.bestLap = numberAt(row, "bestLap");
+  e.status = row.value("status", std::string("error"));
+  e.finished = e.status == "finished";
+  e.reason = row.value("reason", std::string());
+  if (e.bestLap) e.position = 1;
+  return {"qualifying",
+          number,
+          about.value("track", std::string()),
+          about.value("qualifyingLaps", 0),
+          {e}};
+}
+
+standings::Race heatRace(const nlohmann::json& heat,
+                         const std::map<std::string, std::string>& files,
+                         const nlohmann::json& about) {
+  standings::Race race{"heat",
+                       heat.value("heat", 0),
+                       about.value("track", std::string()),
+                       about.value("laps", 0),
+                       {}};
+  if (!heat.contains("results")) return race;
+  for (const auto& row : heat["results"]) {
+    standings::Entry e;
+    e.number = row.value("number", 0);
+    e.driver = row.value("driver", std::string());
+    e.car = row.value("car", std::string());
+    if (auto it = files.find(e.driver); it != files.end()) e.file = it->second;
+    if (auto p = numberAt(row, "position")) e.position = static_cast<int>(*p);
+    e.finished = row.value("finished", false);
+    e.status = row.value("status", std::string(e.finished ? "finished" : "DNF"));
+    e.reason = row.value("reason", std::string());
+    e.laps = row.value("laps", 0);
+    e.bestLap = numberAt(row, "bestLap");
+    e.totalTime = numberAt(row, "totalTime");
+    if (auto t = row.find("lapTimes"); t != row.end() && t->is_array())
+      for (const auto& x : *t)
+        if (x.is_number()) e.lapTimes.push_back(x.get<double>());
+    race.entries.push_back(std::move(e));
+  }
+  return race;
+}
+
+// The standings database of a league (--db, --no-db): opened before anything races, so a file
+// that cannot take the results refuses the league before it costs anything.
+Result<std::unique_ptr<standings::Keeper>, std::string> openKeeper(const LeagueOptions& o,
+                                                                   const nlohmann::json& about) {
+  if (o.noDb) return std::unique_ptr<standings::Keeper>();
+  const std::string path = o.db.empty() ? standings::defaultPath() : o.db;
+  if (path.empty() && o.db.empty()) {
+    std::cerr << "league: no standings database (none of PITWALL_DB, XDG_DATA_HOME, HOME is set; "
+                 "--db FILE names one): the league is not kept\n";
+    return std::unique_ptr<standings::Keeper>();
+  }
+  standings::Event event{"league", about.value("title", std::string("league")),
+                         about.value("track", std::string()), about.dump()};
+  return standings::Keeper::open(path, std::move(event));
+}
+
+// Says where the standings are, or what was not written (status 1 then).
+int finishKeeper(standings::Keeper* keeper) {
+  if (!keeper) return 0;
+  if (auto problem = keeper->finish()) {
+    fail("league", *problem, 1);
+    return 1;
+  }
+  std::cerr << "league: standings kept in " << keeper->path() << " (pitwall standings --db "
+            << keeper->path() << ")\n";
+  return 0;
 }
 
 // K/N with 1 <= K <= N <= 1000.
@@ -279,8 +360,19 @@ int merge(const LeagueOptions& o) {
   for (const auto& [name, file] : files) drivers.push_back({name, file});
   nlohmann::json heatRows = nlohmann::json::array();
   for (auto& [number, h] : heats) heatRows.push_back(std::move(h));
+  auto opened = openKeeper(o, about);
+  if (!opened) return fail("league", opened.error());
+  const nlohmann::json league = about;
   auto all = complete(std::move(about), drivers, std::move(qualifying), std::move(heatRows));
-  return writeOutputs(all, o);
+  if (auto& keeper = *opened) {
+    int number = 0;
+    for (const auto& q : all["qualifying"])
+      keeper->add(qualifyingRace(q, ++number, files[q.value("driver", std::string())], league));
+    for (const auto& h : all["heats"]) keeper->add(heatRace(h, files, league));
+  }
+  const int kept = finishKeeper(opened->get());
+  if (int status = writeOutputs(all, o); status != 0) return status;
+  return kept;
 }
 
 int league(const LeagueOptions& o) {
@@ -317,6 +409,29 @@ int league(const LeagueOptions& o) {
     return s;
   };
   int errors = 0;
+  const auto heats = league::drawHeats(n, perHeat, o.rounds, o.seed);
+  nlohmann::json about = {{"title", fs::path(o.paths.front()).filename().string()},
+                          {"drivers", n},
+                          {"heats", heats.size()},
+                          {"cars", perHeat},
+                          {"laps", o.laps},
+                          {"qualifyingLaps", o.qualifyingLaps},
+                          {"rounds", o.rounds},
+                          {"track", o.track},
+                          {"seed", o.seed}};
+  // The standings (a shard keeps nothing: `league merge` keeps the league it joins)
+  std::unique_ptr<standings::Keeper> keeper;
+  if (shards == 1) {
+    auto opened = openKeeper(o, about);
+    if (!opened) return fail("league", opened.error());
+    keeper = std::move(*opened);
+  }
+  std::map<std::string, std::string> files;  // driver → file
+  for (const auto& d : *drivers) files[d.name] = d.file;
+  auto keep = [&](standings::Race race) {
+    if (!keeper) return;
+    if (auto held = keeper->add(std::move(race))) std::cerr << "league: " << *held << "\n";
+  };
 
   // Qualifying: each driver alone, its best lap
   std::vector<std::optional<double>> qualifying(static_cast<std::size_t>(n));
@@ -342,8 +457,10 @@ int league(const LeagueOptions& o) {
           qualifying[d] = numberAt(first, "bestLap");
           row["status"] = first.value("status", "error");
           if (first.contains("reason")) row["reason"] = first["reason"];
+          if (first.contains("car")) row["car"] = first["car"];
         }
         row["bestLap"] = orNull(qualifying[d]);
+        keep(qualifyingRace(row, static_cast<int>(d + 1), (*drivers)[d].file, about));
         std::cerr << "qualifying " << d + 1 << "/" << n << ": " << (*drivers)[d].name << " "
                   << lapText(qualifying[d])
                   << (row.contains("reason") ? " (" + row["reason"].get<std::string>() + ")" : "")
@@ -352,7 +469,6 @@ int league(const LeagueOptions& o) {
       });
 
   // The heats (this shard's), each grid by qualifying
-  const auto heats = league::drawHeats(n, perHeat, o.rounds, o.seed);
   std::vector<std::size_t> mine;
   for (std::size_t h = 0; h < heats.size(); ++h)
     if (league::inShard(h, shard, shards)) mine.push_back(h);
@@ -404,22 +520,15 @@ int league(const LeagueOptions& o) {
         }
         heat["results"] = results;
         std::cerr << line << "\n";
+        keep(heatRace(heat, files, about));
         heatRows.push_back(std::move(heat));
       });
 
-  nlohmann::json about = {{"title", fs::path(o.paths.front()).filename().string()},
-                          {"drivers", n},
-                          {"heats", heats.size()},
-                          {"cars", perHeat},
-                          {"laps", o.laps},
-                          {"qualifyingLaps", o.qualifyingLaps},
-                          {"rounds", o.rounds},
-                          {"track", o.track},
-                          {"seed", o.seed}};
   if (shards > 1) about["shard"] = std::to_string(shard) + "/" + std::to_string(shards);
   auto all = complete(std::move(about), *drivers, std::move(qualifyingRows), std::move(heatRows));
+  const int kept = finishKeeper(keeper.get());
   if (int status = writeOutputs(all, o); status != 0) return status;
-  return errors ? 1 : 0;
+  return errors || kept ? 1 : 0;
 }
 
 }  // namespace
@@ -457,6 +566,12 @@ Command addLeagueCommand(CLI::App& app) {
   cmd->add_option("--results", o->results,
                   "Write the league as JSON (everything) or CSV (the standings) to FILE");
   cmd->add_option("--report", o->report, "Write an HTML report (standings, heats, charts)");
+  cmd->add_option("--db", o->db,
+                  "Keep the league in this standings database (default: pitwall standings' own; "
+                  "docs/league.md \"Standings\")");
+  cmd->add_flag("--no-db", o->noDb, "Keep nothing in the standings database");
+  merge->add_option("--db", o->db, "Keep the merged league in this standings database");
+  merge->add_flag("--no-db", o->noDb, "Keep nothing in the standings database");
   cmd->add_option("--driver-memory", o->driverMemory, "MB each driver world may hold (default 64)")
       ->check(CLI::Range(1, 4096));
   cmd->add_option("--driver-budget", o->driverBudget,

@@ -31,7 +31,7 @@ for _, r in ipairs(session:results()) do
     if k > r.laps then break end
     times[k] = lap.time
   end
-  rows[#rows + 1] = { number = r.number, position = r.position, status = r.status,
+  rows[#rows + 1] = { number = r.number, car = r.car, position = r.position, status = r.status,
     reason = r.reason, finished = r.finished, laps = r.laps, bestLap = r.bestLap,
     totalTime = r.totalTime, lapTimes = times }
 end

@@ -2,7 +2,7 @@
 // One heat of a league (pitwall league, docs/league.md): its drivers' files raced in the
 // simulator in virtual time, in this process, each file in a driver world of its own
 // (docs/drivers.md) — or one driver alone for qualifying. The result's `data` is the heat's rows
-// as JSON: [{number, position, status, reason?, finished, laps, bestLap?, totalTime?,
+// as JSON: [{number, car, position, status, reason?, finished, laps, bestLap?, totalTime?,
 // lapTimes}], car N being driven by files[N-1].
 #include <cstdint>
 #include <string>

@@ -8,15 +8,20 @@
 #include <map>
 #include <memory>
 
+#include <nlohmann/json.hpp>
+
 #include "bindings/script_file.hpp"
 #include "engine/cli/commands.hpp"
 #include "engine/cli/fail.hpp"
+#include "engine/cli/league_final.hpp"
 #include "engine/cli/options.hpp"
 #include "engine/cli/repl.hpp"
 #include "engine/cli/session.hpp"
 #include "engine/core/log.hpp"
 #include "engine/core/numbers.hpp"
 #include "engine/record/results.hpp"
+#include "engine/standings/keeper.hpp"
+#include "engine/standings/race_json.hpp"
 
 namespace pitwall::cli {
 
@@ -62,7 +67,27 @@ std::string simulatedTime(double seconds) {
 }
 }  // namespace
 
-int run(const RunOptions& options) {
+int run(const RunOptions& given) {
+  RunOptions options = given;
+  // A league's final: the shipped script, its drivers' files, its database (docs/league.md)
+  std::optional<FinalPlan> final;
+  if (!options.leagueFinal.empty()) {
+    if (!options.drivers.empty())
+      return fail("run",
+                  "--league-final gives every car its driver: no --driver with it (the league's "
+                  "files race)");
+    auto plan = planFinal(options.leagueFinal, options.finalCars);
+    if (!plan) return fail("run", plan.error());
+    final = std::move(*plan);
+    if (options.script.empty()) options.script = final->script;
+    if (options.db.empty()) options.db = final->db;
+    for (const auto& [number, file] : final->files)
+      options.drivers.push_back(std::to_string(number) + "=" + file);
+  } else if (options.script.empty()) {
+    return fail("run",
+                "give the script to run: pitwall run SCRIPT (or --league-final DB to race a "
+                "league's final)");
+  }
   // The script is read and compiled before any car is connected: a missing one (status 2) or one
   // that does not compile (status 1) is refused at once, not after a Bluetooth scan. With
   // --watch a script that does not compile yet is waited for, as before.
@@ -80,8 +105,34 @@ int run(const RunOptions& options) {
       return fail("run", checked.error());
     }
   }
-  auto drivers = driverFiles(options.drivers);
+  // (a finalist's file that no longer compiles enters all the same, and is out at the start, as
+  // in the league)
+  auto drivers = final ? Result<std::map<int, std::string>, std::string>(final->files)
+                       : driverFiles(options.drivers);
   if (!drivers) return fail("run", drivers.error());
+  // The standings: a file named with --db must take the results, or the run is refused now; the
+  // default one that cannot is said, and the run goes on without it.
+  std::unique_ptr<standings::Keeper> keeper;
+  if (!options.noDb) {
+    const std::string path = options.db.empty() ? standings::defaultPath() : options.db;
+    const std::string title = std::filesystem::path(options.script).stem().string();
+    auto opened =
+        path.empty()
+            ? Result<std::unique_ptr<standings::Keeper>, std::string>(
+                  Unexpected{std::string("no standings database (none of "
+                                         "PITWALL_DB, XDG_DATA_HOME, HOME is "
+                                         "set; --db FILE names one)")})
+            : standings::Keeper::open(
+                  path, final ? standings::Event{"final", final->title, "",
+                                                 nlohmann::json{{"league", final->league}}.dump()}
+                              : standings::Event{"race", title, "", "{}"});
+    if (opened)
+      keeper = std::move(*opened);
+    else if (!options.db.empty())
+      return fail("run", opened.error());
+    else
+      log::warn("pitwall", opened.error() + ": this run's races are not kept in the standings");
+  }
   if (options.humans > 0 && options.fast && options.view) {  // phones live in real time
     return fail("run",
                 "phones drive in real time: --humans with --view needs no --fast (a phone's "
@@ -130,6 +181,15 @@ int run(const RunOptions& options) {
   host.driverLimits.memory = static_cast<std::size_t>(options.driverMemory) << 20;
   host.driverLimits.budget = std::chrono::milliseconds(std::llround(options.driverBudget * 1000));
   host.driverLimits.watch = options.watch;
+  if (final)
+    host.leagueFinal =
+        HostOptions::LeagueFinal{final->title, final->laps, final->league, final->drivers};
+  if (keeper)
+    host.keepRace = [&keeper](const nlohmann::json& race) -> std::optional<std::string> {
+      auto parsed = standings::raceFromJson(race);
+      if (!parsed) return "the race's results are not a race: " + parsed.error();
+      return keeper->add(std::move(*parsed));
+    };
   try {
     session.startHost(host);
   } catch (const std::exception& e) {
@@ -196,15 +256,26 @@ int run(const RunOptions& options) {
   }
   loop.run();  // ends through Session::finish, which every way out of a run calls
   repl.reset();
+  bool unkept = false;
+  if (keeper) {
+    if (auto problem = keeper->finish()) {
+      log::error("pitwall", *problem);
+      unkept = true;
+    } else if (keeper->written() > 0) {
+      log::info("pitwall", "the results are kept in the standings: " + keeper->path() +
+                               " (pitwall standings)");
+    }
+  }
   if (capped) return session.exitStatus(kExitCapped);
-  return session.exitStatus(session.host().mainFailed() ? 1 : 0);
+  return session.exitStatus(session.host().mainFailed() || unkept ? 1 : 0);
 }
 
 Command addRunCommand(CLI::App& app) {
   auto run = std::make_shared<RunOptions>();
   auto* cmd =
       app.add_subcommand("run", "Run a Lua script; by default against the built-in simulator");
-  cmd->add_option("script", run->script, "The Lua script to run")->required();
+  cmd->add_option("script", run->script,
+                  "The Lua script to run (with --league-final: the shipped final's, by default)");
   auto* fastFlag =
       cmd->add_flag("--fast", run->fast, "Virtual time: the run goes as fast as the machine can");
   auto* durationOption = cmd->add_option("--duration", run->duration,
@@ -233,6 +304,19 @@ Command addRunCommand(CLI::App& app) {
   cmd->add_option("--driver", run->drivers,
                   "CAR=FILE: the race's driver of car number CAR is FILE, in a Lua world of its "
                   "own that commands that car only (repeatable; docs/drivers.md)");
+  cmd->add_option("--db", run->db,
+                  "Keep the races' results in this standings database (default: pitwall "
+                  "standings' own; docs/league.md \"Standings\")");
+  cmd->add_flag("--no-db", run->noDb, "Keep no results in the standings database");
+  auto* finalOption = cmd->add_option(
+      "--league-final", run->leagueFinal,
+      "DB[:LEAGUE]: race the final of a league kept in DB (default: its last) with its top "
+      "drivers' files, the grid by its standings (docs/league.md)");
+  cmd->add_option("--final-cars", run->finalCars,
+                  "With --league-final: how many of the league's top drivers race (default: as "
+                  "many as its heats had)")
+      ->check(CLI::Range(2, 64))
+      ->needs(finalOption);
   cmd->add_option("--driver-memory", run->driverMemory,
                   "MB each driver world may hold (default 64); past it the driver is out")
       ->check(CLI::Range(1, 4096));

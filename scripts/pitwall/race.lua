@@ -257,6 +257,8 @@ for name, fn in pairs(require "pitwall.race_view") do Race[name] = fn end
 for name, fn in pairs(require "pitwall.race_marshal") do Race[name] = fn end
 -- Drivers in worlds of their own: out, back, what they read of the race (race_worlds.lua).
 for name, fn in pairs(require "pitwall.race_worlds") do Race[name] = fn end
+-- The results kept in the standings database when the session ends (race_standings.lua).
+for name, fn in pairs(require "pitwall.race_standings") do Race[name] = fn end
 
 function Race:_start(e)
   e.started = true
@@ -676,6 +678,7 @@ function Race:_cut()
   local path = self.options.results
   if path == nil then path = pitwall.resultsFile end
   if path then self.resultsPath = pitwall.writeResults(self:results(), race.columns, path) end
+  self:_keep()
 end
 
 -- Across reloads: what a session hands to the next version and how it takes it up
@@ -750,6 +753,7 @@ function Race:_race()
   local path = o.results
   if path == nil then path = pitwall.resultsFile end
   if path then self.resultsPath = pitwall.writeResults(self:results(), race.columns, path) end
+  self:_keep()
   self.phase = "done"
   self:_viewNow()
   self:_emit("onEnd", self)

@@ -24,6 +24,7 @@ FLOORS = {
     "engine/view": 7,  # the view shows the seats and its /drive page holds them
     "engine/print": 6,  # printing pieces and reading them back: the sim's geometry, drawn
     "engine/league": 6,  # a league's heats, points and report: plain data, no cars
+    "engine/standings": 7,  # every race's and league's results kept (SQLite): a league's points
     "bindings": 8,
     "engine/cli": 9,
 }

@@ -139,6 +139,10 @@ function Stdout:flush() end
 @param columns string[]
 @param path? string
 @return string path]],
+      keepResults = [[Keeps a race's results in the run's standings database (--db; docs/league.md "Standings"): {kind, number, track, laps, entries = {{number, driver, car, file?, position, finished, status, reason?, laps, bestLap, totalTime, lapTimes}}}. The race library calls it when a race ends.
+@param race table
+@return boolean kept false when the run keeps no standings, or when they were held or saved beside the database
+@return string? why not now]],
       terminal = [[The console: is it a terminal that may be redrawn, and how wide.
 @return pitwall.Terminal]],
       mindroad = [[A MindRoad robot car over TCP or UDP (docs/robots.md); in a task it waits for contact.

@@ -1,0 +1,277 @@
+# Standings that last (docs/league.md "Standings"): every league and `pitwall run` race is kept in
+# a SQLite database; `pitwall standings` prints the table, per track and per driver, with personal
+# bests. A second league adds to the first; a league killed in the middle keeps every race it had
+# finished; a database of the older schema (version 1) is migrated and keeps its rows; a locked
+# database holds the races and saves them beside it, and `standings import` adds them, so the table
+# is the one no lock would have given; a corrupt, foreign, newer or read-only file is a sentence
+# before anything races, and is left as it was.
+source "$(dirname "$0")/lib.sh"
+D="$SRC/tests/integration/drivers"
+mkdir -p "$TMP/class"
+cp "$D/good.lua" "$TMP/class/alice.lua"
+cat > "$TMP/class/bob.lua" <<'LUA'
+local cruiser = require "pitwall.drivers.cruiser"
+return { name = "bob", new = function() return cruiser.new { speed = 1100 } end }
+LUA
+printf 'return require "pitwall.drivers.overtaker"\n' > "$TMP/class/carol.lua"
+printf 'return require "pitwall.drivers.follower"\n' > "$TMP/class/dave.lua"
+cp "$D/errors.lua" "$TMP/class/frank.lua"
+export PITWALL_DB="$TMP/default.db"  # (the default database: never the home folder's)
+
+league() {
+  $PITWALL league "$TMP/class" --laps 2 --qualifying-laps 1 --seed 5 --cars 3 "$@"
+}
+# the table as JSON, one "driver points races wins" line each, in order
+table() {
+  $PITWALL standings --db "$1" --json "${@:2}" | python3 -c '
+import json, sys
+for r in json.load(sys.stdin)["standings"]:
+    print(r["driver"], r["points"], r["races"], r["wins"])'
+}
+# each heat of a --results JSON as "heat driver position points" lines
+heats_of() {
+  python3 - "$1" <<'PY'
+import json, sys
+for h in json.load(open(sys.argv[1]))["heats"]:
+    for r in h.get("results", []):
+        print(h["heat"], r["driver"], r["position"], r["points"])
+PY
+}
+# the same from a database
+heats_in() {
+  python3 - "$1" <<'PY'
+import sqlite3, sys
+db = sqlite3.connect(sys.argv[1])
+for row in db.execute("SELECT ra.number, r.driver, r.position, r.points FROM results r JOIN races "
+                      "ra ON ra.id = r.race WHERE ra.kind = 'heat' ORDER BY ra.number, r.position"):
+    print(*row)
+PY
+}
+
+# A league is kept: its table is the league's own
+league --db "$TMP/a.db" --results "$TMP/one.json" >"$TMP/one.out" 2>"$TMP/one.err"
+check "a league: exit status" 0 "$?"
+contains "a league says where its standings are" "standings kept in $TMP/a.db" "$(cat "$TMP/one.err")"
+want=$(python3 - "$TMP/one.json" <<'PY'
+import json, sys
+for s in json.load(open(sys.argv[1]))["standings"]:
+    print(s["driver"], s["points"], s["heats"], s["wins"])
+PY
+)
+check "the kept table is the league's standings" "$want" "$(table "$TMP/a.db")"
+check "the kept heats are the league's" "$(heats_of "$TMP/one.json")" "$(heats_in "$TMP/a.db")"
+out=$($PITWALL standings --db "$TMP/a.db")
+contains "standings: a table" "POS  DRIVER" "$out"
+contains "standings: personal bests" "Personal bests" "$out"
+contains "standings: a personal best on the track" "oval " "$(echo "$out" | sed -n '/Personal bests/,$p')"
+
+# A second league adds to the first: every driver's points and races double
+league --db "$TMP/a.db" >/dev/null 2>&1
+doubled=$(echo "$want" | awk '{ print $1, 2 * $2, 2 * $3, 2 * $4 }')
+check "a second league adds to the first" "$doubled" "$(table "$TMP/a.db")"
+check "two leagues are two events" 2 "$($PITWALL standings --db "$TMP/a.db" --events --json |
+  python3 -c 'import json,sys; print(len(json.load(sys.stdin)))')"
+# per driver: its races, and its best lap is the smallest of its laps kept
+out=$($PITWALL standings --db "$TMP/a.db" --driver alice --json)
+best=$(echo "$out" | python3 -c '
+import json, sys
+d = json.load(sys.stdin)
+laps = [r["bestLap"] for r in d["races"] if r["bestLap"] is not None]
+pb = [b["lap"] for b in d["personalBests"]]
+print(len(d["races"]), min(laps) == pb[0] and len(pb) == 1)')
+check "standings --driver: qualifying and heats of two leagues, the personal best their best" \
+  "$((2 * (1 + $(echo "$want" | awk '$1 == "alice" { print $3 }')))) True" "$best"
+err=$($PITWALL standings --db "$TMP/a.db" --driver zed 2>&1); rc=$?
+check "an unknown driver: status" 1 "$rc"
+contains "an unknown driver: names the ones there are" "its drivers: " "$err"
+check "--track: the table on one track" "$(table "$TMP/a.db")" "$(table "$TMP/a.db" --track oval)"
+contains "--track: another track has no races" "no races yet on this track" \
+  "$($PITWALL standings --db "$TMP/a.db" --track bowtie)"
+
+# A league killed in the middle keeps every race it finished: more heats (six rounds), killed once
+# the database has three of them; what is kept is the same as those heats of a whole run
+league --db "$TMP/whole.db" --races 6 --results "$TMP/whole.json" >/dev/null 2>&1
+$PITWALL league "$TMP/class" --laps 2 --qualifying-laps 1 --seed 5 --cars 3 --db "$TMP/killed.db" \
+  --races 6 >/dev/null 2>&1 &
+pid=$!  # (pitwall's own: the kill is for it, not for a shell around it)
+python3 - "$TMP/killed.db" "$pid" <<'PY'
+import os, signal, sqlite3, sys, time
+path, pid = sys.argv[1], int(sys.argv[2])
+for _ in range(20000):  # at most 100 s
+    try:
+        n = sqlite3.connect(path).execute("SELECT COUNT(*) FROM races WHERE kind = 'heat'").fetchone()[0]
+    except sqlite3.Error:
+        n = 0
+    if n >= 3:
+        break
+    time.sleep(0.005)
+os.kill(pid, signal.SIGKILL)
+PY
+wait "$pid" 2>/dev/null
+kept=$(heats_in "$TMP/killed.db")
+k=$(echo "$kept" | awk '{ print $1 }' | sort -un | wc -l)
+[ "$k" -ge 3 ] && echo "ok: killed: $k heats were kept" || fail "killed: $k heats kept: $kept"
+check "killed: the heats kept are those of a whole run" \
+  "$(heats_of "$TMP/whole.json" | awk -v k="$k" '$1 <= k')" "$kept"
+contains "killed: the event shows as not finished" "not finished" \
+  "$($PITWALL standings --db "$TMP/killed.db" --events)"
+$PITWALL standings --db "$TMP/killed.db" >/dev/null
+check "killed: the database reads" 0 "$?"
+
+# A database of schema version 1 (no reason, file or laps yet) migrates, and keeps its rows
+python3 - "$TMP/old.db" <<'PY'
+import sqlite3, sys
+db = sqlite3.connect(sys.argv[1])
+db.executescript("""
+CREATE TABLE events(id INTEGER PRIMARY KEY, kind TEXT NOT NULL, title TEXT NOT NULL,
+  track TEXT NOT NULL, started TEXT NOT NULL, ended TEXT, details TEXT NOT NULL DEFAULT '{}');
+CREATE TABLE races(id INTEGER PRIMARY KEY, event INTEGER NOT NULL REFERENCES events(id),
+  kind TEXT NOT NULL, number INTEGER NOT NULL, track TEXT NOT NULL, laps INTEGER NOT NULL,
+  ended TEXT NOT NULL, UNIQUE(event, kind, number));
+CREATE TABLE results(race INTEGER NOT NULL REFERENCES races(id), number INTEGER NOT NULL,
+  driver TEXT NOT NULL, car TEXT NOT NULL, position INTEGER, finished INTEGER NOT NULL,
+  status TEXT NOT NULL, laps INTEGER NOT NULL, best_lap REAL, total_time REAL,
+  points INTEGER NOT NULL, PRIMARY KEY(race, number));
+CREATE INDEX results_driver ON results(driver);
+INSERT INTO events VALUES(1, 'race', 'club night', 'oval', '2026-10-01T19:00:00Z',
+  '2026-10-01T21:00:00Z', '{}');
+INSERT INTO races VALUES(1, 1, 'race', 1, 'oval', 5, '2026-10-01T19:30:00Z');
+INSERT INTO results VALUES(1, 1, 'alice', 'skull', 1, 1, 'finished', 5, 3.456, 18.2, 25);
+INSERT INTO results VALUES(1, 2, 'zoe', 'nuke', 2, 1, 'finished', 5, 3.6, 18.9, 18);
+PRAGMA user_version = 1;
+""")
+db.commit()
+PY
+out=$($PITWALL standings --db "$TMP/old.db" --json)
+check "version 1: migrated to 2" 2 "$(python3 -c "import sqlite3; print(sqlite3.connect('$TMP/old.db').execute('PRAGMA user_version').fetchone()[0])")"
+check "version 1: its rows are kept" "alice 25 1 1
+zoe 18 1 0" "$(table "$TMP/old.db")"
+contains "version 1: its personal best is kept" '"lap": 3.456' "$out"
+league --db "$TMP/old.db" >/dev/null 2>&1
+check "version 1: a league adds to it" \
+  "$(echo "$want" | awk '$1 == "alice" { print $1, $2 + 25, $3 + 1, $4 + 1 }')" \
+  "$(table "$TMP/old.db" | grep '^alice ')"
+
+# A locked database: the lock is taken once the league has written its first race and held to its
+# end. The league holds the races it cannot write, saves them beside the database and says how to
+# add them; `standings import` adds them, and the table is the one without a lock.
+export PITWALL_DB_WAIT=0.2
+python3 - "$TMP/locked.db" "$TMP/lock.ready" "$TMP/lock.release" <<'PY' &
+import os, sqlite3, sys, time
+path, ready, release = sys.argv[1:4]
+while True:
+    try:
+        if sqlite3.connect(path).execute("SELECT COUNT(*) FROM races").fetchone()[0] >= 1:
+            break
+    except sqlite3.Error:
+        pass
+    time.sleep(0.005)
+db = sqlite3.connect(path, isolation_level=None)
+db.execute("BEGIN EXCLUSIVE")
+open(ready, "w").close()
+while not os.path.exists(release):
+    time.sleep(0.02)
+db.execute("ROLLBACK")
+PY
+LOCK_PID=$!
+league --db "$TMP/locked.db" >"$TMP/locked.out" 2>"$TMP/locked.err"
+rc=$?
+touch "$TMP/lock.release"
+wait "$LOCK_PID"
+check "locked: the league ends with status 1" 1 "$rc"
+[ -e "$TMP/lock.ready" ] && echo "ok: locked: the lock was held during the league" ||
+  fail "locked: the lock was never taken"
+err=$(cat "$TMP/locked.err")
+contains "locked: says the file is locked" "is locked by another program" "$err"
+contains "locked: says what is held" "held and written with the next one or at the end" "$err"
+unsaved=$(ls "$TMP"/locked.db.unsaved-*.json 2>/dev/null | head -1)
+[ -n "$unsaved" ] && echo "ok: locked: the races are saved beside the database" ||
+  fail "locked: no unsaved file: $err"
+contains "locked: says how to add them" "pitwall standings --db $TMP/locked.db import $unsaved" "$err"
+out=$($PITWALL standings --db "$TMP/locked.db" import "$unsaved"); rc=$?
+check "import: exit status" 0 "$rc"
+contains "import: says how many" "races from $unsaved added" "$out"
+check "import: the table is the one without a lock" "$want" "$(table "$TMP/locked.db")"
+check "import: one event, as it was raced" 1 "$($PITWALL standings --db "$TMP/locked.db" --events --json |
+  python3 -c 'import json,sys; print(len(json.load(sys.stdin)))')"
+err=$($PITWALL standings --db "$TMP/locked.db" import "$unsaved" 2>&1); rc=$?
+check "import twice: status" 1 "$rc"
+contains "import twice: a race is kept once" "has that race already" "$err"
+check "import twice: the table is unchanged" "$want" "$(table "$TMP/locked.db")"
+unset PITWALL_DB_WAIT
+
+# Files that cannot hold standings: a sentence before anything races, the file left as it was
+refused() {  # NAME FILE EXPECTED-WORDS
+  cp "$2" "$TMP/before"
+  err=$(league --db "$2" 2>&1 >/dev/null); rc=$?
+  check "$1: the league is refused" 2 "$rc"
+  contains "$1: says what is wrong" "$3" "$err"
+  case "$err" in *qualifying*) fail "$1: the league raced: $err" ;; *) echo "ok: $1: nothing raced" ;; esac
+  check "$1: the file is left as it was" "" "$(cmp "$TMP/before" "$2" 2>&1)"
+  err=$($PITWALL standings --db "$2" 2>&1); rc=$?
+  check "$1: standings: status" 1 "$rc"
+  contains "$1: standings: says what is wrong" "$3" "$err"
+}
+head -c 5000 /dev/urandom >"$TMP/noise.db"
+refused "a file of noise" "$TMP/noise.db" "is not a pitwall standings database"
+cp "$TMP/a.db" "$TMP/damaged.db"
+python3 - "$TMP/damaged.db" <<'PY'
+import sys
+import os
+size = os.path.getsize(sys.argv[1])
+with open(sys.argv[1], "r+b") as f:  # page 2 onwards: the tables' own pages, scribbled over
+    f.seek(4096)
+    f.write((bytes(range(256)) * (size // 256 + 1))[: size - 4096])
+PY
+refused "a damaged database" "$TMP/damaged.db" "is damaged"
+python3 -c "
+import sqlite3; db = sqlite3.connect('$TMP/other.db'); db.execute('CREATE TABLE photos(x)'); db.commit()"
+refused "another program's database" "$TMP/other.db" "not pitwall's standings (its tables: photos)"
+cp "$TMP/a.db" "$TMP/newer.db"
+python3 -c "import sqlite3; db = sqlite3.connect('$TMP/newer.db'); db.execute('PRAGMA user_version = 99'); db.commit()"
+refused "a newer schema" "$TMP/newer.db" "has schema version 99, newer than this pitwall's 2"
+# read-only: a file the user may not write (root may write any file: the check runs as nobody)
+cp "$TMP/a.db" "$TMP/ro/a.db" 2>/dev/null || { mkdir -p "$TMP/ro" && cp "$TMP/a.db" "$TMP/ro/a.db"; }
+chmod 755 "$TMP" "$TMP/ro" "$TMP/class"; chmod 644 "$TMP"/class/*.lua; chmod 444 "$TMP/ro/a.db"
+as_user=()
+[ "$(id -u)" = 0 ] && as_user=(setpriv --reuid=65534 --regid=65534 --clear-groups)
+err=$(PITWALL_DB= HOME=/nonexistent "${as_user[@]}" $PITWALL league "$TMP/class" --laps 1 \
+  --qualifying-laps 1 --db "$TMP/ro/a.db" 2>&1 >/dev/null); rc=$?
+check "read-only: the league is refused" 2 "$rc"
+contains "read-only: says so" "cannot be written (read-only" "$err"
+check "read-only: the file is left as it was" "" "$(cmp "$TMP/a.db" "$TMP/ro/a.db" 2>&1)"
+out=$("${as_user[@]}" $PITWALL standings --db "$TMP/ro/a.db" 2>&1); rc=$?
+check "read-only: its standings still read" 0 "$rc"
+contains "read-only: the table" "POS  DRIVER" "$out"
+err=$($PITWALL standings --db "$TMP/none.db" 2>&1); rc=$?
+check "no database yet: status" 1 "$rc"
+contains "no database yet: says so" "no standings at $TMP/none.db yet" "$err"
+err=$($PITWALL standings --db "$TMP" 2>&1)
+contains "a folder: says so" "is a folder" "$err"
+
+# `pitwall run`: a race is kept in the default database, with who drove which car and its laps;
+# --no-db keeps nothing
+$PITWALL run "$SRC/examples/grand_prix.lua" --fast --results "$TMP/gp.json" >/dev/null \
+  2>"$TMP/gp.err"
+check "run: exit status" 0 "$?"
+contains "run: says where the results are kept" "kept in the standings: $PITWALL_DB" "$(cat "$TMP/gp.err")"
+want=$(python3 - "$TMP/gp.json" <<'PY'
+import json, sys
+pts = [25, 18, 15, 12, 10, 8, 6, 4, 2, 1]
+for r in json.load(open(sys.argv[1])):
+    print(r["car"], pts[r["position"] - 1] if r["finished"] else 0, 1, int(r["position"] == 1 and r["finished"]))
+PY
+)
+check "run: the race's places are its table" "$want" "$(table "$PITWALL_DB")"
+laps=$(python3 -c "
+import sqlite3; db = sqlite3.connect('$PITWALL_DB')
+print(db.execute('SELECT COUNT(*) FROM laps').fetchone()[0] == db.execute('SELECT SUM(laps) FROM results').fetchone()[0])")
+check "run: every lap's time is kept" True "$laps"
+$PITWALL run "$SRC/examples/grand_prix.lua" --fast --no-db >/dev/null 2>&1
+check "run --no-db: nothing more is kept" "$want" "$(table "$PITWALL_DB")"
+err=$($PITWALL run "$SRC/examples/grand_prix.lua" --fast --db "$TMP/noise.db" 2>&1 >/dev/null); rc=$?
+check "run --db with a bad file: refused" 2 "$rc"
+contains "run --db with a bad file: says why" "is not a pitwall standings database" "$err"
+
+[ "$FAILURES" -eq 0 ] || { echo "$FAILURES failure(s)"; exit 1; }
+echo "all standings checks passed"

@@ -1,0 +1,230 @@
+// The standings database (engine/standings/database.hpp) and a race's JSON form
+// (engine/standings/race_json.hpp): what is written reads back; the table's order; points only
+// for races; hostile JSON from a script is a sentence naming the field, never a crash or a row.
+#include "engine/standings/database.hpp"
+
+#include <doctest/doctest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "engine/standings/keeper.hpp"
+#include "engine/standings/race_json.hpp"
+
+using namespace pitwall::standings;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct TempDb {
+  fs::path dir = fs::temp_directory_path() / ("pitwall-db-" + std::to_string(::getpid()));
+  std::string path = (dir / "s.db").string();
+  TempDb() {
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+  }
+  ~TempDb() { fs::remove_all(dir); }
+};
+
+Entry entry(int number, std::string driver, int position, bool finished, double best) {
+  Entry e;
+  e.number = number;
+  e.driver = driver;
+  e.car = "car" + std::to_string(number);
+  e.position = position;
+  e.finished = finished;
+  e.status = finished ? "finished" : "DNF";
+  e.laps = finished ? 3 : 1;
+  e.bestLap = best;
+  e.lapTimes = {best + 0.5, best, best + 0.25};
+  return e;
+}
+
+}  // namespace
+
+TEST_CASE("standings: points for races, heats and finals only") {
+  CHECK(pointsFor("race", 1, true) == 25);
+  CHECK(pointsFor("heat", 2, true) == 18);
+  CHECK(pointsFor("final", 10, true) == 1);
+  CHECK(pointsFor("final", 11, true) == 0);
+  CHECK(pointsFor("race", 1, false) == 0);
+  CHECK(pointsFor("qualifying", 1, true) == 0);
+  CHECK(pointsFor("practice", 1, true) == 0);
+  CHECK(pointsFor("stopped", 1, true) == 0);
+  CHECK(pointsFor("race", std::nullopt, true) == 0);
+}
+
+TEST_CASE("standings: races kept read back as the table, the bests and a driver's history") {
+  TempDb t;
+  auto db = Database::open(t.path);
+  REQUIRE(db);
+  CHECK((*db)->versionFound() == 0);
+  auto event = (*db)->beginEvent({"league", "class", "oval", "{}"});
+  REQUIRE(event);
+  REQUIRE((*db)->addRace(*event, {"qualifying", 1, "oval", 1, {entry(1, "ann", 1, true, 3.1)}}));
+  REQUIRE((*db)->addRace(*event, {"heat",
+                                  1,
+                                  "oval",
+                                  3,
+                                  {entry(1, "ann", 2, true, 3.3), entry(2, "bo", 1, true, 3.2),
+                                   entry(3, "cy", 3, false, 4.0)}}));
+  REQUIRE((*db)->addRace(
+      *event,
+      {"heat", 2, "bowtie", 3, {entry(1, "cy", 1, true, 5.0), entry(2, "ann", 2, true, 4.9)}}));
+  REQUIRE((*db)->endEvent(*event));
+
+  auto table = (*db)->table({});
+  REQUIRE(table);
+  REQUIRE(table->size() == 3);
+  // ann: 18 + 18 = 36; cy: 0 + 25; bo: 25 — bo and cy tie on points and wins: the best lap
+  CHECK((*table)[0].driver == "ann");
+  CHECK((*table)[0].points == 36);
+  CHECK((*table)[0].races == 2);  // qualifying is no race
+  CHECK((*table)[0].podiums == 2);
+  CHECK((*table)[0].bestLap == doctest::Approx(3.1));  // its qualifying lap
+  CHECK((*table)[1].driver == "bo");
+  CHECK((*table)[2].driver == "cy");
+  CHECK((*table)[2].finishes == 1);
+
+  auto oval = (*db)->table({std::string("oval"), std::nullopt, std::nullopt});
+  REQUIRE(oval);
+  CHECK(oval->size() == 3);
+  CHECK((*oval)[0].driver == "bo");  // 25 on the oval
+
+  auto bests = (*db)->bests({std::nullopt, std::string("ann"), std::nullopt});
+  REQUIRE(bests);
+  REQUIRE(bests->size() == 2);  // one per track
+  CHECK((*bests)[0].track == "bowtie");
+  CHECK((*bests)[0].lap == doctest::Approx(4.9));
+  CHECK((*bests)[1].lap == doctest::Approx(3.1));
+  CHECK((*bests)[1].event == "class");
+
+  auto history = (*db)->history("cy");
+  REQUIRE(history);
+  REQUIRE(history->size() == 2);
+  CHECK((*history)[0].status == "DNF");
+  CHECK((*history)[1].points == 25);
+
+  auto league = (*db)->league(std::nullopt);
+  REQUIRE(league);
+  CHECK(league->drivers.size() == 3);
+  CHECK(league->drivers[0].name == "ann");
+  CHECK(league->drivers[0].qualifying == doctest::Approx(3.1));
+  CHECK(league->heats.size() == 2);
+
+  // a race is kept once
+  auto again = (*db)->addRace(*event, {"heat", 1, "oval", 3, {entry(1, "ann", 1, true, 3.0)}});
+  REQUIRE_FALSE(again);
+  CHECK(again.error().find("has that race already") != std::string::npos);
+  // a database opened again is at the current version, and keeps what it had
+  db = Database::open(t.path);
+  REQUIRE(db);
+  CHECK((*db)->versionFound() == kSchemaVersion);
+  CHECK((*db)->table({})->size() == 3);
+}
+
+TEST_CASE("standings: a race's JSON from a script: hostile values are sentences naming the field") {
+  nlohmann::json good = {
+      {"kind", "race"},
+      {"track", "oval"},
+      {"laps", 3},
+      {"entries",
+       {{{"number", 1}, {"car", "skull"}, {"position", 1}, {"finished", true}, {"laps", 3}}}}};
+  auto race = raceFromJson(good);
+  REQUIRE(race);
+  CHECK(race->entries[0].driver == "skull");  // no driver: the car
+  CHECK(race->entries[0].status == "finished");
+  CHECK(toJson(*race)["entries"][0]["driver"] == "skull");
+  CHECK(raceFromJson(toJson(*race))->entries[0].car == "skull");
+
+  struct Bad {
+    nlohmann::json patch;
+    const char* says;
+  };
+  const Bad bads[] = {
+      {{{"kind", 5}}, "race.kind must be a string"},
+      {{{"laps", 1e300}}, "race.laps must be a finite number, got 1e+300"},
+      {{{"laps", "x"}}, "race.laps must be a finite number"},
+      {{{"entries", "many"}}, "race.entries must be a list"},
+      {{{"entries", {7}}}, "race.entries[1] must be an object"},
+      {{{"entries", {{{"position", 1e18}, {"car", "a"}}}}}, "race.entries[1].position"},
+      {{{"entries", {{{"bestLap", "fast"}, {"car", "a"}}}}}, "race.entries[1].bestLap"},
+      {{{"entries", {{{"finished", 1}, {"car", "a"}}}}},
+       "race.entries[1].finished must be a boolean"},
+      {{{"entries", {{{"lapTimes", {1, "x"}}, {"car", "a"}}}}},
+       "lapTimes must be a list of seconds"},
+      {{{"entries", {{{"number", 2}}}}}, "names no driver and no car"},
+  };
+  for (const auto& bad : bads) {
+    nlohmann::json j = good;
+    j.merge_patch(bad.patch);
+    auto r = raceFromJson(j);
+    CAPTURE(j.dump());
+    REQUIRE_FALSE(r);
+    CHECK(r.error().find(bad.says) != std::string::npos);
+  }
+  CHECK_FALSE(raceFromJson(nlohmann::json::array()));
+  CHECK_FALSE(raceFromJson(nullptr));
+}
+
+TEST_CASE("standings: names of any bytes are kept as they came") {
+  TempDb t;
+  auto db = Database::open(t.path);
+  REQUIRE(db);
+  auto event = (*db)->beginEvent({"race", "x", "", "{}"});
+  REQUIRE(event);
+  const std::string odd = std::string("b\xff\xfe") + '\0' + "d'; DROP TABLE results; --";
+  REQUIRE((*db)->addRace(*event, {"race", 1, "oval", 1, {entry(1, odd, 1, true, 3.0)}}));
+  auto table = (*db)->table({});
+  REQUIRE(table);
+  REQUIRE(table->size() == 1);
+  CHECK((*table)[0].driver == odd);
+}
+
+TEST_CASE("standings: files that hold no standings are sentences, and are left as they were") {
+  TempDb t;
+  {
+    std::ofstream noise(t.path, std::ios::binary);
+    for (int i = 0; i < 5000; ++i) noise.put(static_cast<char>(i * 7919 % 251));
+  }
+  const auto before = fs::file_size(t.path);
+  auto db = Database::open(t.path);
+  REQUIRE_FALSE(db);
+  CHECK(db.error().find("is not a pitwall standings database") != std::string::npos);
+  CHECK(fs::file_size(t.path) == before);
+
+  auto missing = Database::open((t.dir / "none.db").string(), false);
+  REQUIRE_FALSE(missing);
+  CHECK(missing.error().find("yet: a race or a league writes them") != std::string::npos);
+  CHECK_FALSE(fs::exists(t.dir / "none.db"));
+
+  auto folder = Database::open(t.dir.string());
+  REQUIRE_FALSE(folder);
+  CHECK(folder.error().find("is a folder") != std::string::npos);
+  auto empty = Database::open("");
+  REQUIRE_FALSE(empty);
+  CHECK(empty.error().find("no standings database") != std::string::npos);
+}
+
+TEST_CASE("standings: a keeper writes each race as it comes, and nothing for a run without one") {
+  TempDb t;
+  {
+    auto keeper = Keeper::open(t.path, {"race", "run", "", "{}"});
+    REQUIRE(keeper);
+    CHECK_FALSE((*keeper)->finish());
+  }
+  CHECK((*Database::open(t.path))->events()->empty());
+  auto keeper = Keeper::open(t.path, {"race", "run", "", "{}"});
+  REQUIRE(keeper);
+  CHECK_FALSE((*keeper)->add({"race", 1, "oval", 3, {entry(1, "ann", 1, true, 3.0)}}));
+  CHECK((*keeper)->written() == 1);
+  // written before the run ends: another reader sees it now
+  auto events = (*Database::open(t.path))->events();
+  REQUIRE(events->size() == 1);
+  CHECK(events->front().ended.empty());
+  CHECK(events->front().track == "oval");  // the event's track: its races'
+  CHECK_FALSE((*keeper)->finish());
+  CHECK_FALSE((*Database::open(t.path))->events()->front().ended.empty());
+}
