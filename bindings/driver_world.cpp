@@ -79,7 +79,7 @@ DriverWorld::~DriverWorld() {
   if (sweep_) race_.loop().cancel(sweep_);
 }
 
-bool DriverWorld::reload() {
+void DriverWorld::retire() {
   if (host_) {
     host_->detach();
     host_->shutDown();
@@ -93,6 +93,16 @@ bool DriverWorld::reload() {
       retired_.clear();
     });
   }
+}
+
+void DriverWorld::close() {
+  closed_ = true;
+  retire();
+}
+
+bool DriverWorld::reload() {
+  if (closed_) return false;
+  retire();
   failure_.clear();
   spent_.clear();
   spentSum_ = 0;

@@ -40,6 +40,9 @@ class DriverWorld {
   // Loads the file again into a new world: the old one goes (its car keeps its last speed until
   // the director calls the new one). False, and failure() set, when the new one fails.
   bool reload();
+  // Shuts the world down for good (its session ended): it follows no car any more and is freed on
+  // a later turn of the loop; later calls and reloads do nothing. Its car is left as it is.
+  void close();
 
   const std::string& failure() const { return failure_; }
   const std::string& file() const { return file_; }
@@ -49,6 +52,8 @@ class DriverWorld {
 
  private:
   void fail(const std::string& why);
+  // The world now (if any) retired: freed on a later turn (it may be on the stack).
+  void retire();
   // The CPU time a call used: failed past its share (real time, DriverLimits::share).
   void charge(double cpu);
   void watch();
@@ -64,6 +69,7 @@ class DriverWorld {
   Loop::TimerId sweep_ = 0;
   std::string failure_;
   int version_ = 0;
+  bool closed_ = false;
   std::deque<double> spent_;  // the CPU time of its last calls (DriverLimits::shareCalls)
   double spentSum_ = 0, cpuTotal_ = 0;
   std::unique_ptr<FileWatch> watch_;

@@ -3,7 +3,8 @@
 // --driver CAR=FILE of the command line, and pitwall._driverWorld(file, car), the engine's half
 // of drivers.world (scripts/pitwall/drivers.lua), which a race director calls like any driver.
 // A driver world object: world:call(method, data) → true, or false once the world has failed;
-// world:reload() → true when the new world loaded; fields failure (why it is out, nil while it
+// world:reload() → true when the new world loaded; world:close() ends it for good (its session
+// ended); fields failure (why it is out, nil while it
 // drives), file, version (1, +1 a reload), cpu (s its calls used).
 #include <filesystem>
 #include <memory>
@@ -47,6 +48,11 @@ int reload(lua_State* L) {
   return 1;
 }
 
+int close(lua_State* L) {
+  worldAt(L, 1).close();
+  return 0;
+}
+
 void pushText(lua_State* L, const std::string& s) {
   lua_pushlstring(L, s.data(), s.size());
 }
@@ -66,8 +72,10 @@ const lua::Field kFields[] = {
 };
 
 const lua::TypeSpec& worldType() {
-  static const luaL_Reg methods[] = {
-      {"call", lua::guarded<call>}, {"reload", lua::guarded<reload>}, {nullptr, nullptr}};
+  static const luaL_Reg methods[] = {{"call", lua::guarded<call>},
+                                     {"reload", lua::guarded<reload>},
+                                     {"close", lua::guarded<close>},
+                                     {nullptr, nullptr}};
   static const lua::TypeSpec type{
       .metatable = kMetatable,
       .name = "driver world",

@@ -194,6 +194,9 @@ local DriverWorld = {}
 ---@return boolean ok
 function DriverWorld:call(method, data) end
 
+---Ends the world for good (its session ended, as the race director does at the end): it follows no car any more; later calls return false. Its car is left as it is.
+function DriverWorld:close() end
+
 ---Loads the file again into a new world, as a save does with --watch; false when the new one fails (the car is out).
 ---@return boolean loaded
 function DriverWorld:reload() end

@@ -745,6 +745,7 @@ function Race:_race()
   for _, e in ipairs(self.order) do
     e.unsubscribe(); e.timer:cancel(); e.statusSub:cancel(); e.contactSub:cancel()
   end
+  self:_closeWorlds()
   if self.board then
     self.board.title = self.title .. "   results"
     self.board:final(self:_rows())

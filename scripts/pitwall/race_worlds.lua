@@ -24,6 +24,14 @@ function Worlds:_checkWorld(e)
   end
 end
 
+-- The session ended: its driver worlds end too (they would follow every car until collected).
+function Worlds:_closeWorlds()
+  for _, e in ipairs(self.order) do
+    local w = worldOf(e)
+    if w then w:close() end
+  end
+end
+
 -- Before an update: a driver world's ctx.race is `view`, what it reads of the race (the phase
 -- and every car's place, laps and best lap), made once a tick. Returns the view made.
 function Worlds:_tellWorld(e, view)

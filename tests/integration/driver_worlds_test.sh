@@ -189,6 +189,25 @@ out=$($PITWALL run "$TMP/script_form.lua" --fast --results "$TMP/form.json" 2>&1
 check "race.laps{drivers = {[3] = FILE}}: exit status" 0 "$?"
 contains "the script's form makes a world too" "driver loop.lua of car 3 (thermo) is out" "$out"
 
+# A session's driver worlds end with it: a world's own timer ticks no more once the race is over,
+# though the run goes on (worlds left alive would follow every car of every later session)
+cat > "$TMP/ends.lua" <<LUA
+local race = require "pitwall.race"
+local s = race.laps { laps = 1, drivers = { [2] = "$D/ticker.lua" }, board = false }
+print(string.format("session over at %.1f", pitwall.now()))
+pitwall.sleep(20)
+print(string.format("run over at %.1f", pitwall.now()))
+pitwall.stop()
+LUA
+out=$($PITWALL run "$TMP/ends.lua" --fast --no-db 2>&1)
+check "a session's worlds end with it: exit status" 0 "$?"
+over=$(echo "$out" | sed -n 's/.*session over at \([0-9.]*\).*/\1/p')
+last=$(echo "$out" | sed -n 's/.*ticker at \([0-9.]*\).*/\1/p' | tail -1)
+ticks=$(echo "$out" | grep -c "ticker at")
+awk -v o="$over" -v l="$last" -v n="$ticks" 'BEGIN { exit !(n >= 3 && l <= o + 0.001) }' &&
+  echo "ok: the world ticked $ticks times during the session, never after it ($last <= $over)" ||
+  fail "the world's timer after the session (over at $over, last tick at $last, $ticks ticks): $out"
+
 cat > "$TMP/missing_form.lua" <<LUA
 local race = require "pitwall.race"
 race.laps { laps = 1, drivers = { [2] = "$TMP/nobody.lua" } }

@@ -171,6 +171,7 @@ function Stdout:flush() end
 @return boolean ok]],
       reload = [[Loads the file again into a new world, as a save does with --watch; false when the new one fails (the car is out).
 @return boolean loaded]],
+      close = [[Ends the world for good (its session ended, as the race director does at the end): it follows no car any more; later calls return false. Its car is left as it is.]],
     },
   },
   {
