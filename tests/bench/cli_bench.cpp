@@ -12,6 +12,7 @@
 //   every car to 700 mm/s: cpu_share (CPU time ÷ wall time, 1 = one core) and peak_mb.
 // BM_CliMemory/N: the same in virtual time (--fast, 60 simulated seconds): peak_mb only.
 // BM_ScenarioSuite: `pitwall test tests/scenarios -j 2`: the wall time (manual time).
+// BM_League/J: a league of 4 driver worlds, 100 heats, beside the grand prix's cost (below).
 #include <benchmark/benchmark.h>
 #include <fcntl.h>
 #include <spawn.h>
@@ -206,6 +207,48 @@ BENCHMARK(BM_CliMemory)
     ->Iterations(1)
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond);
+
+// BM_League/J: `pitwall league` of 4 driver files (each the shipped cruiser, in a driver world of
+// its own) with --races 100 --laps 5 and -j J: 4 qualifying runs and 100 four-car, five-lap heats
+// (issue 38 asks 1000 such races in 20 s of CPU: 20 ms a race; with -j 2, 10 s of wall on this
+// 2-core machine). Beside it, in the same benchmark, the floor it is compared with: three
+// `pitwall run examples/grand_prix.lua --fast` (start-up included). Counters: cpu_ms_per_race
+// (the league's CPU, its heats' processes included, over its 104 races), wall_s_per_1000
+// (the league's wall time for 1000 races at this rate), grand_prix_cpu_ms (the median) and
+// race_per_grand_prix (cpu_ms_per_race ÷ grand_prix_cpu_ms).
+void BM_League(benchmark::State& state) {
+  const fs::path dir = fs::temp_directory_path() / "pitwall_bench_league";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  for (const char* name : {"ann", "bo", "cy", "di"})
+    std::ofstream(dir / (std::string(name) + ".lua"))
+        << "return require \"pitwall.drivers.cruiser\"\n";
+  constexpr double kRaces = 104;
+  Totals t;
+  const bool ran = runEach(state,
+                           {"league", dir.string(), "--races", "100", "--laps", "5", "-j",
+                            std::to_string(state.range(0)), "--no-db", "-q"},
+                           t);
+  Totals gp;
+  for (int i = 0; ran && i < 3; ++i) {
+    Child c = runPitwall(
+        {"run", PITWALL_SOURCE_DIR "/examples/grand_prix.lua", "--fast", "--no-db", "-q"});
+    if (!c.ok) {
+      state.SkipWithError(c.error.c_str());
+      break;
+    }
+    gp.cpuOfRun.push_back(c.user + c.sys);
+  }
+  fs::remove_all(dir);
+  if (!ran || gp.cpuOfRun.size() < 3) return;
+  const double perRace = t.cpu / static_cast<double>(state.iterations()) / kRaces;
+  state.counters["cpu_ms_per_race"] = perRace * 1000;
+  state.counters["wall_s_per_1000"] =
+      t.wall / static_cast<double>(state.iterations()) / kRaces * 1000;
+  state.counters["grand_prix_cpu_ms"] = gp.medianCpu() * 1000;
+  state.counters["race_per_grand_prix"] = perRace / gp.medianCpu();
+}
+BENCHMARK(BM_League)->Arg(1)->Arg(2)->Iterations(1)->UseManualTime()->Unit(benchmark::kSecond);
 
 void BM_ScenarioSuite(benchmark::State& state) {
   Totals t;

@@ -118,12 +118,18 @@ void TargetReporter::printTargets() const {
          return *us / 1000;
        }(),
        "BM_MqttFrameToLua/samples:2000/broker_nodelay:1"},
+      {{"league: CPU a four-car, five-lap race (driver worlds)", "ms", true, 20},
+       counter("BM_League/1/iterations:1/manual_time", "cpu_ms_per_race"),
+       "BM_League/1"},
+      {{"league: 1000 races with -j 2, wall", "s", true, 10},
+       counter("BM_League/2/iterations:1/manual_time", "wall_s_per_1000"),
+       "BM_League/2"},
       {{"scenario tests (tests/scenarios -j 2), wall", "s", true, 1.0},
        wall("BM_ScenarioSuite/iterations:3/manual_time"),
        "BM_ScenarioSuite"},
   };
 
-  std::printf("\nTargets (issues 20 and 35; docs/performance.md):\n");
+  std::printf("\nTargets (issues 20, 35 and 38; docs/performance.md):\n");
   std::printf("  %s %s %s  met\n", pad("", 46).c_str(), pad("measured", 12, true).c_str(),
               pad("target", 12, true).c_str());
   int met = 0, measured = 0;
