@@ -20,6 +20,7 @@
 #include "engine/cli/fail.hpp"
 #include "engine/cli/league_heat.hpp"
 #include "engine/cli/options.hpp"
+#include "engine/cli/standings_keeping.hpp"
 #include "engine/cli/test_pool.hpp"
 #include "engine/core/numbers.hpp"
 #include "engine/league/report.hpp"
@@ -170,31 +171,21 @@ standings::Race heatRace(const nlohmann::json& heat,
 }
 
 // The standings database of a league (--db, --no-db): opened before anything races, so a file
-// that cannot take the results refuses the league before it costs anything.
+// named with --db that cannot take the results refuses the league before it costs anything.
 Result<std::unique_ptr<standings::Keeper>, std::string> openKeeper(const LeagueOptions& o,
                                                                    const nlohmann::json& about) {
-  if (o.noDb) return std::unique_ptr<standings::Keeper>();
-  const std::string path = o.db.empty() ? standings::defaultPath() : o.db;
-  if (path.empty() && o.db.empty()) {
-    std::cerr << "league: no standings database (none of PITWALL_DB, XDG_DATA_HOME, HOME is set; "
-                 "--db FILE names one): the league is not kept\n";
-    return std::unique_ptr<standings::Keeper>();
-  }
-  standings::Event event{"league", about.value("title", std::string("league")),
-                         about.value("track", std::string()), about.dump()};
-  return standings::Keeper::open(path, std::move(event));
+  return openStandings(o.db, o.noDb,
+                       {"league", about.value("title", std::string("league")),
+                        about.value("track", std::string()), about.dump()},
+                       "league");
 }
 
 // Says where the standings are, or what was not written (status 1 then).
 int finishKeeper(standings::Keeper* keeper) {
-  if (!keeper) return 0;
-  if (auto problem = keeper->finish()) {
-    fail("league", *problem, 1);
-    return 1;
-  }
-  std::cerr << "league: standings kept in " << keeper->path() << " (pitwall standings --db "
-            << keeper->path() << ")\n";
-  return 0;
+  return finishStandings(keeper, "league",
+                         [](const std::string& text) { std::cerr << "league: " << text << "\n"; })
+             ? 0
+             : 1;
 }
 
 // K/N with 1 <= K <= N <= 1000.
@@ -566,12 +557,8 @@ Command addLeagueCommand(CLI::App& app) {
   cmd->add_option("--results", o->results,
                   "Write the league as JSON (everything) or CSV (the standings) to FILE");
   cmd->add_option("--report", o->report, "Write an HTML report (standings, heats, charts)");
-  cmd->add_option("--db", o->db,
-                  "Keep the league in this standings database (default: pitwall standings' own; "
-                  "docs/league.md \"Standings\")");
-  cmd->add_flag("--no-db", o->noDb, "Keep nothing in the standings database");
-  merge->add_option("--db", o->db, "Keep the merged league in this standings database");
-  merge->add_flag("--no-db", o->noDb, "Keep nothing in the standings database");
+  addStandingsOptions(cmd, o->db, o->noDb, "the league");
+  addStandingsOptions(merge, o->db, o->noDb, "the merged league");
   cmd->add_option("--driver-memory", o->driverMemory, "MB each driver world may hold (default 64)")
       ->check(CLI::Range(1, 4096));
   cmd->add_option("--driver-budget", o->driverBudget,

@@ -17,6 +17,7 @@
 #include "engine/cli/options.hpp"
 #include "engine/cli/repl.hpp"
 #include "engine/cli/session.hpp"
+#include "engine/cli/standings_keeping.hpp"
 #include "engine/core/log.hpp"
 #include "engine/core/numbers.hpp"
 #include "engine/record/results.hpp"
@@ -112,27 +113,15 @@ int run(const RunOptions& given) {
   if (!drivers) return fail("run", drivers.error());
   // The standings: a file named with --db must take the results, or the run is refused now; the
   // default one that cannot is said, and the run goes on without it.
-  std::unique_ptr<standings::Keeper> keeper;
-  if (!options.noDb) {
-    const std::string path = options.db.empty() ? standings::defaultPath() : options.db;
-    const std::string title = std::filesystem::path(options.script).stem().string();
-    auto opened =
-        path.empty()
-            ? Result<std::unique_ptr<standings::Keeper>, std::string>(
-                  Unexpected{std::string("no standings database (none of "
-                                         "PITWALL_DB, XDG_DATA_HOME, HOME is "
-                                         "set; --db FILE names one)")})
-            : standings::Keeper::open(
-                  path, final ? standings::Event{"final", final->title, "",
-                                                 nlohmann::json{{"league", final->league}}.dump()}
-                              : standings::Event{"race", title, "", "{}"});
-    if (opened)
-      keeper = std::move(*opened);
-    else if (!options.db.empty())
-      return fail("run", opened.error());
-    else
-      log::warn("pitwall", opened.error() + ": this run's races are not kept in the standings");
-  }
+  auto opened = openStandings(
+      options.db, options.noDb,
+      final ? standings::Event{"final", final->title, "",
+                               nlohmann::json{{"league", final->league}}.dump()}
+            : standings::Event{"race", std::filesystem::path(options.script).stem().string(), "",
+                               "{}"},
+      "run");
+  if (!opened) return fail("run", opened.error());
+  std::unique_ptr<standings::Keeper> keeper = std::move(*opened);
   if (options.humans > 0 && options.fast && options.view) {  // phones live in real time
     return fail("run",
                 "phones drive in real time: --humans with --view needs no --fast (a phone's "
@@ -256,18 +245,11 @@ int run(const RunOptions& given) {
   }
   loop.run();  // ends through Session::finish, which every way out of a run calls
   repl.reset();
-  bool unkept = false;
-  if (keeper) {
-    if (auto problem = keeper->finish()) {
-      log::error("pitwall", *problem);
-      unkept = true;
-    } else if (keeper->written() > 0) {
-      log::info("pitwall", "the results are kept in the standings: " + keeper->path() +
-                               " (pitwall standings)");
-    }
-  }
+  const bool kept = finishStandings(keeper.get(), "run", [](const std::string& text) {
+    log::info("pitwall", "the results are " + text);
+  });
   if (capped) return session.exitStatus(kExitCapped);
-  return session.exitStatus(session.host().mainFailed() || unkept ? 1 : 0);
+  return session.exitStatus(session.host().mainFailed() || !kept ? 1 : 0);
 }
 
 Command addRunCommand(CLI::App& app) {
@@ -304,10 +286,7 @@ Command addRunCommand(CLI::App& app) {
   cmd->add_option("--driver", run->drivers,
                   "CAR=FILE: the race's driver of car number CAR is FILE, in a Lua world of its "
                   "own that commands that car only (repeatable; docs/drivers.md)");
-  cmd->add_option("--db", run->db,
-                  "Keep the races' results in this standings database (default: pitwall "
-                  "standings' own; docs/league.md \"Standings\")");
-  cmd->add_flag("--no-db", run->noDb, "Keep no results in the standings database");
+  addStandingsOptions(cmd, run->db, run->noDb, "the races' results");
   auto* finalOption = cmd->add_option(
       "--league-final", run->leagueFinal,
       "DB[:LEAGUE]: race the final of a league kept in DB (default: its last) with its top "

@@ -7,14 +7,7 @@
 source "$(dirname "$0")/ble_lib.sh"
 start_bus
 D="$SRC/tests/integration/drivers"
-mkdir -p "$TMP/class"
-cp "$D/good.lua" "$TMP/class/alice.lua"
-cat > "$TMP/class/bob.lua" <<'LUA'
-local cruiser = require "pitwall.drivers.cruiser"
-return { name = "bob", new = function() return cruiser.new { speed = 1000 } end }
-LUA
-printf 'return require "pitwall.drivers.overtaker"\n' > "$TMP/class/carol.lua"
-printf 'return require "pitwall.drivers.follower"\n' > "$TMP/class/dave.lua"
+good_class "$TMP/class"
 export PITWALL_DB="$TMP/default.db"
 DB="$TMP/class.db"
 

@@ -9,13 +9,7 @@ D="$SRC/tests/integration/drivers"
 SHOTS="$(cd "$(dirname "$PITWALL")" && pwd)/test-results"
 mkdir -p "$SHOTS" "$TMP/class"
 
-cp "$D/good.lua" "$TMP/class/alice.lua"
-cat > "$TMP/class/bob.lua" <<'LUA'
-local cruiser = require "pitwall.drivers.cruiser"
-return { name = "bob", new = function() return cruiser.new { speed = 1100 } end }
-LUA
-printf 'return require "pitwall.drivers.overtaker"\n' > "$TMP/class/carol.lua"
-printf 'return require "pitwall.drivers.follower"\n' > "$TMP/class/dave.lua"
+good_class "$TMP/class"
 cp "$D/loop.lua" "$TMP/class/eve.lua"
 cp "$D/errors.lua" "$TMP/class/frank.lua"
 cp "$D/other_car.lua" "$TMP/class/gina.lua"

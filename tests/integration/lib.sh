@@ -114,3 +114,17 @@ wait_suspended() {
 finish() {
   [ "$FAILURES" -eq 0 ] || { echo "$FAILURES check(s) failed"; exit 1; }
 }
+
+# good_class DIR: four good driver files, as a class hands them in (the league, standings and
+# final tests): alice (tests/integration/drivers/good.lua), bob (a cruiser at 1100 mm/s), carol
+# (the shipped overtaker) and dave (the shipped follower).
+good_class() {
+  mkdir -p "$1"
+  cp "$SRC/tests/integration/drivers/good.lua" "$1/alice.lua"
+  cat > "$1/bob.lua" <<'LUA'
+local cruiser = require "pitwall.drivers.cruiser"
+return { name = "bob", new = function() return cruiser.new { speed = 1100 } end }
+LUA
+  printf 'return require "pitwall.drivers.overtaker"\n' > "$1/carol.lua"
+  printf 'return require "pitwall.drivers.follower"\n' > "$1/dave.lua"
+}

@@ -7,14 +7,7 @@
 # before anything races, and is left as it was.
 source "$(dirname "$0")/lib.sh"
 D="$SRC/tests/integration/drivers"
-mkdir -p "$TMP/class"
-cp "$D/good.lua" "$TMP/class/alice.lua"
-cat > "$TMP/class/bob.lua" <<'LUA'
-local cruiser = require "pitwall.drivers.cruiser"
-return { name = "bob", new = function() return cruiser.new { speed = 1100 } end }
-LUA
-printf 'return require "pitwall.drivers.overtaker"\n' > "$TMP/class/carol.lua"
-printf 'return require "pitwall.drivers.follower"\n' > "$TMP/class/dave.lua"
+good_class "$TMP/class"
 cp "$D/errors.lua" "$TMP/class/frank.lua"
 export PITWALL_DB="$TMP/default.db"  # (the default database: never the home folder's)
 
@@ -51,7 +44,7 @@ PY
 # A league is kept: its table is the league's own
 league --db "$TMP/a.db" --results "$TMP/one.json" >"$TMP/one.out" 2>"$TMP/one.err"
 check "a league: exit status" 0 "$?"
-contains "a league says where its standings are" "standings kept in $TMP/a.db" "$(cat "$TMP/one.err")"
+contains "a league says where its standings are" "kept in the standings: $TMP/a.db" "$(cat "$TMP/one.err")"
 want=$(python3 - "$TMP/one.json" <<'PY'
 import json, sys
 for s in json.load(open(sys.argv[1]))["standings"]:

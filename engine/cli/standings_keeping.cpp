@@ -1,0 +1,43 @@
+#include "engine/cli/standings_keeping.hpp"
+
+#include <iostream>
+
+#include "engine/cli/fail.hpp"
+
+namespace pitwall::cli {
+
+void addStandingsOptions(CLI::App* cmd, std::string& db, bool& noDb, const std::string& what) {
+  cmd->add_option("--db", db,
+                  "Keep " + what +
+                      " in this standings database (default: $PITWALL_DB, else "
+                      "$XDG_DATA_HOME/pitwall/standings.db; docs/league.md \"Standings\")");
+  cmd->add_flag("--no-db", noDb, "Keep nothing in the standings database");
+}
+
+Result<std::unique_ptr<standings::Keeper>, std::string> openStandings(const std::string& db,
+                                                                      bool noDb,
+                                                                      standings::Event event,
+                                                                      const std::string& command) {
+  if (noDb) return std::unique_ptr<standings::Keeper>();
+  const std::string path = db.empty() ? standings::defaultPath() : db;
+  auto opened = standings::Keeper::open(path, std::move(event));
+  if (opened || !db.empty()) return opened;
+  std::cerr << "pitwall " << command << ": " << opened.error()
+            << ": nothing of this run is kept in the standings\n";
+  return std::unique_ptr<standings::Keeper>();
+}
+
+bool finishStandings(standings::Keeper* keeper, const std::string& command,
+                     const std::function<void(const std::string&)>& told) {
+  if (!keeper) return true;
+  if (auto problem = keeper->finish()) {
+    fail(command, *problem, 1);
+    return false;
+  }
+  if (keeper->written() > 0)
+    told("kept in the standings: " + keeper->path() + " (pitwall standings --db " + keeper->path() +
+         ")");
+  return true;
+}
+
+}  // namespace pitwall::cli
