@@ -115,15 +115,24 @@ end
 -- when the event does not fit the estimate.
 function Tracker:_step(e, m, id, t0, t)
   local map, d = self.map, self:_dir()
-  local len0 = self:_len(e.index)
+  local pieces, n = map.pieces, #map.pieces
+  local off = self.reverse and -self.offset or self.offset
+  local len0 = pieces[e.index]:length(off)
   local p0 = e.pos * len0
   local r = p0 + m -- reckoned lane mm from the start of the current piece
-  local idx, start = { e.index }, { 0 }
+  -- The pieces from here on and where each starts: the tracker's own two lists, filled anew at
+  -- every event (an event is a frame of one car: no table is made for it)
+  local idx, start = self._idx, self._start
+  if not idx then
+    idx, start = {}, {}
+    self._idx, self._start = idx, start
+  end
+  idx[1], start[1] = e.index, 0
   local at, k = len0, e.index
   for j = 2, MAX_SKIP + 1 do
-    k = map:next(k, d)
+    k = (k - 1 + d) % n + 1 -- Map:next
     idx[j], start[j] = k, at
-    at = at + self:_len(k)
+    at = at + pieces[k]:length(off)
   end
   local choice, into
   local unsure = t - t0 > LONG_GAP
