@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "engine/core/data_dir.hpp"
+#include "engine/core/printable.hpp"
 #include "engine/league/scoring.hpp"
 #include "engine/standings/database.hpp"
 
@@ -19,13 +20,17 @@ Result<FinalPlan, std::string> planFinal(const std::string& given, int cars) {
   FinalPlan plan;
   plan.db = given;
   std::optional<std::int64_t> event;
-  // DB:EVENT — a suffix of digits after the last colon (a path may hold colons of its own)
-  if (auto colon = given.rfind(':');
-      colon != std::string::npos && colon + 1 < given.size() &&
-      given.find_first_not_of("0123456789", colon + 1) == std::string::npos &&
-      given.size() - colon - 1 <= 12) {
+  // DB:LEAGUE — what follows the last colon, when the whole is no file (a path may hold colons)
+  std::error_code ec;
+  if (auto colon = given.rfind(':'); colon != std::string::npos && !fs::exists(given, ec)) {
+    const std::string id = given.substr(colon + 1);
+    if (id.empty() || id.size() > 12 || id.find_first_not_of("0123456789") != std::string::npos)
+      return Unexpected{"--league-final " + printable(given, 200) +
+                        ": LEAGUE in DB:LEAGUE must be a league's number (pitwall standings --db "
+                        "DB --events lists them), got " +
+                        printable(id, 40)};
     plan.db = given.substr(0, colon);
-    event = std::stoll(given.substr(colon + 1));
+    event = std::stoll(id);
   }
   auto db = standings::Database::open(plan.db, false);
   if (!db) return Unexpected{"--league-final " + given + ": " + db.error()};
@@ -33,12 +38,18 @@ Result<FinalPlan, std::string> planFinal(const std::string& given, int cars) {
   if (!league) return Unexpected{"--league-final " + given + ": " + league.error()};
   plan.league = league->event.id;
   plan.title = "Final: " + league->event.title;
+  // Its laps and cars a heat, as the league kept them (a number from 1 to 100 and 2 to 64, or
+  // the defaults: a database may hold anything)
   const auto details = nlohmann::json::parse(league->details, nullptr, false);
-  if (details.is_object()) {
-    plan.laps = details.value("laps", 5);
-    if (cars <= 0) cars = details.value("cars", 4);
-  }
-  if (cars <= 0) cars = 4;
+  auto number = [&](const char* key, int fallback, int lo, int hi) {
+    if (!details.is_object()) return fallback;
+    auto it = details.find(key);
+    if (it == details.end() || !it->is_number_integer()) return fallback;
+    const auto v = it->get<std::int64_t>();
+    return v >= lo && v <= hi ? static_cast<int>(v) : fallback;
+  };
+  plan.laps = number("laps", 5, 1, 100);
+  if (cars <= 0) cars = std::max(2, number("cars", 4, 1, 64));
   // The league's standings, by its own rule (engine/league/scoring.hpp)
   const auto& drivers = league->drivers;
   std::map<std::string, int> index;
@@ -58,17 +69,19 @@ Result<FinalPlan, std::string> planFinal(const std::string& given, int cars) {
   if (k < 2)
     return Unexpected{"--league-final " + given + ": league " + std::to_string(plan.league) +
                       " has " + std::to_string(table.size()) +
-                      " drivers: a final needs 2 (--final-cars K, K ≥ 2)"};
+                      (table.size() == 1 ? " driver" : " drivers") + ": a final needs 2"};
   for (int i = 0; i < k; ++i) {
     const auto& d = drivers[static_cast<std::size_t>(table[static_cast<std::size_t>(i)].driver)];
-    std::error_code ec;
+    ec.clear();
     if (d.file.empty() || !fs::is_regular_file(d.file, ec))
       return Unexpected{"--league-final " + given + ": " + d.name + " (place " +
                         std::to_string(i + 1) + " of the league) drove " +
                         (d.file.empty() ? std::string("a file the database does not name")
                                         : d.file + ", which is not there any more") +
-                        ": put the file back where it was, or race fewer with --final-cars " +
-                        std::to_string(i)};
+                        ": put the file back where it was" +
+                        (i >= 2 ? ", or race the first " + std::to_string(i) +
+                                      " with --final-cars " + std::to_string(i)
+                                : std::string())};
     plan.drivers.push_back(d.name);
     plan.files[i + 1] = d.file;
   }

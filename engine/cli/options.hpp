@@ -27,7 +27,7 @@ Command addScanCommand(CLI::App& app);
 Command addEmulateCommand(CLI::App& app);
 Command addSimRobotCommand(CLI::App& app);
 Command addTestCommand(CLI::App& app);
-Command addLeagueCommand(CLI::App& app);  // `league DIR|FILES…` (docs/league.md)
+Command addLeagueCommand(CLI::App& app);     // `league DIR|FILES…` (docs/league.md)
 Command addStandingsCommand(CLI::App& app);  // `standings` (docs/league.md "Standings")
 Command addReplayCommand(CLI::App& app);
 Command addTrackCommand(CLI::App& app);  // `track show`, `list`, `print`, `verify`

@@ -119,7 +119,10 @@ int run(const RunOptions& given) {
                                nlohmann::json{{"league", final->league}}.dump()}
             : standings::Event{"race", std::filesystem::path(options.script).stem().string(), "",
                                "{}"},
-      "run");
+      "run", {{"--record", options.record}, {"--results", options.results}},
+      // (a run's loop must turn: a race the locked file does not take now is held, and the wait
+      // for the lock comes once the cars are stopped)
+      false);
   if (!opened) return fail("run", opened.error());
   std::unique_ptr<standings::Keeper> keeper = std::move(*opened);
   if (options.humans > 0 && options.fast && options.view) {  // phones live in real time
@@ -176,7 +179,11 @@ int run(const RunOptions& given) {
   if (keeper)
     host.keepRace = [&keeper](const nlohmann::json& race) -> std::optional<std::string> {
       auto parsed = standings::raceFromJson(race);
-      if (!parsed) return "the race's results are not a race: " + parsed.error();
+      if (!parsed) {  // (kept as it came, with why, in the unsaved file at the end)
+        keeper->reject(race, parsed.error());
+        return "the race's results are not a race: " + parsed.error() +
+               " (kept as they came beside the database)";
+      }
       return keeper->add(std::move(*parsed));
     };
   try {
@@ -244,6 +251,7 @@ int run(const RunOptions& given) {
     log::info("pitwall", "watching " + options.script + " and its modules: save to reload");
   }
   loop.run();  // ends through Session::finish, which every way out of a run calls
+  session.loopEnded();
   repl.reset();
   const bool kept = finishStandings(keeper.get(), "run", [](const std::string& text) {
     log::info("pitwall", "the results are " + text);

@@ -96,6 +96,9 @@ class Session {
   // the stop frames are given time to reach the cars, real cars are disconnected, and
   // loop().run() ends. Every way out of a run comes here.
   void finish();
+  // The loop has returned (every car got its stop): the watchdog goes, so that work done after it
+  // (the standings waiting for a lock) is not taken for a stuck loop.
+  void loopEnded() { watchdog_.reset(); }
   // The exit status a run ends with: os.exit's or the memory limit's when the script asked for
   // one, else 130 after a signal, else `otherwise`.
   int exitStatus(int otherwise);

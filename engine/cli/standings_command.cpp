@@ -11,6 +11,7 @@
 #include "engine/cli/fail.hpp"
 #include "engine/cli/options.hpp"
 #include "engine/core/numbers.hpp"
+#include "engine/core/printable.hpp"
 #include "engine/standings/database.hpp"
 #include "engine/standings/keeper.hpp"
 
@@ -53,10 +54,10 @@ int printEvents(standings::Database& db, bool json) {
                     {"ended", e.ended.empty() ? nlohmann::json(nullptr) : nlohmann::json(e.ended)},
                     {"races", e.races}});
     if (json) continue;
-    char line[256];
+    char line[512];
     std::snprintf(line, sizeof line, "%4lld  %-6s  %-20s  %5d  %s (%s)%s\n",
-                  static_cast<long long>(e.id), e.kind.c_str(), e.started.c_str(), e.races,
-                  cut(e.title, 60).c_str(), cut(e.track, 40).c_str(),
+                  static_cast<long long>(e.id), cut(e.kind, 8).c_str(), cut(e.started, 20).c_str(),
+                  e.races, cut(e.title, 60).c_str(), cut(e.track, 40).c_str(),
                   e.ended.empty() ? "  not finished" : "");
     std::cout << line;
   }
@@ -130,11 +131,11 @@ int printTable(standings::Database& db, const StandingsOptions& o) {
     return 0;
   }
   if (history) {
-    std::cout << o.driver << " (" << db.path() << ")\n";
+    std::cout << cut(o.driver, 60) << " (" << db.path() << ")\n";
     std::cout << "WHEN                  EVENT                 RACE           TRACK       CAR"
                  "            POS  POINTS  BEST LAP\n";
     for (const auto& p : *history) {
-      char line[320];
+      char line[640];
       std::snprintf(
           line, sizeof line, "%-20s  %-20s  %-13s  %-10s  %-13s  %3s  %6d  %s\n", p.when.c_str(),
           cut(p.event, 20).c_str(), cut(p.kind + " " + std::to_string(p.number), 13).c_str(),
@@ -152,7 +153,7 @@ int printTable(standings::Database& db, const StandingsOptions& o) {
       std::cout << "POS  DRIVER                POINTS  RACES  WINS  PODIUMS  BEST LAP\n";
     int position = 0;
     for (const auto& r : *table) {
-      char line[200];
+      char line[400];
       std::snprintf(line, sizeof line, "%3d  %-20s  %6d  %5d  %4d  %7d  %s\n", ++position,
                     cut(r.driver, 20).c_str(), r.points, r.races, r.wins, r.podiums,
                     lap(r.bestLap).c_str());
@@ -163,10 +164,10 @@ int printTable(standings::Database& db, const StandingsOptions& o) {
     std::cout << "\nPersonal bests\n";
     std::cout << "TRACK                 DRIVER                BEST LAP  CAR            SET\n";
     for (const auto& b : *bests) {
-      char line[320];
+      char line[640];
       std::snprintf(line, sizeof line, "%-20s  %-20s  %8s  %-13s  %s (%s)\n",
                     cut(b.track, 20).c_str(), cut(b.driver, 20).c_str(), lap(b.lap).c_str(),
-                    cut(b.car, 13).c_str(), b.when.c_str(), cut(b.event, 40).c_str());
+                    cut(b.car, 13).c_str(), cut(b.when, 20).c_str(), cut(b.event, 40).c_str());
       std::cout << line;
     }
   }
@@ -175,18 +176,17 @@ int printTable(standings::Database& db, const StandingsOptions& o) {
 
 int standingsCommand(const StandingsOptions& o) {
   const std::string path = o.db.empty() ? standings::defaultPath() : o.db;
-  const bool importing = !o.imports.empty();
-  auto db = standings::Database::open(path, importing);
-  if (!db) return fail("standings", db.error(), 1);
-  if (importing) {
+  if (!o.imports.empty()) {
     for (const auto& file : o.imports) {
-      auto added = standings::importUnsaved(**db, file);
+      auto added = standings::importUnsaved(path, file);
       if (!added) return fail("standings", added.error(), 1);
       std::cout << "standings: " << *added << (*added == 1 ? " race" : " races") << " from " << file
                 << " added to " << path << "\n";
     }
     return 0;
   }
+  auto db = standings::Database::open(path, false);
+  if (!db) return fail("standings", db.error(), 1);
   if (o.events) return printEvents(**db, o.json);
   return printTable(**db, o);
 }

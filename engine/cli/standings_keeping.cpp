@@ -1,5 +1,6 @@
 #include "engine/cli/standings_keeping.hpp"
 
+#include <filesystem>
 #include <iostream>
 
 #include "engine/cli/fail.hpp"
@@ -14,13 +15,20 @@ void addStandingsOptions(CLI::App* cmd, std::string& db, bool& noDb, const std::
   cmd->add_flag("--no-db", noDb, "Keep nothing in the standings database");
 }
 
-Result<std::unique_ptr<standings::Keeper>, std::string> openStandings(const std::string& db,
-                                                                      bool noDb,
-                                                                      standings::Event event,
-                                                                      const std::string& command) {
+Result<std::unique_ptr<standings::Keeper>, std::string> openStandings(
+    const std::string& db, bool noDb, standings::Event event, const std::string& command,
+    const std::vector<std::pair<std::string, std::string>>& outputs, bool waitWhileRacing) {
   if (noDb) return std::unique_ptr<standings::Keeper>();
   const std::string path = db.empty() ? standings::defaultPath() : db;
-  auto opened = standings::Keeper::open(path, std::move(event));
+  std::error_code ec;
+  const auto at = std::filesystem::weakly_canonical(path, ec);
+  for (const auto& [option, file] : outputs) {
+    std::error_code ec2;
+    if (!file.empty() && !path.empty() && std::filesystem::weakly_canonical(file, ec2) == at)
+      return Unexpected{option + " " + file + " is the standings database (" + path +
+                        "): it would be written over; give another file, or --no-db"};
+  }
+  auto opened = standings::Keeper::open(path, std::move(event), waitWhileRacing);
   if (opened || !db.empty()) return opened;
   std::cerr << "pitwall " << command << ": " << opened.error()
             << ": nothing of this run is kept in the standings\n";

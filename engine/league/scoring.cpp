@@ -36,7 +36,9 @@ std::vector<Standing> standings(int drivers, const std::vector<std::vector<Place
       auto& s = table[static_cast<std::size_t>(p.driver)];
       ++s.heats;
       s.points += pointsFor(p.position, p.finished);
-      if (p.finished && p.position >= 1) {
+      // (a place past the number of drivers is none a heat of this league can give: no
+      // count-back for it, whatever a database says)
+      if (p.finished && p.position >= 1 && p.position <= drivers) {
         ++s.finishes;
         const auto k = static_cast<std::size_t>(p.position - 1);
         if (s.places.size() <= k) s.places.resize(k + 1, 0);

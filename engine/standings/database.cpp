@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <map>
+#include <set>
 
 #include "engine/core/numbers.hpp"
 #include "engine/league/scoring.hpp"
@@ -169,7 +170,9 @@ int pointsFor(const std::string& kind, std::optional<int> position, bool finishe
 }
 
 std::string Database::sentence(int code, const std::string& doing) const {
-  const std::string sqlite = db_ ? sqlite3_errmsg(db_) : sqlite3_errstr(code);
+  // (the message of the last call, unless a later one succeeded: then the code's own)
+  const std::string sqlite =
+      db_ && sqlite3_errcode(db_) != SQLITE_OK ? sqlite3_errmsg(db_) : sqlite3_errstr(code);
   const std::string other = " (or give another file with --db FILE)";
   switch (code & 0xff) {
     case SQLITE_NOTADB:
@@ -238,6 +241,9 @@ Result<std::unique_ptr<Database>, std::string> Database::open(const std::string&
       return Unexpected{db->sentence(SQLITE_CORRUPT, "checking it: " + check.text(0))};
   }
   if (auto migrated = db->migrate(); !migrated) return Unexpected{migrated.error()};
+  if (create) {
+    if (auto written = db->probeWrite(); !written) return Unexpected{written.error()};
+  }
   sqlite3_exec(raw, "PRAGMA foreign_keys = ON", nullptr, nullptr, nullptr);
   return db;
 }
@@ -260,12 +266,16 @@ Result<bool, std::string> Database::migrate() {
   auto v = version();
   if (!v) return Unexpected{v.error()};
   found_ = *v;
+  if (found_ < 0)
+    return Unexpected{path_ + " has schema version " + std::to_string(found_) +
+                      ", which no pitwall writes: not a standings database of ours; move it away, "
+                      "or give another file with --db FILE"};
   if (found_ > kSchemaVersion)
     return Unexpected{path_ + " has schema version " + std::to_string(found_) +
                       ", newer than this pitwall's " + std::to_string(kSchemaVersion) +
                       ": a newer pitwall wrote it; upgrade pitwall (nothing was changed), or give "
                       "another file with --db FILE"};
-  if (found_ == kSchemaVersion) return true;
+  if (found_ == kSchemaVersion) return checkTables();
   if (found_ == 0) {  // new — or another program's SQLite file
     Statement s(db_, "SELECT group_concat(name, ', ') FROM sqlite_master WHERE type = 'table'");
     if (int rc = s.prepared(); rc != SQLITE_OK) return Unexpected{sentence(rc, "reading it")};
@@ -286,7 +296,7 @@ Result<bool, std::string> Database::migrate() {
     if (!now || *now >= kSchemaVersion) {
       sqlite3_exec(db_, "COMMIT", nullptr, nullptr, nullptr);
       if (!now) return Unexpected{now.error()};
-      return true;
+      return checkTables();
     }
     const std::string step = std::string(kMigrations[static_cast<std::size_t>(*now)]) +
                              "; PRAGMA user_version = " + std::to_string(*now + 1) + ";";
@@ -300,6 +310,34 @@ Result<bool, std::string> Database::migrate() {
       return Unexpected{why};
     }
   }
+}
+
+// The tables of the current schema are there (a user may have dropped one: every write would fail
+// with a sentence of SQLite's that says nothing).
+Result<bool, std::string> Database::checkTables() {
+  Statement s(db_, "SELECT name FROM sqlite_master WHERE type = 'table'");
+  if (int rc = s.prepared(); rc != SQLITE_OK) return Unexpected{sentence(rc, "reading it")};
+  std::set<std::string> have;
+  int rc;
+  while ((rc = s.step()) == SQLITE_ROW) have.insert(s.text(0));
+  if (rc != SQLITE_DONE) return Unexpected{sentence(rc, "reading it")};
+  for (const char* table : {"events", "races", "results", "laps"})
+    if (!have.count(table))
+      return Unexpected{path_ + " has schema version " + std::to_string(kSchemaVersion) +
+                        " but no table " + table +
+                        " (removed by hand?): restore a copy, or give another file with --db FILE"};
+  return true;
+}
+
+// Can the file be written? SQLite writes a journal beside it: a folder that takes no new file
+// makes every write fail, so it is tried now (in a transaction rolled back), before a race.
+Result<bool, std::string> Database::probeWrite() {
+  int rc = sqlite3_exec(db_, "BEGIN IMMEDIATE; CREATE TABLE pitwall_probe(x); ROLLBACK;", nullptr,
+                        nullptr, nullptr);
+  if (rc == SQLITE_OK) return true;
+  const std::string why = sentence(rc, "trying a write");
+  sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+  return Unexpected{why};
 }
 
 Result<std::int64_t, std::string> Database::beginEvent(const Event& e) {
@@ -447,13 +485,14 @@ Result<std::vector<EventInfo>, std::string> Database::events() {
               "SELECT e.id, e.kind, e.title, COALESCE(NULLIF(e.track, ''), (SELECT "
               "group_concat(DISTINCT ra.track) FROM races ra WHERE ra.event = e.id), ''), "
               "e.started, e.ended, "
-              "(SELECT COUNT(*) FROM races ra WHERE ra.event = e.id) FROM events e ORDER BY e.id");
+              "(SELECT COUNT(*) FROM races ra WHERE ra.event = e.id), e.details FROM events e "
+              "ORDER BY e.id");
   if (int rc = s.prepared(); rc != SQLITE_OK) return Unexpected{sentence(rc, "reading the events")};
   std::vector<EventInfo> rows;
   int rc;
   while ((rc = s.step()) == SQLITE_ROW)
-    rows.push_back(
-        {s.integer64(0), s.text(1), s.text(2), s.text(3), s.text(4), s.text(5), s.integer(6)});
+    rows.push_back({s.integer64(0), s.text(1), s.text(2), s.text(3), s.text(4), s.text(5),
+                    s.integer(6), s.text(7)});
   if (rc != SQLITE_DONE) return Unexpected{sentence(rc, "reading the events")};
   return rows;
 }

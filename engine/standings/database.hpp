@@ -88,6 +88,7 @@ struct EventInfo {
   std::int64_t id = 0;
   std::string kind, title, track, started, ended;  // ended: empty while running (or killed)
   int races = 0;
+  std::string details;  // JSON
 };
 
 // A league's drivers, qualifying and heats as stored, for its standings and its final.
@@ -138,6 +139,8 @@ class Database {
  private:
   Database(sqlite3* db, std::string path) : db_(db), path_(std::move(path)) {}
   Result<bool, std::string> migrate();
+  Result<bool, std::string> checkTables();
+  Result<bool, std::string> probeWrite();
   std::string sentence(int code, const std::string& doing) const;
 
   sqlite3* db_;

@@ -1,6 +1,7 @@
 #include "engine/standings/race_json.hpp"
 
 #include <cmath>
+#include <set>
 
 namespace pitwall::standings {
 
@@ -10,7 +11,16 @@ nlohmann::json orNull(const std::optional<double>& v) {
   return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
 }
 
+// What a value is, for a sentence: a scalar as JSON (cut at 60 bytes), a list or an object by
+// its kind (never dumped whole: it may be nested a million deep).
+std::string shown(const nlohmann::json& v) {
+  if (v.is_array()) return "a list";
+  if (v.is_object()) return "an object";
+  return v.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace).substr(0, 60);
+}
+
 // The field `key` of `j` as T, absent or null → `fallback`; a value of another type is an error.
+// An int is a whole number of at most 2^31 − 1 either way.
 template <class T>
 Result<T, std::string> field(const nlohmann::json& j, const char* key, T fallback,
                              const std::string& where) {
@@ -22,17 +32,18 @@ Result<T, std::string> field(const nlohmann::json& j, const char* key, T fallbac
   else if constexpr (std::is_same_v<T, bool>)
     ok = it->is_boolean();
   else if constexpr (std::is_same_v<T, int>)
-    ok = it->is_number() && std::isfinite(it->get<double>()) && std::fabs(it->get<double>()) < 1e9;
+    ok = it->is_number() && std::isfinite(it->get<double>()) &&
+         std::fabs(it->get<double>()) <= 2147483647.0 &&
+         it->get<double>() == std::floor(it->get<double>());
   else
     ok = it->is_number() && std::isfinite(it->get<double>());
   if (!ok)
-    return Unexpected{
-        where + "." + key + " must be a " +
-        (std::is_same_v<T, std::string> ? "string"
-         : std::is_same_v<T, bool>      ? "boolean"
-                                        : "finite number") +
-        ", got " +
-        it->dump(-1, ' ', false, nlohmann::json::error_handler_t::replace).substr(0, 60)};
+    return Unexpected{where + "." + key + " must be " +
+                      (std::is_same_v<T, std::string> ? "a string"
+                       : std::is_same_v<T, bool>      ? "true or false"
+                       : std::is_same_v<T, int>       ? "a whole number up to 2147483647"
+                                                      : "a finite number") +
+                      ", got " + shown(*it)};
   return it->get<T>();
 }
 
@@ -83,8 +94,11 @@ Result<Race, std::string> raceFromJson(const nlohmann::json& j) {
   race.number = *number;
   race.track = *track;
   race.laps = *laps;
-  const auto entries = j.value("entries", nlohmann::json::array());
+  static const nlohmann::json kNone = nlohmann::json::array();
+  const auto found = j.find("entries");
+  const nlohmann::json& entries = found == j.end() || found->is_null() ? kNone : *found;
   if (!entries.is_array()) return Unexpected{std::string("race.entries must be a list")};
+  std::set<int> numbers;
   for (std::size_t k = 0; k < entries.size(); ++k) {
     const auto& x = entries[k];
     const std::string where = "race.entries[" + std::to_string(k + 1) + "]";
@@ -121,18 +135,24 @@ Result<Race, std::string> raceFromJson(const nlohmann::json& j) {
     if (x.contains("position") && !x["position"].is_null()) {
       auto p = field<int>(x, "position", 0, where);
       if (!p) return Unexpected{p.error()};
+      // a place in this race: 1 … its entries
+      if (*p < 1 || *p > static_cast<int>(entries.size()))
+        return Unexpected{where + ".position must be a place from 1 to " +
+                          std::to_string(entries.size()) + " (the race's entries), got " +
+                          std::to_string(*p)};
       e.position = *p;
     }
     if (auto it = x.find("lapTimes"); it != x.end() && !it->is_null()) {
       if (!it->is_array()) return Unexpected{where + ".lapTimes must be a list of seconds"};
       for (const auto& t : *it) {
         if (!t.is_number() || !std::isfinite(t.get<double>()))
-          return Unexpected{
-              where + ".lapTimes must be a list of seconds, got " +
-              t.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace).substr(0, 60)};
+          return Unexpected{where + ".lapTimes must be a list of seconds, got " + shown(t)};
         e.lapTimes.push_back(t.get<double>());
       }
     }
+    if (!numbers.insert(e.number).second)
+      return Unexpected{where + ".number " + std::to_string(e.number) +
+                        " is another entry's: each car is in a race once"};
     race.entries.push_back(std::move(e));
   }
   return race;

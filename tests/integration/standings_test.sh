@@ -193,6 +193,49 @@ contains "import twice: a race is kept once" "has that race already" "$err"
 check "import twice: the table is unchanged" "$want" "$(table "$TMP/locked.db")"
 unset PITWALL_DB_WAIT
 
+# Hostile unsaved files: each a sentence, no database made, nothing added (a review's findings)
+printf '{"pitwall": 1, "races": []}' >"$TMP/typ.json"
+mkdir -p "$TMP/adir.json"
+python3 -c "print('{\"pitwall\": \"pitwall unsaved standings\", \"races\": [{\"kind\": ' + '[' * 300000 + ']' * 300000 + '}]}')" >"$TMP/deep.json"
+printf '{"pitwall": "pitwall unsaved standings", "races": [{"entries": [{"car": "a", "position": 999999999, "finished": true}]}]}' >"$TMP/far.json"
+printf '{"pitwall": "pitwall unsaved standings", "races": [' >"$TMP/cut.json"
+mkfifo "$TMP/fifo.json"
+for bad in "typ.json:not an unsaved standings file" "adir.json:not a file" \
+  "deep.json:race.kind must be a string, got a list" \
+  "far.json:position must be a place from 1 to 1 (the race's entries), got 999999999" \
+  "cut.json:not JSON (" "fifo.json:not a file" "none.json:cannot be read ("; do
+  f=${bad%%:*}
+  err=$(timeout 20 $PITWALL standings --db "$TMP/imports.db" import "$TMP/$f" 2>&1); rc=$?
+  check "import $f: status 1" 1 "$rc"
+  contains "import $f: says what is wrong" "${bad#*:}" "$err"
+done
+check "hostile imports made no database" "" "$(ls "$TMP/imports.db" 2>/dev/null)"
+# An unsaved file of a run whose event never reached the database: imported once, not twice
+cat >"$TMP/once.json" <<'JSON'
+{"pitwall": "pitwall unsaved standings", "token": "20261130T000000-1", "eventId": null,
+ "event": {"kind": "race", "title": "club", "track": "oval"},
+ "races": [{"kind": "race", "number": 1, "track": "oval", "laps": 3, "entries": [
+   {"number": 1, "driver": "ann", "car": "skull", "position": 1, "finished": true, "laps": 3},
+   {"number": 2, "driver": "bo", "car": "nuke", "position": 2, "finished": true, "laps": 3}]}]}
+JSON
+$PITWALL standings --db "$TMP/once.db" import "$TMP/once.json" >/dev/null
+check "import: the races of an event that never reached the database" "ann 25 1 1
+bo 18 1 0" "$(table "$TMP/once.db")"
+err=$($PITWALL standings --db "$TMP/once.db" import "$TMP/once.json" 2>&1); rc=$?
+check "import of it again: refused" 1 "$rc"
+contains "import of it again: a race is kept once" "has that race already" "$err"
+check "import of it again: the table is unchanged" "ann 25 1 1
+bo 18 1 0" "$(table "$TMP/once.db")"
+# The database is none of a command's other files: it would be written over
+cp "$TMP/a.db" "$TMP/same.db"
+err=$($PITWALL run "$SRC/examples/hello.lua" --fast --cars 1 --db "$TMP/same.db" \
+  --record "$TMP/same.db" 2>&1); rc=$?
+check "--record onto --db: refused" 2 "$rc"
+contains "--record onto --db: says why" "--record $TMP/same.db is the standings database" "$err"
+err=$(league --db "$TMP/same.db" --results "$TMP/same.db" 2>&1); rc=$?
+check "league --results onto --db: refused" 2 "$rc"
+check "refused: the database is left as it was" "" "$(cmp "$TMP/a.db" "$TMP/same.db" 2>&1)"
+
 # Files that cannot hold standings: a sentence before anything races, the file left as it was
 refused() {  # NAME FILE EXPECTED-WORDS
   cp "$2" "$TMP/before"
@@ -265,6 +308,68 @@ check "run --no-db: nothing more is kept" "$want" "$(table "$PITWALL_DB")"
 err=$($PITWALL run "$SRC/examples/grand_prix.lua" --fast --db "$TMP/noise.db" 2>&1 >/dev/null); rc=$?
 check "run --db with a bad file: refused" 2 "$rc"
 contains "run --db with a bad file: says why" "is not a pitwall standings database" "$err"
+
+# Two races of one kind in one run are two races; a real-time run whose database is locked the
+# whole time races on (the loop never waits for the lock: no car is stopped by the watchdog) and
+# keeps its races beside it
+cat >"$TMP/two.lua" <<'LUA'
+local race = require "pitwall.race"
+race.laps { laps = 1, board = false }
+race.laps { laps = 1, board = false }
+pitwall.stop()
+LUA
+$PITWALL run "$TMP/two.lua" --fast --cars 2 --db "$TMP/two.db" >/dev/null 2>"$TMP/two.err"
+check "two races in a run: exit status" 0 "$?"
+check "two races in a run: both kept" 2 \
+  "$(python3 -c "import sqlite3; print(sqlite3.connect('$TMP/two.db').execute(\"SELECT COUNT(*) FROM races WHERE kind = 'race'\").fetchone()[0])")"
+cp "$TMP/two.db" "$TMP/held.db"
+python3 - "$TMP/held.db" "$TMP/held.ready" "$TMP/held.release" <<'PY' &
+import os, sqlite3, sys, time
+db = sqlite3.connect(sys.argv[1], isolation_level=None)
+db.execute("BEGIN EXCLUSIVE")
+open(sys.argv[2], "w").close()
+while not os.path.exists(sys.argv[3]):
+    time.sleep(0.02)
+db.execute("ROLLBACK")
+PY
+HELD_PID=$!
+wait_for_file() { for _ in $(seq 1 500); do [ -e "$1" ] && return 0; sleep 0.02; done; return 1; }
+wait_for_file "$TMP/held.ready" || fail "the lock was never taken"
+cat >"$TMP/rt.lua" <<'LUA'
+local race = require "pitwall.race"
+race.laps { laps = 1, board = false }
+pitwall.stop()
+LUA
+# (opened while unlocked: the lock is released for the open and taken again by a second holder)
+touch "$TMP/held.release"; wait "$HELD_PID"
+python3 - "$TMP/held.db" "$TMP/held2.ready" "$TMP/held2.release" <<'PY' &
+import os, sqlite3, sys, time
+time.sleep(1.0)  # after pitwall opened it
+db = sqlite3.connect(sys.argv[1], isolation_level=None)
+db.execute("BEGIN EXCLUSIVE")
+open(sys.argv[2], "w").close()
+while not os.path.exists(sys.argv[3]):
+    time.sleep(0.02)
+db.execute("ROLLBACK")
+PY
+HELD_PID=$!
+PITWALL_DB_WAIT=2 $PITWALL run "$TMP/rt.lua" --cars 2 --db "$TMP/held.db" --record "$TMP/rt.jsonl" \
+  >/dev/null 2>"$TMP/rt.err"
+rc=$?
+touch "$TMP/held2.release"; wait "$HELD_PID"
+[ -e "$TMP/held2.ready" ] && echo "ok: real time, locked: the lock was held during the race" ||
+  fail "real time, locked: the lock was never taken"
+check "real time, locked: exit status 1 (the race is not in the database)" 1 "$rc"
+err=$(cat "$TMP/rt.err")
+case "$err" in *"watchdog"*|*"loop was stuck"*) fail "real time, locked: the loop stood: $err" ;;
+  *) echo "ok: real time, locked: the loop never stood for the lock" ;; esac
+held=$(ls "$TMP"/held.db.unsaved-*.json 2>/dev/null | head -1)
+[ -n "$held" ] && echo "ok: real time, locked: the race is saved beside the database" ||
+  fail "real time, locked: no unsaved file: $err"
+expect_stopped "real time, locked" "$TMP/rt.jsonl" 2
+$PITWALL standings --db "$TMP/held.db" import "$held" >/dev/null
+check "real time, locked: imported, the run's race is there" 3 \
+  "$(python3 -c "import sqlite3; print(sqlite3.connect('$TMP/held.db').execute(\"SELECT COUNT(*) FROM races WHERE kind = 'race'\").fetchone()[0])")"
 
 [ "$FAILURES" -eq 0 ] || { echo "$FAILURES failure(s)"; exit 1; }
 echo "all standings checks passed"

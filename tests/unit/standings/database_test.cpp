@@ -4,6 +4,7 @@
 #include "engine/standings/database.hpp"
 
 #include <doctest/doctest.h>
+#include <sqlite3.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -145,14 +146,21 @@ TEST_CASE("standings: a race's JSON from a script: hostile values are sentences 
   };
   const Bad bads[] = {
       {{{"kind", 5}}, "race.kind must be a string"},
-      {{{"laps", 1e300}}, "race.laps must be a finite number, got 1e+300"},
-      {{{"laps", "x"}}, "race.laps must be a finite number"},
+      {{{"laps", 1e300}}, "race.laps must be a whole number up to 2147483647, got 1e+300"},
+      {{{"laps", "x"}}, "race.laps must be a whole number"},
+      {{{"laps", 2.5}}, "race.laps must be a whole number"},
       {{{"entries", "many"}}, "race.entries must be a list"},
       {{{"entries", {7}}}, "race.entries[1] must be an object"},
       {{{"entries", {{{"position", 1e18}, {"car", "a"}}}}}, "race.entries[1].position"},
       {{{"entries", {{{"bestLap", "fast"}, {"car", "a"}}}}}, "race.entries[1].bestLap"},
       {{{"entries", {{{"finished", 1}, {"car", "a"}}}}},
-       "race.entries[1].finished must be a boolean"},
+       "race.entries[1].finished must be true or false"},
+      {{{"entries", {{{"position", 2}, {"car", "a"}}}}},
+       "race.entries[1].position must be a place from 1 to 1 (the race's entries), got 2"},
+      {{{"entries", {{{"number", 1}, {"car", "a"}}, {{"number", 1}, {"car", "b"}}}}},
+       "race.entries[2].number 1 is another entry's"},
+      {{{"kind", nlohmann::json::parse(std::string(20000, '[') + std::string(20000, ']'))}},
+       "race.kind must be a string, got a list"},
       {{{"entries", {{{"lapTimes", {1, "x"}}, {"car", "a"}}}}},
        "lapTimes must be a list of seconds"},
       {{{"entries", {{{"number", 2}}}}}, "names no driver and no car"},
@@ -227,4 +235,50 @@ TEST_CASE("standings: a keeper writes each race as it comes, and nothing for a r
   CHECK(events->front().track == "oval");  // the event's track: its races'
   CHECK_FALSE((*keeper)->finish());
   CHECK_FALSE((*Database::open(t.path))->events()->front().ended.empty());
+}
+
+TEST_CASE(
+    "standings: a script's second race of a kind gets the next number, and a bad one holds "
+    "no other back") {
+  TempDb t;
+  auto keeper = Keeper::open(t.path, {"race", "run", "", "{}"});
+  REQUIRE(keeper);
+  CHECK_FALSE((*keeper)->add({"race", 1, "oval", 3, {entry(1, "ann", 1, true, 3.0)}}));
+  CHECK_FALSE((*keeper)->add({"race", 1, "oval", 3, {entry(1, "ann", 1, true, 2.9)}}));
+  CHECK_FALSE((*keeper)->add({"qualifying", 1, "oval", 1, {entry(1, "ann", 1, true, 2.8)}}));
+  CHECK((*keeper)->written() == 3);
+  // a race that is not one (a script's own call) is kept as it came, beside the database
+  (*keeper)->reject(nlohmann::json{{"kind", 5}}, "race.kind must be a string, got 5");
+  auto finished = (*keeper)->finish();
+  REQUIRE(finished);
+  CHECK(finished->find("not races (race.kind must be a string, got 5): kept in") !=
+        std::string::npos);
+  auto table = (*Database::open(t.path))->table({});
+  REQUIRE(table);
+  CHECK(table->front().races == 2);
+  CHECK(table->front().points == 50);
+}
+
+TEST_CASE("standings: a schema version below zero, or a table removed, is a sentence") {
+  TempDb t;
+  REQUIRE(Database::open(t.path));
+  {
+    sqlite3* raw = nullptr;
+    REQUIRE(sqlite3_open(t.path.c_str(), &raw) == SQLITE_OK);
+    sqlite3_exec(raw, "PRAGMA user_version = -2147483648", nullptr, nullptr, nullptr);
+    sqlite3_close(raw);
+  }
+  auto negative = Database::open(t.path);
+  REQUIRE_FALSE(negative);
+  CHECK(negative.error().find("has schema version -2147483648, which no pitwall writes") !=
+        std::string::npos);
+  {
+    sqlite3* raw = nullptr;
+    REQUIRE(sqlite3_open(t.path.c_str(), &raw) == SQLITE_OK);
+    sqlite3_exec(raw, "PRAGMA user_version = 2; DROP TABLE laps", nullptr, nullptr, nullptr);
+    sqlite3_close(raw);
+  }
+  auto dropped = Database::open(t.path);
+  REQUIRE_FALSE(dropped);
+  CHECK(dropped.error().find("but no table laps") != std::string::npos);
 }
