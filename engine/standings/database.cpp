@@ -184,8 +184,10 @@ std::string Database::sentence(int code, const std::string& doing) const {
              path_ + " .recover`, and move it away" + other;
     case SQLITE_BUSY:
     case SQLITE_LOCKED:
-      return path_ + " is locked by another program (still busy after " +
-             formatNumber(busyMs() / 1000.0, 1) + " s, " + doing +
+      return path_ + " is locked by another program (" +
+             (waitMs_ > 0 ? "still busy after " + formatNumber(waitMs_ / 1000.0, 1) + " s"
+                          : std::string("busy, not waited for while racing")) +
+             ", " + doing +
              "): close what holds it (another pitwall writing, an sqlite3 shell in a "
              "transaction) and try again";
     case SQLITE_READONLY:
@@ -226,7 +228,7 @@ Result<std::unique_ptr<Database>, std::string> Database::open(const std::string&
   const int rc = sqlite3_open_v2(path.c_str(), &raw, flags, nullptr);
   std::unique_ptr<Database> db(new Database(raw, path));
   if (rc != SQLITE_OK) return Unexpected{db->sentence(rc, "opening it")};
-  sqlite3_busy_timeout(raw, busyMs());
+  db->waitForLocks(true);
   sqlite3_extended_result_codes(raw, 0);
   if (create && sqlite3_db_readonly(raw, "main") == 1)
     return Unexpected{db->sentence(SQLITE_READONLY, "opening it to write")};
@@ -253,7 +255,8 @@ Database::~Database() {
 }
 
 void Database::waitForLocks(bool wait) {
-  sqlite3_busy_timeout(db_, wait ? busyMs() : 0);
+  waitMs_ = wait ? busyMs() : 0;
+  sqlite3_busy_timeout(db_, waitMs_);
 }
 
 Result<bool, std::string> Database::migrate() {

@@ -146,6 +146,7 @@ class Database {
   sqlite3* db_;
   std::string path_;
   int found_ = 0;
+  int waitMs_ = 0;  // what a write waits for a lock now
 };
 
 // Points for a place in a race of `kind` (league::pointsFor for races, heats and finals; none
