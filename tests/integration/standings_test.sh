@@ -323,28 +323,18 @@ check "two races in a run: exit status" 0 "$?"
 check "two races in a run: both kept" 2 \
   "$(python3 -c "import sqlite3; print(sqlite3.connect('$TMP/two.db').execute(\"SELECT COUNT(*) FROM races WHERE kind = 'race'\").fetchone()[0])")"
 cp "$TMP/two.db" "$TMP/held.db"
-python3 - "$TMP/held.db" "$TMP/held.ready" "$TMP/held.release" <<'PY' &
-import os, sqlite3, sys, time
-db = sqlite3.connect(sys.argv[1], isolation_level=None)
-db.execute("BEGIN EXCLUSIVE")
-open(sys.argv[2], "w").close()
-while not os.path.exists(sys.argv[3]):
-    time.sleep(0.02)
-db.execute("ROLLBACK")
-PY
-HELD_PID=$!
-wait_for_file() { for _ in $(seq 1 500); do [ -e "$1" ] && return 0; sleep 0.02; done; return 1; }
-wait_for_file "$TMP/held.ready" || fail "the lock was never taken"
 cat >"$TMP/rt.lua" <<'LUA'
 local race = require "pitwall.race"
 race.laps { laps = 1, board = false }
 pitwall.stop()
 LUA
-# (opened while unlocked: the lock is released for the open and taken again by a second holder)
-touch "$TMP/held.release"; wait "$HELD_PID"
+# the lock is taken once the run has opened the database (its cars are connected after that)
+PITWALL_DB_WAIT=2 $PITWALL run "$TMP/rt.lua" --cars 2 --db "$TMP/held.db" --record "$TMP/rt.jsonl" \
+  >/dev/null 2>"$TMP/rt.err" &
+RT_PID=$!
+wait_for "$TMP/rt.err" "connected" 20 || fail "real time, locked: the run never connected its cars"
 python3 - "$TMP/held.db" "$TMP/held2.ready" "$TMP/held2.release" <<'PY' &
 import os, sqlite3, sys, time
-time.sleep(1.0)  # after pitwall opened it
 db = sqlite3.connect(sys.argv[1], isolation_level=None)
 db.execute("BEGIN EXCLUSIVE")
 open(sys.argv[2], "w").close()
@@ -353,8 +343,7 @@ while not os.path.exists(sys.argv[3]):
 db.execute("ROLLBACK")
 PY
 HELD_PID=$!
-PITWALL_DB_WAIT=2 $PITWALL run "$TMP/rt.lua" --cars 2 --db "$TMP/held.db" --record "$TMP/rt.jsonl" \
-  >/dev/null 2>"$TMP/rt.err"
+wait "$RT_PID"
 rc=$?
 touch "$TMP/held2.release"; wait "$HELD_PID"
 [ -e "$TMP/held2.ready" ] && echo "ok: real time, locked: the lock was held during the race" ||

@@ -43,6 +43,14 @@ Entry entry(int number, std::string driver, int position, bool finished, double 
   return e;
 }
 
+// SQL run on the file as another program would.
+void sqlOn(const std::string& path, const char* sql) {
+  sqlite3* raw = nullptr;
+  REQUIRE(sqlite3_open(path.c_str(), &raw) == SQLITE_OK);
+  CHECK(sqlite3_exec(raw, sql, nullptr, nullptr, nullptr) == SQLITE_OK);
+  sqlite3_close(raw);
+}
+
 }  // namespace
 
 TEST_CASE("standings: points for races, heats and finals only") {
@@ -262,22 +270,12 @@ TEST_CASE(
 TEST_CASE("standings: a schema version below zero, or a table removed, is a sentence") {
   TempDb t;
   REQUIRE(Database::open(t.path));
-  {
-    sqlite3* raw = nullptr;
-    REQUIRE(sqlite3_open(t.path.c_str(), &raw) == SQLITE_OK);
-    sqlite3_exec(raw, "PRAGMA user_version = -2147483648", nullptr, nullptr, nullptr);
-    sqlite3_close(raw);
-  }
+  sqlOn(t.path, "PRAGMA user_version = -2147483648");
   auto negative = Database::open(t.path);
   REQUIRE_FALSE(negative);
   CHECK(negative.error().find("has schema version -2147483648, which no pitwall writes") !=
         std::string::npos);
-  {
-    sqlite3* raw = nullptr;
-    REQUIRE(sqlite3_open(t.path.c_str(), &raw) == SQLITE_OK);
-    sqlite3_exec(raw, "PRAGMA user_version = 2; DROP TABLE laps", nullptr, nullptr, nullptr);
-    sqlite3_close(raw);
-  }
+  sqlOn(t.path, "PRAGMA user_version = 2; DROP TABLE laps");
   auto dropped = Database::open(t.path);
   REQUIRE_FALSE(dropped);
   CHECK(dropped.error().find("but no table laps") != std::string::npos);
