@@ -74,15 +74,16 @@ Result<FinalPlan, std::string> planFinal(const std::string& given, int cars) {
     const auto& d = drivers[static_cast<std::size_t>(table[static_cast<std::size_t>(i)].driver)];
     ec.clear();
     if (d.file.empty() || !fs::is_regular_file(d.file, ec))
-      return Unexpected{"--league-final " + given + ": " + d.name + " (place " +
-                        std::to_string(i + 1) + " of the league) drove " +
-                        (d.file.empty() ? std::string("a file the database does not name")
-                                        : d.file + ", which is not there any more") +
+      return Unexpected{"--league-final " + printable(given, 200) + ": " + printable(d.name, 60) +
+                        " (place " + std::to_string(i + 1) + " of the league) drove " +
+                        (d.file.empty()
+                             ? std::string("a file the database does not name")
+                             : printable(d.file, 200) + ", which is not there any more") +
                         ": put the file back where it was" +
                         (i >= 2 ? ", or race the first " + std::to_string(i) +
                                       " with --final-cars " + std::to_string(i)
                                 : std::string())};
-    plan.drivers.push_back(d.name);
+    plan.drivers.push_back(printable(d.name, 60));
     plan.files[i + 1] = d.file;
   }
   auto data = dataDir();

@@ -37,7 +37,7 @@ nlohmann::json orNull(const std::optional<double>& v) {
 }
 
 std::string cut(const std::string& s, std::size_t n) {
-  return s.size() > n ? s.substr(0, n) : s;
+  return printable(s, n);
 }
 
 int printEvents(standings::Database& db, bool json) {

@@ -23,8 +23,10 @@ Result<std::unique_ptr<standings::Keeper>, std::string> openStandings(
   std::error_code ec;
   const auto at = std::filesystem::weakly_canonical(path, ec);
   for (const auto& [option, file] : outputs) {
-    std::error_code ec2;
-    if (!file.empty() && !path.empty() && std::filesystem::weakly_canonical(file, ec2) == at)
+    std::error_code ec2, ec3;
+    if (!file.empty() && !path.empty() &&
+        (std::filesystem::weakly_canonical(file, ec2) == at ||
+         std::filesystem::equivalent(file, path, ec3)))  // (a hard link too)
       return Unexpected{option + " " + file + " is the standings database (" + path +
                         "): it would be written over; give another file, or --no-db"};
   }

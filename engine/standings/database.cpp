@@ -335,12 +335,32 @@ Result<bool, std::string> Database::checkTables() {
 // Can the file be written? SQLite writes a journal beside it: a folder that takes no new file
 // makes every write fail, so it is tried now (in a transaction rolled back), before a race.
 Result<bool, std::string> Database::probeWrite() {
-  int rc = sqlite3_exec(db_, "BEGIN IMMEDIATE; CREATE TABLE pitwall_probe(x); ROLLBACK;", nullptr,
-                        nullptr, nullptr);
+  // (the schema version written again as it is: a write that touches nothing of the user's)
+  const std::string probe =
+      "BEGIN IMMEDIATE; PRAGMA user_version = " + std::to_string(kSchemaVersion) + "; ROLLBACK;";
+  int rc = sqlite3_exec(db_, probe.c_str(), nullptr, nullptr, nullptr);
   if (rc == SQLITE_OK) return true;
+  // Locked by another program now: it can be written, later (the races are held meanwhile)
+  if ((rc & 0xff) == SQLITE_BUSY || (rc & 0xff) == SQLITE_LOCKED) {
+    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+    return true;
+  }
   const std::string why = sentence(rc, "trying a write");
   sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
   return Unexpected{why};
+}
+
+Result<bool, std::string> Database::hasRace(std::int64_t event, const std::string& kind,
+                                            int number) {
+  Statement s(db_, "SELECT 1 FROM races WHERE event = ? AND kind = ? AND number = ?");
+  if (int rc = s.prepared(); rc != SQLITE_OK) return Unexpected{sentence(rc, "reading it")};
+  s.bind(1, event);
+  s.bind(2, kind);
+  s.bind(3, number);
+  const int rc = s.step();
+  if (rc == SQLITE_ROW) return true;
+  if (rc == SQLITE_DONE) return false;
+  return Unexpected{sentence(rc, "reading it")};
 }
 
 Result<std::int64_t, std::string> Database::beginEvent(const Event& e) {

@@ -127,6 +127,7 @@ class Database {
 
   Result<std::int64_t, std::string> beginEvent(const Event& event);
   Result<bool, std::string> addRace(std::int64_t event, const Race& race);  // one transaction
+  Result<bool, std::string> hasRace(std::int64_t event, const std::string& kind, int number);
   Result<bool, std::string> endEvent(std::int64_t event);
 
   Result<std::vector<TableRow>, std::string> table(const Filter& filter);

@@ -39,9 +39,17 @@ Result<std::unique_ptr<Keeper>, std::string> Keeper::open(const std::string& pat
 }
 
 // Every held race tried, each on its own: one that fails does not keep the others back.
+// After the first failure the others are tried without waiting for a lock again (one wait in
+// all, not one a race).
 std::optional<std::string> Keeper::flush() {
   if (!id_) {
-    auto id = db_->beginEvent(event_);
+    // (the event carries this keeper's token: an unsaved file of it, imported, finds it)
+    Event marked = event_;
+    auto details = nlohmann::json::parse(marked.details, nullptr, false);
+    if (!details.is_object()) details = nlohmann::json::object();
+    details["token"] = token_;
+    marked.details = details.dump();
+    auto id = db_->beginEvent(marked);
     if (!id) return id.error();
     id_ = *id;
   }
@@ -50,6 +58,7 @@ std::optional<std::string> Keeper::flush() {
   for (Race& race : held_) {
     if (auto added = db_->addRace(*id_, race); !added) {
       if (!problem) problem = added.error();
+      db_->waitForLocks(false);
       still.push_back(std::move(race));
     } else {
       ++written_;
@@ -187,26 +196,41 @@ Result<int, std::string> importUnsaved(const std::string& dbPath, const std::str
       if (e.id == known->get<std::int64_t>() && e.kind == event->kind && e.title == event->title)
         id = e.id;
   if (!id && !token.empty())
-    for (const auto& e : *events)
-      if (e.details.find("\"import\":\"" + token + "\"") != std::string::npos) id = e.id;
+    for (const auto& e : *events) {
+      const auto details = nlohmann::json::parse(e.details, nullptr, false);
+      if (details.is_object() && details.contains("token") && details["token"] == token) id = e.id;
+    }
+  if (races.empty()) return 0;
   if (!id) {
     auto details = nlohmann::json::parse(event->details, nullptr, false);
     if (!details.is_object()) details = nlohmann::json::object();
-    if (!token.empty()) details["import"] = token;
+    if (!token.empty()) details["token"] = token;
     event->details = details.dump();
     auto begun = db.beginEvent(*event);
     if (!begun) return Unexpected{begun.error()};
     id = *begun;
   }
-  int added = 0;
+  // A race its event has already (an import cut short and done again, a run that wrote it after
+  // all) is left out: a race is kept once
+  int added = 0, there = 0;
   for (const Race& r : races) {
+    auto has = db.hasRace(*id, r.kind, r.number);
+    if (!has) return Unexpected{has.error()};
+    if (*has) {
+      ++there;
+      continue;
+    }
     auto written = db.addRace(*id, r);
     if (!written)
       return Unexpected{written.error() + " (" + std::to_string(added) + " of " +
                         std::to_string(races.size()) +
-                        " races added before it; a race added already cannot be added twice)"};
+                        " races added before it: import the file again once that is mended)"};
     ++added;
   }
+  if (added == 0 && there > 0)
+    return Unexpected{file + ": its " + std::to_string(there) +
+                      (there == 1 ? " race is" : " races are") + " in " + dbPath +
+                      " already: a race is kept once"};
   if (auto ended = db.endEvent(*id); !ended) return Unexpected{ended.error()};
   return added;
 }

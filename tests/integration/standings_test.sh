@@ -189,7 +189,7 @@ check "import: one event, as it was raced" 1 "$($PITWALL standings --db "$TMP/lo
   python3 -c 'import json,sys; print(len(json.load(sys.stdin)))')"
 err=$($PITWALL standings --db "$TMP/locked.db" import "$unsaved" 2>&1); rc=$?
 check "import twice: status" 1 "$rc"
-contains "import twice: a race is kept once" "has that race already" "$err"
+contains "import twice: a race is kept once" "already: a race is kept once" "$err"
 check "import twice: the table is unchanged" "$want" "$(table "$TMP/locked.db")"
 unset PITWALL_DB_WAIT
 
@@ -223,15 +223,53 @@ check "import: the races of an event that never reached the database" "ann 25 1 
 bo 18 1 0" "$(table "$TMP/once.db")"
 err=$($PITWALL standings --db "$TMP/once.db" import "$TMP/once.json" 2>&1); rc=$?
 check "import of it again: refused" 1 "$rc"
-contains "import of it again: a race is kept once" "has that race already" "$err"
+contains "import of it again: a race is kept once" "already: a race is kept once" "$err"
 check "import of it again: the table is unchanged" "ann 25 1 1
 bo 18 1 0" "$(table "$TMP/once.db")"
+# An import cut short is finished by importing the file again: the races there already are left
+python3 - "$TMP/once.json" "$TMP/part.json" <<'PY'
+import json, sys
+full = json.load(open(sys.argv[1]))
+r1 = full["races"][0]
+r2 = json.loads(json.dumps(r1)); r2["number"] = 2
+full["races"] = [r1, r2]
+full["token"] = "20261130T000000-2"
+json.dump(dict(full, races=[r1]), open(sys.argv[2], "w"))
+json.dump(full, open(sys.argv[2] + ".full", "w"))
+PY
+$PITWALL standings --db "$TMP/part.db" import "$TMP/part.json" >/dev/null
+out=$($PITWALL standings --db "$TMP/part.db" import "$TMP/part.json.full"); rc=$?
+check "an import finished: status" 0 "$rc"
+contains "an import finished: the one race not there is added" "1 race from" "$out"
+check "an import finished: both races, each once" "ann 50 2 2
+bo 36 2 0" "$(table "$TMP/part.db")"
+# Names are shown, never obeyed: a driver named with a terminal's escape codes
+python3 - "$TMP/part.db" <<'PY'
+import sqlite3, sys
+db = sqlite3.connect(sys.argv[1])
+db.execute("UPDATE results SET driver = ? WHERE driver = 'ann'", ("\x1b[2J\x1b[31mEVIL\x07",))
+db.commit()
+PY
+out=$($PITWALL standings --db "$TMP/part.db")
+case "$out" in *$'\x1b'*|*$'\x07'*) fail "a name's escape codes reached the terminal: $(echo "$out" | cat -v)" ;;
+  *) echo "ok: a name's escape codes are shown as text" ;; esac
+contains "the name is shown escaped" '\x1b[2J\x1b[31mEVIL' "$out"
+# A table of the user's own named as nothing of ours: the database takes races all the same
+cp "$TMP/a.db" "$TMP/own.db"
+python3 -c "import sqlite3; db = sqlite3.connect('$TMP/own.db'); db.execute('CREATE TABLE pitwall_probe(y)'); db.commit()"
+league --db "$TMP/own.db" >/dev/null 2>&1
+check "a user's own tables: the league is kept" 0 "$?"
+
 # The database is none of a command's other files: it would be written over
 cp "$TMP/a.db" "$TMP/same.db"
 err=$($PITWALL run "$SRC/examples/hello.lua" --fast --cars 1 --db "$TMP/same.db" \
   --record "$TMP/same.db" 2>&1); rc=$?
 check "--record onto --db: refused" 2 "$rc"
 contains "--record onto --db: says why" "--record $TMP/same.db is the standings database" "$err"
+ln "$TMP/same.db" "$TMP/hard.db"
+err=$($PITWALL run "$SRC/examples/hello.lua" --fast --cars 1 --db "$TMP/same.db" \
+  --record "$TMP/hard.db" 2>&1); rc=$?
+check "--record onto a hard link of --db: refused" 2 "$rc"
 err=$(league --db "$TMP/same.db" --results "$TMP/same.db" 2>&1); rc=$?
 check "league --results onto --db: refused" 2 "$rc"
 check "refused: the database is left as it was" "" "$(cmp "$TMP/a.db" "$TMP/same.db" 2>&1)"
@@ -308,6 +346,31 @@ check "run --no-db: nothing more is kept" "$want" "$(table "$PITWALL_DB")"
 err=$($PITWALL run "$SRC/examples/grand_prix.lua" --fast --db "$TMP/noise.db" 2>&1 >/dev/null); rc=$?
 check "run --db with a bad file: refused" 2 "$rc"
 contains "run --db with a bad file: says why" "is not a pitwall standings database" "$err"
+
+# A database locked when the run opens it: the run races, and its race is held and saved beside it
+cp "$TMP/a.db" "$TMP/early.db"
+python3 - "$TMP/early.db" "$TMP/early.ready" "$TMP/early.release" <<'PY' &
+import os, sqlite3, sys, time
+db = sqlite3.connect(sys.argv[1], isolation_level=None)
+db.execute("BEGIN IMMEDIATE")
+open(sys.argv[2], "w").close()
+while not os.path.exists(sys.argv[3]):
+    time.sleep(0.02)
+db.execute("ROLLBACK")
+PY
+EARLY_PID=$!
+for _ in $(seq 1 500); do [ -e "$TMP/early.ready" ] && break; sleep 0.02; done
+PITWALL_DB_WAIT=0.3 $PITWALL run "$SRC/examples/grand_prix.lua" --fast --db "$TMP/early.db" \
+  >/dev/null 2>"$TMP/early.err"
+rc=$?
+touch "$TMP/early.release"; wait "$EARLY_PID"
+check "locked at the start: the run races, and ends with status 1" 1 "$rc"
+early=$(ls "$TMP"/early.db.unsaved-*.json 2>/dev/null | head -1)
+[ -n "$early" ] && echo "ok: locked at the start: the race is saved beside the database" ||
+  fail "locked at the start: nothing saved: $(cat "$TMP/early.err")"
+$PITWALL standings --db "$TMP/early.db" import "$early" >/dev/null
+check "locked at the start: imported, the race is there" 1 \
+  "$(python3 -c "import sqlite3; print(sqlite3.connect('$TMP/early.db').execute(\"SELECT COUNT(*) FROM races WHERE kind = 'race'\").fetchone()[0])")"
 
 # Two races of one kind in one run are two races; a real-time run whose database is locked the
 # whole time races on (the loop never waits for the lock: no car is stopped by the watchdog) and
