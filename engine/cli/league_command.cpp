@@ -177,7 +177,7 @@ Result<std::unique_ptr<standings::Keeper>, std::string> openKeeper(const LeagueO
   return openStandings(o.db, o.noDb,
                        {"league", about.value("title", std::string("league")),
                         about.value("track", std::string()), about.dump()},
-                       "league", {{"--results", o.results}, {"--report", o.report}}, true);
+                       "league", {{"--results", o.results}, {"--report", o.report}}, std::nullopt);
 }
 
 // Says where the standings are, or what was not written (status 1 then).

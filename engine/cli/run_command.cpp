@@ -120,9 +120,10 @@ int run(const RunOptions& given) {
             : standings::Event{"race", std::filesystem::path(options.script).stem().string(), "",
                                "{}"},
       "run", {{"--record", options.record}, {"--results", options.results}},
-      // (a run's loop must turn: a race the locked file does not take now is held, and the wait
+      // (a run's loop must turn: a write waits 50 ms at most for another program's lock — its
+      // own writes take milliseconds; a race the file does not take then is held, and the wait
       // for the lock comes once the cars are stopped)
-      false);
+      50);
   if (!opened) return fail("run", opened.error());
   std::unique_ptr<standings::Keeper> keeper = std::move(*opened);
   if (options.humans > 0 && options.fast && options.view) {  // phones live in real time

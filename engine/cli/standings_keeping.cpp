@@ -17,7 +17,8 @@ void addStandingsOptions(CLI::App* cmd, std::string& db, bool& noDb, const std::
 
 Result<std::unique_ptr<standings::Keeper>, std::string> openStandings(
     const std::string& db, bool noDb, standings::Event event, const std::string& command,
-    const std::vector<std::pair<std::string, std::string>>& outputs, bool waitWhileRacing) {
+    const std::vector<std::pair<std::string, std::string>>& outputs,
+    std::optional<int> racingWaitMs) {
   if (noDb) return std::unique_ptr<standings::Keeper>();
   const std::string path = db.empty() ? standings::defaultPath() : db;
   std::error_code ec;
@@ -30,7 +31,7 @@ Result<std::unique_ptr<standings::Keeper>, std::string> openStandings(
       return Unexpected{option + " " + file + " is the standings database (" + path +
                         "): it would be written over; give another file, or --no-db"};
   }
-  auto opened = standings::Keeper::open(path, std::move(event), waitWhileRacing);
+  auto opened = standings::Keeper::open(path, std::move(event), racingWaitMs);
   if (opened || !db.empty()) return opened;
   std::cerr << "pitwall " << command << ": " << opened.error()
             << ": nothing of this run is kept in the standings\n";

@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -22,11 +23,12 @@ void addStandingsOptions(CLI::App* cmd, std::string& db, bool& noDb, const std::
 // none at all (no PITWALL_DB, XDG_DATA_HOME or HOME), is said on stderr as `command`'s, and the
 // command races on without keeping.
 // `outputs`: the command's other files (--record, --results, --report), named by their option:
-// the database being one of them is refused (it would be written over). `waitWhileRacing`: see
+// the database being one of them is refused (it would be written over). `racingWaitMs`: see
 // standings::Keeper::open.
 Result<std::unique_ptr<standings::Keeper>, std::string> openStandings(
     const std::string& db, bool noDb, standings::Event event, const std::string& command,
-    const std::vector<std::pair<std::string, std::string>>& outputs, bool waitWhileRacing);
+    const std::vector<std::pair<std::string, std::string>>& outputs,
+    std::optional<int> racingWaitMs);
 
 // Writes what is held and ends the event; says where the results are kept (`told`: on stderr as
 // `command`'s) or the sentence of what could not be written. True when everything was kept.

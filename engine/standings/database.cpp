@@ -185,8 +185,8 @@ std::string Database::sentence(int code, const std::string& doing) const {
     case SQLITE_BUSY:
     case SQLITE_LOCKED:
       return path_ + " is locked by another program (" +
-             (waitMs_ > 0 ? "still busy after " + formatNumber(waitMs_ / 1000.0, 1) + " s"
-                          : std::string("busy, not waited for while racing")) +
+             (waitMs_ > 0 ? "still busy after " + formatNumber(waitMs_ / 1000.0, 3) + " s"
+                          : std::string("busy, not waited for again while racing")) +
              ", " + doing +
              "): close what holds it (another pitwall writing, an sqlite3 shell in a "
              "transaction) and try again";
@@ -255,7 +255,11 @@ Database::~Database() {
 }
 
 void Database::waitForLocks(bool wait) {
-  waitMs_ = wait ? busyMs() : 0;
+  waitForLocks(wait ? busyMs() : 0);
+}
+
+void Database::waitForLocks(int ms) {
+  waitMs_ = std::max(0, ms);
   sqlite3_busy_timeout(db_, waitMs_);
 }
 

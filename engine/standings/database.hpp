@@ -121,8 +121,9 @@ class Database {
 
   const std::string& path() const { return path_; }
   // How long a write waits for another program's lock: the default (10 s, $PITWALL_DB_WAIT), or
-  // not at all (a keeper that holds races already tries again without stopping the run).
+  // `ms` (a run's loop while its cars race: a moment; a keeper that holds races already: none).
   void waitForLocks(bool wait);
+  void waitForLocks(int ms);
   int versionFound() const { return found_; }  // the schema it had when opened (0: new)
 
   Result<std::int64_t, std::string> beginEvent(const Event& event);

@@ -30,10 +30,10 @@ std::string stamp() {
 }  // namespace
 
 Result<std::unique_ptr<Keeper>, std::string> Keeper::open(const std::string& path, Event event,
-                                                          bool waitWhileRacing) {
+                                                          std::optional<int> racingWaitMs) {
   auto db = Database::open(path);
   if (!db) return Unexpected{db.error()};
-  std::unique_ptr<Keeper> keeper(new Keeper(std::move(*db), std::move(event), waitWhileRacing));
+  std::unique_ptr<Keeper> keeper(new Keeper(std::move(*db), std::move(event), racingWaitMs));
   keeper->token_ = stamp() + "-" + std::to_string(static_cast<long>(getpid()));
   return keeper;
 }
@@ -74,7 +74,12 @@ std::optional<std::string> Keeper::add(Race race) {
   next = race.number + 1;
   // Races held already: the file was locked for the whole wait once; try again at once, and wait
   // again only at the end (a locked file must not hold a league up for the wait at every heat).
-  db_->waitForLocks(waitWhileRacing_ && held_.empty());
+  if (!held_.empty())
+    db_->waitForLocks(false);
+  else if (racingWaitMs_)
+    db_->waitForLocks(*racingWaitMs_);
+  else
+    db_->waitForLocks(true);
   held_.push_back(std::move(race));
   if (auto problem = flush())
     return *problem + "; " + std::to_string(held_.size()) +

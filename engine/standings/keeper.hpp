@@ -21,11 +21,12 @@ namespace pitwall::standings {
 class Keeper {
  public:
   // Opens the database now (a sentence when it cannot be: before anything races). The event is
-  // added with its first race: a run that races nothing leaves nothing. `waitWhileRacing`: a
-  // write waits for another program's lock (a league's parent: nothing else runs meanwhile), or
-  // not (a run's loop must turn: the race is held, and the wait comes at the end).
-  static Result<std::unique_ptr<Keeper>, std::string> open(const std::string& path, Event event,
-                                                           bool waitWhileRacing = true);
+  // added with its first race: a run that races nothing leaves nothing. `racingWaitMs`: how long
+  // a write waits for another program's lock while racing — the default wait (a league's parent:
+  // nothing else runs meanwhile), or a moment (a run's loop must turn: a lock held longer holds
+  // the race, and the wait comes at the end).
+  static Result<std::unique_ptr<Keeper>, std::string> open(
+      const std::string& path, Event event, std::optional<int> racingWaitMs = std::nullopt);
 
   // Writes the race; a sentence when it is held for later instead. A race whose number its
   // kind has had in this event already gets the next one (a script's second race.laps).
@@ -41,14 +42,14 @@ class Keeper {
   int written() const { return written_; }
 
  private:
-  Keeper(std::unique_ptr<Database> db, Event event, bool wait)
-      : db_(std::move(db)), event_(std::move(event)), waitWhileRacing_(wait) {}
+  Keeper(std::unique_ptr<Database> db, Event event, std::optional<int> racingWaitMs)
+      : db_(std::move(db)), event_(std::move(event)), racingWaitMs_(racingWaitMs) {}
   std::optional<std::string> flush();
   std::string unsavedText() const;
 
   std::unique_ptr<Database> db_;
   Event event_;
-  bool waitWhileRacing_ = true;
+  std::optional<int> racingWaitMs_;
   std::optional<std::int64_t> id_;
   std::vector<Race> held_;
   std::vector<std::pair<nlohmann::json, std::string>> rejected_;

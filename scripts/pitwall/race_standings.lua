@@ -46,8 +46,8 @@ function Standings:_keep()
     laps = self.laps or 0, entries = entries, track = track })
   if not ok then
     pitwall.log("error", "race: the results were not kept in the standings: " .. tostring(kept))
-  elseif why then
-    pitwall.log("error", "race: " .. why)
+  elseif why then -- (held, or kept beside the database: the run's end says what became of it)
+    pitwall.log("warn", "race: " .. why)
   end
 end
 
