@@ -38,8 +38,9 @@
 //   pitwall.seats, .seat       human drivers' seats (bindings/seat_binding.cpp); sim.openSeats
 //   pitwall.driverFiles, _driverWorld  driver files in worlds of their own
 //                              (bindings/driver_world_binding.cpp)
-//   (a driver world: none of the six above, and no pitwall.writeResults or keepResults; its Lua libraries
-//   read no file and require finds the shipped library only: sandbox::restrictToLibrary)
+//   (a driver world: none of the six above, and no pitwall.writeResults or keepResults; its
+//   Lua libraries read no file and require finds the shipped library only:
+//   sandbox::restrictToLibrary)
 //   the cars                   every car the fleet knows gets its Lua object now (later ones as
 //                              they join: ScriptHost::carJoined)
 //   the Lua library            require "pitwall.core" (scripts/pitwall/core.lua); in test mode
