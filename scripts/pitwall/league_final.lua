@@ -24,8 +24,8 @@ if #cars < 2 then
   pitwall._raise(string.format("final: %d of the %d finalists have a car: a final needs 2 "
     .. "(connect more cars, or give fewer with --final-cars)", #cars, #final.drivers))
 end
-pitwall.log("info", string.format("final: %s, %d laps: %s", final.title, final.laps,
-  table.concat(final.drivers, ", ", 1, #cars)))
+pitwall.log("info", string.format("final: %s, %d %s: %s", final.title, final.laps,
+  final.laps == 1 and "lap" or "laps", table.concat(final.drivers, ", ", 1, #cars)))
 local session = race.laps {
   cars = cars, laps = final.laps, title = final.title, scan = #cars <= 4, finishTimeout = 30,
   grid = cars,
