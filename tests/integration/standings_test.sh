@@ -41,6 +41,30 @@ for row in db.execute("SELECT ra.number, r.driver, r.position, r.points FROM res
 PY
 }
 
+# races_of DB KIND: how many races of that kind the database keeps
+races_of() {
+  python3 -c "import sqlite3, sys; print(sqlite3.connect(sys.argv[1]).execute(
+    'SELECT COUNT(*) FROM races WHERE kind = ?', (sys.argv[2],)).fetchone()[0])" "$1" "$2"
+}
+# hold_lock DB MODE: another program takes DB's lock (BEGIN MODE: IMMEDIATE or EXCLUSIVE) and
+# holds it until release_lock; returns once it is held (false when it never was)
+hold_lock() {
+  rm -f "$TMP/lock.ready" "$TMP/lock.release"
+  python3 - "$1" "$2" "$TMP/lock.ready" "$TMP/lock.release" <<'PY' &
+import os, sqlite3, sys, time
+db = sqlite3.connect(sys.argv[1], isolation_level=None)
+db.execute("BEGIN " + sys.argv[2])
+open(sys.argv[3], "w").close()
+while not os.path.exists(sys.argv[4]):
+    time.sleep(0.02)
+db.execute("ROLLBACK")
+PY
+  LOCK_HOLDER=$!
+  for _ in $(seq 1 500); do [ -e "$TMP/lock.ready" ] && return 0; sleep 0.02; done
+  return 1
+}
+release_lock() { touch "$TMP/lock.release"; wait "$LOCK_HOLDER"; }
+
 # A league is kept: its table is the league's own
 league --db "$TMP/a.db" --results "$TMP/one.json" >"$TMP/one.out" 2>"$TMP/one.err"
 check "a league: exit status" 0 "$?"
@@ -349,28 +373,17 @@ contains "run --db with a bad file: says why" "is not a pitwall standings databa
 
 # A database locked when the run opens it: the run races, and its race is held and saved beside it
 cp "$TMP/a.db" "$TMP/early.db"
-python3 - "$TMP/early.db" "$TMP/early.ready" "$TMP/early.release" <<'PY' &
-import os, sqlite3, sys, time
-db = sqlite3.connect(sys.argv[1], isolation_level=None)
-db.execute("BEGIN IMMEDIATE")
-open(sys.argv[2], "w").close()
-while not os.path.exists(sys.argv[3]):
-    time.sleep(0.02)
-db.execute("ROLLBACK")
-PY
-EARLY_PID=$!
-for _ in $(seq 1 500); do [ -e "$TMP/early.ready" ] && break; sleep 0.02; done
+hold_lock "$TMP/early.db" IMMEDIATE || fail "locked at the start: the lock was never taken"
 PITWALL_DB_WAIT=0.3 $PITWALL run "$SRC/examples/grand_prix.lua" --fast --db "$TMP/early.db" \
   >/dev/null 2>"$TMP/early.err"
 rc=$?
-touch "$TMP/early.release"; wait "$EARLY_PID"
+release_lock
 check "locked at the start: the run races, and ends with status 1" 1 "$rc"
 early=$(ls "$TMP"/early.db.unsaved-*.json 2>/dev/null | head -1)
 [ -n "$early" ] && echo "ok: locked at the start: the race is saved beside the database" ||
   fail "locked at the start: nothing saved: $(cat "$TMP/early.err")"
 $PITWALL standings --db "$TMP/early.db" import "$early" >/dev/null
-check "locked at the start: imported, the race is there" 1 \
-  "$(python3 -c "import sqlite3; print(sqlite3.connect('$TMP/early.db').execute(\"SELECT COUNT(*) FROM races WHERE kind = 'race'\").fetchone()[0])")"
+check "locked at the start: imported, the race is there" 1 "$(races_of "$TMP/early.db" race)"
 
 # Two races of one kind in one run are two races; a real-time run whose database is locked the
 # whole time races on (the loop never waits for the lock: no car is stopped by the watchdog) and
@@ -383,8 +396,7 @@ pitwall.stop()
 LUA
 $PITWALL run "$TMP/two.lua" --fast --cars 2 --db "$TMP/two.db" >/dev/null 2>"$TMP/two.err"
 check "two races in a run: exit status" 0 "$?"
-check "two races in a run: both kept" 2 \
-  "$(python3 -c "import sqlite3; print(sqlite3.connect('$TMP/two.db').execute(\"SELECT COUNT(*) FROM races WHERE kind = 'race'\").fetchone()[0])")"
+check "two races in a run: both kept" 2 "$(races_of "$TMP/two.db" race)"
 cp "$TMP/two.db" "$TMP/held.db"
 cat >"$TMP/rt.lua" <<'LUA'
 local race = require "pitwall.race"
@@ -396,20 +408,12 @@ PITWALL_DB_WAIT=2 $PITWALL run "$TMP/rt.lua" --cars 2 --db "$TMP/held.db" --reco
   >/dev/null 2>"$TMP/rt.err" &
 RT_PID=$!
 wait_for "$TMP/rt.err" "connected" 20 || fail "real time, locked: the run never connected its cars"
-python3 - "$TMP/held.db" "$TMP/held2.ready" "$TMP/held2.release" <<'PY' &
-import os, sqlite3, sys, time
-db = sqlite3.connect(sys.argv[1], isolation_level=None)
-db.execute("BEGIN EXCLUSIVE")
-open(sys.argv[2], "w").close()
-while not os.path.exists(sys.argv[3]):
-    time.sleep(0.02)
-db.execute("ROLLBACK")
-PY
-HELD_PID=$!
+held=0
+hold_lock "$TMP/held.db" EXCLUSIVE && held=1
 wait "$RT_PID"
 rc=$?
-touch "$TMP/held2.release"; wait "$HELD_PID"
-[ -e "$TMP/held2.ready" ] && echo "ok: real time, locked: the lock was held during the race" ||
+release_lock
+[ "$held" = 1 ] && echo "ok: real time, locked: the lock was held during the race" ||
   fail "real time, locked: the lock was never taken"
 check "real time, locked: exit status 1 (the race is not in the database)" 1 "$rc"
 err=$(cat "$TMP/rt.err")
@@ -420,8 +424,7 @@ held=$(ls "$TMP"/held.db.unsaved-*.json 2>/dev/null | head -1)
   fail "real time, locked: no unsaved file: $err"
 expect_stopped "real time, locked" "$TMP/rt.jsonl" 2
 $PITWALL standings --db "$TMP/held.db" import "$held" >/dev/null
-check "real time, locked: imported, the run's race is there" 3 \
-  "$(python3 -c "import sqlite3; print(sqlite3.connect('$TMP/held.db').execute(\"SELECT COUNT(*) FROM races WHERE kind = 'race'\").fetchone()[0])")"
+check "real time, locked: imported, the run's race is there" 3 "$(races_of "$TMP/held.db" race)"
 
 [ "$FAILURES" -eq 0 ] || { echo "$FAILURES failure(s)"; exit 1; }
 echo "all standings checks passed"
