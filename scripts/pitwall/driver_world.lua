@@ -15,13 +15,18 @@ local function call(method, data)
   if not METHODS[method] then error("no driver method " .. tostring(method), 0) end
   local car = data.car
   if not ctx then
-    local field = {}
-    for _, c in ipairs(pitwall.cars()) do field[#field + 1] = c end
     local map = data.map and track._adopt(data.map)
     if not map then error("the race director sent no map", 0) end
+    -- The other cars join the field after the context is made: each is followed from the first
+    -- ctx:ahead() or ctx:nearby() on (drivers.context), so a driver that never asks (the
+    -- cruiser) pays for no tracker of another car.
+    local field = {}
     ctx = drivers.context(car, map, field, { period = data.period })
+    for _, c in ipairs(pitwall.cars()) do field[#field + 1] = c end
   end
-  ctx.limit, ctx.pieceLimits, ctx.race = data.limit, data.pieceLimits, data.race
+  -- ctx.race: a race view the same as the last one is not sent again (drivers.lua's send)
+  ctx.limit, ctx.pieceLimits = data.limit, data.pieceLimits
+  if not data.sameRace then ctx.race = data.race end
   local fn = driver[method]
   if fn then fn(driver, car, ctx) end
 end

@@ -280,17 +280,26 @@ local function send(self, method, car, ctx)
   local w = self.world
   if w.failure then return end
   local data = { car = car, limit = ctx and ctx.limit, pieceLimits = ctx and ctx.pieceLimits,
-    period = ctx and ctx.period, race = ctx and ctx.race }
-  if self.version ~= w.version then
-    self.version = w.version
+    period = ctx and ctx.period }
+  local race = ctx and ctx.race
+  if self.version ~= w.version then -- a new world (the first, or a save): the map, the race
+    self.version, self.race = w.version, nil
     data.map = ctx and ctx.map
     if self.started and method ~= "start" and method ~= "finish" then
+      data.race = race
       if not w:call("start", data) then return end
-      data.map = nil
+      self.race, data.map = race, nil
     end
   end
+  -- The race view the world has already (the same table: race_worlds' _tellWorld keeps it while
+  -- nothing in it changes) is not copied again.
+  if race ~= nil and race == self.race then
+    data.race, data.sameRace = nil, true
+  else
+    data.race = race
+  end
   if method == "start" then self.started = true end
-  w:call(method, data)
+  if w:call(method, data) then self.race = race end
 end
 
 for _, method in ipairs { "start", "update", "finish", "waiting" } do

@@ -32,10 +32,29 @@ function Worlds:_closeWorlds()
   end
 end
 
+-- The last view made (self._view) while nothing in it has changed since: the same table, which
+-- drivers.lua's send does not copy into a world again.
+local function unchanged(self, last)
+  if not last or last.phase ~= self.phase or last.mode ~= self.mode or last.laps ~= self.laps
+    or #last.standings ~= #self.order then
+    return false
+  end
+  for k, o in ipairs(self.order) do
+    local t, s = o.finished and o.final or o.timer, last.standings[k]
+    if s.car ~= o.car or s.laps ~= t.count or s.bestLap ~= (t.best and t.best.time)
+      or s.finished ~= (o.finished or false) or s.out ~= (o.out ~= nil) then
+      return false
+    end
+  end
+  return true
+end
+
 -- Before an update: a driver world's ctx.race is `view`, what it reads of the race (the phase
--- and every car's place, laps and best lap), made once a tick. Returns the view made.
+-- and every car's place, laps and best lap), made once a tick — or the last one, when nothing in
+-- it changed. Returns the view.
 function Worlds:_tellWorld(e, view)
   if not worldOf(e) or not e.ctx then return view end
+  if not view and unchanged(self, self._view) then view = self._view end
   if not view then
     local standings = {}
     for k, o in ipairs(self.order) do
@@ -44,6 +63,7 @@ function Worlds:_tellWorld(e, view)
         bestLap = t.best and t.best.time, finished = o.finished or false, out = o.out ~= nil }
     end
     view = { phase = self.phase, mode = self.mode, laps = self.laps, standings = standings }
+    self._view = view
   end
   e.ctx.race = view
   return view

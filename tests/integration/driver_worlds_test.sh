@@ -114,6 +114,41 @@ adversary read_file "$D/read_file.lua" "io.open is not available to scripts: a d
 adversary broken_save - "its file does not load:" "$TMP/save_race.lua" "$D/broken_save.lua" \
   "$D/stop_at_load.lua"
 
+# What a driver world reads of the race: ctx.race as the director sees it, sent again each time
+# it changes (a view that is the same is not copied again: drivers.lua), and the cars ahead,
+# which the world follows from its driver's first ctx:ahead() on.
+$PITWALL run "$TMP/race.lua" --fast --seed 7 --driver 2="$D/reader.lua" >"$TMP/reader.out" \
+  2>"$TMP/reader.err"
+check "a driver reading the race: exit status" 0 "$?"
+views=$(python3 - "$TMP/reader.out" <<'PY'
+import re, sys
+laps = {}  # car → the laps the world saw it at, in order
+for line in open(sys.argv[1]):
+    m = re.match(r"race view: (\w+) (.*)", line)
+    if not m:
+        continue
+    if m.group(1) != "racing":
+        print("phase", m.group(1))
+    for item in m.group(2).split():
+        car, n = map(int, item.split(":"))
+        seen = laps.setdefault(car, [])
+        if not seen or seen[-1] != n:
+            seen.append(n)
+for car in sorted(laps):
+    print(car, laps[car])
+PY
+)
+# every car seen at each lap in turn, car 2 (the reader's) up to its last update before the flag
+check "the world saw every lap of every car, in order" "1 [0, 1, 2, 3]
+2 [0, 1, 2]
+3 [0, 1, 2, 3]
+4 [0, 1, 2, 3]" "$views"
+ahead=$(sed -n 's/^ahead: car \([0-9]*\), .*/\1/p' "$TMP/reader.out")
+case "$ahead" in
+  1 | 3 | 4) echo "ok: the world's ctx:ahead() found car $ahead" ;;
+  *) fail "the world's ctx:ahead() found no other car: [$ahead] $(cat "$TMP/reader.out")" ;;
+esac
+
 # A good save brings a driver that was out back: at car 1's second lap (after the broken save at
 # its first) the file is good again, and car 2 races to the flag
 cat > "$TMP/repair_race.lua" <<'LUA'
