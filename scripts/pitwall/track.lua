@@ -48,10 +48,27 @@ local Map = {}
 Map.__index = Map
 Map.__name = "track map" -- (how errors name it: "track map has no method …")
 
+-- Lap lengths already summed, by map (weak: a map no one holds goes) and offset, while the map
+-- has as many pieces as when they were summed (drivers ask every update, the race every tick):
+-- the first 8 offsets asked, the lanes (a car's own offset changes all the time: not kept).
+local lapLengths = setmetatable({}, { __mode = "k" })
+local KEPT_OFFSETS = 8
+
 --- Length in mm of one lap along the lane at `offset` (default 0: the centre line).
 function Map:lapLength(offset)
-  local total = 0
+  offset = offset or 0
+  local known = lapLengths[self]
+  if not known or known.n ~= #self.pieces then
+    known = { n = #self.pieces, count = 0, lengths = {} }
+    lapLengths[self] = known
+  end
+  local total = known.lengths[offset]
+  if total then return total end
+  total = 0
   for _, p in ipairs(self.pieces) do total = total + p:length(offset) end
+  if known.count < KEPT_OFFSETS and offset == offset then -- (NaN is no key)
+    known.lengths[offset], known.count = total, known.count + 1
+  end
   return total
 end
 

@@ -31,6 +31,16 @@ pitwall.listen(scout, "onPosition", function(_, e) seen[e.piece] = (seen[e.piece
 local map = track.scan(scout, { speed = 400 })
 expect.eq(map:layout(true), LAYOUT:gsub("^start ", "start "), "the scan's layout is the design")
 expect.near(map:lapLength(0), sim.track().lapLength, 0.01, "the map's lap length is the design's")
+-- lapLength keeps what it summed (track.lua): asked again, and for more offsets than it keeps,
+-- it is the sum of the pieces' lengths every time; NaN is asked like any offset
+for round = 1, 2 do
+  for o = -90, 90, 10 do
+    local sum = 0
+    for _, p in ipairs(map.pieces) do sum = sum + p:length(o) end
+    expect.eq(map:lapLength(o), sum, "the lap length at offset " .. o .. ", round " .. round)
+  end
+end
+expect.truthy(map:lapLength(0 / 0) ~= map:lapLength(0 / 0), "a NaN offset gives NaN, no error")
 for _, id in ipairs { 34, 33, 60, 61, 36, 62, 64 } do
   expect.gt(seen[id] or 0, 0, "position updates on piece " .. id)
 end
