@@ -13,6 +13,7 @@
 #include <string>
 #include <string_view>
 #include <unordered_map>
+#include <vector>
 
 #include "bindings/interrupt.hpp"
 #include "bindings/metatables.hpp"
@@ -436,6 +437,16 @@ void restrictToLibrary(lua_State* L, const std::string& path) {
     lua_rawseti(L, -2, i);
   }
   lua_pop(L, 2);
+}
+
+void compileAhead(const std::vector<std::string>& files) {
+  lua_State* L = luaL_newstate();
+  if (!L) return;
+  for (const auto& file : files) {
+    (void)loadModuleFile(L, file.c_str());  // (a file that does not compile fails when required)
+    lua_settop(L, 0);
+  }
+  lua_close(L);
 }
 
 }  // namespace pitwall::sandbox

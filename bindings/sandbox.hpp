@@ -24,6 +24,7 @@
 
 #include <cstddef>
 #include <string>
+#include <vector>
 
 namespace pitwall::sandbox {
 
@@ -59,5 +60,10 @@ void restrict(lua_State* L);
 // loadfile, dofile, os.remove, … refused with a sentence; os.getenv too), and require finds only
 // what `path` (Lua's "DIR/?.lua;…" form) finds — fixed now: changing package.path moves nothing.
 void restrictToLibrary(lua_State* L, const std::string& path);
+
+// Compiles each Lua file into this process's module cache, as require would (a file that does
+// not compile is left out: require reports it). A process that forks a child per race (pitwall
+// league) does this once before, so no child parses the library again.
+void compileAhead(const std::vector<std::string>& files);
 
 }  // namespace pitwall::sandbox

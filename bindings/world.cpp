@@ -230,6 +230,22 @@ void prependRequirePath(lua_State* L, const std::vector<std::string>& dirs) {
   lua_pop(L, 1);
 }
 
+void compileLibraryAhead() {
+  namespace fs = std::filesystem;
+  const std::string lib = scriptsDir();
+  std::vector<std::string> files;
+  std::error_code ec;
+  for (fs::recursive_directory_iterator
+           it(lib, fs::directory_options::follow_directory_symlink, ec),
+       end;
+       !ec && it != end; it.increment(ec)) {
+    // (the name require finds it by: the folder as given, then the path inside it)
+    if (it->path().extension() == ".lua" && it->is_regular_file(ec))
+      files.push_back(lib + "/" + it->path().lexically_relative(lib).generic_string());
+  }
+  sandbox::compileAhead(files);
+}
+
 void openWorld(ScriptHost& host) {
   lua_State* L = host.state();
   const std::string lib = scriptsDir();

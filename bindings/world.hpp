@@ -21,4 +21,9 @@ void openWorld(ScriptHost& host);
 // folders when it opens, a script's own folder when it is loaded (ScriptHost::loadFile).
 void prependRequirePath(lua_State* L, const std::vector<std::string>& dirs);
 
+// Compiles every file of the shipped library into this process's module cache
+// (sandbox::compileAhead): worlds made afterwards, in this process or in a child forked from it,
+// load the library's bytecode instead of parsing it.
+void compileLibraryAhead();
+
 }  // namespace pitwall

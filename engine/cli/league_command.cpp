@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bindings/script_file.hpp"
+#include "bindings/world.hpp"
 #include "engine/cli/fail.hpp"
 #include "engine/cli/league_heat.hpp"
 #include "engine/cli/options.hpp"
@@ -423,6 +424,13 @@ int league(const LeagueOptions& o) {
     if (!keeper) return;
     if (auto held = keeper->add(std::move(race))) std::cerr << "league: " << *held << "\n";
   };
+
+  // Every heat is a child of this process (runInProcesses): the library is parsed once, here,
+  // and each child's worlds load its bytecode (docs/performance.md "Issue 38").
+  try {
+    compileLibraryAhead();
+  } catch (const std::exception&) {  // (no library: the first heat says so, as a sentence)
+  }
 
   // Qualifying: each driver alone, its best lap
   std::vector<std::optional<double>> qualifying(static_cast<std::size_t>(n));
