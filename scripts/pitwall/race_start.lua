@@ -127,18 +127,33 @@ function Start:_lights()
   local o = self.options
   local count, interval, hold = o.lights or 5, o.lightInterval or 1, o.hold or 0.5
   self.state = "lights"
+  -- A car that moves (or is told to) has jumped the start: stopped at once, held after green.
+  local function judge(e)
+    if e.falseStart then return end
+    e.falseStart = true
+    pitwall.log("warn", string.format("race: false start by %s: held %g s after green",
+      tostring(e.car), self.penalty))
+    if e.car.connected then pcall(e.car.stop, e.car) end
+    self:_emit("onFalseStart", e.car, self)
+  end
   local subs = {}
   for _, e in ipairs(self.order) do
-    -- a car that moves reports it; one that is only told to (targetSpeed) is caught as well
-    subs[#subs + 1] = pitwall.listen(e.car, "onTransition", function() e.moved = true end)
-    subs[#subs + 1] = pitwall.listen(e.car, "onPosition", function() e.moved = true end)
+    -- a car that moves reports it, one told to move acknowledges the speed (a speed update);
+    -- one only told to (targetSpeed) is caught at the next period as well
+    local function moved() judge(e) end
+    subs[#subs + 1] = pitwall.listen(e.car, "onTransition", moved)
+    subs[#subs + 1] = pitwall.listen(e.car, "onPosition", moved)
+    subs[#subs + 1] = pitwall.listen(e.car, "onSpeed", function(_, ev)
+      if (ev.desired or 0) > 0 then judge(e) end
+    end)
   end
   -- Drivers that drive during the lights (driver:waiting: a human's throttle goes through) are
   -- asked every period; what they do is judged like everything else.
   local period, nextWait = self.period or 0.1, -math.huge
+  local EPS = 1e-6 -- (times are whole ns: a sleep of 0.1 s may end a hair before now + 0.1)
   local function check()
     local now = pitwall.now()
-    if now >= nextWait then
+    if now >= nextWait - EPS then
       nextWait = now + period
       for _, e in ipairs(self.order) do
         if not e.falseStart and e.driver and e.driver.waiting and e.car.connected then
@@ -147,18 +162,19 @@ function Start:_lights()
       end
     end
     for _, e in ipairs(self.order) do
-      if not e.falseStart and (e.moved or (e.car.targetSpeed or 0) > 0) then
-        e.falseStart = true
-        pitwall.log("warn", string.format("race: false start by %s: held %g s after green",
-          tostring(e.car), self.penalty))
-        if e.car.connected then pcall(e.car.stop, e.car) end
-        self:_emit("onFalseStart", e.car, self)
-      end
+      if (e.car.targetSpeed or 0) > 0 then judge(e) end
     end
-    return false
   end
+  -- A light's time, waking for each period's check (and no more often: the events judge the
+  -- cars that move in between), the light's end exactly.
   local function wait(k, spent)
-    pitwall.waitUntil(check, math.max(0, (k < count and interval or hold) - spent), 0.005)
+    local deadline = pitwall.now() + math.max(0, (k < count and interval or hold) - spent)
+    while true do
+      check()
+      local now = pitwall.now()
+      if now >= deadline - EPS then return end
+      pitwall.sleep(math.min(nextWait, deadline) - now)
+    end
   end
   -- A version that took the session up during the lights waits out the light that was on.
   local from = self.light or 0

@@ -8,21 +8,27 @@ local track = require "pitwall.track"
 local cars = {}
 for i = 1, 3 do cars[i] = sim.addCar {} end
 
-local lights, jumped = {}, {}
+local lights, jumped, jumpedAt = {}, {}, nil
 local r = race.laps {
   laps = 2, map = track.fromSim(), results = false, board = false, falseStartPenalty = 4,
   drivers = function() return race.Steady.new { speed = 700 } end,
   onLights = function(k, session)
     lights[#lights + 1] = pitwall.now()
-    if k == 3 then cars[2]:setSpeed(400) end -- the jump
+    -- the jump, between two of the race's periodic checks (0.1 s apart, from the light on)
+    if k == 3 then pitwall.after(0.03, function() cars[2]:setSpeed(400) end) end
   end,
-  onFalseStart = function(car) jumped[#jumped + 1] = car end,
+  onFalseStart = function(car)
+    jumped[#jumped + 1] = car
+    jumpedAt = jumpedAt or pitwall.now()
+  end,
 }
 expect.eq(#lights, 5, "five lights")
-expect.near(lights[5] - lights[1], 4, 0.05, "a light a second")
+expect.near(lights[5] - lights[1], 4, 0.001, "a light a second, to the ms")
 expect.eq(#jumped, 1, "one false start")
 expect.eq(jumped[1], cars[2], "by the car that moved")
-expect.near(r.green - lights[5], 0.5, 0.05, "green half a second after the last light")
+-- judged as the car acknowledges the speed (or reports moving), not at the next period's check
+expect.le(jumpedAt - (lights[3] + 0.03), 0.04, "judged within 40 ms of the jump (its speed acknowledged)")
+expect.near(r.green - lights[5], 0.5, 0.001, "green half a second after the last light")
 local rows = r:results()
 for _, row in ipairs(rows) do
   expect.eq(row.falseStart, row.car == cars[2].name, row.car .. " flagged")
