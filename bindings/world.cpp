@@ -64,9 +64,16 @@ namespace {
 // folder found beside the binary (engine/core/data_dir.hpp).
 std::string scriptsDir() {
   if (const char* env = std::getenv("PITWALL_SCRIPTS"); env && *env) return env;
-  auto data = dataDir();
-  if (!data) throw std::runtime_error(data.error());
-  return (*data / "scripts").string();
+  // found once a process: every world asks (a league race opens five), and the binary stays put
+  static const std::string found = [] {
+    auto data = dataDir();
+    return data ? (*data / "scripts").string() : std::string();
+  }();
+  if (found.empty()) {
+    auto data = dataDir();  // (the sentence of why not)
+    throw std::runtime_error(data ? "no scripts folder" : data.error());
+  }
+  return found;
 }
 
 // print, io.write and pitwall.stdout:write go to the console: straight to stdout, or above the
