@@ -54,18 +54,22 @@ std::string noSuchField(lua_State* L, const TypeSpec& type) {
 }
 
 // __index (1: the object, 2: the key). Upvalues: 1 the methods table, 2 the fields' numbers by
-// name, 3 the TypeSpec. A method, else a state field, else (ownFields) the object's own table,
-// else nil.
+// name, 3 the TypeSpec, 4 the metatable. A method, else a state field, else (ownFields) the
+// object's own table, else nil.
 int index(lua_State* L) {
   lua_pushvalue(L, 2);
   if (lua_rawget(L, lua_upvalueindex(1)) != LUA_TNIL) return 1;
   lua_pop(L, 1);
   const auto& type = *static_cast<const TypeSpec*>(lua_touserdata(L, lua_upvalueindex(3)));
+  // The object is of this type — its metatable is the one this __index belongs to (an upvalue:
+  // the hot path of every car field read, no registry lookup) — else checkBox's sentence.
+  const bool own = lua_type(L, 1) == LUA_TUSERDATA && lua_getmetatable(L, 1);
+  if (!own || !lua_rawequal(L, -1, lua_upvalueindex(4))) checkBox(L, 1, type);
+  lua_pop(L, 1);
   lua_pushvalue(L, 2);
   if (lua_rawget(L, lua_upvalueindex(2)) == LUA_TNUMBER) {
     const auto i = static_cast<std::size_t>(lua_tointeger(L, -1));
     lua_pop(L, 1);
-    checkBox(L, 1, type);  // the getter is given an object of its type
     type.fields[i].push(L, 1);
     return 1;
   }
@@ -216,7 +220,8 @@ void registerType(lua_State* L, const TypeSpec& type) {
   lua_pushvalue(L, methods);
   lua_pushvalue(L, fieldNumbers);
   lua_pushlightuserdata(L, spec);
-  lua_pushcclosure(L, guarded<index>, 3);
+  lua_pushvalue(L, mt);  // (index's check of its object: this metatable, no registry lookup)
+  lua_pushcclosure(L, guarded<index>, 4);
   lua_setfield(L, mt, "__index");
   lua_pushvalue(L, methods);
   lua_pushlightuserdata(L, spec);

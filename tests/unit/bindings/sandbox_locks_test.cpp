@@ -151,6 +151,27 @@ TEST_CASE("a table dressed as an engine object is refused, not read as one") {
   CHECK(LockedWorld().run("pitwall._setHub(pitwall.cars()[1], 'onPing', print)") == "");
 }
 
+TEST_CASE("a type's own __index, given another value, refuses it with a sentence") {
+  // A script never reaches it (getmetatable gives a face without it); the engine's own code
+  // could: __index checks its object against its metatable (an upvalue, lua_object.cpp), so a
+  // timer, a table, a string or nothing given to a car's field reader is refused, not read.
+  LockedWorld w;
+  lua_State* L = w.host->state();
+  REQUIRE(luaL_getmetatable(L, "pitwall.car") == LUA_TTABLE);
+  REQUIRE(lua_getfield(L, -1, "__index") == LUA_TFUNCTION);
+  lua_setglobal(L, "READ");  // (a test's back door, to call it from Lua)
+  lua_pop(L, 1);
+  CHECK(w.run(R"(
+    for _, other in ipairs { pitwall.after(1e9, print), {}, "speed", 42, io.stdout } do
+      local ok, err = pcall(READ, other, "speed")
+      assert(not ok, type(other) .. " was read as a car")
+      assert(err:find("expected a car", 1, true), err)
+    end
+    assert(not pcall(READ), "nothing was read as a car")
+    assert(READ(pitwall.cars()[1], "number") == 1, "a car's own field")
+  )") == "");
+}
+
 // Each back door a script could try, and the sentence that refuses it ("" for none: the chunk
 // itself errors when the attempt had an effect it must not have).
 TEST_CASE("the sandbox's back doors, tried one by one, are each refused or harmless") {
