@@ -50,7 +50,17 @@ bool WorldCopy::table(int idx, const std::string& path, int depth) {
   const void* key = lua_topointer(from_, idx);
   if (lua_rawgetp(to_, memo_, key) == LUA_TTABLE) return true;
   lua_pop(to_, 1);
-  lua_newtable(to_);
+  // Made at its size: filled key by key, an empty table is rehashed at 1, 2, 4, … entries.
+  int array = 0, hash = 0;
+  lua_pushnil(from_);
+  while (lua_next(from_, idx)) {
+    if (lua_isinteger(from_, -2) && lua_tointeger(from_, -2) == array + 1)
+      ++array;
+    else
+      ++hash;
+    lua_pop(from_, 1);
+  }
+  lua_createtable(to_, array, hash);
   lua_pushvalue(to_, -1);
   lua_rawsetp(to_, memo_, key);
   if (isCarList(from_, idx)) {
