@@ -122,17 +122,18 @@ function Tracker:_step(e, m, id, t0, t)
   local r = p0 + m -- reckoned lane mm from the start of the current piece
   -- The pieces from here on and where each starts: the tracker's own two lists, filled anew at
   -- every event (an event is a frame of one car: no table is made for it)
-  local idx, start = self._idx, self._start
+  local idx, start, lens = self._idx, self._start, self._lens
   if not idx then
-    idx, start = {}, {}
-    self._idx, self._start = idx, start
+    idx, start, lens = {}, {}, {}
+    self._idx, self._start, self._lens = idx, start, lens
   end
-  idx[1], start[1] = e.index, 0
+  idx[1], start[1], lens[1] = e.index, 0, len0
   local at, k = len0, e.index
   for j = 2, MAX_SKIP + 1 do
     k = (k - 1 + d) % n + 1 -- Map:next
-    idx[j], start[j] = k, at
-    at = at + pieces[k]:length(off)
+    local len = pieces[k]:length(off)
+    idx[j], start[j], lens[j] = k, at, len
+    at = at + len
   end
   local choice, into
   local unsure = t - t0 > LONG_GAP
@@ -150,7 +151,7 @@ function Tracker:_step(e, m, id, t0, t)
     local best, bestDist
     for j = 1, MAX_SKIP + 1 do
       if map:fits(idx[j], id) then
-        local lo, hi = start[j], start[j] + self:_len(idx[j])
+        local lo, hi = start[j], start[j] + lens[j]
         if j == 1 then
           hi = hi + TWIN_MARGIN
           if not e.anchored then lo = -math.huge end
@@ -162,7 +163,7 @@ function Tracker:_step(e, m, id, t0, t)
     end
     if not best or bestDist > SLACK + 0.3 * m then return false end
     choice = best
-    into = math.max(0, math.min(r - start[choice], self:_len(idx[choice])))
+    into = math.max(0, math.min(r - start[choice], lens[choice]))
   end
   for j = 2, choice do
     local when = t
@@ -172,7 +173,7 @@ function Tracker:_step(e, m, id, t0, t)
     self:_entered(e, idx[j], idx[j - 1], when)
   end
   e.index = idx[choice]
-  e.pos = into / self:_len(e.index)
+  e.pos = into / lens[choice]
   if not id then e.anchored = true end
   return true
 end
