@@ -10,6 +10,7 @@
 
 #include "engine/cli/fail.hpp"
 #include "engine/cli/options.hpp"
+#include "engine/cli/standings_keeping.hpp"
 #include "engine/core/numbers.hpp"
 #include "engine/core/printable.hpp"
 #include "engine/standings/database.hpp"
@@ -201,7 +202,8 @@ Command addStandingsCommand(CLI::App& app) {
       "bests (docs/league.md)");
   cmd->add_option("--db", o->db,
                   "The standings database (default: $PITWALL_DB, else "
-                  "$XDG_DATA_HOME/pitwall/standings.db or ~/.local/share/pitwall/standings.db)");
+                  "$XDG_DATA_HOME/pitwall/standings.db or ~/.local/share/pitwall/standings.db)")
+      ->check(standingsFile());
   cmd->add_option("--track", o->track, "Only the races on this track (its name, as listed)");
   cmd->add_option("--driver", o->driver, "One driver's races and personal bests");
   cmd->add_flag("--events", o->events, "List the events kept: leagues, races, finals");

@@ -7,11 +7,22 @@
 
 namespace pitwall::cli {
 
+CLI::Validator standingsFile() {
+  return CLI::Validator(
+      [](std::string& file) -> std::string {
+        if (!file.empty()) return "";
+        return "the standings database's file name is empty: give a file, or leave --db out "
+               "for the default ($PITWALL_DB, else $XDG_DATA_HOME/pitwall/standings.db)";
+      },
+      "FILE");
+}
+
 void addStandingsOptions(CLI::App* cmd, std::string& db, bool& noDb, const std::string& what) {
   cmd->add_option("--db", db,
                   "Keep " + what +
                       " in this standings database (default: $PITWALL_DB, else "
-                      "$XDG_DATA_HOME/pitwall/standings.db; docs/league.md \"Standings\")");
+                      "$XDG_DATA_HOME/pitwall/standings.db; docs/league.md \"Standings\")")
+      ->check(standingsFile());
   cmd->add_flag("--no-db", noDb, "Keep nothing in the standings database");
 }
 

@@ -15,6 +15,10 @@
 
 namespace pitwall::cli {
 
+// --db's check: a file name, not an empty one (`--db ''` or `--db "$UNSET"` would otherwise
+// mean the default database, silently).
+CLI::Validator standingsFile();
+
 // --db FILE and --no-db on `cmd`; `what` says what is kept ("the league", "the races' results").
 void addStandingsOptions(CLI::App* cmd, std::string& db, bool& noDb, const std::string& what);
 
