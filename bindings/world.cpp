@@ -65,13 +65,11 @@ namespace {
 std::string scriptsDir() {
   if (const char* env = std::getenv("PITWALL_SCRIPTS"); env && *env) return env;
   // found once a process: every world asks (a league race opens five), and the binary stays put
-  static const std::string found = [] {
-    auto data = dataDir();
-    return data ? (*data / "scripts").string() : std::string();
-  }();
+  static std::string found;
   if (found.empty()) {
-    auto data = dataDir();  // (the sentence of why not)
-    throw std::runtime_error(data ? "no scripts folder" : data.error());
+    auto data = dataDir();
+    if (!data) throw std::runtime_error(data.error());
+    found = (*data / "scripts").string();
   }
   return found;
 }

@@ -32,29 +32,30 @@ function Worlds:_closeWorlds()
   end
 end
 
--- The last view made (self._view) while nothing in it has changed since: the same table, which
--- drivers.lua's send does not copy into a world again.
-local function unchanged(self, last)
-  if not last or last.phase ~= self.phase or last.mode ~= self.mode or last.laps ~= self.laps
-    or #last.standings ~= #self.order then
+-- What a view says of each car (its standings entries' fields).
+local ENTRY = { "car", "position", "laps", "bestLap", "finished", "out" }
+
+-- Two views that say the same.
+local function same(a, b)
+  if a.phase ~= b.phase or a.mode ~= b.mode or a.laps ~= b.laps
+    or #a.standings ~= #b.standings then
     return false
   end
-  for k, o in ipairs(self.order) do
-    local t, s = o.finished and o.final or o.timer, last.standings[k]
-    if s.car ~= o.car or s.laps ~= t.count or s.bestLap ~= (t.best and t.best.time)
-      or s.finished ~= (o.finished or false) or s.out ~= (o.out ~= nil) then
-      return false
+  for k, s in ipairs(a.standings) do
+    local t = b.standings[k]
+    for _, f in ipairs(ENTRY) do
+      if s[f] ~= t[f] then return false end
     end
   end
   return true
 end
 
 -- Before an update: a driver world's ctx.race is `view`, what it reads of the race (the phase
--- and every car's place, laps and best lap), made once a tick — or the last one, when nothing in
--- it changed. Returns the view.
+-- and every car's place, laps and best lap), made once a tick. While it says the same as the last
+-- one (self._view), that table is kept: drivers.lua's send does not copy it into a world again.
+-- Returns the view.
 function Worlds:_tellWorld(e, view)
   if not worldOf(e) or not e.ctx then return view end
-  if not view and unchanged(self, self._view) then view = self._view end
   if not view then
     local standings = {}
     for k, o in ipairs(self.order) do
@@ -63,6 +64,7 @@ function Worlds:_tellWorld(e, view)
         bestLap = t.best and t.best.time, finished = o.finished or false, out = o.out ~= nil }
     end
     view = { phase = self.phase, mode = self.mode, laps = self.laps, standings = standings }
+    if self._view and same(view, self._view) then view = self._view end
     self._view = view
   end
   e.ctx.race = view
