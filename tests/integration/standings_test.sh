@@ -169,28 +169,28 @@ check "version 1: a league adds to it" \
   "$(echo "$want" | awk '$1 == "alice" { print $1, $2 + 25, $3 + 1, $4 + 1 }')" \
   "$(table "$TMP/old.db" | grep '^alice ')"
 
-# A locked database: the lock is taken once the league has written its first race and held to its
-# end. The league holds the races it cannot write, saves them beside the database and says how to
-# add them; `standings import` adds them, and the table is the one without a lock.
+# A locked database: another program holds the write lock before the league starts and to its end
+# (readers pass: the league opens the file, then cannot write). The league holds the races it
+# cannot write, saves them beside the database and says how to add them; `standings import` adds
+# them, and the table is the one without a lock. (Taken before the league, not after its first
+# race: a poller racing the league lost on a busy machine, and the lock came too late or never.)
 export PITWALL_DB_WAIT=0.2
-python3 - "$TMP/locked.db" "$TMP/lock.ready" "$TMP/lock.release" <<'PY' &
+python3 - "$TMP/a.db" "$TMP/locked.db" "$TMP/lock.ready" "$TMP/lock.release" <<'PY' &
 import os, sqlite3, sys, time
-path, ready, release = sys.argv[1:4]
-while True:
-    try:
-        if sqlite3.connect(path).execute("SELECT COUNT(*) FROM races").fetchone()[0] >= 1:
-            break
-    except sqlite3.Error:
-        pass
-    time.sleep(0.005)
+schema_of, path, ready, release = sys.argv[1:5]
+src = sqlite3.connect(schema_of)
 db = sqlite3.connect(path, isolation_level=None)
-db.execute("BEGIN EXCLUSIVE")
+for (sql,) in src.execute("SELECT sql FROM sqlite_master WHERE sql IS NOT NULL"):
+    db.execute(sql)  # an empty standings database of the current schema
+db.execute("PRAGMA user_version = %d" % src.execute("PRAGMA user_version").fetchone()[0])
+db.execute("BEGIN IMMEDIATE")  # the write lock: readers pass, writers wait
 open(ready, "w").close()
 while not os.path.exists(release):
     time.sleep(0.02)
 db.execute("ROLLBACK")
 PY
 LOCK_PID=$!
+for _ in $(seq 500); do [ -e "$TMP/lock.ready" ] && break; sleep 0.02; done
 league --db "$TMP/locked.db" >"$TMP/locked.out" 2>"$TMP/locked.err"
 rc=$?
 touch "$TMP/lock.release"
