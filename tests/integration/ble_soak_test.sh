@@ -15,6 +15,11 @@ at() { awk "BEGIN { printf \"%.1f\", $1 * $S }"; }  # a fraction of the race, in
 car() { printf 'E0:00:00:00:00:%02X' "$1"; }
 # the faults go round cars 1 … N-1; car N vanishes for good
 nth() { echo $(( ($1 - 1) % (N - 1) + 1 )); }
+# The mute goes to a cruiser (soak_race.lua's lineup: cars 1 and 5), a driver that never tells its
+# car to stand: a silence counts only until the car is told to stop, and a follower or an
+# overtaker closing on the car ahead may do so within the mute's first second (CI at dc9c2a8:
+# an overtaker muted for 3 s, no silence counted).
+MUTED=$(( N >= 6 ? 5 : 1 ))
 
 # The faults, in seconds after each car's first connection (unplug and restart: after the fake
 # starts; the scan and the grid take 20–40 s of the race's first part)
@@ -22,8 +27,8 @@ faults=(
   --fault "drop:$(car "$(nth 1)")@$(at 0.10)"
   --fault "burst:$(car "$(nth 2)")@$(at 0.15)"
   --fault "reboot:$(car "$(nth 3)")@$(at 0.20)+4"
-  --fault "mute:$(car "$(nth 4)")@$(at 0.30)+3"
-  --fault "writefail:$(car "$(nth 5)")@$(at 0.35)+2"
+  --fault "writefail:$(car "$(nth 4)")@$(at 0.30)+2"
+  --fault "mute:$(car "$MUTED")@$(at 0.35)+4"
   --fault "writehang:$(car "$(nth 6)")@$(at 0.40)+3"
   --fault "unplug:hci1@$(at 0.50)+5"
   --fault "restart@$(at 0.65)+3"
@@ -73,20 +78,21 @@ d=$(echo "$line" | sed -n 's/.* drops=\([0-9]*\).*/\1/p')
   fail "soak: car.link of car 1: ${d:-none} drops: $line"
 contains "soak: car.link: connected again after each drop" "connects=$((d + 1))" "$line"
 # The muted car's lost notifications show in car.link: a silence of at least the 1 s a silence
-# needs, and no longer than the mute's 3 s (and a tick). It may be shorter than the mute: a silence
-# counts until the car speaks or is told to stop (engine/vehicles/anki_car.cpp, noteSilence), and
-# its driver may tell it to stand within the mute (a follower closing on the car ahead: in clean
-# clone run 18, under a CPU quota, 2.1 s). A car stuck in a contact later in the race (behind the
-# vanished car's body, which stands on the track) reads no track code and sends nothing either, as
-# a real car would: that silence is the car's, not the mute's (clean clone run 37: 7.2 s), so the
-# cap holds only when the log shows no contact of that car.
-muted=$(echo "$out" | grep "^car $(nth 4) ")
+# needs, and no longer than the mute's 4 s and a piece either side of it (the last frame before
+# the mute and the first after it come at piece boundaries: up to 2 × 560 mm, at 950 mm/s about
+# 1.2 s; 4.5 s seen here). A silence needs the distance of two pieces
+# at the car's speed (engine/vehicles/anki_car.cpp, noteSilence): 4 s is enough down to 280 mm/s,
+# below the 300 mm/s the race slows a car to for an obstacle. A car stuck in a contact later in the
+# race (behind the vanished car's body, which stands on the track) reads no track code and sends
+# nothing either, as a real car would: that silence is the car's, not the mute's (clean clone run
+# 37: 7.2 s), so the cap holds only when the log shows no contact of that car.
+muted=$(echo "$out" | grep "^car $MUTED ")
 sil=$(echo "$muted" | sed -n 's/.* silences=\([0-9]*\) longestSilence=\([0-9.]*\).*/\1 \2/p')
-cap=3.5
-grep -q "car $(nth 4) ([a-z]*) is slow: .*stuck in a contact" "$TMP/run.err" && cap=$S
+cap=6
+grep -q "car $MUTED ([a-z]*) is slow: .*stuck in a contact" "$TMP/run.err" && cap=$S
 awk -v s="$sil" -v cap="$cap" 'BEGIN { split(s, a, " "); exit !(a[1] >= 1 && a[2] >= 1.0 && a[2] <= cap) }' &&
-  echo "ok: soak: car.link shows car $(nth 4)'s lost notifications (silences, longest: $sil)" ||
-  fail "soak: car $(nth 4) was muted for 3 s, car.link says silences/longest [$sil]: $muted"
+  echo "ok: soak: car.link shows car $MUTED's lost notifications (silences, longest: $sil)" ||
+  fail "soak: car $MUTED was muted for 4 s, car.link says silences/longest [$sil]: $muted"
 # (a number as Lua prints it: 0.0123, or 9.7e-05 for a round trip under 0.1 ms)
 check "soak: car.link has a round trip" 1 "$(echo "$out" | grep "^car 1 " | grep -cE 'roundTrip=[0-9][0-9.]*(e-[0-9]+)?( |$)')"
 # The results file has every car
