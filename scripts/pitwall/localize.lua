@@ -90,6 +90,7 @@ end
 function Tracker:_rebase(t, speed)
   local v = speed or speedAfter(self.modelSpeed, self.target, self.accel, t - self.modelTime)
   self.time, self.modelTime, self.carry = t, t, 0
+  self._mt = nil
   self.modelSpeed, self.speed = v, v
 end
 
@@ -183,7 +184,7 @@ function Tracker:_lose(t, why)
   -- where it was reckoned when it was lost (a car thrown off a curve: that curve)
   local _, at = self:locate(t)
   self.index, self.localized, self.anchored = nil, false, false
-  self.hyps, self.entrySeen = nil, false
+  self.hyps, self.entrySeen, self._mt = nil, false, nil
   if was then self:_notify("lost", t, why, at) end
 end
 
@@ -244,6 +245,7 @@ end
 
 function Tracker:_onPosition(ev)
   local t = ev.time
+  self._mt = nil -- (a watcher told of a piece entered asks where the car is now)
   self.seenAt = t -- the car read the track: it moved
   if ev.reverse ~= self.reverse then
     -- A U-turn somewhere since the last update: about as far forth as back, so stay put.
@@ -273,6 +275,7 @@ end
 
 function Tracker:_onTransition(ev)
   local t = ev.time
+  self._mt = nil
   self.seenAt = t
   local m = self:_travel(t)
   if self.index then
@@ -299,7 +302,7 @@ function Tracker:_onSpeed(ev)
   local t = ev.time
   local v = ev.actual or speedAfter(self.modelSpeed, self.target, self.accel, t - self.modelTime)
   self.carry = self:_travel(t)
-  self.modelTime, self.modelSpeed = t, v
+  self.modelTime, self.modelSpeed, self._mt = t, v, nil
   -- Firmware 0x266e's short form says neither the acceleration nor the actual speed: the
   -- reckoning goes on as for a car that sends no speed update (by the commanded speed).
   if not ev.accel then return end
@@ -406,6 +409,12 @@ end
 function Tracker:locate(t)
   if not self.index then return nil end
   t = math.min(t or pitwall.now(), self.time + self.horizon)
+  -- The last answer, asked again for the same time (a driver asks, then ctx:upcoming asks): kept
+  -- until the car's next event, and — with no speed update to go by — while the car is told the
+  -- same speed (Tracker:_travel).
+  if self._mt == t and (self.target or self._ms == self.car.targetSpeed) then
+    return self._md, self._mi, self._mf
+  end
   local i = self.index
   local len = self:_len(i)
   local into = self.pos * len + self:_travel(t)
@@ -418,7 +427,10 @@ function Tracker:locate(t)
   local f = into / len
   if self.reverse then f = 1 - f end
   local p = self.map.pieces[i]
-  return p.start + f * p.centre, i, f
+  local d = p.start + f * p.centre
+  self._mt, self._md, self._mi, self._mf = t, d, i, f
+  self._ms = not self.target and self.car.targetSpeed or nil
+  return d, i, f
 end
 
 --- The speed the car is reckoned at, at time t (default now): its last reported speed, heading
