@@ -301,6 +301,27 @@ function Race:_onLap(e, lap)
   end
 end
 
+-- The order of a practice or qualifying: by best lap (a time before none); the grid breaks ties.
+local function byBestLap(a, b)
+  local ab, bb = a.timer.best, b.timer.best
+  if ab and bb and ab.time ~= bb.time then return ab.time < bb.time end
+  if (ab == nil) ~= (bb == nil) then return ab ~= nil end
+  return a.gridSlot < b.gridSlot
+end
+
+-- The order of a race: by laps (a finisher's laps are frozen at the line), then finishing time;
+-- the grid breaks ties.
+local function byProgress(a, b)
+  local pa, pb = a.progress or -math.huge, b.progress or -math.huge
+  -- (by the time each crossed the line: a lap recovered late is timed when it was driven)
+  if a.finished and b.finished and pa == pb and a.finishTime ~= b.finishTime then
+    return a.finishTime < b.finishTime
+  end
+  if a.finished and b.finished and pa == pb then return a.finishRank < b.finishRank end
+  if pa ~= pb then return pa > pb end
+  return a.gridSlot < b.gridSlot
+end
+
 -- Sorts self.order: finishers in finishing order, then by progress; the grid breaks ties.
 function Race:_standings(now)
   for _, e in ipairs(self.order) do
@@ -309,23 +330,7 @@ function Race:_standings(now)
     if p and not e.finished then e.progress = p end
   end
   local timing = self.mode == "qualifying" or self.mode == "practice"
-  table.sort(self.order, function(a, b)
-    if timing then
-      local ab, bb = a.timer.best, b.timer.best
-      if ab and bb and ab.time ~= bb.time then return ab.time < bb.time end
-      if (ab == nil) ~= (bb == nil) then return ab ~= nil end
-    else
-      -- classified by laps (a finisher's laps are frozen at the line), then finishing time
-      local pa, pb = a.progress or -math.huge, b.progress or -math.huge
-      -- (by the time each crossed the line: a lap recovered late is timed when it was driven)
-      if a.finished and b.finished and pa == pb and a.finishTime ~= b.finishTime then
-        return a.finishTime < b.finishTime
-      end
-      if a.finished and b.finished and pa == pb then return a.finishRank < b.finishRank end
-      if pa ~= pb then return pa > pb end
-    end
-    return a.gridSlot < b.gridSlot
-  end)
+  table.sort(self.order, timing and byBestLap or byProgress)
 end
 
 -- The time `e` was at `progress` (laps), from its trace; nil before its trace begins.
@@ -408,7 +413,8 @@ end
 
 function Race:_tick()
   local now = pitwall.now()
-  local old = {}
+  local old = self._was or {} -- (each entry's place before this tick: one table a session)
+  self._was = old
   for k, e in ipairs(self.order) do old[e] = e.position or k end
   for _, e in ipairs(self.order) do
     if e.lost and e.loc.localized then self:_found(e) end

@@ -32,40 +32,43 @@ function Worlds:_closeWorlds()
   end
 end
 
--- What a view says of each car (its standings entries' fields).
-local ENTRY = { "car", "position", "laps", "bestLap", "finished", "out" }
-
--- Two views that say the same.
-local function same(a, b)
-  if a.phase ~= b.phase or a.mode ~= b.mode or a.laps ~= b.laps
-    or #a.standings ~= #b.standings then
+-- Whether `view` (the last one made) still says what the race says: the phase, the mode, the
+-- laps, and of each car in order its place, laps, best lap, finish and whether it is out. Read in
+-- place: a tick that changed nothing makes no table.
+local function current(self, view)
+  if view.phase ~= self.phase or view.mode ~= self.mode or view.laps ~= self.laps
+    or #view.standings ~= #self.order then
     return false
   end
-  for k, s in ipairs(a.standings) do
-    local t = b.standings[k]
-    for _, f in ipairs(ENTRY) do
-      if s[f] ~= t[f] then return false end
+  local standings = view.standings
+  for k, o in ipairs(self.order) do
+    local s, t = standings[k], o.finished and o.final or o.timer
+    if s.car ~= o.car or s.laps ~= t.count or s.bestLap ~= (t.best and t.best.time)
+      or s.finished ~= (o.finished or false) or s.out ~= (o.out ~= nil) then
+      return false
     end
   end
   return true
 end
 
 -- Before an update: a driver world's ctx.race is `view`, what it reads of the race (the phase
--- and every car's place, laps and best lap), made once a tick. While it says the same as the last
--- one (self._view), that table is kept: drivers.lua's send does not copy it into a world again.
--- Returns the view.
+-- and every car's place, laps and best lap), looked at once a tick. While the race says what the
+-- last view says (self._view), that table is kept: drivers.lua's send does not copy it into a
+-- world again. Returns the view.
 function Worlds:_tellWorld(e, view)
   if not worldOf(e) or not e.ctx then return view end
   if not view then
-    local standings = {}
-    for k, o in ipairs(self.order) do
-      local t = o.finished and o.final or o.timer
-      standings[k] = { car = o.car, position = k, laps = t.count,
-        bestLap = t.best and t.best.time, finished = o.finished or false, out = o.out ~= nil }
+    view = self._view
+    if not (view and current(self, view)) then
+      local standings = {}
+      for k, o in ipairs(self.order) do
+        local t = o.finished and o.final or o.timer
+        standings[k] = { car = o.car, position = k, laps = t.count,
+          bestLap = t.best and t.best.time, finished = o.finished or false, out = o.out ~= nil }
+      end
+      view = { phase = self.phase, mode = self.mode, laps = self.laps, standings = standings }
+      self._view = view
     end
-    view = { phase = self.phase, mode = self.mode, laps = self.laps, standings = standings }
-    if self._view and same(view, self._view) then view = self._view end
-    self._view = view
   end
   e.ctx.race = view
   return view
