@@ -343,6 +343,10 @@ end
 --- map give the same tracker. options.horizon: how many seconds past the last event the
 --- position is extrapolated (default 3; at 300 mm/s two lost frames leave a gap over 1 s).
 function localize.follow(car, map, options)
+  -- (the tracker it has already: a driver's context asks for every car at every update)
+  local known = options == nil and followed[car]
+  known = known and known[map]
+  if known then return known end
   if type(map) ~= "table" or type(map.pieces) ~= "table" or not map.lapLength then
     pitwall._raise("localize.follow(car, map): map must be a track map from pitwall.track "
       .. "(track.scan or track.fromSim), got " .. type(map))
