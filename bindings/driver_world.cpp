@@ -22,12 +22,14 @@ std::string fileName(const std::string& file) {
   return std::filesystem::path(file).filename().string();
 }
 
-// What runs inside the driver world's protected call: the director's data copied in (an
+// What runs inside the driver world's protected call: the director's values copied in (an
 // allocation past the world's cap fails there, as a call, not as a panic), then
-// pitwall._driverCall(method, data) (scripts/pitwall/driver_world.lua).
+// pitwall._driverCall(method, …) (scripts/pitwall/driver_world.lua). Values, not one table of
+// them: most calls carry no table at all (the car, its limit, the period), and then nothing is
+// made in the world but the call.
 struct CallIn {
   lua_State* from;
-  int data;
+  int first, last;
   const char* method;
 };
 
@@ -38,12 +40,20 @@ int callIn(lua_State* L) {
   lua_getfield(L, -1, "_driverCall");
   lua_remove(L, -2);
   lua_pushstring(L, in->method);
+  const int count = in->last - in->first + 1;
+  luaL_checkstack(L, count + 8, "a driver call's values");
   std::vector<std::string> dropped;  // (quiet: what cannot cross is the director's own)
   lua::WorldCopy copy(in->from, L, dropped, true);
-  copy.openMemo();
-  if (!copy.copy(in->data, "data", 0)) lua_pushnil(L);
-  copy.closeMemo();
-  lua_call(L, 2, 0);
+  // One memo for all the values (a table two of them share is one table in the world), made only
+  // when there is a table to copy; it stands below the values, and goes when they are copied.
+  bool tables = false;
+  for (int i = in->first; i <= in->last && !tables; ++i)
+    tables = lua_type(in->from, i) == LUA_TTABLE;
+  if (tables) copy.openMemo();
+  for (int i = in->first; i <= in->last; ++i)
+    if (!copy.copy(i, "data", 0)) lua_pushnil(L);
+  if (tables) copy.closeMemo();
+  lua_call(L, 1 + count, 0);
   return 0;
 }
 
@@ -62,7 +72,7 @@ int setupIn(lua_State* L) {
 }  // namespace
 
 DriverWorld::DriverWorld(ScriptHost& race, AnkiCar& car, std::string file, DriverLimits limits)
-    : race_(race), car_(car), file_(std::move(file)), limits_(limits) {
+    : race_(race), car_(car), file_(std::move(file)), name_(fileName(file_)), limits_(limits) {
   std::weak_ptr<bool> alive = alive_;
   // The run's world shuts down (the run ends): so does every driver world it made.
   race_.atShutDown([this, alive] {
@@ -131,24 +141,24 @@ bool DriverWorld::reload() {
   }
   lua_State* L = host_->state();
   // The main chunk: what it returns is the driver (a class or an instance).
-  if (!host_->call(0, 1, "main chunk", fileName(file_))) return false;
+  if (!host_->call(0, 1, "main chunk", name_)) return false;
   lua_pushcfunction(L, setupIn);
   lua_insert(L, -2);
-  lua_pushstring(L, fileName(file_).c_str());
-  if (!host_->call(2, 0, "driver", fileName(file_))) return false;
+  lua_pushstring(L, name_.c_str());
+  if (!host_->call(2, 0, "driver", name_)) return false;
   return failure_.empty();
 }
 
-bool DriverWorld::call(lua_State* from, const char* method, int data) {
+bool DriverWorld::call(lua_State* from, const char* method, int first) {
   if (!failure_.empty() || !host_ || host_->isShutDown()) return false;
   const int top = lua_gettop(from);
-  CallIn in{from, lua_absindex(from, data), method};
+  CallIn in{from, lua_absindex(from, first), top, method};
   lua_State* L = host_->state();
   lua_pushcfunction(L, callIn);
   lua_pushlightuserdata(L, &in);
   const double cpu = threadCpuSeconds();
   // "update of driver alice.lua" of "car 2 (skull)"
-  const std::string what = std::string(method) + " of driver " + fileName(file_);
+  const std::string what = std::string(method) + " of driver " + name_;
   host_->call(1, 0, what.c_str(), car_.label());
   lua_settop(from, top);  // a copy cut short by an error leaves the director's stack as it was
   if (failure_.empty()) charge(threadCpuSeconds() - cpu);
@@ -160,8 +170,8 @@ void DriverWorld::fail(const std::string& why) {
   failure_ = why.substr(0, why.find('\n'));  // the sentence; the log keeps the traceback
   (void)car_.stop();  // (a world that failed stopped it already: this one may never have run)
   if (host_ && !host_->isShutDown()) host_->shutDown();
-  log::error("driver", "driver " + fileName(file_) + " of " + car_.label() +
-                           " is out, its car stopped: " + why);
+  log::error("driver",
+             "driver " + name_ + " of " + car_.label() + " is out, its car stopped: " + why);
 }
 
 void DriverWorld::charge(double cpu) {
@@ -202,8 +212,7 @@ void DriverWorld::watch() {
     return;
   }
   watch_->onChange = [this](const std::vector<std::string>&) {
-    if (reload())
-      log::info("driver", "driver " + fileName(file_) + " of " + car_.label() + " reloaded");
+    if (reload()) log::info("driver", "driver " + name_ + " of " + car_.label() + " reloaded");
   };
 }
 

@@ -32,11 +32,11 @@ class DriverWorld {
   DriverWorld(const DriverWorld&) = delete;
   DriverWorld& operator=(const DriverWorld&) = delete;
 
-  // Calls the driver's `method` (start, update, finish, waiting) in the world with the value at
-  // index `data` of `from` (a thread of the director's world) copied in (what drivers.world sends:
-  // the limits, the race's phase and standings, the map once). False when the world has failed, now
-  // or before.
-  bool call(lua_State* from, const char* method, int data);
+  // Calls the driver's `method` (start, update, finish, waiting) in the world with the values from
+  // index `first` of `from` (a thread of the director's world) to its top copied in (what
+  // drivers.world sends: the car, its limits, the period, the race's phase and standings, the map
+  // once). False when the world has failed, now or before.
+  bool call(lua_State* from, const char* method, int first);
   // Loads the file again into a new world: the old one goes (its car keeps its last speed until
   // the director calls the new one). False, and failure() set, when the new one fails.
   bool reload();
@@ -61,6 +61,7 @@ class DriverWorld {
   ScriptHost& race_;
   AnkiCar& car_;
   std::string file_;
+  std::string name_;  // the file's name without its folder, as the log and errors say it
   DriverLimits limits_;
   std::unique_ptr<ScriptHost> host_;
   // Worlds replaced or failed: a world may be on the stack when it goes (it failed inside its

@@ -2,7 +2,8 @@
 // league final's pitwall.final, docs/league.md), the
 // --driver CAR=FILE of the command line, and pitwall._driverWorld(file, car), the engine's half
 // of drivers.world (scripts/pitwall/drivers.lua), which a race director calls like any driver.
-// A driver world object: world:call(method, data) → true, or false once the world has failed;
+// A driver world object: world:call(method, …) → true, or false once the world has failed (the
+// values after the method are copied into the world: drivers.lua's send, driver_world.lua's call);
 // world:reload() → true when the new world loaded; world:close() ends it for good (its session
 // ended); fields failure (why it is out, nil while it
 // drives), file, version (1, +1 a reload), cpu (s its calls used).
@@ -38,8 +39,8 @@ DriverWorld& worldAt(lua_State* L, int idx) {
 int call(lua_State* L) {
   DriverWorld& w = worldAt(L, 1);
   const char* method = luaL_checkstring(L, 2);
-  lua_settop(L, 3);
-  lua_pushboolean(L, w.call(L, method, 3));
+  const bool ok = w.call(L, method, 3);
+  lua_pushboolean(L, ok);
   return 1;
 }
 

@@ -1,8 +1,9 @@
 -- In a driver world (docs/drivers.md): the driver its file returned, the context it drives by,
 -- and the race director's calls, which come through bindings/driver_world.cpp as
--- pitwall._driverCall(method, data). `data` is what drivers.world in the run's world sends, a
--- copy: the car (this world's own object of it), ctx's limits, the race (phase, standings) and,
--- on the first call of each world, the map.
+-- pitwall._driverCall(method, car, limit, pieceLimits, period, race, sameRace, map): copies of
+-- what drivers.world in the run's world sends — the car (this world's own object of it), ctx's
+-- limits and period, the race (phase, standings; nil with sameRace when it is the one sent last)
+-- and, on the first call of each world, the map.
 local drivers = require "pitwall.drivers"
 local track = require "pitwall.track"
 
@@ -11,22 +12,21 @@ local driver, ctx
 
 local METHODS = { start = true, update = true, finish = true, waiting = true }
 
-local function call(method, data)
+local function call(method, car, limit, pieceLimits, period, race, sameRace, sentMap)
   if not METHODS[method] then error("no driver method " .. tostring(method), 0) end
-  local car = data.car
   if not ctx then
-    local map = data.map and track._adopt(data.map)
+    local map = sentMap and track._adopt(sentMap)
     if not map then error("the race director sent no map", 0) end
     -- The other cars join the field after the context is made: each is followed from the first
     -- ctx:ahead() or ctx:nearby() on (drivers.context), so a driver that never asks (the
     -- cruiser) pays for no tracker of another car.
     local field = {}
-    ctx = drivers.context(car, map, field, { period = data.period })
+    ctx = drivers.context(car, map, field, { period = period })
     for _, c in ipairs(pitwall.cars()) do field[#field + 1] = c end
   end
   -- ctx.race: a race view the same as the last one is not sent again (drivers.lua's send)
-  ctx.limit, ctx.pieceLimits = data.limit, data.pieceLimits
-  if not data.sameRace then ctx.race = data.race end
+  ctx.limit, ctx.pieceLimits = limit, pieceLimits
+  if not sameRace then ctx.race = race end
   local fn = driver[method]
   if fn then fn(driver, car, ctx) end
 end

@@ -276,30 +276,29 @@ drivers.call = call
 local World = { __name = "driver world" }
 World.__index = World
 
+-- The world is called with the values driver_world.lua's call takes: the car, its limits, the
+-- period, the race view (nil: the one it has), and the map (its first call, or after a save).
 local function send(self, method, car, ctx)
   local w = self.world
   if w.failure then return end
-  local data = { car = car, limit = ctx and ctx.limit, pieceLimits = ctx and ctx.pieceLimits,
-    period = ctx and ctx.period }
-  local race = ctx and ctx.race
+  local limit, pieceLimits, period, race = nil, nil, nil, nil
+  if ctx then limit, pieceLimits, period, race = ctx.limit, ctx.pieceLimits, ctx.period, ctx.race end
+  local map
   if self.version ~= w.version then -- a new world (the first, or a save): the map, the race
     self.version, self.race = w.version, nil
-    data.map = ctx and ctx.map
+    map = ctx and ctx.map
     if self.started and method ~= "start" and method ~= "finish" then
-      data.race = race
-      if not w:call("start", data) then return end
-      self.race, data.map = race, nil
+      if not w:call("start", car, limit, pieceLimits, period, race, false, map) then return end
+      self.race, map = race, nil
     end
   end
   -- The race view the world has already (the same table: race_worlds' _tellWorld keeps it while
   -- nothing in it changes) is not copied again.
-  if race ~= nil and race == self.race then
-    data.race, data.sameRace = nil, true
-  else
-    data.race = race
-  end
+  local same = race ~= nil and race == self.race
   if method == "start" then self.started = true end
-  if w:call(method, data) then self.race = race end
+  if w:call(method, car, limit, pieceLimits, period, not same and race or nil, same, map) then
+    self.race = race
+  end
 end
 
 for _, method in ipairs { "start", "update", "finish", "waiting" } do
