@@ -1,7 +1,9 @@
 #include "bindings/lua_object.hpp"
 
 #include <cctype>
+#include <stdexcept>
 #include <string>
+#include <string_view>
 
 namespace pitwall::lua {
 
@@ -53,26 +55,48 @@ std::string noSuchField(lua_State* L, const TypeSpec& type) {
          "' (" + names + ")";
 }
 
-// __index (1: the object, 2: the key). Upvalues: 1 the methods table, 2 the fields' numbers by
-// name, 3 the TypeSpec, 4 the metatable. A method, else a state field, else (ownFields) the
-// object's own table, else nil.
+// While a getter runs: checkBox of its object is a compare (lua_object.hpp); restored after,
+// also when the getter throws.
+class BoxChecked {
+ public:
+  BoxChecked(const void* box, const TypeSpec& type) : saved_(checkedBox) {
+    checkedBox = {box, &type};
+  }
+  ~BoxChecked() { checkedBox = saved_; }
+  BoxChecked(const BoxChecked&) = delete;
+  BoxChecked& operator=(const BoxChecked&) = delete;
+
+ private:
+  CheckedBox saved_;
+};
+
+// __index (1: the object, 2: the key). Upvalues: 1 the fields' numbers by name, 2 the methods
+// table (a binding may replace a method in it after registerType: alphabot's ping), 3 the
+// TypeSpec, 4 the metatable. A state field (the hot path: one lookup), else a method (no field
+// has a method's name: registerType), else (ownFields) the object's own table, else nil.
 int index(lua_State* L) {
   lua_pushvalue(L, 2);
-  if (lua_rawget(L, lua_upvalueindex(1)) != LUA_TNIL) return 1;
-  lua_pop(L, 1);
+  if (lua_rawget(L, lua_upvalueindex(1)) != LUA_TNUMBER) {
+    lua_pop(L, 1);
+    lua_pushvalue(L, 2);
+    if (lua_rawget(L, lua_upvalueindex(2)) != LUA_TNIL) return 1;
+    lua_pop(L, 1);
+    lua_pushnil(L);  // (no field: the check below, then the object's own table)
+  }
   const auto& type = *static_cast<const TypeSpec*>(lua_touserdata(L, lua_upvalueindex(3)));
   // The object is of this type — its metatable is the one this __index belongs to (an upvalue:
   // the hot path of every car field read, no registry lookup) — else checkBox's sentence.
   const bool own = lua_type(L, 1) == LUA_TUSERDATA && lua_getmetatable(L, 1);
   if (!own || !lua_rawequal(L, -1, lua_upvalueindex(4))) checkBox(L, 1, type);
-  lua_pop(L, 1);
-  lua_pushvalue(L, 2);
-  if (lua_rawget(L, lua_upvalueindex(2)) == LUA_TNUMBER) {
+  if (own) lua_pop(L, 1);
+  if (lua_type(L, -1) == LUA_TNUMBER) {
     const auto i = static_cast<std::size_t>(lua_tointeger(L, -1));
     lua_pop(L, 1);
+    BoxChecked checked(lua_touserdata(L, 1), type);
     type.fields[i].push(L, 1);
     return 1;
   }
+  lua_pop(L, 1);
   if (!type.ownFields) {
     if (type.strict) throw LuaError(noSuchField(L, type));
     lua_pushnil(L);
@@ -213,12 +237,14 @@ void registerType(lua_State* L, const TypeSpec& type) {
   lua_setfield(L, mt, "__events");
   lua_createtable(L, 0, static_cast<int>(type.fields.size()));  // field numbers by name
   for (std::size_t i = 0; i < type.fields.size(); ++i) {
+    for (const luaL_Reg* m = type.methods; m && m->name; ++m)
+      if (std::string_view(m->name) == type.fields[i].name)
+        throw std::logic_error(std::string(type.name) + " has a field and a method named " +
+                               m->name);
     lua_pushinteger(L, static_cast<lua_Integer>(i));
     lua_setfield(L, -2, type.fields[i].name);
   }
-  const int fieldNumbers = lua_gettop(L);
   lua_pushvalue(L, methods);
-  lua_pushvalue(L, fieldNumbers);
   lua_pushlightuserdata(L, spec);
   lua_pushvalue(L, mt);  // (index's check of its object: this metatable, no registry lookup)
   lua_pushcclosure(L, guarded<index>, 4);

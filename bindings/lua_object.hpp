@@ -276,8 +276,20 @@ template <class T>
 T* test(lua_State* L, int idx, const TypeSpec& type) {
   return static_cast<T*>(luaL_testudata(L, idx, type.metatable));
 }
+// The box __index has just checked while it runs one of its type's field getters (which check
+// their object again): that check is then a compare, not luaL_testudata's registry lookup.
+struct CheckedBox {
+  const void* box = nullptr;
+  const TypeSpec* type = nullptr;
+};
+inline thread_local CheckedBox checkedBox;
+
 // The box of the object of `type` at idx; anything else raises expectedSentence.
 inline void* checkBox(lua_State* L, int idx, const TypeSpec& type) {
+  if (checkedBox.type == &type) {
+    void* p = lua_touserdata(L, idx);
+    if (p && p == checkedBox.box) return p;
+  }
   if (void* p = luaL_testudata(L, idx, type.metatable)) return p;
   throw LuaError(expectedSentence(L, idx, type));
 }
