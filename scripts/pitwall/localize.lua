@@ -68,9 +68,23 @@ end
 
 function Tracker:_dir() return self.reverse and -1 or 1 end
 
+-- The lane length of every map piece at the car's offset (map frame: mirrored when reversed),
+-- summed again only when the offset, the direction or the map's count of pieces changed (a car
+-- keeps its lane for most frames).
+function Tracker:_lengths()
+  local off = self.reverse and -self.offset or self.offset
+  local lens, pieces = self._laneLens, self.map.pieces
+  if lens and self._laneOff == off and lens.n == #pieces then return lens end
+  lens = lens or {}
+  for k, p in ipairs(pieces) do lens[k] = p:length(off) end
+  lens.n = #pieces
+  self._laneLens, self._laneOff = lens, off
+  return lens
+end
+
 -- Lane length of piece i at the car's offset (map frame: mirrored when reversed).
 function Tracker:_len(i)
-  return self.map.pieces[i]:length(self.reverse and -self.offset or self.offset)
+  return self:_lengths()[i]
 end
 
 -- Lane mm travelled from the last position/transition update until time t.
@@ -116,9 +130,9 @@ end
 -- when the event does not fit the estimate.
 function Tracker:_step(e, m, id, t0, t)
   local map, d = self.map, self:_dir()
-  local pieces, n = map.pieces, #map.pieces
-  local off = self.reverse and -self.offset or self.offset
-  local len0 = pieces[e.index]:length(off)
+  local n = #map.pieces
+  local laneLens = self:_lengths()
+  local len0 = laneLens[e.index]
   local p0 = e.pos * len0
   local r = p0 + m -- reckoned lane mm from the start of the current piece
   -- The pieces from here on and where each starts: the tracker's own two lists, filled anew at
@@ -132,7 +146,7 @@ function Tracker:_step(e, m, id, t0, t)
   local at, k = len0, e.index
   for j = 2, MAX_SKIP + 1 do
     k = (k - 1 + d) % n + 1 -- Map:next
-    local len = pieces[k]:length(off)
+    local len = laneLens[k]
     idx[j], start[j], lens[j] = k, at, len
     at = at + len
   end
@@ -420,12 +434,13 @@ function Tracker:locate(t)
     return self._md, self._mi, self._mf
   end
   local i = self.index
-  local len = self:_len(i)
+  local laneLens = self:_lengths()
+  local len = laneLens[i]
   local into = self.pos * len + self:_travel(t)
   for _ = 1, MAX_SKIP do -- on into the next pieces (their frames may have been lost)
     if into <= len then break end
     i, into = self.map:next(i, self:_dir()), into - len
-    len = self:_len(i)
+    len = laneLens[i]
   end
   into = math.min(into, len)
   local f = into / len
