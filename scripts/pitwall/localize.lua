@@ -24,7 +24,6 @@
 -- meanwhile are then reported in order.
 local localize = {}
 
-local LANES = { -68, -23, 23, 68 } -- engine/sim/grid.hpp kLaneOffsets, anki-overdrive.md
 local MAX_SKIP = 4        -- pieces a position update may lie ahead when frames were lost
 local TWIN_MARGIN = 120   -- mm past a piece's end before the next piece with the same id wins
 local SLACK = 120         -- mm a position may lie off the reckoning (plus 30 % of the travel)
@@ -39,12 +38,18 @@ Tracker.__name = "tracker" -- (how errors name it: "tracker has no method …")
 
 local followed = setmetatable({}, { __mode = "k" }) -- car → { [map] = tracker }
 
+local abs = math.abs
+
 --- The lane offset (−68, −23, 23, 68 mm) nearest to `offset`.
 function localize.nearestLane(offset)
-  local best = LANES[1]
-  for _, lane in ipairs(LANES) do
-    if math.abs(lane - offset) < math.abs(best - offset) then best = lane end
-  end
+  -- The lanes −68, −23, 23, 68 (engine/sim/grid.hpp kLaneOffsets, anki-overdrive.md), one by one
+  -- (every frame asks): the first of two as near wins, NaN gives the first.
+  local best, near = -68, abs(-68 - offset)
+  local d = abs(-23 - offset)
+  if d < near then best, near = -23, d end
+  d = abs(23 - offset)
+  if d < near then best, near = 23, d end
+  if abs(68 - offset) < near then best = 68 end
   return best
 end
 

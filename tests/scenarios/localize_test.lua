@@ -7,6 +7,12 @@ local sim = require "pitwall.sim"
 local track = require "pitwall.track"
 local localize = require "pitwall.localize"
 
+-- The nearest lane: halfway between two, the first (the one further left); NaN, the first.
+for _, c in ipairs { { 0, -23 }, { -45.5, -68 }, { 45.5, 23 }, { -45.4, -23 }, { 45.6, 68 },
+  { 30, 23 }, { -1e9, -68 }, { 1e9, 68 }, { 0 / 0, -68 }, { -23, -23 } } do
+  expect.eq(localize.nearestLane(c[1]), c[2], "nearest lane to " .. tostring(c[1]))
+end
+
 local map = track.fromSim()
 local n, simFinish = #map.pieces, sim.track().finishIndex
 local LAP = map:lapLength(0)
