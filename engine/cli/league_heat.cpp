@@ -3,6 +3,7 @@
 #include <lua.hpp>
 
 #include <chrono>
+#include <memory>
 
 #include "bindings/lua_json.hpp"
 #include "engine/cli/session.hpp"
@@ -70,7 +71,8 @@ ScenarioResult runHeat(const HeatSpec& spec) {
     out.message = track.error();
     return out;
   }
-  Session session(ClockKind::Virtual, std::move(*track), spec.seed);
+  auto kept = std::make_unique<Session>(ClockKind::Virtual, std::move(*track), spec.seed);
+  Session& session = *kept;
   session.sim().world->setSensor(
       sim::sensorModelNamed(spec.sensor).value_or(sim::SensorModel::Real));
   HostOptions host;
@@ -125,6 +127,7 @@ ScenarioResult runHeat(const HeatSpec& spec) {
     out.message = e.what();
   }
   lua_settop(L, 0);
+  if (spec.endsProcess) (void)kept.release();  // (HeatSpec::endsProcess)
   return out;
 }
 
