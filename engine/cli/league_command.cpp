@@ -398,7 +398,6 @@ int league(const LeagueOptions& o) {
     s.seed = seed;
     s.title = std::move(title);
     s.limits = limits;
-    s.endsProcess = true;  // (runInProcesses: each heat in a process of its own)
     return s;
   };
   int errors = 0;

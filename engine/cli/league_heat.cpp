@@ -3,7 +3,6 @@
 #include <lua.hpp>
 
 #include <chrono>
-#include <memory>
 
 #include "bindings/lua_json.hpp"
 #include "engine/cli/session.hpp"
@@ -71,8 +70,7 @@ ScenarioResult runHeat(const HeatSpec& spec) {
     out.message = track.error();
     return out;
   }
-  auto kept = std::make_unique<Session>(ClockKind::Virtual, std::move(*track), spec.seed);
-  Session& session = *kept;
+  Session session(ClockKind::Virtual, std::move(*track), spec.seed);
   session.sim().world->setSensor(
       sim::sensorModelNamed(spec.sensor).value_or(sim::SensorModel::Real));
   HostOptions host;
@@ -127,7 +125,6 @@ ScenarioResult runHeat(const HeatSpec& spec) {
     out.message = e.what();
   }
   lua_settop(L, 0);
-  if (spec.endsProcess) (void)kept.release();  // (HeatSpec::endsProcess)
   return out;
 }
 

@@ -22,10 +22,6 @@ struct HeatSpec {
   std::uint64_t seed = 1;
   std::string title;
   DriverLimits limits;
-  // The process ends right after (a league's heat, in a process of its own): at the end the
-  // session — its Lua worlds, its simulator — is left as it is, not taken apart object by object
-  // (2.5 % of a heat's instructions); its memory goes with the process.
-  bool endsProcess = false;
 };
 
 ScenarioResult runHeat(const HeatSpec& spec);
