@@ -425,8 +425,9 @@ int league(const LeagueOptions& o) {
     if (auto held = keeper->add(std::move(race))) std::cerr << "league: " << *held << "\n";
   };
 
-  // Every heat is a child of this process (runInProcesses): the library is parsed once, here,
-  // and each child's worlds load its bytecode (docs/performance.md "Issue 38").
+  // Every heat runs in a child of this process (runInWorkers: `-j` children, each running heat
+  // after heat): the library is parsed once, here, and each child's worlds load its bytecode
+  // (docs/performance.md "Issue 38").
   try {
     compileLibraryAhead();
   } catch (const std::exception&) {  // (no library: the first heat says so, as a sentence)
@@ -437,7 +438,7 @@ int league(const LeagueOptions& o) {
   nlohmann::json qualifyingRows = nlohmann::json::array();
   std::cerr << "league: " << n << " drivers; qualifying (" << o.qualifyingLaps
             << (o.qualifyingLaps == 1 ? " lap" : " laps") << " each)\n";
-  runInProcesses(
+  runInWorkers(
       static_cast<std::size_t>(n), jobs,
       [&](std::size_t d) {
         return runHeat(spec({(*drivers)[d].file}, true, o.seed * 1000003 + 500000 + d,
@@ -480,7 +481,7 @@ int league(const LeagueOptions& o) {
                                  " races " + std::to_string(mine.size()) + " of them"
                            : std::string())
             << "\n";
-  runInProcesses(
+  runInWorkers(
       mine.size(), jobs,
       [&](std::size_t i) {
         const std::size_t h = mine[i];
@@ -559,7 +560,8 @@ Command addLeagueCommand(CLI::App& app) {
   cmd->add_option("--sensor", o->sensor,
                   "The simulated cars' sensors: real (default, as real cars report) or ideal")
       ->check(CLI::IsMember({"real", "ideal"}));
-  cmd->add_option("-j,--jobs", o->jobs, "Heats raced at once, each in a process of its own")
+  cmd->add_option("-j,--jobs", o->jobs,
+                  "Heats raced at once: N child processes, each racing heat after heat")
       ->check(CLI::Range(1, 256));
   cmd->add_option("--seed", o->seed, "The draw's and the simulator's seed (default 1)");
   cmd->add_option("--results", o->results,

@@ -1,18 +1,26 @@
 #include "engine/cli/test_pool.hpp"
 
+#include <fcntl.h>
+#include <poll.h>
+#include <pthread.h>
 #include <sched.h>
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <iostream>
 #include <map>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <vector>
 
 namespace pitwall::cli {
 
@@ -116,6 +124,111 @@ struct Child {
   std::FILE* result;
 };
 
+// What a child that ended without a result left of one.
+ScenarioResult crashed(int status) {
+  ScenarioResult r;
+  r.status = ScenarioResult::Status::Crashed;
+  if (WIFSIGNALED(status))
+    r.message = "the scenario's process crashed: signal " + std::to_string(WTERMSIG(status)) +
+                " (" + strsignal(WTERMSIG(status)) + ")";
+  else
+    r.message = "the scenario's process ended with status " + std::to_string(WEXITSTATUS(status)) +
+                " without a result";
+  return r;
+}
+
+// Hands results to report() in order: each as soon as it and every one before it are in.
+class InOrder {
+ public:
+  explicit InOrder(const std::function<void(std::size_t, ScenarioResult)>& report)
+      : report_(report) {}
+  void add(std::size_t index, ScenarioResult r) {
+    done_.emplace(index, std::move(r));
+    for (auto d = done_.find(reported_); d != done_.end(); d = done_.find(reported_)) {
+      report_(reported_, std::move(d->second));
+      done_.erase(d);
+      ++reported_;
+    }
+  }
+  std::size_t reported() const { return reported_; }
+
+ private:
+  const std::function<void(std::size_t, ScenarioResult)>& report_;
+  std::map<std::size_t, ScenarioResult> done_;  // ended, waiting for those before them
+  std::size_t reported_ = 0;
+};
+
+// Whole reads and writes on a pipe (EINTR retried); false at its end or on an error.
+bool readAll(int fd, void* data, std::size_t size) {
+  auto* p = static_cast<char*>(data);
+  while (size > 0) {
+    ssize_t n = ::read(fd, p, size);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    p += n;
+    size -= static_cast<std::size_t>(n);
+  }
+  return true;
+}
+bool writeAll(int fd, const void* data, std::size_t size) {
+  const auto* p = static_cast<const char*>(data);
+  while (size > 0) {
+    ssize_t n = ::write(fd, p, size);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    p += n;
+    size -= static_cast<std::size_t>(n);
+  }
+  return true;
+}
+
+// Writes a task's index to a worker; false when the worker is gone (EPIPE: the SIGPIPE that
+// write raises is blocked and taken back, the parent's own handling of it left as it is).
+bool sendTask(int fd, std::uint64_t index) {
+  sigset_t pipeSignal, old;
+  sigemptyset(&pipeSignal);
+  sigaddset(&pipeSignal, SIGPIPE);
+  pthread_sigmask(SIG_BLOCK, &pipeSignal, &old);
+  const bool ok = writeAll(fd, &index, sizeof index);
+  if (!ok && errno == EPIPE) {
+    const timespec now{};
+    while (sigtimedwait(&pipeSignal, nullptr, &now) < 0 && errno == EINTR) {
+    }
+  }
+  pthread_sigmask(SIG_SETMASK, &old, nullptr);
+  return ok;
+}
+
+// A worker of runInWorkers: a child that runs the tasks its parent sends (an index on `tasks`)
+// one after the other, each with its output in DIR/INDEX.out and its result in DIR/INDEX.res,
+// and answers with the index on `done`. Ends at the end of `tasks`.
+[[noreturn]] void work(int tasks, int done, const std::string& dir,
+                       const std::function<ScenarioResult(std::size_t)>& run) {
+  std::uint64_t index = 0;
+  while (readAll(tasks, &index, sizeof index)) {
+    const std::string base = dir + "/" + std::to_string(index);
+    std::cout.flush();
+    std::cerr.flush();
+    std::fflush(nullptr);
+    int out = ::open((base + ".out").c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+    if (out < 0) _exit(3);
+    dup2(out, STDOUT_FILENO);
+    dup2(out, STDERR_FILENO);
+    ::close(out);
+    // Line by line, as on a terminal: what it printed just before a crash is kept.
+    std::setvbuf(stdout, nullptr, _IOLBF, 0);
+    ScenarioResult r = run(static_cast<std::size_t>(index));
+    std::cout.flush();
+    std::cerr.flush();
+    std::fflush(nullptr);
+    std::FILE* res = std::fopen((base + ".res").c_str(), "wb");
+    if (!res) _exit(3);
+    save(res, r);
+    if (std::fclose(res) != 0 || !writeAll(done, &index, sizeof index)) _exit(3);
+  }
+  _exit(0);  // no destructors, no atexit handlers: they are the parent's
+}
+
 }  // namespace
 
 int availableCores() {
@@ -128,8 +241,8 @@ void runInProcesses(std::size_t count, int jobs,
                     const std::function<ScenarioResult(std::size_t)>& run,
                     const std::function<void(std::size_t, ScenarioResult)>& report) {
   std::map<pid_t, Child> running;
-  std::map<std::size_t, ScenarioResult> done;  // ended, waiting for those before them
-  std::size_t next = 0, reported = 0;
+  InOrder inOrder(report);
+  std::size_t next = 0;
   auto start = [&](std::size_t i) {
     Child c{i, std::tmpfile(), std::tmpfile()};
     if (!c.output || !c.result)
@@ -154,7 +267,7 @@ void runInProcesses(std::size_t count, int jobs,
     }
     running.emplace(pid, c);
   };
-  while (reported < count) {
+  while (inOrder.reported() < count) {
     while (next < count && static_cast<int>(running.size()) < jobs) start(next++);
     int status = 0;
     pid_t pid = waitpid(-1, &status, 0);
@@ -168,26 +281,136 @@ void runInProcesses(std::size_t count, int jobs,
     running.erase(it);
     std::optional<ScenarioResult> r;
     if (WIFEXITED(status) && WEXITSTATUS(status) == 0) r = load(c.result);
-    if (!r) {
-      r.emplace();
-      r->status = ScenarioResult::Status::Crashed;
-      if (WIFSIGNALED(status))
-        r->message = "the scenario's process crashed: signal " + std::to_string(WTERMSIG(status)) +
-                     " (" + strsignal(WTERMSIG(status)) + ")";
-      else
-        r->message = "the scenario's process ended with status " +
-                     std::to_string(WEXITSTATUS(status)) + " without a result";
-    }
+    if (!r) r = crashed(status);
     r->output = readAll(c.output);
     std::fclose(c.output);
     std::fclose(c.result);
-    done.emplace(c.index, std::move(*r));
-    for (auto d = done.find(reported); d != done.end(); d = done.find(reported)) {
-      report(reported, std::move(d->second));
-      done.erase(d);
-      ++reported;
+    inOrder.add(c.index, std::move(*r));
+  }
+}
+
+void runInWorkers(std::size_t count, int jobs,
+                  const std::function<ScenarioResult(std::size_t)>& run,
+                  const std::function<void(std::size_t, ScenarioResult)>& report) {
+  namespace fs = std::filesystem;
+  std::string pattern = (fs::temp_directory_path() / "pitwall-workers-XXXXXX").string();
+  if (!::mkdtemp(pattern.data()))
+    throw std::runtime_error(std::string("mkdtemp: ") + strerror(errno));
+  const std::string dir = pattern;
+  struct Worker {
+    pid_t pid = -1;
+    int tasks = -1, done = -1;  // the parent's ends of its two pipes
+    std::optional<std::size_t> task;
+  };
+  std::vector<Worker> workers;
+  auto spawn = [&] {
+    int tasks[2], done[2];
+    if (::pipe2(tasks, O_CLOEXEC) != 0 || ::pipe2(done, O_CLOEXEC) != 0)
+      throw std::runtime_error(std::string("pipe: ") + strerror(errno));
+    std::cout.flush();
+    std::cerr.flush();
+    std::fflush(nullptr);
+    pid_t pid = fork();
+    if (pid < 0) throw std::runtime_error(std::string("fork: ") + strerror(errno));
+    if (pid == 0) {
+      for (const Worker& w : workers) {  // (the others' pipes are not this one's)
+        ::close(w.tasks);
+        ::close(w.done);
+      }
+      ::close(tasks[1]);
+      ::close(done[0]);
+      work(tasks[0], done[1], dir, run);
+    }
+    ::close(tasks[0]);
+    ::close(done[1]);
+    workers.push_back(Worker{pid, tasks[1], done[0], std::nullopt});
+  };
+  auto file = [&](std::size_t index, const char* ext) {
+    return dir + "/" + std::to_string(index) + ext;
+  };
+  // What a task left: its output, and its result or (none) what its worker's end says.
+  auto collect = [&](std::size_t index, std::optional<ScenarioResult> r, int status) {
+    if (!r) {
+      if (std::FILE* res = std::fopen(file(index, ".res").c_str(), "rb")) {
+        r = load(res);
+        std::fclose(res);
+      }
+    }
+    if (!r) r = crashed(status);
+    if (std::FILE* out = std::fopen(file(index, ".out").c_str(), "rb")) {
+      r->output = readAll(out);
+      std::fclose(out);
+    }
+    std::remove(file(index, ".out").c_str());
+    std::remove(file(index, ".res").c_str());
+    return std::move(*r);
+  };
+  InOrder inOrder(report);
+  std::size_t next = 0;
+  auto give = [&](Worker& w) {
+    if (next >= count) return;
+    const std::uint64_t index = next++;
+    w.task = static_cast<std::size_t>(index);
+    if (!sendTask(w.tasks, index)) {  // (gone: poll sees its end, and a new worker takes it)
+      w.task.reset();
+      --next;
+    }
+  };
+  try {
+    for (int j = 0; j < jobs && static_cast<std::size_t>(j) < count; ++j) spawn();
+    for (Worker& w : workers) give(w);
+    while (inOrder.reported() < count) {
+      std::vector<pollfd> fds;
+      for (const Worker& w : workers) fds.push_back(pollfd{w.done, POLLIN, 0});
+      if (::poll(fds.data(), fds.size(), -1) < 0) {
+        if (errno == EINTR) continue;
+        throw std::runtime_error(std::string("poll: ") + strerror(errno));
+      }
+      for (std::size_t k = 0; k < workers.size(); ++k) {
+        if (!fds[k].revents) continue;
+        Worker& w = workers[k];
+        std::uint64_t index = 0;
+        if (readAll(w.done, &index, sizeof index) && w.task && index == *w.task) {
+          w.task.reset();
+          inOrder.add(static_cast<std::size_t>(index), collect(index, std::nullopt, 0));
+          give(w);
+          continue;
+        }
+        // Its end: it crashed (its task too) — or the pipe broke. A new worker takes over.
+        ::close(w.tasks);
+        ::close(w.done);
+        int status = 0;
+        while (::waitpid(w.pid, &status, 0) < 0 && errno == EINTR) {
+        }
+        std::optional<std::size_t> lost = w.task;
+        w.pid = -1;
+        w.tasks = w.done = -1;
+        w.task.reset();
+        if (lost) inOrder.add(*lost, collect(*lost, std::nullopt, status == 0 ? 1 << 8 : status));
+        if (next < count) {
+          workers.erase(workers.begin() + static_cast<std::ptrdiff_t>(k));
+          spawn();
+          give(workers.back());
+        } else {
+          workers.erase(workers.begin() + static_cast<std::ptrdiff_t>(k));
+        }
+        break;  // (the list changed: poll again)
+      }
+    }
+  } catch (...) {
+    for (Worker& w : workers) ::close(w.tasks);
+    fs::remove_all(dir);
+    throw;
+  }
+  for (Worker& w : workers) ::close(w.tasks);  // the end of their tasks: they exit
+  for (Worker& w : workers) {
+    ::close(w.done);
+    int status = 0;
+    while (::waitpid(w.pid, &status, 0) < 0 && errno == EINTR) {
     }
   }
+  std::error_code ec;
+  fs::remove_all(dir, ec);
 }
 
 }  // namespace pitwall::cli
