@@ -158,26 +158,17 @@ class InOrder {
   std::size_t reported_ = 0;
 };
 
-// Whole reads and writes on a pipe (EINTR retried); false at its end or on an error.
-bool readAll(int fd, void* data, std::size_t size) {
-  auto* p = static_cast<char*>(data);
-  while (size > 0) {
-    ssize_t n = ::read(fd, p, size);
+// A task's index through a pipe, whole (EINTR retried): read, or written; false at the pipe's
+// end or on an error.
+bool moveIndex(int fd, std::uint64_t& index, bool writing) {
+  auto* p = reinterpret_cast<char*>(&index);
+  std::size_t left = sizeof index;
+  while (left > 0) {
+    const ssize_t n = writing ? ::write(fd, p, left) : ::read(fd, p, left);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) return false;
     p += n;
-    size -= static_cast<std::size_t>(n);
-  }
-  return true;
-}
-bool writeAll(int fd, const void* data, std::size_t size) {
-  const auto* p = static_cast<const char*>(data);
-  while (size > 0) {
-    ssize_t n = ::write(fd, p, size);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return false;
-    p += n;
-    size -= static_cast<std::size_t>(n);
+    left -= static_cast<std::size_t>(n);
   }
   return true;
 }
@@ -189,7 +180,7 @@ bool sendTask(int fd, std::uint64_t index) {
   sigemptyset(&pipeSignal);
   sigaddset(&pipeSignal, SIGPIPE);
   pthread_sigmask(SIG_BLOCK, &pipeSignal, &old);
-  const bool ok = writeAll(fd, &index, sizeof index);
+  const bool ok = moveIndex(fd, index, true);
   if (!ok && errno == EPIPE) {
     const timespec now{};
     while (sigtimedwait(&pipeSignal, nullptr, &now) < 0 && errno == EINTR) {
@@ -205,7 +196,7 @@ bool sendTask(int fd, std::uint64_t index) {
 [[noreturn]] void work(int tasks, int done, const std::string& dir,
                        const std::function<ScenarioResult(std::size_t)>& run) {
   std::uint64_t index = 0;
-  while (readAll(tasks, &index, sizeof index)) {
+  while (moveIndex(tasks, index, false)) {
     const std::string base = dir + "/" + std::to_string(index);
     std::cout.flush();
     std::cerr.flush();
@@ -224,7 +215,7 @@ bool sendTask(int fd, std::uint64_t index) {
     std::FILE* res = std::fopen((base + ".res").c_str(), "wb");
     if (!res) _exit(3);
     save(res, r);
-    if (std::fclose(res) != 0 || !writeAll(done, &index, sizeof index)) _exit(3);
+    if (std::fclose(res) != 0 || !moveIndex(done, index, true)) _exit(3);
   }
   _exit(0);  // no destructors, no atexit handlers: they are the parent's
 }
@@ -370,7 +361,7 @@ void runInWorkers(std::size_t count, int jobs,
         if (!fds[k].revents) continue;
         Worker& w = workers[k];
         std::uint64_t index = 0;
-        if (readAll(w.done, &index, sizeof index) && w.task && index == *w.task) {
+        if (moveIndex(w.done, index, false) && w.task && index == *w.task) {
           w.task.reset();
           inOrder.add(static_cast<std::size_t>(index), collect(index, std::nullopt, 0));
           give(w);
