@@ -137,6 +137,29 @@ ScenarioResult crashed(int status) {
   return r;
 }
 
+// Everything printed so far written out (before a fork, or before the output moves).
+void flushAll() {
+  std::cout.flush();
+  std::cerr.flush();
+  std::fflush(nullptr);
+}
+
+// fork() with nothing buffered twice; throws when it fails.
+pid_t forkFlushed() {
+  flushAll();
+  const pid_t pid = fork();
+  if (pid < 0) throw std::runtime_error(std::string("fork: ") + strerror(errno));
+  return pid;
+}
+
+// From now on this process prints (stdout and stderr) to `fd`, line by line as on a terminal:
+// what it printed just before a crash is kept.
+void printTo(int fd) {
+  dup2(fd, STDOUT_FILENO);
+  dup2(fd, STDERR_FILENO);
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
+}
+
 // Hands results to report() in order: each as soon as it and every one before it are in.
 class InOrder {
  public:
@@ -198,20 +221,13 @@ bool sendTask(int fd, std::uint64_t index) {
   std::uint64_t index = 0;
   while (moveIndex(tasks, index, false)) {
     const std::string base = dir + "/" + std::to_string(index);
-    std::cout.flush();
-    std::cerr.flush();
-    std::fflush(nullptr);
+    flushAll();
     int out = ::open((base + ".out").c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
     if (out < 0) _exit(3);
-    dup2(out, STDOUT_FILENO);
-    dup2(out, STDERR_FILENO);
+    printTo(out);
     ::close(out);
-    // Line by line, as on a terminal: what it printed just before a crash is kept.
-    std::setvbuf(stdout, nullptr, _IOLBF, 0);
     ScenarioResult r = run(static_cast<std::size_t>(index));
-    std::cout.flush();
-    std::cerr.flush();
-    std::fflush(nullptr);
+    flushAll();
     std::FILE* res = std::fopen((base + ".res").c_str(), "wb");
     if (!res) _exit(3);
     save(res, r);
@@ -238,20 +254,11 @@ void runInProcesses(std::size_t count, int jobs,
     Child c{i, std::tmpfile(), std::tmpfile()};
     if (!c.output || !c.result)
       throw std::runtime_error(std::string("tmpfile: ") + strerror(errno));
-    std::cout.flush();
-    std::cerr.flush();
-    std::fflush(nullptr);
-    pid_t pid = fork();
-    if (pid < 0) throw std::runtime_error(std::string("fork: ") + strerror(errno));
+    const pid_t pid = forkFlushed();
     if (pid == 0) {
-      dup2(fileno(c.output), STDOUT_FILENO);
-      dup2(fileno(c.output), STDERR_FILENO);
-      // Line by line, as on a terminal: what it printed just before a crash is kept.
-      std::setvbuf(stdout, nullptr, _IOLBF, 0);
+      printTo(fileno(c.output));
       ScenarioResult r = run(i);
-      std::cout.flush();
-      std::cerr.flush();
-      std::fflush(nullptr);
+      flushAll();
       save(c.result, r);
       std::fflush(c.result);
       _exit(0);  // no destructors, no atexit handlers: they are the parent's
@@ -298,11 +305,7 @@ void runInWorkers(std::size_t count, int jobs,
     int tasks[2], done[2];
     if (::pipe2(tasks, O_CLOEXEC) != 0 || ::pipe2(done, O_CLOEXEC) != 0)
       throw std::runtime_error(std::string("pipe: ") + strerror(errno));
-    std::cout.flush();
-    std::cerr.flush();
-    std::fflush(nullptr);
-    pid_t pid = fork();
-    if (pid < 0) throw std::runtime_error(std::string("fork: ") + strerror(errno));
+    const pid_t pid = forkFlushed();
     if (pid == 0) {
       for (const Worker& w : workers) {  // (the others' pipes are not this one's)
         ::close(w.tasks);
