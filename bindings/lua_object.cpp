@@ -55,21 +55,6 @@ std::string noSuchField(lua_State* L, const TypeSpec& type) {
          "' (" + names + ")";
 }
 
-// While a getter runs: checkBox of its object is a compare (lua_object.hpp); restored after,
-// also when the getter throws.
-class BoxChecked {
- public:
-  BoxChecked(const void* box, const TypeSpec& type) : saved_(checkedBox) {
-    checkedBox = {box, &type};
-  }
-  ~BoxChecked() { checkedBox = saved_; }
-  BoxChecked(const BoxChecked&) = delete;
-  BoxChecked& operator=(const BoxChecked&) = delete;
-
- private:
-  CheckedBox saved_;
-};
-
 // __index (1: the object, 2: the key). Upvalues: 1 the fields' numbers by name, 2 the methods
 // table (a binding may replace a method in it after registerType: alphabot's ping), 3 the
 // TypeSpec, 4 the metatable. A state field (the hot path: one lookup), else a method (no field
@@ -92,7 +77,6 @@ int index(lua_State* L) {
   if (lua_type(L, -1) == LUA_TNUMBER) {
     const auto i = static_cast<std::size_t>(lua_tointeger(L, -1));
     lua_pop(L, 1);
-    BoxChecked checked(lua_touserdata(L, 1), type);
     type.fields[i].push(L, 1);
     return 1;
   }
@@ -167,7 +151,7 @@ int tostring(lua_State* L) {
 
 int gc(lua_State* L) {
   const auto& type = *static_cast<const TypeSpec*>(lua_touserdata(L, lua_upvalueindex(1)));
-  if (!luaL_testudata(L, 1, type.metatable)) return 0;
+  if (!testBox(L, 1, type)) return 0;
   type.gc(L, 1);
   // What the box held is gone, but the object may be met again: a weak-keyed table keeps a
   // finalized key until the next collection. Without its type it is a plain userdata there, which
@@ -221,6 +205,8 @@ void registerType(lua_State* L, const TypeSpec& type) {
   }
   const int mt = lua_gettop(L);
   auto* spec = const_cast<TypeSpec*>(&type);
+  lua_pushvalue(L, mt);  // (testBox finds it by the type's address)
+  lua_rawsetp(L, LUA_REGISTRYINDEX, &type);
   lua_newtable(L);  // the methods
   if (type.methods) luaL_setfuncs(L, type.methods, 0);
   const int methods = lua_gettop(L);

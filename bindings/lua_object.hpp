@@ -266,31 +266,29 @@ T& newBox(lua_State* L, const TypeSpec& type, Args&&... args) {
   finishBox(L, type);
   return *made;
 }
+// The box of the object of `type` at idx, or nullptr: a full userdata whose metatable is the
+// type's — found in the registry by the TypeSpec's address (registerType), not by its name as
+// luaL_testudata does (every car field read checks its car: no string lookup).
+inline void* testBox(lua_State* L, int idx, const TypeSpec& type) {
+  if (lua_type(L, idx) != LUA_TUSERDATA || !lua_getmetatable(L, idx)) return nullptr;
+  lua_rawgetp(L, LUA_REGISTRYINDEX, &type);
+  const bool same = lua_rawequal(L, -1, -2);
+  lua_pop(L, 2);
+  return same ? lua_touserdata(L, idx) : nullptr;
+}
 template <class T>
 void destroyBox(lua_State* L, int self, const TypeSpec& type) {
-  if (void* p = luaL_testudata(L, self, type.metatable)) static_cast<T*>(p)->~T();
+  if (void* p = testBox(L, self, type)) static_cast<T*>(p)->~T();
 }
 
 // The object of `type` at idx, or nullptr.
 template <class T>
 T* test(lua_State* L, int idx, const TypeSpec& type) {
-  return static_cast<T*>(luaL_testudata(L, idx, type.metatable));
+  return static_cast<T*>(testBox(L, idx, type));
 }
-// The box __index has just checked while it runs one of its type's field getters (which check
-// their object again): that check is then a compare, not luaL_testudata's registry lookup.
-struct CheckedBox {
-  const void* box = nullptr;
-  const TypeSpec* type = nullptr;
-};
-inline thread_local CheckedBox checkedBox;
-
 // The box of the object of `type` at idx; anything else raises expectedSentence.
 inline void* checkBox(lua_State* L, int idx, const TypeSpec& type) {
-  if (checkedBox.type == &type) {
-    void* p = lua_touserdata(L, idx);
-    if (p && p == checkedBox.box) return p;
-  }
-  if (void* p = luaL_testudata(L, idx, type.metatable)) return p;
+  if (void* p = testBox(L, idx, type)) return p;
   throw LuaError(expectedSentence(L, idx, type));
 }
 // The object of `type` at idx; anything else raises expectedSentence.
