@@ -226,7 +226,17 @@ bool sendTask(int fd, std::uint64_t index) {
     if (out < 0) _exit(3);
     printTo(out);
     ::close(out);
-    ScenarioResult r = run(static_cast<std::size_t>(index));
+    // (an exception is this task's error: unwinding past here would run the parent's code)
+    ScenarioResult r;
+    try {
+      r = run(static_cast<std::size_t>(index));
+    } catch (const std::exception& e) {
+      r.status = ScenarioResult::Status::Errored;
+      r.message = e.what();
+    } catch (...) {
+      r.status = ScenarioResult::Status::Errored;
+      r.message = "an unknown exception";
+    }
     flushAll();
     std::FILE* res = std::fopen((base + ".res").c_str(), "wb");
     if (!res) _exit(3);
@@ -303,8 +313,14 @@ void runInWorkers(std::size_t count, int jobs,
   std::vector<Worker> workers;
   auto spawn = [&] {
     int tasks[2], done[2];
-    if (::pipe2(tasks, O_CLOEXEC) != 0 || ::pipe2(done, O_CLOEXEC) != 0)
+    if (::pipe2(tasks, O_CLOEXEC) != 0)
       throw std::runtime_error(std::string("pipe: ") + strerror(errno));
+    if (::pipe2(done, O_CLOEXEC) != 0) {
+      const int error = errno;
+      ::close(tasks[0]);
+      ::close(tasks[1]);
+      throw std::runtime_error(std::string("pipe: ") + strerror(error));
+    }
     const pid_t pid = forkFlushed();
     if (pid == 0) {
       for (const Worker& w : workers) {  // (the others' pipes are not this one's)
@@ -339,6 +355,23 @@ void runInWorkers(std::size_t count, int jobs,
     std::remove(file(index, ".res").c_str());
     return std::move(*r);
   };
+  // The end: the workers told there is nothing more (or, `now`, stopped), waited for; the folder
+  // gone.
+  auto finish = [&](bool now) {
+    for (Worker& w : workers) {
+      ::close(w.tasks);
+      if (now) ::kill(w.pid, SIGKILL);
+    }
+    for (Worker& w : workers) {
+      ::close(w.done);
+      int status = 0;
+      while (::waitpid(w.pid, &status, 0) < 0 && errno == EINTR) {
+      }
+    }
+    workers.clear();
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+  };
   InOrder inOrder(report);
   std::size_t next = 0;
   auto give = [&](Worker& w) {
@@ -370,9 +403,11 @@ void runInWorkers(std::size_t count, int jobs,
           give(w);
           continue;
         }
-        // Its end: it crashed (its task too) — or the pipe broke. A new worker takes over.
+        // Its end: it crashed (its task too) — or the pipe broke, and it goes (it may be alive).
+        // A new worker takes over.
         ::close(w.tasks);
         ::close(w.done);
+        ::kill(w.pid, SIGKILL);
         int status = 0;
         while (::waitpid(w.pid, &status, 0) < 0 && errno == EINTR) {
         }
@@ -392,19 +427,10 @@ void runInWorkers(std::size_t count, int jobs,
       }
     }
   } catch (...) {
-    for (Worker& w : workers) ::close(w.tasks);
-    fs::remove_all(dir);
+    finish(true);
     throw;
   }
-  for (Worker& w : workers) ::close(w.tasks);  // the end of their tasks: they exit
-  for (Worker& w : workers) {
-    ::close(w.done);
-    int status = 0;
-    while (::waitpid(w.pid, &status, 0) < 0 && errno == EINTR) {
-    }
-  }
-  std::error_code ec;
-  fs::remove_all(dir, ec);
+  finish(false);
 }
 
 }  // namespace pitwall::cli

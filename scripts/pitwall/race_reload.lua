@@ -10,7 +10,8 @@ return function(Race, shared)
   -- What the next version takes up (race.lua registers it with pitwall._carry): the session's data, each entry's data
   -- and what its driver hands over; not the options, drivers, handlers or board, which the next
   -- version brings.
-  local LEFT_BEHIND = { options = true, board = true, lastKind = true }
+  -- (_was: the places before a tick, keyed by this version's entries; the next tick makes it anew)
+  local LEFT_BEHIND = { options = true, board = true, lastKind = true, _was = true }
   local LEFT_BEHIND_ENTRY = { driver = true, ctx = true, unsubscribe = true, statusSub = true,
     contactSub = true }
   function Race:_carry()

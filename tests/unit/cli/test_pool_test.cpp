@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <set>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -109,6 +110,23 @@ TEST_CASE(
       CHECK(r.results[i].passed());
     }
   }
+  CHECK(temp.empty());
+}
+
+TEST_CASE("runInWorkers: a task that throws is its own error; its child runs the next ones") {
+  OwnTemp temp;
+  Reported r = runAll(4, 1, [](std::size_t i) -> ScenarioResult {
+    if (i == 1) throw std::runtime_error("task 1 threw");
+    ScenarioResult out;
+    out.data = std::to_string(::getpid());
+    return out;
+  });
+  REQUIRE(r.order.size() == 4);
+  CHECK(r.results[1].status == ScenarioResult::Status::Errored);
+  CHECK(r.results[1].message == "task 1 threw");
+  CHECK(r.results[0].passed());
+  CHECK(r.results[3].passed());
+  CHECK(r.results[0].data == r.results[3].data);  // the same child before and after
   CHECK(temp.empty());
 }
 
