@@ -23,6 +23,17 @@ add_custom_command(OUTPUT ${COMPLETIONS}/pitwall ${COMPLETIONS}/_pitwall
   COMMENT "shell completion (bash, zsh)")
 add_custom_target(completions ALL DEPENDS ${COMPLETIONS}/pitwall ${COMPLETIONS}/_pitwall)
 
+# The view's code editor's completions, from the binary's own API definitions (`pitwall types
+# --completions`, the same the LuaLS definitions are generated from): web/vendor/, beside the
+# editor (docs/view.md)
+file(GLOB TYPE_ANNOTATIONS CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/scripts/pitwall/types/*.lua)
+set(EDITOR_COMPLETIONS ${PITWALL_VIEW_BUILD_DIR}/vendor/pitwall-completions.json)
+add_custom_command(OUTPUT ${EDITOR_COMPLETIONS}
+  COMMAND $<TARGET_FILE:pitwall> types --completions ${EDITOR_COMPLETIONS} > /dev/null
+  DEPENDS pitwall ${CMAKE_SOURCE_DIR}/scripts/pitwall/types.lua ${TYPE_ANNOTATIONS}
+  COMMENT "the code editor's completions (pitwall types --completions)")
+add_custom_target(editor_completions ALL DEPENDS ${EDITOR_COMPLETIONS})
+
 # The man page, by help2man from the binary's --help (packaging/manpage.sh).
 find_program(HELP2MAN help2man)
 set(MANPAGE ${CMAKE_BINARY_DIR}/share/man/man1/pitwall.1)

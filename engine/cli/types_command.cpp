@@ -7,11 +7,13 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <memory>
 #include <sstream>
 
+#include "bindings/lua_json.hpp"
 #include "bindings/object_types.hpp"
 #include "engine/cli/fail.hpp"
 #include "engine/cli/options.hpp"
@@ -27,14 +29,16 @@ namespace {
 
 struct TypesOptions {
   std::string dir = ".";
-  bool check = false;  // compare with DIR/types instead of writing
-  bool luarc = true;   // write DIR/.luarc.json too
+  bool check = false;       // compare with DIR/types instead of writing
+  bool luarc = true;        // write DIR/.luarc.json too
+  std::string completions;  // write an editor's completions as JSON to this file instead
 };
 
-// The definition files, path under types/ → text; an error message when the annotations and the
-// binary disagree (the generator names every difference).
-Result<std::map<std::string, std::string>, std::string> generate() {
-  // A world as `pitwall test` makes one: the simulator (pitwall.sim) and `expect`.
+// Runs `chunk`, called with the registered object types, in a Lua world of this binary made as
+// `pitwall test` makes one (the simulator, pitwall.sim, and `expect`), and hands its one result
+// to `take`; an error message when the annotations and the binary disagree (the generator names
+// every difference) or the chunk fails.
+std::string inTypesWorld(const char* chunk, const std::function<void(lua_State*)>& take) {
   auto track = sim::namedLayout("oval");
   Session session(ClockKind::Virtual, std::move(*track), 1);
   HostOptions host;
@@ -43,24 +47,39 @@ Result<std::map<std::string, std::string>, std::string> generate() {
   session.startHost(host);
   lua_State* L = session.host().state();
   const int top = lua_gettop(L);
-  std::map<std::string, std::string> files;
   std::string error;
-  if (luaL_loadstring(L, "return require('pitwall.types').generate(...)") != LUA_OK) {
+  if (luaL_loadstring(L, chunk) != LUA_OK) {
     error = lua_tostring(L, -1);
   } else {
     lua::pushObjectTypes(L);
     if (!session.host().callCapturing(1, 1, error)) {
       error = error.substr(0, error.find("\nstack traceback:"));  // the differences, named
-    } else if (lua_istable(L, -1)) {
-      lua_pushnil(L);
-      while (lua_next(L, -2)) {
-        if (lua_type(L, -2) == LUA_TSTRING && lua_type(L, -1) == LUA_TSTRING)
-          files[lua_tostring(L, -2)] = lua_tostring(L, -1);
-        lua_pop(L, 1);
+    } else {
+      try {
+        take(L);
+      } catch (const std::exception& e) {
+        error = e.what();
       }
     }
   }
   lua_settop(L, top);
+  return error;
+}
+
+// The definition files, path under types/ → text; an error message when the annotations and the
+// binary disagree.
+Result<std::map<std::string, std::string>, std::string> generate() {
+  std::map<std::string, std::string> files;
+  std::string error =
+      inTypesWorld("return require('pitwall.types').generate(...)", [&](lua_State* L) {
+        if (!lua_istable(L, -1)) return;
+        lua_pushnil(L);
+        while (lua_next(L, -2)) {
+          if (lua_type(L, -2) == LUA_TSTRING && lua_type(L, -1) == LUA_TSTRING)
+            files[lua_tostring(L, -2)] = lua_tostring(L, -1);
+          lua_pop(L, 1);
+        }
+      });
   if (!error.empty()) return Unexpected{error};
   return files;
 }
@@ -83,6 +102,26 @@ bool writeFile(const fs::path& path, const std::string& text) {
     return false;
   }
   return true;
+}
+
+// --completions FILE: what an editor offers, from the definitions generate() makes (types.lua
+// `completions`: prefix → [{label, type, detail, info}]), as JSON.
+int writeCompletions(const fs::path& file) {
+  nlohmann::json out;
+  const std::string error = inTypesWorld(
+      "local types = require('pitwall.types') return types.completions(types.generate(...))",
+      [&](lua_State* L) {
+        lua::CopyBudget budget(L, "pitwall types --completions", std::size_t{64} << 20);
+        out =
+            lua::toJson(L, -1, {"pitwall types --completions", "the file"}, budget, "completions");
+      });
+  if (!error.empty()) return fail("types", error, 1);
+  if (!writeFile(file, out.dump(1) + "\n")) return 2;
+  std::size_t count = 0;
+  for (const auto& [prefix, list] : out.items()) count += list.size();
+  std::cout << "wrote " << count << " completions under " << out.size() << " prefixes to "
+            << file.string() << "\n";
+  return 0;
 }
 
 // DIR/.luarc.json: made when there is none; one that exists gets "types" added to its
@@ -150,6 +189,7 @@ int writeLuarc(const fs::path& dir) {
 }
 
 int types(const TypesOptions& options) {
+  if (!options.completions.empty()) return writeCompletions(options.completions);
   auto files = generate();
   if (!files) {
     return fail("types", files.error(), 1);
@@ -211,6 +251,9 @@ Command addTypesCommand(CLI::App& app) {
                 "Write nothing: exit 1 when DIR/types is not what this binary generates");
   cmd->add_flag("!--no-luarc", options->luarc,
                 "Write only DIR/types, no DIR/.luarc.json (the repository's own types/)");
+  cmd->add_option("--completions", options->completions,
+                  "Write what a code editor offers after car:, ctx., pitwall., … as JSON to FILE, "
+                  "from the same definitions, instead of DIR/types (the view's code editor)");
   return {cmd, [options] { return cli::types(*options); }};
 }
 

@@ -210,4 +210,93 @@ function types.generate(objectTypes, sources)
   return out
 end
 
+-- ---- completions for an editor ----
+
+--- The names code gives the API's objects by convention (the shipped drivers' and examples'):
+--- after `car:` an editor offers pitwall.Car's methods, after `ctx.` a driver context's fields.
+types.conventions = {
+  car = "pitwall.Car", ctx = "pitwall.drivers.Context", loc = "pitwall.localize.Tracker",
+  map = "pitwall.track.Map", piece = "pitwall.track.Piece", session = "pitwall.race.Session",
+  entry = "pitwall.race.Entry", timer = "pitwall.Timer", lap = "pitwall.laps.Lap",
+  seat = "pitwall.Seat", world = "pitwall.DriverWorld", driver = "pitwall.drivers.Driver",
+}
+
+-- The first sentence of a doc comment's lines (what a completion says beside its name).
+local function firstSentence(lines)
+  local text = table.concat(lines, " "):gsub("%s+", " "):gsub("^ ", "")
+  return text:match("^(.-%.)%s") or text
+end
+
+--- What an editor offers (issue 39's /code page) from the generated definitions `files` (path →
+--- text, types.generate's result) — the same definitions LuaLS reads, so the two never disagree:
+--- prefix → a list of {label, type, detail, info}, sorted by label. Prefixes: "NAME:" (methods)
+--- and "NAME." (fields, functions, events) for each table the definitions declare (`pitwall`,
+--- `pitwall.sim`, `expect`, a library module as `race`, `drivers`, …) and each name of
+--- types.conventions; "" for the global names.
+function types.completions(files)
+  local classes, tables = {}, {} -- class → {members}; a table's name in the files → its class
+  local function member(class, sep, m)
+    local c = classes[class] or {}
+    classes[class] = c
+    m.sep = sep
+    c[#c + 1] = m
+  end
+  local paths = sortedKeys(files)
+  for _, path in ipairs(paths) do
+    local class, doc, params = nil, {}, {}
+    for line in (files[path] .. "\n"):gmatch("(.-)\n") do
+      local cls = line:match("^%-%-%-@class ([%w_%.]+)")
+      local fname, ftype, frest = line:match("^%-%-%-@field ([%w_]+)%??%s+(%S+)%s*(.*)$")
+      local tname = line:match("^local ([%w_]+) = {}") or line:match("^([%a_][%w_%.]*) = {}")
+      local target, sep, name, args = line:match("^function ([%w_%.]+)([:%.])([%w_]+)%((.-)%) end")
+      if cls then
+        class, doc, params = cls, {}, {}
+      elseif fname and class then
+        local kind = ftype:match("^fun%(") and (fname:match("^on%u") and "event" or "function")
+          or "property"
+        member(class, ".", { label = fname, type = kind, detail = ftype, info = frest })
+      elseif tname then
+        tables[tname] = class
+        doc, params = {}, {}
+      elseif target then
+        local owner = tables[target]
+        if owner then
+          member(owner, sep, { label = name, type = sep == ":" and "method" or "function",
+            detail = "(" .. args .. ")", info = firstSentence(doc) })
+        end
+        doc, params = {}, {}
+      elseif line:match("^%-%-%-@") then
+        -- (@param, @return: in the detail's names already)
+      elseif line:match("^%-%-%-") then
+        doc[#doc + 1] = line:sub(4)
+      else
+        doc, params = {}, {}
+      end
+    end
+  end
+  local out = {}
+  local function offer(name, class)
+    for _, m in ipairs(classes[class] or {}) do
+      local prefix = name .. m.sep
+      out[prefix] = out[prefix] or {}
+      table.insert(out[prefix], { label = m.label, type = m.type, detail = m.detail, info = m.info })
+    end
+  end
+  for name, class in pairs(tables) do
+    if not name:match("^%u") then offer(name, class) end -- (Car, Context: a definition's own)
+  end
+  for name, class in pairs(types.conventions) do offer(name, class) end
+  local globals = {}
+  for name in pairs(tables) do
+    if not name:find(".", 1, true) and not name:match("^%u") then
+      globals[#globals + 1] = { label = name, type = "variable", detail = tables[name] }
+    end
+  end
+  out[""] = globals
+  for _, list in pairs(out) do
+    table.sort(list, function(a, b) return a.label < b.label end)
+  end
+  return out
+end
+
 return types

@@ -42,7 +42,7 @@ runs_from() {
   check "$name: track print and verify run (exit status)" 0 "$rc"
   contains "$name: track verify reads the print back" "all decode to the design" "$out"
   for f in scripts/pitwall/core.lua scripts/pitwall/race.lua examples/.luarc.json web/index.html \
-      web/vendor/pitwall-editor.js \
+      web/vendor/pitwall-editor.js web/vendor/pitwall-completions.json \
       types/pitwall.lua; do
     [ -f "$data/$f" ] && echo "ok: $name: share/pitwall/$f" || fail "$name: share/pitwall/$f is missing"
   done

@@ -70,6 +70,28 @@ out=$($PITWALL types "$TMP/nowhere" 2>&1); rc=$?
 check "a folder that does not exist: exit status" 2 "$rc"
 contains "names it" "$TMP/nowhere is not a folder" "$out"
 
+# 5. an editor's completions (the view's code editor, docs/view.md) come from the same
+# definitions: after car: every method of pitwall.Car in types/pitwall.lua (which step 1 checked
+# against the binary), after car. its fields and events, after ctx: the driver context's methods
+out=$($PITWALL types --completions "$TMP/completions.json" 2>&1); rc=$?
+check "types --completions exit status" 0 "$rc"
+contains "says what it wrote" "completions under" "$out"
+labels() { json "$TMP/completions.json" "' '.join(m['label'] for m in c['$1'])"; }
+defined() { grep -oE "^function $1[:.][A-Za-z_]+" "$2" | sed -E "s/^function $1[:.]//" | sort | tr '\n' ' ' | sed 's/ $//'; }
+check "car: offers pitwall.Car's methods, as defined" "$(defined Car "$SRC/types/pitwall.lua")" "$(labels car:)"
+check "ctx: offers the driver context's methods, as defined" \
+  "$(defined Context "$SRC/types/pitwall/drivers.lua")" "$(labels ctx:)"
+check "pitwall.sim. offers its functions, as defined" \
+  "$(defined pitwall.sim "$SRC/types/pitwall.lua" | tr ' ' '\n' | sort | tr '\n' ' ' | sed 's/ $//')" \
+  "$(json "$TMP/completions.json" "' '.join(sorted(m['label'] for m in c['pitwall.sim.'] if m['type'] == 'function'))")"
+contains "car. offers its fields and events" "speed" "$(labels car.)"
+contains "car. offers its events" "onTransition" "$(labels car.)"
+check "setSpeed's completion says its parameters and what it does" \
+  "(speed, accel, respectLimit) | Sets the speed (frame 0x24)." \
+  "$(json "$TMP/completions.json" "[m['detail'] + ' | ' + m['info'] for m in c['car:'] if m['label'] == 'setSpeed'][0]")"
+check "globals: pitwall among them" "pitwall" \
+  "$(json "$TMP/completions.json" "[m['label'] for m in c[''] if m['label'] == 'pitwall'][0]")"
+
 # 4. examples/ uses the repository's definitions
 check "examples/.luarc.json library" "['../types']" "$(json "$SRC/examples/.luarc.json" "c['workspace']['library']")"
 check "examples/.luarc.json runtime" "Lua 5.4" "$(json "$SRC/examples/.luarc.json" "c['runtime']['version']")"

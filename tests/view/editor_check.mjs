@@ -6,7 +6,9 @@
 //
 // Checks: /vendor/pitwall-editor.js is served as JavaScript and sets window.PitwallEditor; an
 // editor made with a driver's text shows it with Lua highlighting (a keyword coloured apart from a
-// name); typing "car:se" offers the completions given for "car:" and not those of another prefix;
+// name); with the completions the build generated from the API's definitions
+// (/vendor/pitwall-completions.json, `pitwall types --completions`), typing "car:se" offers
+// car:setSpeed with its parameters and not what another prefix has (ctx:ahead);
 // an error shown at line 2 is marked on line 2 and cleared by []; each change reaches onChange.
 // Writes EDITOR.png. One PASS/FAIL line per check; exit status 1 when a check failed, 2 on bad
 // arguments.
@@ -36,16 +38,20 @@ try {
   await page.addScriptTag({ url: "/vendor/pitwall-editor.js" });
   check("it sets window.PitwallEditor", await page.evaluate(() =>
     typeof window.PitwallEditor?.create === "function"));
+  const served = await page.evaluate(async () => {
+    const r = await fetch("/vendor/pitwall-completions.json");
+    window.completions = r.ok ? await r.json() : null;
+    return { status: r.status, type: r.headers.get("content-type"),
+      car: window.completions && (window.completions["car:"] || []).length,
+      ctx: window.completions && (window.completions["ctx:"] || []).map((m) => m.label).join(" ") };
+  });
+  check("the view serves the completions made from the API's definitions", served.status === 200 &&
+    /json/.test(served.type || "") && served.car > 5 && /ahead/.test(served.ctx), JSON.stringify(served));
   await page.evaluate((text) => {
     window.changes = [];
     window.ed = window.PitwallEditor.create(document.getElementById("ed"), {
       doc: text,
-      completions: {
-        "car:": [{ label: "setSpeed", type: "method", detail: "(speed, accel)" },
-                 { label: "changeLane", type: "method", detail: "(offset)" }],
-        "ctx:": [{ label: "ahead", type: "method" }],
-        "": [{ label: "pitwall", type: "variable" }],
-      },
+      completions: window.completions || {},
       onChange: (t) => window.changes.push(t),
     });
   }, DRIVER);
@@ -71,7 +77,8 @@ try {
     document.querySelectorAll(".cm-tooltip-autocomplete li").length > 0)) {
     const offered = await page.evaluate(() =>
       [...document.querySelectorAll(".cm-tooltip-autocomplete li")].map((li) => li.textContent));
-    check("car:'s completions, not another prefix's", offered.some((o) => o.startsWith("setSpeed")) &&
+    check("car:setSpeed with its parameters, not another prefix's (ctx:ahead)",
+      offered.some((o) => o.startsWith("setSpeed") && o.includes("(speed, accel, respectLimit)")) &&
       !offered.some((o) => o.startsWith("ahead")), offered.join(" | "));
   }
   check("each change reaches onChange", await page.evaluate(() =>
