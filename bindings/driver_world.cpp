@@ -110,14 +110,11 @@ void DriverWorld::close() {
   retire();
 }
 
-bool DriverWorld::reload() {
-  if (closed_) return false;
-  retire();
-  failure_.clear();
-  spent_.clear();
-  spentSum_ = 0;
-  ++version_;
-  if (race_.isShutDown()) return false;
+std::unique_ptr<ScriptHost> DriverWorld::open(std::string& why, const std::shared_ptr<bool>& live) {
+  if (race_.isShutDown()) {
+    why = "the run is ending";
+    return nullptr;
+  }
   HostOptions o;
   o.memory_limit = limits_.memory;
   o.budget = limits_.budget;
@@ -125,28 +122,89 @@ bool DriverWorld::reload() {
   o.library_frames = race_.options().library_frames;
   o.driverCar = &car_;
   std::weak_ptr<bool> alive = alive_;
-  o.driverFailed = [this, alive](const std::string& why) {
-    if (!alive.expired()) fail(why);
+  auto loading = std::make_shared<std::string>();
+  o.driverFailed = [this, alive, live, loading](const std::string& failure) {
+    if (alive.expired()) return;
+    if (*live)
+      fail(failure);
+    else if (loading->empty())
+      *loading = failure;
   };
+  std::unique_ptr<ScriptHost> host;
   try {
-    host_ = std::make_unique<ScriptHost>(race_.loop(), race_.fleet(), nullptr, std::move(o));
+    host = std::make_unique<ScriptHost>(race_.loop(), race_.fleet(), nullptr, std::move(o));
   } catch (const std::exception& e) {
-    fail(std::string("its world did not open: ") + e.what());
+    why = std::string("its world did not open: ") + e.what();
+    return nullptr;
+  }
+  // (its library failed: its memory cap, say)
+  bool ok = loading->empty();
+  if (ok) {
+    if (auto loaded = host->loadFile(file_); !loaded) {
+      *loading = "its file does not load: " + loaded.error();
+      ok = false;
+    }
+  }
+  if (ok) {
+    lua_State* L = host->state();
+    // The main chunk: what it returns is the driver (a class or an instance).
+    ok = host->call(0, 1, "main chunk", name_);
+    if (ok) {
+      lua_pushcfunction(L, setupIn);
+      lua_insert(L, -2);
+      lua_pushstring(L, name_.c_str());
+      ok = host->call(2, 0, "driver", name_);
+    }
+    ok = ok && loading->empty();
+  }
+  if (!ok) {
+    why = loading->empty() ? "its driver did not set up" : *loading;
+    host->detach();
+    host->shutDown();
+    retired_.push_back(std::move(host));  // (freed on a later turn, as a replaced world is)
+    retire();
+    return nullptr;
+  }
+  return host;
+}
+
+bool DriverWorld::reload() {
+  if (closed_) return false;
+  retire();
+  failure_.clear();
+  spent_.clear();
+  spentSum_ = 0;
+  ++version_;
+  auto live = std::make_shared<bool>(false);
+  std::string why;
+  host_ = open(why, live);
+  if (!host_) {
+    if (!race_.isShutDown()) fail(why);
     return false;
   }
-  if (!failure_.empty()) return false;  // its library failed (its memory cap, say)
-  if (auto loaded = host_->loadFile(file_); !loaded) {
-    fail("its file does not load: " + loaded.error());
-    return false;
-  }
-  lua_State* L = host_->state();
-  // The main chunk: what it returns is the driver (a class or an instance).
-  if (!host_->call(0, 1, "main chunk", name_)) return false;
-  lua_pushcfunction(L, setupIn);
-  lua_insert(L, -2);
-  lua_pushstring(L, name_.c_str());
-  if (!host_->call(2, 0, "driver", name_)) return false;
+  *live = true;
   return failure_.empty();
+}
+
+bool DriverWorld::tryReload(std::string& why) {
+  if (closed_) {
+    why = "the driver world is closed (its session ended)";
+    return false;
+  }
+  auto live = std::make_shared<bool>(false);
+  auto made = open(why, live);
+  if (!made) {
+    why = why.substr(0, why.find('\n'));  // the sentence (the log keeps the traceback)
+    return false;
+  }
+  retire();
+  host_ = std::move(made);
+  *live = true;
+  failure_.clear();
+  spent_.clear();
+  spentSum_ = 0;
+  ++version_;
+  return true;
 }
 
 bool DriverWorld::call(lua_State* from, const char* method, int first) {

@@ -40,6 +40,11 @@ class DriverWorld {
   // Loads the file again into a new world: the old one goes (its car keeps its last speed until
   // the director calls the new one). False, and failure() set, when the new one fails.
   bool reload();
+  // Loads the file again into a new world that replaces the one driving only when it loads and
+  // sets its driver up (the code editor's save, issue 39): true, its version +1 (the director
+  // starts it, and a driver that was out is back); else false, `why` the engine's sentence
+  // ("alice.lua:3: …"), and the world driving goes on as it was.
+  bool tryReload(std::string& why);
   // Shuts the world down for good (its session ended): it follows no car any more and is freed on
   // a later turn of the loop; later calls and reloads do nothing. Its car is left as it is.
   void close();
@@ -52,6 +57,9 @@ class DriverWorld {
 
  private:
   void fail(const std::string& why);
+  // A new world of the file with its driver set up, or nullptr and `why`. Its failures go to
+  // fail() once *live is true; before, to `why`.
+  std::unique_ptr<ScriptHost> open(std::string& why, const std::shared_ptr<bool>& live);
   // The world now (if any) retired: freed on a later turn (it may be on the stack).
   void retire();
   // The CPU time a call used: failed past its share (real time, DriverLimits::share).

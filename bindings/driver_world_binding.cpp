@@ -4,7 +4,9 @@
 // of drivers.world (scripts/pitwall/drivers.lua), which a race director calls like any driver.
 // A driver world object: world:call(method, …) → true, or false once the world has failed (the
 // values after the method are copied into the world: drivers.lua's send, driver_world.lua's call);
-// world:reload() → true when the new world loaded; world:close() ends it for good (its session
+// world:reload() → true when the new world loaded; world:tryReload() → true, or false and why
+// (the world driving goes on: a new one replaces it only when it loads); world:close() ends it
+// for good (its session
 // ended); fields failure (why it is out, nil while it
 // drives), file, version (1, +1 a reload), cpu (s its calls used).
 #include <filesystem>
@@ -49,6 +51,17 @@ int reload(lua_State* L) {
   return 1;
 }
 
+int tryReload(lua_State* L) {
+  std::string why;
+  if (worldAt(L, 1).tryReload(why)) {
+    lua_pushboolean(L, 1);
+    return 1;
+  }
+  lua_pushboolean(L, 0);
+  lua_pushlstring(L, why.data(), why.size());
+  return 2;
+}
+
 int close(lua_State* L) {
   worldAt(L, 1).close();
   return 0;
@@ -75,6 +88,7 @@ const lua::Field kFields[] = {
 const lua::TypeSpec& worldType() {
   static const luaL_Reg methods[] = {{"call", lua::guarded<call>},
                                      {"reload", lua::guarded<reload>},
+                                     {"tryReload", lua::guarded<tryReload>},
                                      {"close", lua::guarded<close>},
                                      {nullptr, nullptr}};
   static const lua::TypeSpec type{

@@ -188,11 +188,11 @@ function pitwall.writeResults(rows, columns, path) end
 ---@field version integer 1 for its first world, +1 for each reload
 local DriverWorld = {}
 
----Calls the driver's `method` with `data` copied in (what drivers.world sends); false once the world has failed.
+---Calls the driver's `method` with the values after it copied in (what drivers.world sends: the car, its limit and piece limits, the period, the race view or nil, whether that is the one sent last, the map or nil); false once the world has failed.
 ---@param method "start"|"update"|"finish"|"waiting"
----@param data table
+---@param ... any
 ---@return boolean ok
-function DriverWorld:call(method, data) end
+function DriverWorld:call(method, ...) end
 
 ---Ends the world for good (its session ended, as the race director does at the end): it follows no car any more; later calls return false. Its car is left as it is.
 function DriverWorld:close() end
@@ -200,6 +200,11 @@ function DriverWorld:close() end
 ---Loads the file again into a new world, as a save does with --watch; false when the new one fails (the car is out).
 ---@return boolean loaded
 function DriverWorld:reload() end
+
+---Loads the file again into a new world that replaces the one driving only when it loads and sets its driver up (a code editor's save): true, its version +1 (the director starts it; a driver that was out is back); else false and the engine's sentence ("alice.lua:3: …"), the world driving going on as it was.
+---@return boolean replaced
+---@return string? why
+function DriverWorld:tryReload() end
 
 ---A human driver's seat (docs/racing.md "Human drivers"): --humans N opens cars 1..N; a phone (/drive), a gamepad, the keyboard or a script holds it.
 ---@class pitwall.Seat
