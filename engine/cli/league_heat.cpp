@@ -20,6 +20,16 @@ local race = require "pitwall.race"
 local spec = LEAGUE
 local cars = {}
 for i = 1, #spec.files do cars[i] = sim.addCar {} end
+-- spec.trace: car 1's lap, lap distance and speed as the simulator knows them, every 0.05 s
+local trace
+if spec.trace then
+  trace = {}
+  pitwall.every(0.05, function()
+    local t = sim.truth(cars[1])
+    trace[#trace + 1] = { time = pitwall.now(), lap = t.laps, distance = t.lapDistance,
+      speed = t.speed }
+  end)
+end
 local session = race[spec.qualifying and "qualifying" or "laps"] {
   laps = spec.laps, drivers = spec.files, board = false, title = spec.title,
   seconds = spec.cap, finishTimeout = 30 }
@@ -35,7 +45,7 @@ for _, r in ipairs(session:results()) do
     reason = r.reason, finished = r.finished, laps = r.laps, bestLap = r.bestLap,
     totalTime = r.totalTime, lapTimes = times }
 end
-spec.results = rows
+spec.results = trace and { rows = rows, trace = trace } or rows
 pitwall.stop()
 )";
 
@@ -55,6 +65,8 @@ void pushSpec(lua_State* L, const HeatSpec& spec, double cap) {
   lua_setfield(L, -2, "cap");
   lua_pushlstring(L, spec.title.data(), spec.title.size());
   lua_setfield(L, -2, "title");
+  lua_pushboolean(L, spec.trace);
+  lua_setfield(L, -2, "trace");
   lua_setglobal(L, "LEAGUE");
 }
 

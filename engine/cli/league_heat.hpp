@@ -22,6 +22,10 @@ struct HeatSpec {
   std::uint64_t seed = 1;
   std::string title;
   DriverLimits limits;
+  // `data` is {"rows": [...], "trace": [{time, lap, distance, speed}]} instead: car 1's laps
+  // counted, lap distance (mm) and speed (mm/s) as the simulator knows them, every 0.05 s
+  // (pitwall try)
+  bool trace = false;
 };
 
 ScenarioResult runHeat(const HeatSpec& spec);

@@ -30,12 +30,12 @@ int main(int argc, char** argv) {
   app.add_flag("--version", version, "The version, the libraries, where the data is");
 
   const std::vector<cli::Command> commands = {
-      cli::addRunCommand(app),       cli::addReplCommand(app),   cli::addBridgeCommand(app),
-      cli::addViewCommand(app),      cli::addScanCommand(app),   cli::addEmulateCommand(app),
-      cli::addSimRobotCommand(app),  cli::addTestCommand(app),   cli::addLeagueCommand(app),
-      cli::addStandingsCommand(app), cli::addReplayCommand(app), cli::addTrackCommand(app),
-      cli::addDecodeCommand(app),    cli::addEncodeCommand(app), cli::addTypesCommand(app),
-      cli::addCompletionCommand(app)};
+      cli::addRunCommand(app),      cli::addReplCommand(app),      cli::addBridgeCommand(app),
+      cli::addViewCommand(app),     cli::addScanCommand(app),      cli::addEmulateCommand(app),
+      cli::addSimRobotCommand(app), cli::addTestCommand(app),      cli::addLeagueCommand(app),
+      cli::addTryCommand(app),      cli::addStandingsCommand(app), cli::addReplayCommand(app),
+      cli::addTrackCommand(app),    cli::addDecodeCommand(app),    cli::addEncodeCommand(app),
+      cli::addTypesCommand(app),    cli::addCompletionCommand(app)};
 
   // --version anywhere on the line answers before anything else is checked
   // (`pitwall run --version` has no script to ask for).

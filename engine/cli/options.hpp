@@ -28,6 +28,7 @@ Command addEmulateCommand(CLI::App& app);
 Command addSimRobotCommand(CLI::App& app);
 Command addTestCommand(CLI::App& app);
 Command addLeagueCommand(CLI::App& app);     // `league DIR|FILES…` (docs/league.md)
+Command addTryCommand(CLI::App& app);        // `try FILE`: a driver alone in the simulator
 Command addStandingsCommand(CLI::App& app);  // `standings` (docs/league.md "Standings")
 Command addReplayCommand(CLI::App& app);
 Command addTrackCommand(CLI::App& app);  // `track show`, `list`, `print`, `verify`
