@@ -23,6 +23,13 @@ struct MqttSettings {
   std::size_t maxPayload = 64 * 1024;
 };
 
+// --driver-memory MB and --driver-budget S: each driver world's limits (docs/drivers.md), for run,
+// league and try (addDriverLimits).
+struct DriverLimitOptions {
+  int driverMemory = 64;
+  double driverBudget = 0.05;
+};
+
 // Where the cars of a run or a REPL come from: the simulator's starting grid, or real cars over
 // Bluetooth LE through BlueZ (docs/bluetooth.md).
 struct CarSource {
@@ -70,11 +77,9 @@ struct RunOptions : CarSource {
   // has not ended the run is stopped and the run ends with kExitCapped; none: the default cap
   std::optional<double> fastCap;
   // --driver CAR=FILE (repeatable): the race's driver of car number CAR is FILE, in a Lua world of
-  // its own; --driver-memory MB and --driver-budget S are each such world's limits
-  // (docs/drivers.md).
+  // its own, with the limits of `limits` (docs/drivers.md).
   std::vector<std::string> drivers;
-  int driverMemory = 64;
-  double driverBudget = 0.05;
+  DriverLimitOptions limits;
   // --db FILE: the standings database its races are kept in (default: standings::defaultPath());
   // --no-db: none (docs/league.md "Standings")
   std::string db;

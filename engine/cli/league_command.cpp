@@ -50,8 +50,7 @@ struct LeagueOptions {
   std::uint64_t seed = 1;
   std::string results;
   std::string report;
-  int driverMemory = 64;
-  double driverBudget = 0.05;
+  DriverLimitOptions limits;
   std::string db;     // --db FILE: the standings database (default: standings::defaultPath())
   bool noDb = false;  // --no-db: keep nothing
   std::string shard;  // K/N: the heats of shard K of N only
@@ -385,8 +384,8 @@ int league(const LeagueOptions& o) {
   const int perHeat = std::min(o.cars, n);
   const int jobs = std::max(1, o.jobs);
   DriverLimits limits;
-  limits.memory = static_cast<std::size_t>(o.driverMemory) << 20;
-  limits.budget = std::chrono::milliseconds(std::llround(o.driverBudget * 1000));
+  limits.memory = static_cast<std::size_t>(o.limits.driverMemory) << 20;
+  limits.budget = std::chrono::milliseconds(std::llround(o.limits.driverBudget * 1000));
   auto spec = [&](std::vector<std::string> files, bool qualifying, std::uint64_t seed,
                   std::string title) {
     HeatSpec s;
@@ -569,11 +568,7 @@ Command addLeagueCommand(CLI::App& app) {
   cmd->add_option("--report", o->report, "Write an HTML report (standings, heats, charts)");
   addStandingsOptions(cmd, o->db, o->noDb, "the league");
   addStandingsOptions(merge, o->db, o->noDb, "the merged league");
-  cmd->add_option("--driver-memory", o->driverMemory, "MB each driver world may hold (default 64)")
-      ->check(CLI::Range(1, 4096));
-  cmd->add_option("--driver-budget", o->driverBudget,
-                  "Seconds of CPU one call into a driver world may take (default 0.05)")
-      ->check(CLI::Range(0.001, 10.0));
+  addDriverLimits(cmd, o->limits, "each driver world");
   return {cmd, [o] { return league(*o); }};
 }
 

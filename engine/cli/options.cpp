@@ -176,4 +176,14 @@ const std::vector<std::string>& viewHosts() {
   return g_viewHosts;
 }
 
+void addDriverLimits(CLI::App* cmd, DriverLimitOptions& limits, const std::string& each) {
+  cmd->add_option("--driver-memory", limits.driverMemory,
+                  "MB " + each + " may hold (default 64); past it the driver is out")
+      ->check(CLI::Range(1, 4096));
+  cmd->add_option("--driver-budget", limits.driverBudget,
+                  "Seconds of CPU one call into " + each +
+                      " may take (default 0.05); past it the driver is out")
+      ->check(CLI::Range(0.001, 10.0));
+}
+
 }  // namespace pitwall::cli

@@ -55,5 +55,8 @@ void takeViews();
 const std::vector<std::string>& viewHosts();
 // --humans N, --gamepads, --keyboard (run): the seats of human drivers and what holds them.
 void addHumans(CLI::App* cmd, CarSource& source);
+// --driver-memory MB and --driver-budget S (run, league, try); `each` names the worlds in the help
+// ("each driver world", "the driver world").
+void addDriverLimits(CLI::App* cmd, DriverLimitOptions& limits, const std::string& each);
 
 }  // namespace pitwall::cli

@@ -171,8 +171,9 @@ int run(const RunOptions& given) {
   host.view = session.viewFeed();
   host.seats = session.seats();
   host.driverFiles = *drivers;
-  host.driverLimits.memory = static_cast<std::size_t>(options.driverMemory) << 20;
-  host.driverLimits.budget = std::chrono::milliseconds(std::llround(options.driverBudget * 1000));
+  host.driverLimits.memory = static_cast<std::size_t>(options.limits.driverMemory) << 20;
+  host.driverLimits.budget =
+      std::chrono::milliseconds(std::llround(options.limits.driverBudget * 1000));
   host.driverLimits.watch = options.watch;
   if (final)
     host.leagueFinal =
@@ -305,13 +306,7 @@ Command addRunCommand(CLI::App& app) {
                   "many as its heats had)")
       ->check(CLI::Range(2, 64))
       ->needs(finalOption);
-  cmd->add_option("--driver-memory", run->driverMemory,
-                  "MB each driver world may hold (default 64); past it the driver is out")
-      ->check(CLI::Range(1, 4096));
-  cmd->add_option("--driver-budget", run->driverBudget,
-                  "Seconds of CPU one call into a driver world may take (default 0.05); past it "
-                  "the driver is out")
-      ->check(CLI::Range(0.001, 10.0));
+  addDriverLimits(cmd, run->limits, "each driver world");
   // A prompt needs the real clock: virtual time would race ahead while the operator types.
   replFlag->excludes(fastFlag);
   // Hands on a gamepad or the keys drive in real time; the keys are the prompt's with --repl.

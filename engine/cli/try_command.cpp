@@ -27,8 +27,7 @@ struct TryOptions {
   std::string sensor = "real";
   std::uint64_t seed = 1;
   bool json = false;
-  int driverMemory = 64;
-  double driverBudget = 0.05;
+  DriverLimitOptions limits;
 };
 
 std::string seconds(double s) {
@@ -70,8 +69,8 @@ int tryDriver(const TryOptions& o) {
   spec.sensor = o.sensor;
   spec.seed = o.seed;
   spec.title = "Try";
-  spec.limits.memory = static_cast<std::size_t>(o.driverMemory) << 20;
-  spec.limits.budget = std::chrono::milliseconds(std::llround(o.driverBudget * 1000));
+  spec.limits.memory = static_cast<std::size_t>(o.limits.driverMemory) << 20;
+  spec.limits.budget = std::chrono::milliseconds(std::llround(o.limits.driverBudget * 1000));
   spec.trace = true;
   ScenarioResult r = runHeat(spec);
   if (!r.passed()) return fail("try", r.message, 1);
@@ -145,11 +144,7 @@ Command addTryCommand(CLI::App& app) {
   cmd->add_flag("--json", o->json,
                 "One JSON object: laps, best, status, reason, and the speed trace (time, lap, "
                 "distance, speed every 0.05 s)");
-  cmd->add_option("--driver-memory", o->driverMemory, "MB the driver world may hold (default 64)")
-      ->check(CLI::Range(1, 4096));
-  cmd->add_option("--driver-budget", o->driverBudget,
-                  "Seconds of CPU one call into the driver world may take (default 0.05)")
-      ->check(CLI::Range(0.001, 10.0));
+  addDriverLimits(cmd, o->limits, "the driver world");
   return {cmd, [o] { return tryDriver(*o); }};
 }
 

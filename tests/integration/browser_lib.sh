@@ -52,6 +52,14 @@ artifacts() {
   rm -f "$ART"/$1
 }
 
+# start_drive_race: tests/view/drive_race.lua in real time, its view on a free port of loopback
+# with two seats (--humans 2 --cars 2, 300 s); its output in $TMP/out and $TMP/err, $pid the run.
+start_drive_race() {
+  "$PITWALL" run "$SRC/tests/view/drive_race.lua" --view 127.0.0.1:0 --humans 2 --cars 2 \
+    --duration 300 > "$TMP/out" 2> "$TMP/err" &
+  pid=$!
+}
+
 # await_view STDERR [NAME]: until pitwall's "view: http://127.0.0.1:PORT/" line is in the file
 # STDERR (at most 20 s), then $url is that address. False, with a FAIL and the file shown, when it
 # never came.

@@ -14,9 +14,7 @@ source "$(dirname "$0")/browser_lib.sh"
 install_checks drive_browser_check drive_check.mjs
 artifacts 'drive-*.png'
 
-"$PITWALL" run "$SRC/tests/view/drive_race.lua" --view 127.0.0.1:0 --humans 2 --cars 2 \
-  --duration 300 > "$TMP/out" 2> "$TMP/err" &
-pid=$!
+start_drive_race
 await_view "$TMP/err" || finish
 
 # GET /drive is the controller page

@@ -9,9 +9,7 @@ source "$(dirname "$0")/browser_lib.sh"
 install_checks view_editor_check editor_check.mjs
 artifacts 'editor*.png'
 
-"$PITWALL" run "$SRC/tests/view/drive_race.lua" --view 127.0.0.1:0 --humans 2 --cars 2 \
-  --duration 300 > "$TMP/out" 2> "$TMP/err" &
-pid=$!
+start_drive_race
 if await_view "$TMP/err" editor; then
   timeout -k 5 120 node "$CHECK/editor_check.mjs" "$url" "$ART/editor.png" --timeout 30 \
     --chromium "$CHROMIUM"
