@@ -339,12 +339,11 @@ void runInWorkers(std::size_t count, int jobs,
     return dir + "/" + std::to_string(index) + ext;
   };
   // What a task left: its output, and its result or (none) what its worker's end says.
-  auto collect = [&](std::size_t index, std::optional<ScenarioResult> r, int status) {
-    if (!r) {
-      if (std::FILE* res = std::fopen(file(index, ".res").c_str(), "rb")) {
-        r = load(res);
-        std::fclose(res);
-      }
+  auto collect = [&](std::size_t index, int status) {
+    std::optional<ScenarioResult> r;
+    if (std::FILE* res = std::fopen(file(index, ".res").c_str(), "rb")) {
+      r = load(res);
+      std::fclose(res);
     }
     if (!r) r = crashed(status);
     if (std::FILE* out = std::fopen(file(index, ".out").c_str(), "rb")) {
@@ -399,7 +398,7 @@ void runInWorkers(std::size_t count, int jobs,
         std::uint64_t index = 0;
         if (moveIndex(w.done, index, false) && w.task && index == *w.task) {
           w.task.reset();
-          inOrder.add(static_cast<std::size_t>(index), collect(index, std::nullopt, 0));
+          inOrder.add(static_cast<std::size_t>(index), collect(index, 0));
           give(w);
           continue;
         }
@@ -411,17 +410,12 @@ void runInWorkers(std::size_t count, int jobs,
         int status = 0;
         while (::waitpid(w.pid, &status, 0) < 0 && errno == EINTR) {
         }
-        std::optional<std::size_t> lost = w.task;
-        w.pid = -1;
-        w.tasks = w.done = -1;
-        w.task.reset();
-        if (lost) inOrder.add(*lost, collect(*lost, std::nullopt, status == 0 ? 1 << 8 : status));
+        const std::optional<std::size_t> lost = w.task;
+        workers.erase(workers.begin() + static_cast<std::ptrdiff_t>(k));
+        if (lost) inOrder.add(*lost, collect(*lost, status));
         if (next < count) {
-          workers.erase(workers.begin() + static_cast<std::ptrdiff_t>(k));
           spawn();
           give(workers.back());
-        } else {
-          workers.erase(workers.begin() + static_cast<std::ptrdiff_t>(k));
         }
         break;  // (the list changed: poll again)
       }

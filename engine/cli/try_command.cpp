@@ -80,7 +80,11 @@ int tryDriver(const TryOptions& o) {
   const nlohmann::json& row = data["rows"][0];
   const nlohmann::json& trace = data["trace"];
   const std::string name = fs::path(o.file).filename().string();
-  const bool out = row.value("status", "") != "finished" && row.contains("reason");
+  // not finished: out (a failure, its reason), or still on its way when the heat's cap came
+  const bool out = row.value("status", "") != "finished";
+  const std::string why = row.contains("reason") && row["reason"].is_string()
+                              ? row["reason"].get<std::string>()
+                              : "it did not finish its laps (" + row.value("status", "?") + ")";
   std::vector<double> laps;
   for (const auto& t : row["lapTimes"])
     if (t.is_number()) laps.push_back(t.get<double>());
@@ -118,8 +122,8 @@ int tryDriver(const TryOptions& o) {
               << "\n";
   }
   if (out) {
-    std::cout << "  out after " << laps.size() << (laps.size() == 1 ? " lap: " : " laps: ")
-              << row["reason"].get<std::string>() << "\n";
+    std::cout << "  out after " << laps.size() << (laps.size() == 1 ? " lap: " : " laps: ") << why
+              << "\n";
     return 1;
   }
   return 0;

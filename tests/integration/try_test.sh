@@ -1,7 +1,7 @@
 # pitwall try FILE (docs/cli.md): a driver file alone in the simulator, virtual time, real sensor
 # model — its laps, its best and its speed along the lap, as text or one JSON object whose trace
 # follows the car (distance within a lap growing, speed within the car's range); a driver that
-# fails is out with the engine's sentence (exit 1); a file that is not there is a usage error.
+# fails is out with the engine's sentence (exit 1), as is one that never finishes; a file that is not there is a usage error.
 source "$(dirname "$0")/lib.sh"
 D="$SRC/tests/integration/drivers"
 
@@ -37,6 +37,11 @@ printf 'while true do end\n' >"$TMP/loop.lua"
 out=$("$PITWALL" try "$TMP/loop.lua" -q 2>"$TMP/err"); rc=$?
 check "a looping driver: exit status" 1 "$rc"
 contains "it is out on its budget" "still running after 50 ms" "$out"
+
+printf 'return { update = function(self, car) car:setSpeed(0) end }\n' >"$TMP/stand.lua"
+out=$("$PITWALL" try "$TMP/stand.lua" --laps 1 -q 2>"$TMP/err"); rc=$?
+check "a driver that never finishes (no failure): exit status" 1 "$rc"
+contains "it says so" "out after 0 laps: it did not finish its laps (DNF)" "$out"
 
 out=$("$PITWALL" try "$TMP/missing.lua" 2>&1); rc=$?
 check "a file that is not there: exit status" 2 "$rc"
