@@ -241,36 +241,35 @@ function types.completions(files)
     m.sep = sep
     c[#c + 1] = m
   end
-  local paths = sortedKeys(files)
-  for _, path in ipairs(paths) do
-    local class, doc, params = nil, {}, {}
+  for _, path in ipairs(sortedKeys(files)) do
+    local class, doc = nil, {}
     for line in (files[path] .. "\n"):gmatch("(.-)\n") do
       local cls = line:match("^%-%-%-@class ([%w_%.]+)")
       local fname, ftype, frest = line:match("^%-%-%-@field ([%w_]+)%??%s+(%S+)%s*(.*)$")
       local tname = line:match("^local ([%w_]+) = {}") or line:match("^([%a_][%w_%.]*) = {}")
       local target, sep, name, args = line:match("^function ([%w_%.]+)([:%.])([%w_]+)%((.-)%) end")
       if cls then
-        class, doc, params = cls, {}, {}
+        class, doc = cls, {}
       elseif fname and class then
         local kind = ftype:match("^fun%(") and (fname:match("^on%u") and "event" or "function")
           or "property"
         member(class, ".", { label = fname, type = kind, detail = ftype, info = frest })
       elseif tname then
         tables[tname] = class
-        doc, params = {}, {}
+        doc = {}
       elseif target then
         local owner = tables[target]
         if owner then
           member(owner, sep, { label = name, type = sep == ":" and "method" or "function",
             detail = "(" .. args .. ")", info = firstSentence(doc) })
         end
-        doc, params = {}, {}
+        doc = {}
       elseif line:match("^%-%-%-@") then
         -- (@param, @return: in the detail's names already)
       elseif line:match("^%-%-%-") then
         doc[#doc + 1] = line:sub(4)
       else
-        doc, params = {}, {}
+        doc = {}
       end
     end
   end
