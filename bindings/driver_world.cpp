@@ -82,9 +82,32 @@ DriverWorld::DriverWorld(ScriptHost& race, AnkiCar& car, std::string file, Drive
   });
   reload();
   if (limits_.watch) watch();
+  // a desk's file (--code): its saves and the teacher's reset reach this world while it drives
+  if (auto* room = race_.options().classroom;
+      room && std::filesystem::path(file_).lexically_normal() ==
+                  room->driverFile(car_.identity().number).lexically_normal()) {
+    desk_ = room;
+    room->attach(car_.identity().number, this);
+  }
+}
+
+void DriverWorld::leaveDesk() {
+  if (desk_) desk_->detach(car_.identity().number, this);
+  desk_ = nullptr;
+}
+
+bool DriverWorld::restart(std::string& why) {
+  if (closed_) {
+    why = "the driver world is closed (its session ended)";
+    return false;
+  }
+  if (reload()) return true;
+  why = failure_.substr(0, failure_.find('\n'));
+  return false;
 }
 
 DriverWorld::~DriverWorld() {
+  leaveDesk();
   *alive_ = false;
   if (sweep_) race_.loop().cancel(sweep_);
 }
@@ -106,6 +129,7 @@ void DriverWorld::retire() {
 }
 
 void DriverWorld::close() {
+  leaveDesk();
   closed_ = true;
   retire();
 }

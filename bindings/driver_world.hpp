@@ -19,16 +19,20 @@
 #include <string>
 
 #include "bindings/script_host.hpp"
+#include "engine/classroom/classroom.hpp"
 #include "engine/core/file_watch.hpp"
 
 namespace pitwall {
 
-class DriverWorld {
+// A desk's driver of the code page's classroom too (engine/classroom): while its file is a desk's
+// and its session on, a student's save reloads it (trySave: tryReload) and the teacher's reset
+// starts it again (restart: reload).
+class DriverWorld : public classroom::DeskDriver {
  public:
   // `race` is the director's world (its loop, fleet, seed and traceback style are the world's
   // too); `file` the driver file. Loads it (failure() says whether it did).
   DriverWorld(ScriptHost& race, AnkiCar& car, std::string file, DriverLimits limits);
-  ~DriverWorld();
+  ~DriverWorld() override;
   DriverWorld(const DriverWorld&) = delete;
   DriverWorld& operator=(const DriverWorld&) = delete;
 
@@ -50,6 +54,11 @@ class DriverWorld {
   void close();
 
   const std::string& failure() const { return failure_; }
+  // the classroom's (classroom::DeskDriver)
+  bool trySave(std::string& why) override { return tryReload(why); }
+  bool restart(std::string& why) override;
+  int drivingVersion() const override { return version_; }
+  std::string whyOut() const override { return failure_; }
   const std::string& file() const { return file_; }
   AnkiCar& car() { return car_; }
   int version() const { return version_; }         // 1 for the first world, +1 for each reload
@@ -65,6 +74,7 @@ class DriverWorld {
   // The CPU time a call used: failed past its share (real time, DriverLimits::share).
   void charge(double cpu);
   void watch();
+  void leaveDesk();
 
   ScriptHost& race_;
   AnkiCar& car_;
@@ -82,6 +92,7 @@ class DriverWorld {
   std::deque<double> spent_;  // the CPU time of its last calls (DriverLimits::shareCalls)
   double spentSum_ = 0, cpuTotal_ = 0;
   std::unique_ptr<FileWatch> watch_;
+  classroom::Classroom* desk_ = nullptr;  // the classroom whose desk it drives, if any
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };
 

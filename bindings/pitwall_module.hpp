@@ -21,4 +21,6 @@ void openSeatModule(ScriptHost& host);
 // pitwall.driverFiles and pitwall._driverWorld (driver_world_binding.cpp): driver files, each in
 // a Lua world of its own (docs/drivers.md).
 void openDriverWorlds(ScriptHost& host);
+// pitwall.classroom (classroom_binding.cpp): the view's code page's classroom (--code).
+void openClassroomModule(ScriptHost& host);
 }  // namespace pitwall

@@ -39,6 +39,9 @@ class Seats;
 namespace view {
 class Feed;
 }
+namespace classroom {
+class Classroom;
+}
 
 // The simulator as scripts see it (pitwall.sim): present for simulator runs and scenario tests.
 struct SimSession {
@@ -108,6 +111,9 @@ struct HostOptions {
   // of its own) and those worlds' limits (--driver-memory, --driver-budget, --watch).
   std::map<int, std::string> driverFiles;
   DriverLimits driverLimits;
+  // --code: the classroom of the view's code page (docs/classroom.md): a driver world of a desk's
+  // file attaches to its desk (a save reloads it), and pitwall.classroom is there.
+  classroom::Classroom* classroom = nullptr;
   // --league-final: the league's final this run races (pitwall.final, read by the shipped
   // scripts/pitwall/league_final.lua; docs/league.md "The final"); driverFiles holds its files.
   struct LeagueFinal {

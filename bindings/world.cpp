@@ -276,6 +276,7 @@ void openWorld(ScriptHost& host) {
     openViewModule(host);
     openSeatModule(host);
     openDriverWorlds(host);
+    openClassroomModule(host);
   }
   for (AnkiCar* car : host.fleet().cars()) host.cars().bind(*car);
   openLuaLibrary(host, lib);

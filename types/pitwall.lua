@@ -54,6 +54,7 @@ function Stdout:flush() end
 
 ---The engine: cars, timers, tasks, the clock (docs/lua-api.md).
 ---@class pitwall
+---@field classroom pitwall.classroom the view's code page's classroom (--code FOLDER; docs/classroom.md)
 ---@field driverFiles table<integer, string> the run's --driver CAR=FILE: car number → driver file, each raced in a Lua world of its own (docs/drivers.md)
 ---@field persist table survives hot reloads: plain data and cars, copied into each new version
 ---@field reloads integer how many times the script was reloaded: 0 in the first version
@@ -250,6 +251,21 @@ function pitwall.view.race(state) end
 ---Draws a pitwall.track map (real cars; the simulator's layout stays).
 ---@param map pitwall.track.Map
 function pitwall.view.track(map) end
+
+---The classroom of the view's code page (--code FOLDER, docs/classroom.md): a desk for each
+---car, each desk's driver file pitwall.driverFiles[car]. Without --code it is not active.
+---@class pitwall.classroom
+---@field active boolean true when the run has a classroom (--code)
+---@field folder string? the desks' folder (absolute); nil without --code
+pitwall.classroom = {}
+
+---The desks in car order (empty without --code).
+---@return {car: integer, student: string, joined: boolean, saves: integer}[]
+function pitwall.classroom.desks() end
+
+---The race the teacher started on their page, taken once: its laps; nil when none waits.
+---@return integer? laps
+function pitwall.classroom.nextStart() end
 
 ---Expectations for scenario tests (`pitwall test` only): each failure names the file and
 ---line of the expectation and the values compared, then ends the scenario. `what` names the value.

@@ -88,6 +88,10 @@ struct RunOptions : CarSource {
   // optional (docs/league.md "The final"); --final-cars K of them (default: as many as the cars)
   std::string leagueFinal;
   int finalCars = 0;
+  // --code FOLDER: the view's code page (docs/classroom.md): a desk for each car, its driver file
+  // in FOLDER/car-N/driver.lua, students editing it in the browser; the script defaults to the
+  // shipped examples/classroom.lua
+  std::string code;
 };
 int run(const RunOptions& options);
 // The exit status of a --fast run that its safety cap ended (docs/cli.md).

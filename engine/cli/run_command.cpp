@@ -18,6 +18,7 @@
 #include "engine/cli/repl.hpp"
 #include "engine/cli/session.hpp"
 #include "engine/cli/standings_keeping.hpp"
+#include "engine/core/data_dir.hpp"
 #include "engine/core/log.hpp"
 #include "engine/core/numbers.hpp"
 #include "engine/record/results.hpp"
@@ -84,6 +85,21 @@ int run(const RunOptions& given) {
     if (options.db.empty()) options.db = final->db;
     for (const auto& [number, file] : final->files)
       options.drivers.push_back(std::to_string(number) + "=" + file);
+  } else if (!options.code.empty()) {
+    // the view's code page (docs/classroom.md): every car's driver is its desk's file
+    if (!options.drivers.empty())
+      return fail("run",
+                  "--code gives every car its desk's driver (FOLDER/car-N/driver.lua): no "
+                  "--driver with it");
+    if (!options.view)
+      return fail("run",
+                  "--code serves the code page on the race view: give --view too (--view "
+                  "0.0.0.0:8080 for a classroom's laptops and tablets)");
+    if (options.script.empty()) {
+      auto data = dataDir();
+      if (!data) return fail("run", data.error());
+      options.script = (*data / "examples" / "classroom" / "race.lua").string();
+    }
   } else if (options.script.empty()) {
     return fail("run",
                 "give the script to run: pitwall run SCRIPT (or --league-final DB to race a "
@@ -149,6 +165,8 @@ int run(const RunOptions& given) {
   // Everything that can refuse the start comes before the first car is connected, and the record
   // is opened (truncated) only once nothing can: a refused start leaves an old record as it was
   // and no car driven (docs/safety.md).
+  if (!options.code.empty())
+    if (int status = session.openClassroom(options.code, "run"); status != 0) return status;
   if (options.view) {
     if (int status = session.startView(*options.view, options.ble ? "ble" : "simulator", "run");
         status != 0)
@@ -165,12 +183,25 @@ int run(const RunOptions& given) {
     return 2;
   }
 
+  std::map<int, std::string> files = *drivers;
+  if (session.classroom()) {  // a desk for each car, its file the car's driver
+    auto desks = session.addDesks();
+    if (!desks) {
+      fail("run", desks.error());
+      session.finish();
+      loop.run();
+      return 2;
+    }
+    files = std::move(*desks);
+  }
+
   HostOptions host;
   host.seed = options.seed;
+  host.classroom = session.classroom();
   host.results = options.results;
   host.view = session.viewFeed();
   host.seats = session.seats();
-  host.driverFiles = *drivers;
+  host.driverFiles = files;
   host.driverLimits.memory = static_cast<std::size_t>(options.limits.driverMemory) << 20;
   host.driverLimits.budget =
       std::chrono::milliseconds(std::llround(options.limits.driverBudget * 1000));
@@ -307,6 +338,11 @@ Command addRunCommand(CLI::App& app) {
       ->check(CLI::Range(2, 64))
       ->needs(finalOption);
   addDriverLimits(cmd, run->limits, "each driver world");
+  cmd->add_option("--code", run->code,
+                  "FOLDER: serve the code page on --view: students write, test and race their "
+                  "car's driver in the browser, kept in FOLDER/car-N (docs/classroom.md)")
+      ->excludes(fastFlag)
+      ->excludes(finalOption);
   // A prompt needs the real clock: virtual time would race ahead while the operator types.
   replFlag->excludes(fastFlag);
   // Hands on a gamepad or the keys drive in real time; the keys are the prompt's with --repl.

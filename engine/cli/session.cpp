@@ -10,6 +10,8 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <sstream>
+#include <thread>
 
 #include "bindings/car_binding.hpp"
 #include "bindings/interrupt.hpp"
@@ -17,6 +19,7 @@
 #include "engine/cli/fail.hpp"
 #include "engine/cli/options.hpp"
 #include "engine/core/console.hpp"
+#include "engine/core/data_dir.hpp"
 #include "engine/core/log.hpp"
 #include "engine/core/numbers.hpp"
 #include "engine/protocol/anki/advertisement.hpp"
@@ -580,6 +583,8 @@ int Session::startView(const std::string& endpoint, const std::string& source,
   }
   options->assets = *assets;
   options->names = viewHosts();
+  options->classroom = classroom_.get();
+  options->tests = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   startFeed(source);
   feed_->followLog(true);
   server_ = std::make_unique<view::Server>(loop_, *feed_, *options);
@@ -600,11 +605,44 @@ int Session::startView(const std::string& endpoint, const std::string& source,
     std::cerr << "view: join code " << server_->joinCode() << ": to drive, phones open "
               << server_->driveUrl() << "\n";
   }
+  if (classroom_) {  // docs/classroom.md
+    std::cerr << "code: students open " << server_->codeUrl()
+              << (server_->joinCode().empty() ? "" : " (join code " + server_->joinCode() + ")")
+              << "\ncode: the teacher's page (keep it to yourself): " << server_->teacherUrl()
+              << "\n";
+  }
   if (options->host != "127.0.0.1" && options->host != "::1")
     log::warn("view", "serving on " + options->host +
                           ": anyone who can reach this machine can watch (read-only); driving "
                           "and replay controls need the join code");
   return 0;
+}
+
+int Session::openClassroom(const std::string& folder, const char* command) {
+  auto data = dataDir();
+  if (!data) return fail(command, data.error());
+  const auto starterPath = *data / "examples" / "classroom" / "starter.lua";
+  std::ifstream f(starterPath, std::ios::binary);
+  if (!f)
+    return fail(command, "cannot read the classroom's starter driver " + starterPath.string());
+  std::ostringstream starter;
+  starter << f.rdbuf();
+  classroom_ = std::make_unique<classroom::Classroom>(loop_, folder, starter.str());
+  if (auto ok = classroom_->prepare(); !ok) {
+    classroom_.reset();
+    return fail(command, ok.error());
+  }
+  return 0;
+}
+
+Result<std::map<int, std::string>, std::string> Session::addDesks() {
+  std::map<int, std::string> files;
+  for (AnkiCar* car : fleet_.cars()) {
+    const int n = car->identity().number;
+    if (auto ok = classroom_->addDesk(n, car->identity().name); !ok) return Unexpected{ok.error()};
+    files[n] = classroom_->driverFile(n).string();
+  }
+  return files;
 }
 
 int Session::startSeats(const CarSource& source, const char* command) {

@@ -8,6 +8,7 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "bindings/reloader.hpp"
+#include "engine/classroom/classroom.hpp"
 #include "engine/cli/commands.hpp"
 #include "engine/core/emergency_stops.hpp"
 #include "engine/core/lag_monitor.hpp"
@@ -88,6 +89,13 @@ class Session {
   // cannot start (no terminal for --keyboard, an unreadable input folder).
   int startSeats(const CarSource& source, const char* command);
   drive::Seats* seats() { return seats_.get(); }
+  // --code FOLDER (docs/classroom.md): the classroom, made before the view (which serves its
+  // page) and given a desk for each car once the cars are there (addDesks). Non-zero (an error
+  // printed) when the folder cannot be used.
+  int openClassroom(const std::string& folder, const char* command);
+  // A desk for each car of the run: the driver files the race races (car number → file).
+  Result<std::map<int, std::string>, std::string> addDesks();
+  classroom::Classroom* classroom() { return classroom_.get(); }
   // A spectator (pitwall view): remote cars are read-only, and the end of the run sends them
   // nothing (they are their bridges' cars, not ours).
   void spectate() { spectator_ = true; }
@@ -136,6 +144,8 @@ class Session {
   std::unique_ptr<drive::Seats> seats_;
   std::unique_ptr<drive::Gamepads> gamepads_;
   std::unique_ptr<drive::Keyboard> keyboard_;
+  // --code: before the view's server (its page) and the Lua world (its driver worlds attach)
+  std::unique_ptr<classroom::Classroom> classroom_;
   // the race view: the feed follows the fleet (restores its hooks when destroyed, before it)
   std::unique_ptr<view::Feed> feed_;
   std::unique_ptr<view::Server> server_;

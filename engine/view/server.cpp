@@ -12,9 +12,12 @@
 #include <set>
 #include <sstream>
 
+#include "engine/classroom/classroom.hpp"
+#include "engine/core/child_runs.hpp"
 #include "engine/core/log.hpp"
 #include "engine/drive/seats.hpp"
 #include "engine/view/assets.hpp"
+#include "engine/view/code_api.hpp"
 #include "engine/view/host_check.hpp"
 #include "engine/view/page_messages.hpp"
 
@@ -31,6 +34,8 @@ namespace {
 constexpr auto kWriteStall = std::chrono::seconds(5);  // a browser that reads nothing for this long
 constexpr auto kHeartbeat = std::chrono::seconds(1);   // an unchanged state is sent this often
 constexpr std::size_t kMaxIncoming = 64 * 1024;        // a page's message, a request's body
+// the code page's save or test: a driver file of 32 KiB at most, escaped in JSON
+constexpr std::size_t kMaxCodeBody = 256 * 1024;
 constexpr auto kRequestTimeout = std::chrono::seconds(5);  // for a request to arrive whole
 constexpr auto kSocketIdle = std::chrono::seconds(10);  // a WebSocket that answers no ping: closed
 constexpr std::size_t kMaxBrowsers = 64;                // WebSockets at once
@@ -51,7 +56,17 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
         options(std::move(o)),
         acceptor(l.io()),
         retry(l.io()),
-        pairing(needsCode(options), options.code) {}
+        pairing(needsCode(options), options.code) {
+    if (options.classroom) {
+      ChildLimits limits;
+      limits.parallel = std::max(1, options.tests);
+      tests = std::make_unique<ChildRuns>(l, limits);
+      std::error_code ec;
+      auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+      code = std::make_unique<CodeApi>(l, *options.classroom, pairing, *tests,
+                                       std::vector<std::string>{exe.string(), "try"});
+    }
+  }
 
   // The join code is needed unless the view is on loopback alone (and not behind a proxy).
   static bool needsCode(const ServerOptions& o) {
@@ -75,7 +90,9 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   std::size_t open = 0;
   std::uint64_t phones = 0;  // the controller pages seen: each WebSocket a holder "phone#k"
   Pairing pairing;
-  HostCheck hosts;  // the names a Host may give (DNS rebinding)
+  HostCheck hosts;                   // the names a Host may give (DNS rebinding)
+  std::unique_ptr<ChildRuns> tests;  // --code: the Tests' children
+  std::unique_ptr<CodeApi> code;     // --code: the code page's requests
 
   void accept();
   void closeAll();
@@ -230,21 +247,22 @@ struct Server::Impl::Http : std::enable_shared_from_this<Http> {
 
   void read() {
     parser.emplace();
-    parser->body_limit(kMaxIncoming);
+    parser->body_limit(server->code ? kMaxCodeBody : kMaxIncoming);
     parser->header_limit(16 * 1024);
     stream.expires_after(kRequestTimeout);  // a request (or the next on a kept-alive connection)
-    http::async_read(stream, buffer, *parser,
-                     [self = shared_from_this()](beast::error_code ec, std::size_t) {
-                       // too large: said, then closed (nothing else of it is read)
-                       if (ec == http::error::header_limit)
-                         return self->refuse(http::status::request_header_fields_too_large,
-                                             "the request's header is over 16 KiB\n");
-                       if (ec == http::error::body_limit)
-                         return self->refuse(http::status::payload_too_large,
-                                             "the view takes no body over 64 KiB\n");
-                       if (ec) return self->close();
-                       self->handle(self->parser->release());
-                     });
+    http::async_read(
+        stream, buffer, *parser, [self = shared_from_this()](beast::error_code ec, std::size_t) {
+          // too large: said, then closed (nothing else of it is read)
+          if (ec == http::error::header_limit)
+            return self->refuse(http::status::request_header_fields_too_large,
+                                "the request's header is over 16 KiB\n");
+          if (ec == http::error::body_limit)
+            return self->refuse(http::status::payload_too_large,
+                                self->server->code ? "the view takes no body over 256 KiB\n"
+                                                   : "the view takes no body over 64 KiB\n");
+          if (ec) return self->close();
+          self->handle(self->parser->release());
+        });
   }
 
   // An answer to a request that is not read to its end; the connection closes after it.
@@ -347,6 +365,13 @@ struct Server::Impl::Http : std::enable_shared_from_this<Http> {
                     peerLoopback && !forwarded && server->options.names.empty());
       return;
     }
+    if (target.starts_with("/api/code/")) {
+      if (!server->code)
+        return text(
+            req, http::status::not_found, "application/json",
+            R"({"error":"the code page is off: the run was started without --code FOLDER"})");
+      return code(std::move(req));
+    }
     if (req.method() != http::verb::get && req.method() != http::verb::head)
       return text(req, http::status::method_not_allowed, "text/plain",
                   "only GET: the view is read-only\n");
@@ -358,6 +383,12 @@ struct Server::Impl::Http : std::enable_shared_from_this<Http> {
     }
     // the controller page (docs/view.md "The controller page"): a short address for a phone
     if (target == "/drive" || target.starts_with("/drive?")) target = "/drive.html";
+    if (target == "/code" || target.starts_with("/code?")) {  // docs/classroom.md
+      if (!server->code)
+        return text(req, http::status::not_found, "text/plain",
+                    "the code page is off: the run was started without --code FOLDER\n");
+      target = "/code.html";
+    }
     auto path = assetPath(server->options.assets, target);
     std::ifstream file;
     if (path) file.open(*path, std::ios::binary);
@@ -367,6 +398,35 @@ struct Server::Impl::Http : std::enable_shared_from_this<Http> {
     std::ostringstream body;
     body << file.rdbuf();
     text(req, http::status::ok, contentType(*path), body.str());
+  }
+
+  // The code page's request (engine/view/code_api.hpp), answered now or when its Test has run.
+  void code(http::request<http::string_body> req) {
+    bool forwarded = false;
+    CodeRequest r;
+    r.method = std::string(req.method_string());
+    r.target = std::string(req.target());
+    r.body = std::move(req.body());
+    if (auto a = req.find(http::field::authorization); a != req.end())
+      r.authorization = std::string(sv(a->value()));
+    r.client = client(req, forwarded);
+    const unsigned version = req.version();
+    const bool keep = req.keep_alive();
+    server->code->handle(r, [self = shared_from_this(), version, keep](CodeReply reply) {
+      if (self->closed) return;
+      http::response<http::string_body> res{static_cast<http::status>(reply.status), version};
+      res.set(http::field::server, "pitwall");
+      res.set(http::field::content_type, reply.contentType);
+      res.set(http::field::cache_control, "no-store");
+      res.set("X-Content-Type-Options", "nosniff");
+      if (!reply.filename.empty())
+        res.set(http::field::content_disposition,
+                "attachment; filename=\"" + reply.filename + "\"");
+      res.keep_alive(keep);
+      res.body() = std::move(reply.body);
+      res.prepare_payload();
+      self->respond(std::move(res));
+    });
   }
 
   void close() {
@@ -553,6 +613,17 @@ std::string Server::driveUrl() const {
 
 std::string Server::viewUrl() const {
   return impl_->driveUrl("");
+}
+
+std::string Server::codeUrl() const {
+  return impl_->options.classroom ? impl_->driveUrl("code") : std::string();
+}
+
+std::string Server::teacherUrl() const {
+  if (!impl_->options.classroom) return {};
+  std::string url = impl_->driveUrl("code");
+  url += (url.find('?') == std::string::npos ? "?" : "&");
+  return url + "teacher=" + impl_->options.classroom->teacherToken();
 }
 
 std::string Server::Impl::driveUrl(std::string_view page) const {

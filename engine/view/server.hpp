@@ -3,6 +3,8 @@
 //   GET /            the page, and its assets, from the installed data folder
 //   GET /drive       the controller page (drive.html): a phone takes a seat and drives it
 //   GET /api/state   the feed's whole state as JSON
+//   GET /code        with a classroom (--code): the code page, and its requests /api/code/…
+//                    (engine/view/code_api.hpp)
 // Every request's Host must be a name the view serves (loopback, this machine's addresses and
 // name, the bound address, --view-host) and its Origin, when sent, that Host: a page on another
 // site, even one whose name was made to resolve here (DNS rebinding), is refused (403).
@@ -23,6 +25,10 @@
 #include "engine/view/assets.hpp"
 #include "engine/view/feed.hpp"
 
+namespace pitwall::classroom {
+class Classroom;
+}
+
 namespace pitwall::view {
 
 struct ServerOptions {
@@ -36,6 +42,10 @@ struct ServerOptions {
   std::vector<std::string> names;
   bool alwaysPair = false;  // the join code is needed on loopback too (tests)
   std::string code;         // the join code when one is needed; empty: a new one (getrandom)
+  // --code: the classroom the code page serves (GET /code, /api/code/…; docs/classroom.md);
+  // nullptr: the page is off. `tests` children run at once (Test: `pitwall try`).
+  classroom::Classroom* classroom = nullptr;
+  int tests = 2;
 };
 
 // "[HOST:]PORT" from the command line; an empty text is the default port. The error says what
@@ -62,6 +72,9 @@ class Server {
   std::string joinCode() const;
   std::string driveUrl() const;
   std::string viewUrl() const;
+  // The code page (with --code), with the join code; the teacher's page, with the teacher's key.
+  std::string codeUrl() const;
+  std::string teacherUrl() const;
 
  private:
   struct Impl;

@@ -72,6 +72,7 @@ function Stdout:flush() end
       stdout = { "pitwall.Stdout", "a file-like object (:write, :flush) for the console" },
       sim = { "pitwall.sim?", "the simulator's API: present when the run uses the built-in simulator" },
       view = { "pitwall.view", "what the race view shows (docs/view.md)" },
+      classroom = { "pitwall.classroom", "the view's code page's classroom (--code FOLDER; docs/classroom.md)" },
       driverFiles = { "table<integer, string>", "the run's --driver CAR=FILE: car number → driver file, each raced in a Lua world of its own (docs/drivers.md)" },
     },
     settable = {
@@ -218,6 +219,23 @@ function Stdout:flush() end
       event = [[A line in the view's event log.
 @param text string
 @param level? "info"|"warn"|"error" (default "info")]],
+    },
+  },
+  {
+    class = "pitwall.classroom",
+    declare = "pitwall.classroom",
+    live = function() return pitwall.classroom end,
+    doc = [[The classroom of the view's code page (--code FOLDER, docs/classroom.md): a desk for each
+car, each desk's driver file pitwall.driverFiles[car]. Without --code it is not active.]],
+    fields = {
+      active = { "boolean", "true when the run has a classroom (--code)" },
+      folder = { "string?", "the desks' folder (absolute); nil without --code", sometimes = true },
+    },
+    functions = {
+      nextStart = [[The race the teacher started on their page, taken once: its laps; nil when none waits.
+@return integer? laps]],
+      desks = [[The desks in car order (empty without --code).
+@return {car: integer, student: string, joined: boolean, saves: integer}[] ]],
     },
   },
   {

@@ -1,0 +1,336 @@
+// The code page (code.html; docs/classroom.md): a student joins with the lesson's code, takes a
+// free car and edits its driver — Save races it (the old version drives on when the new one does
+// not load), Test runs it alone on the simulator — beside their car's telemetry. With ?teacher=KEY
+// it is the teacher's page: every desk, the lock, the start of a race, a car's reset.
+// Its requests: engine/view/code_api.hpp. A student's credential is kept in the browser
+// (localStorage), so a reload keeps the desk.
+"use strict";
+
+const $ = (id) => document.getElementById(id);
+const params = new URLSearchParams(location.search);
+const teacherKey = params.get("teacher");
+const TOKEN_KEY = "pitwall.code.token";
+let token = null;
+try { token = localStorage.getItem(TOKEN_KEY); } catch { /* storage off: the tab only */ }
+let editor = null, me = null, completions = {}, testing = false;
+
+async function api(method, path, body, key = token) {
+  const headers = {};
+  if (key) headers.Authorization = "Bearer " + key;
+  if (body !== undefined) headers["Content-Type"] = "application/json";
+  let r;
+  try {
+    r = await fetch("/api/code/" + path, {
+      method, headers, cache: "no-store",
+      body: body === undefined ? undefined : JSON.stringify(body),
+    });
+  } catch (e) {
+    return { ok: false, status: 0, data: { error: "the engine cannot be reached (" + e.message + ")" } };
+  }
+  let data = {};
+  try { data = await r.json(); } catch { /* not JSON */ }
+  return { ok: r.ok, status: r.status, data };
+}
+
+function notice(text) {
+  $("notice").textContent = text || "";
+  $("notice").hidden = !text;
+}
+
+function status(el, text, kind) {
+  el.textContent = text;
+  el.className = "status" + (kind ? " " + kind : "");
+}
+
+function fixed(v, digits = 3) {
+  return typeof v === "number" ? v.toFixed(digits) : "–";
+}
+
+// ---- joining ----
+async function showJoin() {
+  $("desk").hidden = true;
+  $("join").hidden = false;
+  const r = await api("GET", "desks", undefined, null);
+  if (!r.ok) return notice(r.data.error || "the code page did not answer (" + r.status + ")");
+  $("code-row").hidden = !r.data.codeNeeded;
+  if (!$("code").value) $("code").value = pitwallJoinCode();
+  const list = $("desks");
+  list.textContent = "";
+  for (const d of r.data.desks) {
+    const li = document.createElement("li");
+    const b = document.createElement("button");
+    b.type = "button";
+    b.dataset.car = d.car;
+    b.textContent = "car " + d.car + " · " + d.carName + (d.taken ? " (taken)" : "");
+    b.disabled = d.taken;
+    b.addEventListener("click", () => join(d.car));
+    li.append(b);
+    list.append(li);
+  }
+}
+
+async function join(car) {
+  const r = await api("POST", "join", { code: $("code").value.trim(), car, name: $("name").value }, null);
+  if (!r.ok) return notice(r.data.error || "could not join (" + r.status + ")");
+  token = r.data.token;
+  try { localStorage.setItem(TOKEN_KEY, token); } catch { /* the tab only */ }
+  notice("");
+  await loadDesk();
+}
+
+// ---- the desk ----
+async function loadDesk() {
+  const r = await api("GET", "me");
+  if (r.status === 401) {
+    token = null;
+    try { localStorage.removeItem(TOKEN_KEY); } catch { /* */ }
+    notice(r.data.error);
+    return showJoin();
+  }
+  if (!r.ok) return notice(r.data.error || "the desk did not load (" + r.status + ")");
+  me = r.data;
+  $("join").hidden = true;
+  $("desk").hidden = false;
+  $("who").textContent = me.student + " · car " + me.car + " (" + me.carName + ")";
+  $("car-name").textContent = "car " + me.car + " · " + me.carName;
+  if (!editor) {
+    try {
+      const c = await fetch("vendor/pitwall-completions.json");
+      if (c.ok) completions = await c.json();
+    } catch { /* no completions: the editor still edits */ }
+    editor = window.PitwallEditor.create($("editor"), {
+      doc: me.text, completions, onChange: () => editor.showErrors([]),
+    });
+    window.codePageEditor = editor;  // (the page's tests reach it here)
+  } else {
+    editor.setText(me.text);
+  }
+  showDesk(me);
+  await loadHistory();
+  watchCar();
+  setInterval(refreshDesk, 3000);
+}
+
+function showDesk(d) {
+  $("lock").hidden = !d.locked;
+  $("save").disabled = d.locked;
+  let driver = "no race yet: it drives when one starts";
+  if (d.raceOn) driver = d.failure ? "out: " + d.failure : "version " + d.driving + " driving";
+  $("t-driver").textContent = driver;
+  $("t-driver").className = d.failure ? "bad" : "";
+}
+
+async function refreshDesk() {
+  const r = await api("GET", "me");
+  if (r.status === 401) return location.reload();
+  if (r.ok) showDesk(r.data);
+}
+
+async function save() {
+  if (!editor) return;
+  const r = await api("POST", "save", { text: editor.text() });
+  const el = $("status");
+  if (!r.ok) return status(el, r.data.error || "not saved (" + r.status + ")", "bad");
+  const d = r.data;
+  if (d.error) {
+    editor.showErrors(d.line > 0 ? [{ line: d.line, message: d.error }] : []);
+    status(el, "Saved as save " + d.version + ", but it does not load: " + d.error +
+      "\nYour car drives on with the version before.", "bad");
+  } else if (d.driving) {
+    editor.showErrors([]);
+    status(el, "Saved as save " + d.version + ": it drives your car now.", "good");
+  } else {
+    editor.showErrors([]);
+    status(el, "Saved as save " + d.version + ": it drives your car in the next race.", "good");
+  }
+  await loadHistory();
+  refreshDesk();
+}
+
+async function test() {
+  if (!editor || testing) return;
+  testing = true;
+  $("test").disabled = true;
+  const out = $("test-result");
+  out.className = "test-result muted";
+  out.textContent = "testing…";
+  const started = performance.now();
+  const r = await api("POST", "test", { text: editor.text() });
+  testing = false;
+  $("test").disabled = false;
+  $("test-when").textContent = ((performance.now() - started) / 1000).toFixed(1) + " s";
+  if (!r.ok) {
+    out.className = "test-result bad";
+    out.textContent = r.data.error || "the test did not run (" + r.status + ")";
+    return;
+  }
+  const d = r.data;
+  const lines = [];
+  (d.laps || []).forEach((t, i) => lines.push("lap " + (i + 1) + "  " + fixed(t) + " s" +
+    (d.bestLap === i + 1 ? "  best" : "")));
+  if (d.status !== "finished") {
+    const none = d.status === "error" || !(d.laps || []).length;
+    lines.push((none ? "it did not run: " : "out: ") + (d.reason || d.status));
+    if (d.line > 0) editor.showErrors([{ line: d.line, message: d.reason }]);
+  }
+  out.className = "test-result" + (d.status === "finished" ? "" : " bad");
+  out.textContent = lines.join("\n");
+  chart(d.trace || []);
+}
+
+// Speed against distance along the lap, one line per lap.
+let plot = null;
+function chart(trace) {
+  const laps = [...new Set(trace.map((s) => s.lap).filter((l) => l >= 1))];
+  const box = $("chart");
+  if (plot) { plot.destroy(); plot = null; }
+  if (!laps.length || !window.uPlot) return;
+  const xs = [...new Set(trace.filter((s) => s.lap >= 1).map((s) => Math.round(s.distance / 10) * 10))].sort((a, b) => a - b);
+  const series = laps.map((lap) => {
+    const at = new Map(trace.filter((s) => s.lap === lap).map((s) => [Math.round(s.distance / 10) * 10, s.speed]));
+    return xs.map((x) => at.has(x) ? at.get(x) : null);
+  });
+  const colours = ["#f5c518", "#3ecf8e", "#4da3ff", "#ff5d5d", "#c77dff"];
+  plot = new uPlot({
+    width: box.clientWidth || 290, height: 180,
+    scales: { x: { time: false } },
+    axes: [{ stroke: "#8a94a3", label: "mm along the lap" }, { stroke: "#8a94a3", label: "mm/s" }],
+    series: [{}, ...laps.map((lap, i) => ({ label: "lap " + lap, stroke: colours[i % colours.length], spanGaps: true }))],
+  }, [xs.map((x) => x), ...series], box);
+}
+
+async function loadHistory() {
+  const r = await api("GET", "history");
+  if (!r.ok) return;
+  const sel = $("history");
+  sel.textContent = "";
+  const now = new Option("the editor's text", "");
+  sel.append(now);
+  for (const s of r.data.saves) {
+    sel.append(new Option("save " + s.version + " (" + s.bytes + " B, " + Math.round(s.age) + " s ago)", s.version));
+  }
+}
+
+async function download() {
+  const v = $("history").value;
+  let text = editor ? editor.text() : "", name = "car-" + (me ? me.car : "") + "-driver.lua";
+  if (v) {
+    const r = await fetch("/api/code/history/" + encodeURIComponent(v), {
+      headers: { Authorization: "Bearer " + token }, cache: "no-store" });
+    if (!r.ok) return status($("status"), "save " + v + " could not be read (" + r.status + ")", "bad");
+    text = await r.text();
+    name = "car-" + me.car + "-save-" + v + ".lua";
+  }
+  const a = document.createElement("a");
+  a.href = URL.createObjectURL(new Blob([text], { type: "text/x-lua" }));
+  a.download = name;
+  a.click();
+  setTimeout(() => URL.revokeObjectURL(a.href), 1000);
+}
+
+// The car's telemetry from the race view's feed (/ws: read-only, as a spectator's)
+function watchCar() {
+  const conn = $("connection");
+  const ws = new WebSocket((location.protocol === "https:" ? "wss://" : "ws://") + location.host + "/ws");
+  ws.onopen = () => { conn.textContent = "live"; conn.className = "connection live"; };
+  ws.onclose = () => {
+    conn.textContent = "engine gone"; conn.className = "connection gone";
+    setTimeout(watchCar, 2000);
+  };
+  ws.onmessage = (m) => {
+    let msg;
+    try { msg = JSON.parse(m.data); } catch { return; }
+    if (!me || !Array.isArray(msg.cars)) return;
+    const car = msg.cars.find((c) => c.number === me.car);
+    if (!car) return;
+    $("t-speed").textContent = car.speed + " mm/s";
+    $("t-lane").textContent = fixed(car.offset, 0) + " mm";
+    $("t-piece").textContent = car.piece ?? "–";
+    $("t-lap").textContent = car.lap ?? "–";
+    $("t-last").textContent = car.lastLap != null ? fixed(car.lastLap) + " s" : "–";
+    $("t-best").textContent = car.bestLap != null ? fixed(car.bestLap) + " s" : "–";
+  };
+}
+
+// ---- the teacher ----
+async function teacher() {
+  $("teacher").hidden = false;
+  $("who").textContent = "teacher";
+  const code = pitwallJoinCode();
+  $("race-view").src = "/" + (code ? "?code=" + encodeURIComponent(code) : "");
+  $("lock-all").addEventListener("click", async () => {
+    const locking = $("lock-all").dataset.locked !== "true";
+    const r = await api("POST", "teacher", { action: locking ? "lock" : "unlock" }, teacherKey);
+    status($("teacher-status"), r.ok ? (locking ? "editors locked" : "editors unlocked") : r.data.error, r.ok ? "good" : "bad");
+    refreshTeacher();
+  });
+  $("start").addEventListener("click", async () => {
+    const r = await api("POST", "teacher", { action: "start", laps: Number($("laps").value) }, teacherKey);
+    status($("teacher-status"), r.ok ? "a race of " + r.data.started + " laps starts" : r.data.error, r.ok ? "good" : "bad");
+  });
+  await refreshTeacher();
+  setInterval(refreshTeacher, 1000);
+}
+
+async function teacherAction(action, car) {
+  const r = await api("POST", "teacher", { action, car }, teacherKey);
+  status($("teacher-status"), r.ok ? (r.data.said || action + ": car " + car) : r.data.error, r.ok ? "good" : "bad");
+  refreshTeacher();
+}
+
+async function refreshTeacher() {
+  const r = await api("GET", "teacher", undefined, teacherKey);
+  const conn = $("connection");
+  if (!r.ok) {
+    conn.textContent = r.status === 0 ? "engine gone" : "refused"; conn.className = "connection gone";
+    return notice(r.data.error);
+  }
+  conn.textContent = "live"; conn.className = "connection live";
+  $("lock-all").dataset.locked = r.data.locked;
+  $("lock-all").textContent = r.data.locked ? "Unlock editors" : "Lock editors";
+  $("lock").hidden = !r.data.locked;
+  const body = $("teacher-desks");
+  body.textContent = "";
+  for (const d of r.data.desks) {
+    const tr = document.createElement("tr");
+    tr.dataset.car = d.car;
+    const cell = (text, cls) => {
+      const td = document.createElement("td");
+      td.textContent = text;
+      if (cls) td.className = cls;
+      tr.append(td);
+      return td;
+    };
+    cell(d.car + " · " + d.carName);
+    cell(d.joined ? d.student : "free");
+    cell(d.seen == null ? "–" : d.seen < 10 ? "yes" : Math.round(d.seen) + " s ago");
+    cell(String(d.saves));
+    let driver = d.raceOn ? (d.failure ? "out: " + d.failure : "driving") : "no race";
+    if (d.lastError && !d.failure) driver += " · last save: " + d.lastError;
+    cell(driver, d.failure ? "out" : "");
+    const td = cell("");
+    for (const [label, action] of [["Reset", "reset"], ["Free", "free"]]) {
+      const b = document.createElement("button");
+      b.type = "button";
+      b.textContent = label;
+      b.dataset.action = action;
+      b.addEventListener("click", () => teacherAction(action, d.car));
+      td.append(b, " ");
+    }
+    body.append(tr);
+  }
+}
+
+$("save").addEventListener("click", save);
+$("test").addEventListener("click", test);
+$("download").addEventListener("click", download);
+document.addEventListener("keydown", (e) => {
+  if ((e.ctrlKey || e.metaKey) && e.key === "s" && !$("desk").hidden) {
+    e.preventDefault();
+    save();
+  }
+});
+
+if (teacherKey) teacher();
+else if (token) loadDesk();
+else showJoin();
