@@ -1,0 +1,32 @@
+-- The live race's loop while the code page's students test (docs/performance.md "The code page's
+-- tests"; run by tests/bench/code_tests_lag.py, not by ctest): every car drives its desk's driver
+-- in free practice, and a timer every 5 ms measures how late the loop runs it. The teacher's
+-- "start" marks the phases (the bench's client presses it): before, during the tests, after.
+-- Prints one line a phase — "lag PHASE n=… p50=… p99=… max=… ms" — then ends the run.
+local race = require "pitwall.race"
+local room = pitwall.classroom
+local phases, phase = { "idle", "tests", "after" }, 1
+local samples = { {}, {}, {} }
+local due = pitwall.now() + 0.005
+pitwall.every(0.005, function()
+  local now = pitwall.now()
+  local s = samples[phase]
+  s[#s + 1] = math.max(0, now - due) * 1000
+  due = math.floor(now / 0.005 + 1) * 0.005
+  if room.nextStart() then
+    phase = phase + 1
+    if phase > #phases then
+      for k, name in ipairs(phases) do
+        local v = samples[k]
+        table.sort(v)
+        local function at(q) return v[math.max(1, math.ceil(q * #v))] or 0 end
+        print(string.format("lag %s n=%d p50=%.2f p99=%.2f max=%.2f ms", name, #v, at(0.5),
+          at(0.99), v[#v] or 0))
+      end
+      io.stdout:flush()
+      pitwall.stop()
+    end
+  end
+end)
+print("ready")
+race.practice { minutes = 60, board = false }
