@@ -57,6 +57,18 @@ const std::string* text(const json& j, const char* key) {
   return it != j.end() && it->is_string() ? it->get_ptr<const std::string*>() : nullptr;
 }
 
+// A save's or a test's driver text ({"text": "…"}); nullopt, and `reply` answered, without one.
+std::optional<std::string> driverText(const CodeRequest& r, CodeApi::Reply& reply) {
+  auto j = object(r, reply);
+  if (!j) return std::nullopt;
+  const std::string* t = text(*j, "text");
+  if (!t) {
+    reply(refuse(400, "give the driver's text as a string (\"text\": \"…\")"));
+    return std::nullopt;
+  }
+  return *t;
+}
+
 json deskJson(const classroom::Desk& d, const classroom::Classroom& room) {
   json j = {{"car", d.car},         {"carName", d.carName},          {"student", d.student},
             {"version", d.version}, {"raceOn", d.driver != nullptr}, {"locked", room.locked()}};
@@ -137,10 +149,8 @@ void CodeApi::handle(const CodeRequest& r, Reply reply) {
     return reply(answer(200, j));
   }
   if (path == "/api/code/save" && post) {
-    auto j = object(r, reply);
-    if (!j) return;
-    const std::string* t = text(*j, "text");
-    if (!t) return reply(refuse(400, "give the driver's text as a string (\"text\": \"…\")"));
+    auto t = driverText(r, reply);
+    if (!t) return;
     auto saved = room_.save(*desk, *t);
     if (!saved) return reply(refuse(saved.error()));
     json out = {{"version", saved->version},
@@ -151,10 +161,8 @@ void CodeApi::handle(const CodeRequest& r, Reply reply) {
     return reply(answer(200, out));
   }
   if (path == "/api/code/test" && post) {
-    auto j = object(r, reply);
-    if (!j) return;
-    const std::string* t = text(*j, "text");
-    if (!t) return reply(refuse(400, "give the driver's text as a string (\"text\": \"…\")"));
+    auto t = driverText(r, reply);
+    if (!t) return;
     return test(*desk, *t, std::move(reply));
   }
   if (path == "/api/code/history" && get) {

@@ -10,21 +10,14 @@
 
 #include "engine/classroom/classroom.hpp"
 #include "engine/core/loop.hpp"
+#include "tests/support/temp_dir.hpp"
 
 using namespace pitwall;
 using namespace pitwall::classroom;
 namespace fs = std::filesystem;
+using testing::TempDir;
 
 namespace {
-
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    char tmpl[] = "/tmp/pitwall-classroom-XXXXXX";
-    path = ::mkdtemp(tmpl);
-  }
-  ~TempDir() { fs::remove_all(path); }
-};
 
 std::string slurp(const fs::path& p) {
   std::ifstream f(p, std::ios::binary);
@@ -57,7 +50,7 @@ struct FakeDriver : DeskDriver {
 }  // namespace
 
 TEST_CASE("classroom: desks, credentials, saves and their history, within the folder") {
-  TempDir dir;
+  TempDir dir("pitwall-classroom");
   Loop loop(ClockKind::Virtual);
   Limits limits;
   limits.history = 3;
@@ -197,7 +190,7 @@ TEST_CASE("classroom: the line an engine's sentence names in a desk's file") {
 }
 
 TEST_CASE("classroom: a folder that cannot be used is a sentence") {
-  TempDir dir;
+  TempDir dir("pitwall-classroom");
   Loop loop(ClockKind::Virtual);
   std::ofstream(dir.path / "file") << "x";
   Classroom room(loop, dir.path / "file" / "lesson", "", {});

@@ -11,6 +11,7 @@
 #include <iterator>
 
 #include "tests/support/run_until.hpp"
+#include "tests/support/temp_dir.hpp"
 
 using namespace pitwall;
 using namespace std::chrono_literals;
@@ -18,12 +19,8 @@ namespace fs = std::filesystem;
 
 namespace {
 struct Folder {
-  fs::path dir;
-  Folder() {
-    char tmpl[] = "/tmp/pitwall-watch-XXXXXX";
-    dir = ::mkdtemp(tmpl);
-  }
-  ~Folder() { fs::remove_all(dir); }
+  testing::TempDir temp{"pitwall-watch"};
+  fs::path dir = temp.path;
   std::string write(const std::string& name, const std::string& text) {
     std::ofstream(dir / name) << text;
     return (dir / name).string();

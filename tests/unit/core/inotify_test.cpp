@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "tests/support/run_until.hpp"
+#include "tests/support/temp_dir.hpp"
 
 using namespace pitwall;
 using namespace std::chrono_literals;
@@ -19,7 +20,8 @@ namespace fs = std::filesystem;
 namespace {
 struct Rig {
   Loop loop{ClockKind::Real};
-  fs::path dir;
+  pitwall::testing::TempDir temp{"pitwall-inotify"};
+  fs::path dir = temp.path;
   std::unique_ptr<Inotify> inotify;
   struct Seen {
     int wd;
@@ -29,8 +31,6 @@ struct Rig {
   std::vector<Seen> events;
   int overflows = 0;
   Rig() {
-    char tmpl[] = "/tmp/pitwall-inotify-XXXXXX";
-    dir = ::mkdtemp(tmpl);
     auto made = Inotify::open(loop);
     REQUIRE(made);
     inotify = std::move(made).value();
@@ -39,7 +39,6 @@ struct Rig {
     };
     inotify->onOverflow = [this] { ++overflows; };
   }
-  ~Rig() { fs::remove_all(dir); }
 };
 }  // namespace
 

@@ -13,19 +13,14 @@
 #include "engine/print/raster.hpp"
 #include "engine/print/sensor.hpp"
 #include "engine/print/svg_metadata.hpp"
+#include "tests/support/temp_dir.hpp"
 
 using namespace pitwall;
 
 namespace {
 
-struct TempDir {
-  std::filesystem::path path;
-  TempDir() {
-    char name[] = "/tmp/pitwall-print-XXXXXX";
-    path = mkdtemp(name);
-  }
-  ~TempDir() { std::filesystem::remove_all(path); }
-  std::string file(const std::string& name) const { return (path / name).string(); }
+struct TempDir : pitwall::testing::TempDir {
+  TempDir() : pitwall::testing::TempDir("pitwall-print") {}
 };
 
 void write(const std::string& path, const std::string& text) {

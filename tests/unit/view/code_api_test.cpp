@@ -13,6 +13,7 @@
 #include "engine/core/loop.hpp"
 #include "engine/view/code_api.hpp"
 #include "engine/view/pairing.hpp"
+#include "tests/support/temp_dir.hpp"
 
 using namespace pitwall;
 using nlohmann::json;
@@ -21,7 +22,8 @@ namespace fs = std::filesystem;
 namespace {
 
 struct Room {
-  fs::path dir;
+  pitwall::testing::TempDir temp{"pitwall-code-api"};
+  fs::path dir = temp.path / "lesson";
   Loop loop{ClockKind::Real};
   classroom::Classroom room;
   view::Pairing pairing{false, ""};
@@ -36,15 +38,12 @@ struct Room {
             "*) echo '{\"status\":\"finished\",\"laps\":[4.1,4.0],\"reason\":null}';; esac"};
   }
   explicit Room(int parallel = 2, std::size_t queue = 64)
-      : dir(fs::temp_directory_path() / ("pitwall-code-api-" + std::to_string(::getpid()))),
-        room(loop, dir, "-- starter\n"),
+      : room(loop, dir, "-- starter\n"),
         runs(loop, ChildLimits{.parallel = parallel, .queue = queue}),
         api(loop, room, pairing, runs, stand_in()) {
-    fs::remove_all(dir);
     REQUIRE(room.prepare());
     for (int car = 1; car <= 4; ++car) REQUIRE(room.addDesk(car, "car" + std::to_string(car)));
   }
-  ~Room() { fs::remove_all(dir); }
 
   std::string join(int car) {
     std::optional<view::CodeReply> r;
