@@ -90,32 +90,39 @@ bool ScriptHost::call(int nargs, int nresults, const char* what, std::string_vie
     lua_pop(L_, nargs + 1);
     return false;
   }
-  return finishCall(tracedCall(nargs, nresults, interrupt::Kind::Callback), what, who);
+  return finishCall(tracedCall(nargs, nresults, interrupt::Kind::Callback, options_.budget), what,
+                    who);
 }
 
-int ScriptHost::tracedCall(int nargs, int nresults, interrupt::Kind kind) {
+int ScriptHost::tracedCall(int nargs, int nresults, interrupt::Kind kind,
+                           std::chrono::milliseconds budget) {
   const int base = lua_gettop(L_) - nargs;  // the function's slot
   lua_pushcfunction(L_, lua::traceback);
   lua_insert(L_, base);
-  const int status = ownBudget()
-                         ? lua::protectedOwnCall(L_, nargs, nresults, base, kind, options_.budget)
-                         : lua::protectedCall(L_, nargs, nresults, base, kind, options_.budget);
+  const int status = ownBudget() ? lua::protectedOwnCall(L_, nargs, nresults, base, kind, budget)
+                                 : lua::protectedCall(L_, nargs, nresults, base, kind, budget);
   lua_remove(L_, base);
   return status;
 }
 
 bool ScriptHost::callInteractive(int nargs, int nresults, std::string& error) {
-  return protectedCall(nargs, nresults, error, true);
+  return protectedCall(nargs, nresults, error, interrupt::Kind::Console, options_.budget);
 }
 
 bool ScriptHost::callCapturing(int nargs, int nresults, std::string& error) {
-  return protectedCall(nargs, nresults, error, false);
+  return protectedCall(nargs, nresults, error, interrupt::Kind::Callback, options_.budget);
 }
 
-bool ScriptHost::protectedCall(int nargs, int nresults, std::string& error, bool console) {
-  if (tracedCall(nargs, nresults, console ? interrupt::Kind::Console : interrupt::Kind::Callback) ==
-      LUA_OK)
-    return true;
+bool ScriptHost::callLibrary(int nargs, int nresults, std::string& error) {
+  // (a budget of 0 is none: a world without one keeps none)
+  const auto budget =
+      options_.budget.count() == 0 ? options_.budget : std::max(options_.budget, kLibraryBudget);
+  return protectedCall(nargs, nresults, error, interrupt::Kind::Callback, budget);
+}
+
+bool ScriptHost::protectedCall(int nargs, int nresults, std::string& error, interrupt::Kind kind,
+                               std::chrono::milliseconds budget) {
+  if (tracedCall(nargs, nresults, kind, budget) == LUA_OK) return true;
   error = lua_tostring(L_, -1) ? lua_tostring(L_, -1) : "(error without a message)";
   lua_pop(L_, 1);
   if (memory_.exceeded) error = sandbox::memoryMessage(memory_);

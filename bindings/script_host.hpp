@@ -193,6 +193,12 @@ class ScriptHost {
   // The same for a call from the engine that wants the error rather than a report (a hot
   // reload's onReload hook): budgeted like any callback.
   bool callCapturing(int nargs, int nresults, std::string& error);
+  // The same for the engine's own Lua library as the world opens (require 'pitwall.core'): a
+  // budget of its own, kLibraryBudget or the world's when larger — a slow machine (a QEMU guest
+  // under load, a small board) takes more than a callback's 100 ms (a driver world's 50 ms) to
+  // compile and run it, and that is no script's fault. A library that never loads still fails.
+  static constexpr std::chrono::milliseconds kLibraryBudget{5000};
+  bool callLibrary(int nargs, int nresults, std::string& error);
 
   // Routes the cars' events (and cars that join) into this world; detach() hands them back.
   void attach();
@@ -261,7 +267,8 @@ class ScriptHost {
  private:
   friend class ErrorReport;  // counts a car's handler errors towards its stop (cars_)
   void carJoined(AnkiCar& car);
-  bool protectedCall(int nargs, int nresults, std::string& error, bool console);
+  bool protectedCall(int nargs, int nresults, std::string& error, interrupt::Kind kind,
+                     std::chrono::milliseconds budget);
   bool finishCall(int status, const char* what, std::string_view who);
   // callAboveHandler's error path, out of line: the error over the handler.
   bool failedAboveHandler(int status, const char* what, std::string_view who);
@@ -270,7 +277,7 @@ class ScriptHost {
   Result<bool, std::string> startLoaded();
   // Calls the function under the top `nargs` values with the traceback handler under it (gone
   // after): lua::protectedCall's status, the error or the results on the stack.
-  int tracedCall(int nargs, int nresults, interrupt::Kind kind);
+  int tracedCall(int nargs, int nresults, interrupt::Kind kind, std::chrono::milliseconds budget);
 
   Loop& loop_;
   Fleet& fleet_;

@@ -214,7 +214,7 @@ void openLuaLibrary(ScriptHost& host, const std::string& lib) {
     err = lua_tostring(L, -1);
     lua_pop(L, 1);
   } else {
-    host.callCapturing(0, 0, err);  // the world's budget: a library that never loads fails too
+    host.callLibrary(0, 0, err);  // a budget of its own: a library that never loads fails too
   }
   if (!err.empty())
     throw std::runtime_error("cannot load the pitwall Lua library from " + lib + ": " + err +

@@ -4,12 +4,15 @@
 #include <doctest/doctest.h>
 
 #include <chrono>
+#include <filesystem>
+#include <fstream>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "bindings/script_host.hpp"
 #include "engine/core/log.hpp"
+#include "tests/support/temp_dir.hpp"
 
 using namespace pitwall;
 using namespace std::chrono_literals;
@@ -156,4 +159,38 @@ TEST_CASE("pitwall.log tells the world's library from the script") {
   CHECK(logged[0].find("race: from the library") != std::string::npos);
   CHECK(logged[0].find("fake.lua") == std::string::npos);
   CHECK(logged[1].find("user.lua:2: from the script") != std::string::npos);
+}
+
+// The engine's own library loads under a budget of its own (ScriptHost::kLibraryBudget), not the
+// callbacks': on a slow machine it took more than a callback's 100 ms (a QEMU guest under load,
+// clean-clone run 57: "cannot load the pitwall Lua library … still running after 100 ms"). Here a
+// library that takes 150 ms of CPU time to load opens a world whose callbacks get 100 ms, and
+// those callbacks still get their 100 ms; one that never ends its loading still fails.
+TEST_CASE("the library loads under its own budget; the world's callbacks keep theirs") {
+  Loop loop(ClockKind::Virtual);
+  Fleet fleet(loop);
+  pitwall::testing::TempDir lib("pitwall-slow-lib");
+  std::filesystem::create_directories(lib.path / "pitwall");
+  HostOptions options;
+  options.budget = 100ms;
+  auto open = [&](const std::string& core) -> std::string {
+    std::ofstream(lib.path / "pitwall" / "core.lua") << core;
+    setenv("PITWALL_SCRIPTS", lib.path.c_str(), 1);
+    std::string error;
+    try {
+      ScriptHost host(loop, fleet, nullptr, options);
+      lua_State* L = host.state();
+      REQUIRE(luaL_dostring(L, kSpin150) == LUA_OK);
+      lua_getglobal(L, "spin");
+      CHECK_FALSE(host.call(0, 0, "test callback"));  // the callbacks' budget is 100 ms still
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+    setenv("PITWALL_SCRIPTS", PITWALL_SOURCE_DIR "/scripts", 1);
+    return error;
+  };
+  CHECK(open("local t = os.clock() while os.clock() - t < 0.15 do end return true\n") == "");
+  const std::string never = open("while true do end\n");
+  CHECK(never.find("cannot load the pitwall Lua library") != std::string::npos);
+  CHECK(never.find("still running after 5000 ms") != std::string::npos);
 }
