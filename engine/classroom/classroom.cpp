@@ -271,6 +271,41 @@ Result<std::string, Refusal> Classroom::version(const Desk& d, int v) const {
   return text.str();
 }
 
+fs::path Classroom::leagueFolder(int number) const {
+  return folder_ / "leagues" / std::to_string(number);
+}
+
+Result<Classroom::League, Refusal> Classroom::prepareLeague() {
+  League league;
+  std::error_code ec;
+  for (league.number = 1; fs::exists(leagueFolder(league.number), ec); ++league.number) {
+  }
+  league.folder = leagueFolder(league.number);
+  fs::create_directories(league.folder, ec);
+  if (ec)
+    return Unexpected{Refusal{507, "cannot make " + league.folder.string() + ": " + ec.message()}};
+  for (const auto& [car, d] : desks_) {
+    // the league names a driver by its file: the car, and the student's name in letters and
+    // digits (nothing of it reaches a path but those)
+    std::string name = "car-" + std::to_string(car);
+    std::string slug;
+    for (char c : d.student)
+      if ((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9'))
+        slug += c;
+      else if (c >= 'A' && c <= 'Z')
+        slug += static_cast<char>(c - 'A' + 'a');
+    if (!slug.empty()) name += "-" + slug.substr(0, 20);
+    const fs::path copy = league.folder / (name + ".lua");
+    fs::copy_file(driverFile(car), copy, fs::copy_options::overwrite_existing, ec);
+    if (ec)
+      return Unexpected{
+          Refusal{507, "cannot copy " + driverFile(car).string() + ": " + ec.message()}};
+    league.files.push_back(copy);
+  }
+  if (league.files.size() < 2) return Unexpected{Refusal{409, "a league needs 2 desks at least"}};
+  return league;
+}
+
 std::optional<int> Classroom::takeStart() {
   auto s = start_;
   start_.reset();

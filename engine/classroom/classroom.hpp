@@ -133,6 +133,16 @@ class Classroom {
   // (pitwall.classroom.nextStart()).
   void requestStart(int laps) { start_ = laps; }
   std::optional<int> takeStart();
+  // The teacher's league (`pitwall league` over the desks' drivers, off the loop): a new folder
+  // FOLDER/leagues/K with a copy of each desk's driver named by its car and student
+  // ("car-2-bob.lua", as the league names its drivers). The error names the folder.
+  struct League {
+    int number = 0;
+    std::filesystem::path folder;
+    std::vector<std::filesystem::path> files;
+  };
+  Result<League, Refusal> prepareLeague();
+  std::filesystem::path leagueFolder(int number) const;
   // The teacher's reset of a desk's car: its driver loaded again from its file.
   Result<std::string, Refusal> reset(int car);
 

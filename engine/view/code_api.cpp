@@ -1,7 +1,9 @@
 #include "engine/view/code_api.hpp"
 
 #include <charconv>
+#include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 namespace pitwall::view {
 
@@ -90,12 +92,15 @@ std::string sentenceOf(const std::string& err) {
 }  // namespace
 
 CodeApi::CodeApi(Loop& loop, classroom::Classroom& room, Pairing& pairing, ChildRuns& tests,
-                 std::vector<std::string> tryCommand)
+                 std::vector<std::string> tryCommand, ChildRuns& leagues,
+                 std::vector<std::string> leagueCommand)
     : loop_(loop),
       room_(room),
       pairing_(pairing),
       tests_(tests),
-      tryCommand_(std::move(tryCommand)) {}
+      tryCommand_(std::move(tryCommand)),
+      leagues_(leagues),
+      leagueCommand_(std::move(leagueCommand)) {}
 
 bool CodeApi::handles(const std::string& target) const {
   return target.starts_with("/api/code/");
@@ -126,11 +131,25 @@ void CodeApi::handle(const CodeRequest& r, Reply reply) {
     if (!token) return reply(refuse(token.error()));
     return reply(answer(200, {{"token", *token}, {"car", *car}}));
   }
-  if (path == "/api/code/teacher") {
+  if (path == "/api/code/teacher" || path.starts_with("/api/code/teacher/")) {
     if (!room_.isTeacher(bearer(r.authorization)))
       return reply(refuse(403,
                           "the teacher's page needs the teacher's address, with its key, "
                           "as the terminal printed it"));
+    if (path.starts_with("/api/code/teacher/league/") && get) {
+      const std::string k = path.substr(std::string_view("/api/code/teacher/league/").size());
+      int n = 0;
+      auto [end, ec] = std::from_chars(k.data(), k.data() + k.size(), n);
+      std::ifstream f;
+      if (!k.empty() && ec == std::errc{} && end == k.data() + k.size() && n >= 1)
+        f.open(room_.leagueFolder(n) / "report.html", std::ios::binary);
+      if (!f.is_open() || !f)
+        return reply(refuse(404, "there is no league report '" + k.substr(0, 40) + "'"));
+      std::ostringstream html;
+      html << f.rdbuf();
+      return reply({200, "text/html; charset=utf-8", html.str(), {}});
+    }
+    if (path != "/api/code/teacher") return reply(refuse(404, "no such page of the teacher's"));
     if (get) return reply(answer(200, room_.status()));
     if (post) return teacher(r, reply);
     return reply(refuse(405, "GET or POST"));
@@ -251,6 +270,12 @@ void CodeApi::teacher(const CodeRequest& r, Reply& reply) {
     room_.requestStart(*laps);
     return reply(answer(200, {{"started", *laps}}));
   }
+  if (a == "league") {
+    auto laps = j->contains("laps") ? number(*j, "laps", 20) : std::optional<int>(3);
+    if (!laps)
+      return reply(refuse(400, "a league's heats of 1 to 20 laps: give \"laps\" as a number"));
+    return league(*laps, reply);
+  }
   if (a == "reset" || a == "free") {
     auto car = number(*j, "car", 1 << 20);
     if (!car || !room_.byCar(*car))
@@ -263,8 +288,52 @@ void CodeApi::teacher(const CodeRequest& r, Reply& reply) {
     if (!done) return reply(refuse(done.error()));
     return reply(answer(200, {{"said", *done}}));
   }
-  reply(refuse(400, "the teacher's actions are lock, unlock, start, reset and free; not '" +
-                        a.substr(0, 40) + "'"));
+  reply(refuse(400,
+               "the teacher's actions are lock, unlock, start, league, reset and free; "
+               "not '" +
+                   a.substr(0, 40) + "'"));
+}
+
+// The teacher's league: `pitwall league` over a copy of every desk's driver, off the loop; the
+// answer is its standings and the address of its report.
+void CodeApi::league(int laps, Reply reply) {
+  if (leagues_.running() > 0 || leagues_.queued() > 0)
+    return reply(refuse(409, "a league is running: wait for its standings"));
+  auto prepared = room_.prepareLeague();
+  if (!prepared) return reply(refuse(prepared.error()));
+  std::vector<std::string> argv = leagueCommand_;
+  for (const auto& f : prepared->files) argv.push_back(f.string());
+  const auto folder = prepared->folder;
+  const int number = prepared->number;
+  argv.push_back("--laps");
+  argv.push_back(std::to_string(laps));
+  argv.push_back("--results");
+  argv.push_back((folder / "results.json").string());
+  argv.push_back("--report");
+  argv.push_back((folder / "report.html").string());
+  const bool queued = leagues_.run(std::move(argv), [reply, folder, number](ChildOutcome o) {
+    if (!o.failure.empty()) return reply(refuse(500, "the league did not start: " + o.failure));
+    if (o.timedOut) return reply(refuse(504, "the league ran too long and was stopped"));
+    std::ifstream f(folder / "results.json");
+    json results = json::parse(f, nullptr, false);
+    if (o.status != 0 || results.is_discarded() || !results.contains("standings")) {
+      std::string why = o.err.substr(o.err.size() > 2000 ? o.err.size() - 2000 : 0);
+      return reply(
+          refuse(500, "the league failed (status " + std::to_string(o.status) + "): " + why));
+    }
+    json standings = json::array();
+    for (const auto& row : results["standings"])
+      standings.push_back({{"position", row.value("position", 0)},
+                           {"driver", row.value("driver", "")},
+                           {"points", row.value("points", 0)},
+                           {"wins", row.value("wins", 0)},
+                           {"bestLap", row.contains("bestLap") ? row["bestLap"] : json(nullptr)}});
+    reply(answer(200, {{"league", number},
+                       {"standings", standings},
+                       {"report", "/api/code/teacher/league/" + std::to_string(number)},
+                       {"seconds", o.seconds}}));
+  });
+  if (!queued) reply(refuse(409, "a league is running: wait for its standings"));
 }
 
 }  // namespace pitwall::view

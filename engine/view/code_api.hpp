@@ -10,8 +10,10 @@
 //   GET  /api/code/history            the student's saves
 //   GET  /api/code/history/K          save K's text (a download)
 //   GET  /api/code/teacher            every desk (the teacher's credential)
-//   POST /api/code/teacher            {action: lock | unlock | start (laps) | reset (car) | free
-//   (car)}
+//   POST /api/code/teacher            {action: lock | unlock | start (laps) | reset (car) |
+//                                      free (car) | league (laps)}: a league answers with its
+//                                      standings
+//   GET  /api/code/teacher/league/K   league K's HTML report
 //
 // A student's requests carry "Authorization: Bearer TOKEN" (their desk's credential, from join);
 // the teacher's carry the teacher's, which the terminal prints. Nothing else names a desk: a
@@ -45,9 +47,11 @@ class CodeApi {
  public:
   using Reply = std::function<void(CodeReply)>;
   // `tryCommand`: the program and first arguments a Test runs (the pitwall binary and "try");
-  // the file and "--json" follow.
+  // the file and "--json" follow. `leagueCommand` the same for the teacher's league ("league"),
+  // run by `leagues`.
   CodeApi(Loop& loop, classroom::Classroom& room, Pairing& pairing, ChildRuns& tests,
-          std::vector<std::string> tryCommand);
+          std::vector<std::string> tryCommand, ChildRuns& leagues,
+          std::vector<std::string> leagueCommand);
   // True when the target is one of its own (/api/code/…); `reply` is called once, now or later.
   bool handles(const std::string& target) const;
   void handle(const CodeRequest& request, Reply reply);
@@ -55,12 +59,15 @@ class CodeApi {
  private:
   void test(classroom::Desk& desk, const std::string& text, Reply reply);
   void teacher(const CodeRequest& request, Reply& reply);
+  void league(int laps, Reply reply);
 
   Loop& loop_;
   classroom::Classroom& room_;
   Pairing& pairing_;
   ChildRuns& tests_;
   std::vector<std::string> tryCommand_;
+  ChildRuns& leagues_;
+  std::vector<std::string> leagueCommand_;
 };
 
 }  // namespace pitwall::view

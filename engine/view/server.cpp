@@ -61,10 +61,14 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
       ChildLimits limits;
       limits.parallel = std::max(1, options.tests);
       tests = std::make_unique<ChildRuns>(l, limits);
+      // the teacher's league: one at a time, a few minutes at most (every pair of drivers meets)
+      leagues = std::make_unique<ChildRuns>(
+          l, ChildLimits{.parallel = 1, .queue = 1, .timeout = std::chrono::minutes(10)});
       std::error_code ec;
       auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
       code = std::make_unique<CodeApi>(l, *options.classroom, pairing, *tests,
-                                       std::vector<std::string>{exe.string(), "try"});
+                                       std::vector<std::string>{exe.string(), "try"}, *leagues,
+                                       std::vector<std::string>{exe.string(), "league"});
     }
   }
 
@@ -90,9 +94,10 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   std::size_t open = 0;
   std::uint64_t phones = 0;  // the controller pages seen: each WebSocket a holder "phone#k"
   Pairing pairing;
-  HostCheck hosts;                   // the names a Host may give (DNS rebinding)
-  std::unique_ptr<ChildRuns> tests;  // --code: the Tests' children
-  std::unique_ptr<CodeApi> code;     // --code: the code page's requests
+  HostCheck hosts;                     // the names a Host may give (DNS rebinding)
+  std::unique_ptr<ChildRuns> tests;    // --code: the Tests' children
+  std::unique_ptr<ChildRuns> leagues;  // --code: the teacher's league
+  std::unique_ptr<CodeApi> code;       // --code: the code page's requests
 
   void accept();
   void closeAll();

@@ -11,7 +11,8 @@
 // drives her car; Bob saves one that does not load: the error is marked at its line, the page says
 // his car drives on with the version before, and Alice's car is not touched. Each tests: Alice's
 // laps and the speed chart; Bob's error at its line. The teacher's page lists both, locks the
-// editors (Alice's save is refused, then allowed again), starts a race and resets a car.
+// editors (Alice's save is refused, then allowed again), resets a car, runs a league of every
+// desk's driver in the simulator (standings and report) and starts a race.
 // Screenshots: code-editor.png, code-error.png, code-teacher.png in ARTIFACTS.
 import { check, finish, launch, parseArgs, passWhen, settings, watchPage } from "./check_lib.mjs";
 
@@ -171,7 +172,29 @@ try {
   await bob.click("#save");
   await passWhen(bob, "Bob: a good save brings his driver back", () =>
     /drives your car now/.test(document.getElementById("status").textContent));
-  await teacher.type("#laps", "", {});
+  // a league of every desk's driver in the simulator, off the loop: its standings and report
+  await teacher.evaluate(() => { document.getElementById("laps").value = "2"; });
+  await teacher.click("#league");
+  if (await passWhen(teacher, "teacher: a league's standings, one row a desk", () =>
+    document.querySelectorAll("#league-result tbody tr").length === 3)) {
+    const rows = await teacher.evaluate(() =>
+      [...document.querySelectorAll("#league-result tbody tr")].map((r) => r.children[1].textContent));
+    check("the league names each driver by its car and student",
+      rows.some((r) => /car-1-alice/.test(r)) && rows.some((r) => /car-2-bob/.test(r)) &&
+      rows.includes("car-3"), rows.join(" | "));
+    const report = await teacher.evaluate(async (key) => {
+      const r = await fetch("/api/code/teacher/league/1", { headers: { Authorization: "Bearer " + key } });
+      return { status: r.status, type: r.headers.get("content-type"), html: (await r.text()).slice(0, 20000) };
+    }, teacherKey);
+    check("its report is served to the teacher", report.status === 200 && /html/.test(report.type) &&
+      /car-1-alice/.test(report.html), `HTTP ${report.status} ${report.type}`);
+    const studentTry = await alice.evaluate(async () => {
+      const r = await fetch("/api/code/teacher/league/1", {
+        headers: { Authorization: "Bearer " + localStorage.getItem("pitwall.code.token") } });
+      return r.status;
+    });
+    check("and not to a student", studentTry === 403, `HTTP ${studentTry}`);
+  }
   await teacher.evaluate(() => { document.getElementById("laps").value = "1"; });
   await teacher.click("#start");
   await passWhen(teacher, "teacher: the race is started", () =>
@@ -179,9 +202,10 @@ try {
   await passWhen(alice, "Alice's telemetry shows her car moving", () =>
     /^[1-9]\d* mm\/s$/.test(document.getElementById("t-speed").textContent));
 } finally {
-  // (a refusal the page shows — 423 locked, 422 a reset whose file does not load — is logged by
-  // Chromium as a failed resource: expected here, not a script error)
-  const errors = log.errors.filter((e) => !/status of 42[23] /.test(e));
+  // (a refusal the page shows — 423 locked, 422 a reset whose file does not load, 403 the report
+  // asked for with a student's credential — is logged by Chromium as a failed resource: expected
+  // here, not a script error)
+  const errors = log.errors.filter((e) => !/status of (42[23]|403) /.test(e));
   check("no script errors in the pages", errors.length === 0, errors.join("; "));
   await browser.close();
 }

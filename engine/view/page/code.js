@@ -268,8 +268,46 @@ async function teacher() {
     const r = await api("POST", "teacher", { action: "start", laps: Number($("laps").value) }, teacherKey);
     status($("teacher-status"), r.ok ? "a race of " + r.data.started + " laps starts" : r.data.error, r.ok ? "good" : "bad");
   });
+  $("league").addEventListener("click", league);
   await refreshTeacher();
   setInterval(refreshTeacher, 1000);
+}
+
+// A league of every desk's driver in the simulator (`pitwall league`, off the race's loop): its
+// standings here, its report a click away.
+async function league() {
+  $("league").disabled = true;
+  status($("teacher-status"), "the league is racing in the simulator…");
+  const r = await api("POST", "teacher", { action: "league", laps: Number($("laps").value) }, teacherKey);
+  $("league").disabled = false;
+  if (!r.ok) return status($("teacher-status"), r.data.error || "no league (" + r.status + ")", "bad");
+  status($("teacher-status"), "league " + r.data.league + " raced in " + r.data.seconds.toFixed(1) + " s", "good");
+  const box = $("league-result");
+  box.hidden = false;
+  box.textContent = "";
+  const table = document.createElement("table");
+  table.innerHTML = "<thead><tr><th>pos</th><th>driver</th><th>points</th><th>wins</th><th>best lap</th></tr></thead>";
+  const body = document.createElement("tbody");
+  for (const s of r.data.standings) {
+    const tr = document.createElement("tr");
+    for (const v of [s.position, s.driver, s.points, s.wins, fixed(s.bestLap)]) {
+      const td = document.createElement("td");
+      td.textContent = v;
+      tr.append(td);
+    }
+    body.append(tr);
+  }
+  table.append(body);
+  const report = document.createElement("button");
+  report.type = "button";
+  report.id = "league-report";
+  report.textContent = "Report";
+  report.addEventListener("click", async () => {
+    const page = await fetch(r.data.report, { headers: { Authorization: "Bearer " + teacherKey } });
+    if (!page.ok) return status($("teacher-status"), "the report could not be read (" + page.status + ")", "bad");
+    window.open(URL.createObjectURL(new Blob([await page.text()], { type: "text/html" })), "_blank");
+  });
+  box.append(table, report);
 }
 
 async function teacherAction(action, car) {

@@ -171,6 +171,19 @@ TEST_CASE("classroom: desks, credentials, saves and their history, within the fo
     CHECK(room.reset(1).error().status == 409);
   }
 
+  SUBCASE("a league: a copy of each desk's driver, named by car and student, in a folder of its own") {
+    REQUIRE(room.join(1, "Ada Lovelace"));
+    REQUIRE(room.join(2, "../../etc/x"));
+    auto league = room.prepareLeague();
+    REQUIRE(league);
+    CHECK(league->number == 1);
+    REQUIRE(league->files.size() == 2);
+    CHECK(league->files[0] == dir.path / "lesson" / "leagues" / "1" / "car-1-adalovelace.lua");
+    CHECK(league->files[1] == dir.path / "lesson" / "leagues" / "1" / "car-2-etcx.lua");
+    CHECK(slurp(league->files[0]) == "-- starter\n");
+    CHECK(room.prepareLeague()->number == 2);
+  }
+
   SUBCASE("the teacher's start is taken once") {
     CHECK_FALSE(room.takeStart());
     room.requestStart(4);

@@ -27,7 +27,7 @@ struct Room {
   Loop loop{ClockKind::Real};
   classroom::Classroom room;
   view::Pairing pairing{false, ""};
-  ChildRuns runs;
+  ChildRuns runs, leagues;
   view::CodeApi api;
   // the stand-in for `pitwall try FILE --json`: reads the file's first line as what to do
   static std::vector<std::string> stand_in() {
@@ -40,7 +40,8 @@ struct Room {
   explicit Room(int parallel = 2, std::size_t queue = 64)
       : room(loop, dir, "-- starter\n"),
         runs(loop, ChildLimits{.parallel = parallel, .queue = queue}),
-        api(loop, room, pairing, runs, stand_in()) {
+        leagues(loop, ChildLimits{}),
+        api(loop, room, pairing, runs, stand_in(), leagues, {"/bin/false"}) {
     REQUIRE(room.prepare());
     for (int car = 1; car <= 4; ++car) REQUIRE(room.addDesk(car, "car" + std::to_string(car)));
   }
