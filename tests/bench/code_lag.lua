@@ -1,18 +1,19 @@
 -- The live race's loop while the code page's students test (docs/performance.md "The code page's
 -- tests"; run by tests/bench/code_tests_lag.py, not by ctest): every car drives its desk's driver
--- in free practice, and a timer every 5 ms measures how late the loop runs it. The teacher's
+-- in free practice, and a timer every 5 ms measures how much later than 5 ms after its last tick
+-- the loop runs it. The teacher's
 -- "start" marks the phases (the bench's client presses it): before, during the tests, after.
 -- Prints one line a phase — "lag PHASE n=… p50=… p99=… max=… ms" — then ends the run.
 local race = require "pitwall.race"
 local room = pitwall.classroom
 local phases, phase = { "idle", "tests", "after" }, 1
 local samples = { {}, {}, {} }
-local due = pitwall.now() + 0.005
+local last
 pitwall.every(0.005, function()
   local now = pitwall.now()
   local s = samples[phase]
-  s[#s + 1] = math.max(0, now - due) * 1000
-  due = math.floor(now / 0.005 + 1) * 0.005
+  if last then s[#s + 1] = math.max(0, now - last - 0.005) * 1000 end
+  last = now
   if room.nextStart() then
     phase = phase + 1
     if phase > #phases then
