@@ -43,9 +43,17 @@ runs_from() {
   contains "$name: track verify reads the print back" "all decode to the design" "$out"
   for f in scripts/pitwall/core.lua scripts/pitwall/race.lua examples/.luarc.json web/index.html \
       web/vendor/pitwall-editor.js web/vendor/pitwall-completions.json \
+      web/code.html web/code.js examples/classroom/race.lua examples/classroom/starter.lua \
       types/pitwall.lua; do
     [ -f "$data/$f" ] && echo "ok: $name: share/pitwall/$f" || fail "$name: share/pitwall/$f is missing"
   done
+  # the code page's classroom: the shipped race and starter are found from the installed data
+  rm -rf "$TMP/lesson"
+  out=$(hidden "$bin" run --code "$TMP/lesson" --view 127.0.0.1:0 --cars 1 --duration 2 2>&1); rc=$?
+  check "$name: run --code (exit status)" 0 "$rc"
+  contains "$name: run --code prints the students' address" "code: students open http://127.0.0.1:" "$out"
+  contains "$name: the desk starts from the shipped starter" "function driver:update" \
+    "$(cat "$TMP/lesson/car-1/driver.lua" 2>/dev/null)"
   # Moved elsewhere, it still runs: nothing points back to where it was installed.
   rm -rf "$TMP/moved" && mkdir -p "$TMP/moved" && cp -a "$(dirname "$(dirname "$bin")")/." "$TMP/moved/"
   out=$(hidden "$TMP/moved/bin/pitwall" run "$TMP/moved/share/pitwall/examples/hello.lua" --fast --cars 1 2>&1); rc=$?
