@@ -132,7 +132,7 @@ Desk* Classroom::byCar(int car) {
   return it == desks_.end() ? nullptr : &it->second;
 }
 
-Result<std::string, Refusal> Classroom::join(int car, std::string_view name) {
+Result<std::string, Refusal> Classroom::join(int car, std::string_view name, std::string device) {
   Desk* d = byCar(car);
   if (!d) {
     std::string cars;
@@ -147,13 +147,28 @@ Result<std::string, Refusal> Classroom::join(int car, std::string_view name) {
     return Unexpected{Refusal{400, "your name has " + std::to_string(characters(name)) +
                                        " characters: give at most " +
                                        std::to_string(limits_.maxName)}};
-  if (std::any_of(name.begin(), name.end(),
-                  [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; }))
+  // control characters, and the bidi overrides (U+202A–202E, U+2066–2069) that would show a
+  // name reversed on the teacher's table
+  static constexpr std::string_view kBidi[] = {"\xE2\x80\xAA", "\xE2\x80\xAB", "\xE2\x80\xAC",
+                                               "\xE2\x80\xAD", "\xE2\x80\xAE", "\xE2\x81\xA6",
+                                               "\xE2\x81\xA7", "\xE2\x81\xA8", "\xE2\x81\xA9"};
+  const bool bidi = std::any_of(std::begin(kBidi), std::end(kBidi), [&](std::string_view b) {
+    return name.find(b) != std::string_view::npos;
+  });
+  if (bidi || std::any_of(name.begin(), name.end(),
+                          [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; }))
     return Unexpected{Refusal{400, "your name has a control character: give letters and spaces"}};
   if (!d->token.empty())
     return Unexpected{Refusal{409, "car " + std::to_string(car) + " is taken by " + d->student +
                                        ": pick a free car, or ask the teacher to free it"}};
+  if (!device.empty())
+    for (const auto& [n, other] : desks_)
+      if (!other.token.empty() && other.device == device)
+        return Unexpected{Refusal{409, "this device holds car " + std::to_string(n) +
+                                           " already (one car a device): ask the teacher to "
+                                           "give you another, or to free it"}};
   d->student = std::string(name);
+  d->device = std::move(device);
   d->token = newToken();
   d->lastSeen = loop_.seconds();
   return d->token;
@@ -164,6 +179,8 @@ bool Classroom::free(int car) {
   if (!d || d->token.empty()) return false;
   d->token.clear();
   d->student.clear();
+  d->device.clear();
+  d->testing = false;  // (a test of the student who left answers them, not the next)
   return true;
 }
 

@@ -67,6 +67,7 @@ struct Desk {
   std::string carName;
   std::string student;  // empty: free
   std::string token;    // the student's credential; empty: free
+  std::string device;   // the client that joined it (empty: not counted)
   DeskDriver* driver = nullptr;
   int saves = 0;          // this run's saves
   int version = 0;        // the last history entry's number
@@ -114,8 +115,10 @@ class Classroom {
   const std::map<int, Desk>& desks() const { return desks_; }
 
   // A student takes a free desk under a name: their new credential. Refused when the desk is
-  // taken or is none, or the name is empty or too long.
-  Result<std::string, Refusal> join(int car, std::string_view name);
+  // taken or is none, the name is empty, too long or has control characters — or `device` (the
+  // client's key; empty: not counted — this machine, the teacher's gift) holds a desk already:
+  // one desk a device, so one student cannot take the class's cars.
+  Result<std::string, Refusal> join(int car, std::string_view name, std::string device = {});
   // The teacher frees a desk: its credential stops working (its files stay).
   bool free(int car);
 

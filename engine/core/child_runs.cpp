@@ -41,6 +41,7 @@ ChildRuns::ChildRuns(Loop& loop, ChildLimits limits) : loop_(loop), limits_(limi
 
 ChildRuns::~ChildRuns() {
   *alive_ = false;
+  queue_.clear();
   for (auto& w : live_)
     if (auto job = w.lock()) {
       job->kill();
@@ -103,6 +104,9 @@ void ChildRuns::start(std::shared_ptr<Job> job) {
   posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
   posix_spawn_file_actions_adddup2(&actions, outPipe[1], 1);
   posix_spawn_file_actions_adddup2(&actions, errPipe[1], 2);
+  // nothing else of the run's: its listening socket, browsers, links (Boost.Asio opens sockets
+  // without close-on-exec) — a child that outlived the run would hold the view's port
+  posix_spawn_file_actions_addclosefrom_np(&actions, 3);
   // its own process group (a terminal's Ctrl-C is the run's; a kill reaches all it started),
   // no signal blocked and none ignored (the run ignores SIGPIPE: a child should not)
   sigset_t none, defaults;
@@ -164,6 +168,15 @@ void ChildRuns::start(std::shared_ptr<Job> job) {
     if (ec || !*alive || job->ended) return;
     job->outcome.timedOut = true;
     job->kill();
+    // whatever still holds the pipes (a process that left the group) is not waited for: a
+    // second later they are closed, the reads end and the child is reaped
+    job->clock.expires_after(std::chrono::seconds(1));
+    job->clock.async_wait([job, alive](boost::system::error_code e) {
+      if (e || !*alive || job->ended) return;
+      boost::system::error_code ignored;
+      job->out.cancel(ignored);
+      job->err.cancel(ignored);
+    });
   });
 }
 
@@ -182,6 +195,7 @@ void ChildRuns::finished(const std::shared_ptr<Job>& job) {
   job->clock.cancel();
   job->pid = -1;
   if (got > 0 && WIFEXITED(st)) job->outcome.status = WEXITSTATUS(st);
+  if (got > 0 && WIFSIGNALED(st)) job->outcome.signal = WTERMSIG(st);
   job->outcome.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - job->startedAt).count();
   running_--;

@@ -25,6 +25,7 @@ struct ChildOutcome {
   std::string out, err;  // what it wrote (each cut at the cap)
   bool timedOut = false;  // killed: it ran past its time
   bool tooLong = false;   // killed: it wrote past the cap
+  int signal = 0;         // the signal that ended it, if one did
   std::string failure;    // it could not be started: why
   double seconds = 0;     // from its start to its end (wall clock)
   double waited = 0;      // in the queue before it started

@@ -1,6 +1,7 @@
 #include "engine/view/code_api.hpp"
 
 #include <charconv>
+#include <cstring>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -127,7 +128,7 @@ void CodeApi::handle(const CodeRequest& r, Reply reply) {
     auto car = number(*j, "car", 1 << 20);
     if (!car) return reply(refuse(400, "give the car to take as a number (\"car\": 2)"));
     const std::string* name = text(*j, "name");
-    auto token = room_.join(*car, name ? *name : std::string());
+    auto token = room_.join(*car, name ? *name : std::string(), r.local ? std::string() : r.client);
     if (!token) return reply(refuse(token.error()));
     return reply(answer(200, {{"token", *token}, {"car", *car}}));
   }
@@ -221,6 +222,13 @@ void CodeApi::test(classroom::Desk& desk, const std::string& t, Reply reply) {
       return reply(refuse(504, "the test ran past " +
                                    std::to_string(tests_.limits().timeout.count() / 1000) +
                                    " s and was stopped: does the driver loop for ever?"));
+    if (o.tooLong)
+      return reply(refuse(413, "the test wrote more than " +
+                                   std::to_string(tests_.limits().maxOutput >> 20) +
+                                   " MiB and was stopped: does the driver print in a loop?"));
+    if (o.signal != 0 && o.out.empty())
+      return reply(refuse(500, "the test was ended by signal " + std::to_string(o.signal) + " (" +
+                                   strsignal(o.signal) + "): test again"));
     json result = json::parse(o.out, nullptr, false);
     if (result.is_discarded() || !result.is_object()) {
       // it did not run (a file that does not load, a driver that fails at once): the sentence
@@ -276,6 +284,13 @@ void CodeApi::teacher(const CodeRequest& r, Reply& reply) {
       return reply(refuse(400, "a league's heats of 1 to 20 laps: give \"laps\" as a number"));
     return league(*laps, reply);
   }
+  if (a == "assign") {  // the teacher gives a free desk to a student: their credential, in a link
+    auto car = number(*j, "car", 1 << 20);
+    const std::string* name = text(*j, "name");
+    auto token = room_.join(car ? *car : 0, name ? *name : std::string());
+    if (!token) return reply(refuse(token.error()));
+    return reply(answer(200, {{"car", *car}, {"link", "/code#desk=" + *token}}));
+  }
   if (a == "reset" || a == "free") {
     auto car = number(*j, "car", 1 << 20);
     if (!car || !room_.byCar(*car))
@@ -289,7 +304,7 @@ void CodeApi::teacher(const CodeRequest& r, Reply& reply) {
     return reply(answer(200, {{"said", *done}}));
   }
   reply(refuse(400,
-               "the teacher's actions are lock, unlock, start, league, reset and free; "
+               "the teacher's actions are lock, unlock, start, league, assign, reset and free; "
                "not '" +
                    a.substr(0, 40) + "'"));
 }

@@ -11,8 +11,9 @@
 //   GET  /api/code/history/K          save K's text (a download)
 //   GET  /api/code/teacher            every desk (the teacher's credential)
 //   POST /api/code/teacher            {action: lock | unlock | start (laps) | reset (car) |
-//                                      free (car) | league (laps)}: a league answers with its
-//                                      standings
+//                                      free (car) | assign (car, name) | league (laps)}: an
+//                                      assign answers with the student's link (/code#desk=…),
+//                                      a league with its standings
 //   GET  /api/code/teacher/league/K   league K's HTML report
 //
 // A student's requests carry "Authorization: Bearer TOKEN" (their desk's credential, from join);
@@ -34,6 +35,7 @@ struct CodeRequest {
   std::string body;           // what came (at most the server's limit)
   std::string authorization;  // the header's value
   std::string client;         // Pairing::clientKey of who sent it
+  bool local = false;         // from this machine itself (not through a --view-host proxy)
 };
 
 struct CodeReply {

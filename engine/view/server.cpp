@@ -415,9 +415,11 @@ struct Server::Impl::Http : std::enable_shared_from_this<Http> {
     if (auto a = req.find(http::field::authorization); a != req.end())
       r.authorization = std::string(sv(a->value()));
     r.client = client(req, forwarded);
+    r.local = peerLoopback && !forwarded;
     const unsigned version = req.version();
     const bool keep = req.keep_alive();
-    server->code->handle(r, [self = shared_from_this(), version, keep](CodeReply reply) {
+    const bool head = req.method() == http::verb::head;
+    server->code->handle(r, [self = shared_from_this(), version, keep, head](CodeReply reply) {
       if (self->closed) return;
       http::response<http::string_body> res{static_cast<http::status>(reply.status), version};
       res.set(http::field::server, "pitwall");
@@ -430,6 +432,7 @@ struct Server::Impl::Http : std::enable_shared_from_this<Http> {
       res.keep_alive(keep);
       res.body() = std::move(reply.body);
       res.prepare_payload();
+      if (head) res.body().clear();  // the length stays, not the body
       self->respond(std::move(res));
     });
   }
@@ -590,6 +593,11 @@ void Server::stop() {
   impl_->retry.cancel();
   impl_->acceptor.close(ignored);
   impl_->closeAll();
+  // the code page's children (Tests, a league) are killed and reaped now: their replies hold
+  // connections that hold this server, which would otherwise outlive the run with them
+  impl_->code.reset();
+  impl_->tests.reset();
+  impl_->leagues.reset();
 }
 
 std::uint16_t Server::port() const {
@@ -626,9 +634,9 @@ std::string Server::codeUrl() const {
 
 std::string Server::teacherUrl() const {
   if (!impl_->options.classroom) return {};
-  std::string url = impl_->driveUrl("code");
-  url += (url.find('?') == std::string::npos ? "?" : "&");
-  return url + "teacher=" + impl_->options.classroom->teacherToken();
+  // in the fragment: never sent in a request, never in a log; the page takes it out of the
+  // address bar (a projected screen shows no key)
+  return impl_->driveUrl("code") + "#teacher=" + impl_->options.classroom->teacherToken();
 }
 
 std::string Server::Impl::driveUrl(std::string_view page) const {

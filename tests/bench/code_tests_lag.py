@@ -36,7 +36,7 @@ while time.time() < deadline and not (port and teacher):
     time.sleep(0.1)
     text = "".join(err_lines)
     m = re.search(r"view: http://127\.0\.0\.1:(\d+)/", text)
-    t = re.search(r"teacher=([0-9a-f]{32})", text)
+    t = re.search(r"#teacher=([0-9a-f]{32})", text)
     port, teacher = (m and int(m.group(1))), (t and t.group(1))
 assert port and teacher, "".join(err_lines)[-2000:]
 

@@ -24,7 +24,7 @@ fi
 code=$(grep -oE '^view: join code [0-9]{6}' "$TMP/err" | head -1 | grep -oE '[0-9]{6}$')
 port=$(grep -oE '^view: http://127\.0\.0\.1:[0-9]+/' "$TMP/err" | head -1 | grep -oE '[0-9]+/$' | tr -d /)
 check "a join code is printed" 6 "${#code}"
-teacher=$(grep -oE 'teacher=[0-9a-f]{32}' "$TMP/err" | head -1 | cut -d= -f2)
+teacher=$(grep -oE '#teacher=[0-9a-f]{32}' "$TMP/err" | head -1 | cut -d= -f2)
 contains "the students' address is printed, with the join code" "/code?code=$code" "$(cat "$TMP/err")"
 check "the teacher's key is 32 hex digits" 32 "${#teacher}"
 for n in 1 2 3; do

@@ -169,6 +169,25 @@ check("desks 1 and 2 are byte for byte as they were", snapshot(1) == before[1] a
 new = {p for p in everything() - outside if "/car-3/" not in p}
 check("nothing was written outside Mallory's desk folder", not new, str(sorted(new)[:10]))
 
+# one desk a device: students behind the --view-host proxy (X-Forwarded-For names them)
+def proxied(ip):
+    return {"Host": f"classroom.test:{port}", "X-Forwarded-For": ip}
+
+
+status, _, _ = request("POST", "/api/code/teacher", {"action": "free", "car": 3}, token=teacher)
+check("the teacher frees Mallory's desk", status == 200, f"HTTP {status}")
+status, j, _ = request("POST", "/api/code/join", {"code": code, "car": 3, "name": "Eve"},
+                       headers=proxied("10.9.0.5"))
+check("a student behind the proxy takes desk 3", status == 200, f"HTTP {status} {j}")
+status, _, _ = request("POST", "/api/code/teacher", {"action": "free", "car": 2}, token=teacher)
+status, j, _ = request("POST", "/api/code/join", {"code": code, "car": 2, "name": "Eve again"},
+                       headers=proxied("10.9.0.5"))
+check("the same device cannot take a second desk (409, with a sentence)",
+      status == 409 and "holds car 3 already" in (j or {}).get("error", ""), f"HTTP {status} {j}")
+status, j, _ = request("POST", "/api/code/join", {"code": code, "car": 2, "name": "Frank"},
+                       headers=proxied("10.9.0.6"))
+check("another device takes it", status == 200, f"HTTP {status} {j}")
+
 # last: wrong join codes are counted per address and locked out
 said = []
 for k in range(7):

@@ -72,6 +72,23 @@ try {
       /setSpeed/.test(offered) && !/ahead/.test(offered), offered);
   }
   await alice.keyboard.press("Escape");
+  // hover docs from the same definitions: the pointer on drivers.setSpeed in the starter
+  const at = await alice.evaluate(() => {
+    const ed = window.codePageEditor;
+    const text = ed.text();
+    const pos = text.indexOf("drivers.setSpeed") + "drivers.set".length;
+    const c = ed.view.coordsAtPos(pos);
+    return c && { x: (c.left + c.right) / 2, y: (c.top + c.bottom) / 2 };
+  });
+  if (check("the starter calls drivers.setSpeed, on screen", !!at)) {
+    await alice.mouse.move(at.x, at.y);
+    if (await passWhen(alice, "hovering drivers.setSpeed shows its doc", () =>
+      /drivers\.setSpeed/.test(document.querySelector(".cm-pitwall-doc")?.textContent || ""))) {
+      const doc = await alice.evaluate(() => document.querySelector(".cm-pitwall-doc").textContent);
+      check("the doc is the definitions' (a signature and a sentence)", doc.length > 30, doc);
+    }
+    await alice.mouse.move(5, 5);
+  }
 
   // Alice saves a faster driver: it drives her car
   const starter = await alice.evaluate(() => window.codePageEditor.text());
@@ -135,8 +152,10 @@ try {
   const teacherContext = await browser.createBrowserContext();
   const teacher = await teacherContext.newPage();
   watchPage(teacher, log, "teacher");
-  await teacher.goto(new URL(`/code?teacher=${teacherKey}&code=${joinCode}`, base).href,
+  await teacher.goto(new URL(`/code?code=${joinCode}#teacher=${teacherKey}`, base).href,
     { timeout: settings.timeoutMs });
+  await passWhen(teacher, "teacher: the key is taken out of the address bar", () =>
+    !location.hash.includes("teacher="));
   await passWhen(teacher, "teacher: every desk, with who joined", () => {
     const rows = [...document.querySelectorAll("#teacher-desks tr")].map((r) => r.textContent);
     return rows.length === 3 && rows.some((r) => /Alice/.test(r)) && rows.some((r) => /Bob/.test(r)) &&
@@ -148,7 +167,26 @@ try {
     return d && d.querySelector("#connection")?.textContent === "live" &&
       d.querySelectorAll("#leaderboard tbody tr").length === 3;
   });
+  // the teacher gives the free desk (car 3) to Carol: her link opens her desk, no code or pick
+  await teacher.type('#teacher-desks tr[data-car="3"] .give-name', "Carol");
+  await teacher.click('#teacher-desks tr[data-car="3"] button[data-action="assign"]');
+  if (await passWhen(teacher, "teacher: giving car 3 to Carol gives a link", () =>
+    /#desk=[0-9a-f]{32}$/.test(document.getElementById("teacher-status").dataset.link || ""))) {
+    const link = await teacher.evaluate(() => document.getElementById("teacher-status").dataset.link);
+    const carol = await (await browser.createBrowserContext()).newPage();
+    watchPage(carol, log, "Carol");
+    await carol.goto(link, { timeout: settings.timeoutMs });
+    await passWhen(carol, "Carol's link opens her desk (car 3), the credential out of the address bar", () =>
+      !document.getElementById("desk").hidden && /Carol · car 3/.test(document.getElementById("who").textContent) &&
+      !location.hash.includes("desk="));
+    await carol.close();
+  }
+  await passWhen(teacher, "teacher: car 3 is Carol's", () =>
+    /Carol/.test(document.querySelector('#teacher-desks tr[data-car="3"]').textContent));
   await teacher.screenshot({ path: `${artifacts}/code-teacher.png` });
+  await teacher.click('#teacher-desks tr[data-car="3"] button[data-action="free"]');
+  await passWhen(teacher, "teacher: car 3 is free again", () =>
+    /free/.test(document.querySelector('#teacher-desks tr[data-car="3"]').children[1].textContent));
   await teacher.click("#lock-all");
   await passWhen(teacher, "teacher: the editors are locked", () =>
     /Unlock/.test(document.getElementById("lock-all").textContent));

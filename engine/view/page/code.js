@@ -7,11 +7,26 @@
 "use strict";
 
 const $ = (id) => document.getElementById(id);
-const params = new URLSearchParams(location.search);
-const teacherKey = params.get("teacher");
+// The teacher's key comes in the address's fragment (#teacher=…, never sent in a request), is
+// kept for the tab and taken out of the address bar: a projected screen shows no key.
+const TEACHER_KEY = "pitwall.code.teacher";
+let teacherKey = new URLSearchParams(location.hash.slice(1)).get("teacher");
+try {
+  if (teacherKey) sessionStorage.setItem(TEACHER_KEY, teacherKey);
+  else teacherKey = sessionStorage.getItem(TEACHER_KEY);
+} catch { /* storage off: this load only */ }
 const TOKEN_KEY = "pitwall.code.token";
 let token = null;
 try { token = localStorage.getItem(TOKEN_KEY); } catch { /* storage off: the tab only */ }
+// a desk the teacher gave: its credential in the link's fragment (never sent to the server in
+// the address), kept like a join's and taken out of the address bar
+const given = new URLSearchParams(location.hash.slice(1)).get("desk");
+if (location.hash.includes("teacher=")) history.replaceState(null, "", location.pathname + location.search);
+if (given) {
+  token = given;
+  try { localStorage.setItem(TOKEN_KEY, token); } catch { /* the tab only */ }
+  history.replaceState(null, "", location.pathname + location.search);
+}
 let editor = null, me = null, completions = {}, testing = false;
 
 async function api(method, path, body, key = token) {
@@ -27,8 +42,10 @@ async function api(method, path, body, key = token) {
   } catch (e) {
     return { ok: false, status: 0, data: { error: "the engine cannot be reached (" + e.message + ")" } };
   }
+  // (a refusal before the code page — a body too large, another site's page — is plain text)
+  const text = await r.text();
   let data = {};
-  try { data = await r.json(); } catch { /* not JSON */ }
+  try { data = JSON.parse(text); } catch { data = r.ok ? {} : { error: text.trim() || r.statusText }; }
   return { ok: r.ok, status: r.status, data };
 }
 
@@ -112,8 +129,7 @@ async function loadDesk() {
 }
 
 function showDesk(d) {
-  $("lock").hidden = !d.locked;
-  $("save").disabled = d.locked;
+  $("lock").hidden = !d.locked;  // (Save stays: pressed, it says why nothing was saved)
   let driver = "no race yet: it drives when one starts";
   if (d.raceOn) driver = d.failure ? "out: " + d.failure : "version " + d.driving + " driving";
   $("t-driver").textContent = driver;
@@ -305,7 +321,8 @@ async function league() {
   report.addEventListener("click", async () => {
     const page = await fetch(r.data.report, { headers: { Authorization: "Bearer " + teacherKey } });
     if (!page.ok) return status($("teacher-status"), "the report could not be read (" + page.status + ")", "bad");
-    window.open(URL.createObjectURL(new Blob([await page.text()], { type: "text/html" })), "_blank");
+    window.open(URL.createObjectURL(new Blob([await page.text()], { type: "text/html" })), "_blank",
+      "noopener");
   });
   box.append(table, report);
 }
@@ -316,6 +333,7 @@ async function teacherAction(action, car) {
   refreshTeacher();
 }
 
+const teacherRows = new Map();  // car → its row on the teacher's page
 async function refreshTeacher() {
   const r = await api("GET", "teacher", undefined, teacherKey);
   const conn = $("connection");
@@ -327,35 +345,58 @@ async function refreshTeacher() {
   $("lock-all").dataset.locked = r.data.locked;
   $("lock-all").textContent = r.data.locked ? "Unlock editors" : "Lock editors";
   $("lock").hidden = !r.data.locked;
+  // Each desk's row is made once and its cells updated in place: a name being typed to give a
+  // desk to, or a button being pressed, is never swept away by the next refresh.
   const body = $("teacher-desks");
-  body.textContent = "";
   for (const d of r.data.desks) {
-    const tr = document.createElement("tr");
-    tr.dataset.car = d.car;
-    const cell = (text, cls) => {
-      const td = document.createElement("td");
-      td.textContent = text;
-      if (cls) td.className = cls;
-      tr.append(td);
-      return td;
-    };
-    cell(d.car + " · " + d.carName);
-    cell(d.joined ? d.student : "free");
-    cell(d.seen == null ? "–" : d.seen < 10 ? "yes" : Math.round(d.seen) + " s ago");
-    cell(String(d.saves));
+    let row = teacherRows.get(d.car);
+    if (!row) {
+      const tr = document.createElement("tr");
+      tr.dataset.car = d.car;
+      const cells = [0, 1, 2, 3, 4, 5].map(() => tr.appendChild(document.createElement("td")));
+      row = { tr, cells, joined: null };
+      teacherRows.set(d.car, row);
+      body.append(tr);
+    }
+    const [car, student, seen, saves, driverCell, actions] = row.cells;
+    car.textContent = d.car + " · " + d.carName;
+    student.textContent = d.joined ? d.student : "free";
+    seen.textContent = d.seen == null ? "–" : d.seen < 10 ? "yes" : Math.round(d.seen) + " s ago";
+    saves.textContent = String(d.saves);
     let driver = d.raceOn ? (d.failure ? "out: " + d.failure : "driving") : "no race";
     if (d.lastError && !d.failure) driver += " · last save: " + d.lastError;
-    cell(driver, d.failure ? "out" : "");
-    const td = cell("");
-    for (const [label, action] of [["Reset", "reset"], ["Free", "free"]]) {
-      const b = document.createElement("button");
-      b.type = "button";
-      b.textContent = label;
-      b.dataset.action = action;
-      b.addEventListener("click", () => teacherAction(action, d.car));
-      td.append(b, " ");
+    driverCell.textContent = driver;
+    driverCell.className = d.failure ? "out" : "";
+    if (row.joined !== d.joined) {  // the actions: Give on a free desk; Reset and Free
+      row.joined = d.joined;
+      actions.textContent = "";
+      if (!d.joined) {
+        const name = document.createElement("input");
+        name.placeholder = "student's name";
+        name.className = "give-name";
+        const give = document.createElement("button");
+        give.type = "button";
+        give.textContent = "Give";
+        give.dataset.action = "assign";
+        give.addEventListener("click", async () => {
+          const r = await api("POST", "teacher", { action: "assign", car: d.car, name: name.value }, teacherKey);
+          if (!r.ok) return status($("teacher-status"), r.data.error, "bad");
+          const link = new URL(r.data.link, location.href).href;
+          status($("teacher-status"), "car " + d.car + " is " + name.value + "'s: give them " + link, "good");
+          $("teacher-status").dataset.link = link;
+          refreshTeacher();
+        });
+        actions.append(name, " ", give, " ");
+      }
+      for (const [label, action] of [["Reset", "reset"], ["Free", "free"]]) {
+        const b = document.createElement("button");
+        b.type = "button";
+        b.textContent = label;
+        b.dataset.action = action;
+        b.addEventListener("click", () => teacherAction(action, d.car));
+        actions.append(b, " ");
+      }
     }
-    body.append(tr);
   }
 }
 

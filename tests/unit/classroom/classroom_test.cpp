@@ -86,12 +86,31 @@ TEST_CASE("classroom: desks, credentials, saves and their history, within the fo
     CHECK(room.join(1, "Carol"));
   }
 
+  SUBCASE("one desk a device; this machine and the teacher's gift are not counted") {
+    CHECK(room.join(1, "Alice", "10.0.0.5"));
+    auto second = room.join(2, "Alice again", "10.0.0.5");
+    REQUIRE_FALSE(second);
+    CHECK(second.error().status == 409);
+    CHECK(second.error().why.find("holds car 1 already") != std::string::npos);
+    CHECK(room.join(2, "Bob", "10.0.0.6"));
+    CHECK(room.free(1));
+    CHECK(room.join(1, "Alice", "10.0.0.5"));  // freed, the device may take one again
+    Classroom more(loop, dir.path / "more", "", limits);
+    REQUIRE(more.prepare());
+    for (int car = 1; car <= 3; ++car) REQUIRE(more.addDesk(car, "c"));
+    CHECK(more.join(1, "a"));  // (no device: this machine, the teacher's gift)
+    CHECK(more.join(2, "b"));
+    CHECK(more.join(3, "c"));
+  }
+
   SUBCASE("names: empty, too long, control characters; desks that are none") {
     CHECK(room.join(1, "   ").error().status == 400);
     CHECK(room.join(1, std::string(41, 'x')).error().why.find("41 characters") !=
           std::string::npos);
     CHECK(room.join(1, std::string(40, 'x')));
     CHECK(room.join(2, "a\nb").error().why.find("control character") != std::string::npos);
+    CHECK(room.join(2, "evil\xE2\x80\xAEgnp.exe").error().why.find("control character") !=
+          std::string::npos);
     auto none = room.join(7, "Dan");
     CHECK(none.error().status == 404);
     CHECK(none.error().why.find("pick one of 1, 2") != std::string::npos);
@@ -171,7 +190,8 @@ TEST_CASE("classroom: desks, credentials, saves and their history, within the fo
     CHECK(room.reset(1).error().status == 409);
   }
 
-  SUBCASE("a league: a copy of each desk's driver, named by car and student, in a folder of its own") {
+  SUBCASE(
+      "a league: a copy of each desk's driver, named by car and student, in a folder of its own") {
     REQUIRE(room.join(1, "Ada Lovelace"));
     REQUIRE(room.join(2, "../../etc/x"));
     auto league = room.prepareLeague();

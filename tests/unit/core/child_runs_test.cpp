@@ -3,6 +3,9 @@
 // most `parallel` run at once, the rest wait in a bounded queue; the loop turns meanwhile.
 #include <doctest/doctest.h>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <optional>
 
 #include "engine/core/child_runs.hpp"
@@ -83,4 +86,28 @@ TEST_CASE("child runs: at most `parallel` at once, a bounded queue, a missing pr
   REQUIRE(loop.runUntil([&] { return missing.has_value(); }, std::chrono::seconds(10)));
   CHECK(missing->status == -1);  // glibc's posix_spawn says the exec failed: not started
   CHECK(missing->failure.find("/nonexistent/program") != std::string::npos);
+}
+
+TEST_CASE(
+    "child runs: a child sees none of the run's descriptors; one that escapes its group "
+    "does not hold the slot") {
+  Loop loop(ClockKind::Real);
+  ChildLimits limits;
+  limits.timeout = std::chrono::milliseconds(300);
+  ChildRuns runs(loop, limits);
+  // a descriptor of the run's without close-on-exec (as Boost.Asio's sockets are)
+  const int fd = ::open("/dev/null", O_RDONLY);
+  REQUIRE(fd > 2);
+  std::optional<ChildOutcome> fds, escaped;
+  REQUIRE(runs.run(sh("ls /proc/$$/fd"), [&](ChildOutcome o) { fds = std::move(o); }));
+  // a grandchild in a session of its own keeps the pipes open past the group's kill
+  REQUIRE(
+      runs.run(sh("setsid sleep 3 & sleep 30"), [&](ChildOutcome o) { escaped = std::move(o); }));
+  const auto began = std::chrono::steady_clock::now();
+  REQUIRE(loop.runUntil([&] { return fds && escaped; }, std::chrono::seconds(10)));
+  ::close(fd);
+  CHECK(fds->out == "0\n1\n2\n");
+  CHECK(escaped->timedOut);
+  CHECK(std::chrono::steady_clock::now() - began < std::chrono::milliseconds(2500));
+  CHECK(runs.running() == 0);
 }

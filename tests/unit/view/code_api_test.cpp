@@ -35,6 +35,7 @@ struct Room {
             "sleep 0.3; case \"$(head -1 \"$0\")\" in "
             "*broken*) echo 'pitwall try: its file does not load: /x/test/driver.lua:2: boom' >&2; "
             "exit 1;; "
+            "*killed*) kill -9 $$;; "
             "*) echo '{\"status\":\"finished\",\"laps\":[4.1,4.0],\"reason\":null}';; esac"};
   }
   explicit Room(int parallel = 2, std::size_t queue = 64)
@@ -49,7 +50,7 @@ struct Room {
   std::string join(int car) {
     std::optional<view::CodeReply> r;
     api.handle({"POST", "/api/code/join",
-                json{{"car", car}, {"name", "s" + std::to_string(car)}}.dump(), "", "c"},
+                json{{"car", car}, {"name", "s" + std::to_string(car)}}.dump(), "", "c", true},
                [&](view::CodeReply x) { r = x; });
     REQUIRE(r);
     REQUIRE(r->status == 200);
@@ -95,6 +96,12 @@ TEST_CASE("code api: a test runs off the loop; one at a time per desk; its answe
   // each desk's test read its own file
   CHECK(fs::exists(r.room.testFile(1)));
   CHECK(fs::exists(r.room.testFile(2)));
+  // a test that dies by a signal is said so
+  auto* killed = r.ask("/api/code/test", {{"text", "-- killed\n"}}, b);
+  REQUIRE(r.loop.runUntil([&] { return killed->has_value(); }, std::chrono::seconds(10)));
+  CHECK((*killed)->status == 500);
+  CHECK(json::parse((*killed)->body)["error"].get<std::string>().find("signal 9") !=
+        std::string::npos);
   // and once it answered, the desk may test again
   auto* later = r.ask("/api/code/test", {{"text", "-- good\n"}}, a);
   REQUIRE(r.loop.runUntil([&] { return later->has_value(); }, std::chrono::seconds(10)));

@@ -12,8 +12,10 @@
 //   editor.text()                       // the text now
 //   editor.setText(text)
 //   editor.showErrors([{ line: 3, message: "…" }])  // marked at their lines (1-based); [] clears
+// Hovering a name the completions know (car:setSpeed, drivers.cap, …) shows its signature and doc.
 //   editor.view                         // the EditorView
 import { basicSetup, EditorView } from "codemirror";
+import { hoverTooltip } from "@codemirror/view";
 import { EditorState } from "@codemirror/state";
 import { StreamLanguage } from "@codemirror/language";
 import { lua } from "@codemirror/legacy-modes/mode/lua";
@@ -39,6 +41,44 @@ function completionSource(completions) {
   };
 }
 
+// The doc of the name under the pointer: "NAME:word" or "NAME.word" by that prefix's entries, a
+// name typed alone by those of "".
+function hoverDocs(completions) {
+  const name = /[A-Za-z0-9_]/;
+  return hoverTooltip((view, pos) => {
+    const line = view.state.doc.lineAt(pos);
+    const text = line.text;
+    let start = pos - line.from, end = start;
+    while (start > 0 && name.test(text[start - 1])) start--;
+    while (end < text.length && name.test(text[end])) end++;
+    if (start === end) return null;
+    const word = text.slice(start, end);
+    let prefix = "";
+    if (start > 0 && (text[start - 1] === ":" || text[start - 1] === ".")) {
+      let p = start - 1;
+      while (p > 0 && name.test(text[p - 1])) p--;
+      prefix = text.slice(p, start);
+    }
+    const entry = (completions[prefix] || []).find((c) => c.label === word);
+    if (!entry) return null;
+    return {
+      pos: line.from + start,
+      end: line.from + end,
+      above: true,
+      create() {
+        const dom = document.createElement("div");
+        dom.className = "cm-pitwall-doc";
+        const signature = document.createElement("code");
+        signature.textContent = prefix + entry.label + (entry.detail || "");
+        const info = document.createElement("div");
+        info.textContent = entry.info || "";
+        dom.append(signature, info);
+        return { dom };
+      },
+    };
+  });
+}
+
 function create(parent, options = {}) {
   const completions = options.completions || {};
   const onChange = options.onChange;
@@ -50,6 +90,7 @@ function create(parent, options = {}) {
         basicSetup,
         StreamLanguage.define(lua),
         autocompletion({ override: [completionSource(completions)] }),
+        hoverDocs(completions),
         EditorView.updateListener.of((update) => {
           if (update.docChanged && onChange) onChange(update.state.doc.toString());
         }),
