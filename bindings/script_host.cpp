@@ -24,8 +24,17 @@ ScriptHost::ScriptHost(Loop& loop, Fleet& fleet, SimSession* sim, HostOptions op
   if (!L_) throw std::runtime_error("cannot create a Lua state (out of memory)");
   interrupt::watchThisThread(options_.budget.count() > 0);
   *static_cast<ScriptHost**>(lua_getextraspace(L_)) = this;
-  cars_ = std::make_unique<CarBinding>(*this);
-  openWorld(*this);
+  try {
+    cars_ = std::make_unique<CarBinding>(*this);
+    openWorld(*this);
+  } catch (...) {
+    // a world that does not open (its library does not load) is closed here: no destructor
+    // runs for it, and a driver world's failed open must not leak its state
+    cars_.reset();
+    lua_close(L_);
+    L_ = nullptr;
+    throw;
+  }
   if (!options_.detached) attach();
 }
 
