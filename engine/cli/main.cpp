@@ -34,8 +34,8 @@ int main(int argc, char** argv) {
       cli::addViewCommand(app),     cli::addScanCommand(app),      cli::addEmulateCommand(app),
       cli::addSimRobotCommand(app), cli::addTestCommand(app),      cli::addLeagueCommand(app),
       cli::addTryCommand(app),      cli::addStandingsCommand(app), cli::addReplayCommand(app),
-      cli::addTrackCommand(app),    cli::addDecodeCommand(app),    cli::addEncodeCommand(app),
-      cli::addTypesCommand(app),    cli::addCompletionCommand(app)};
+      cli::addCompareCommand(app),  cli::addTrackCommand(app),     cli::addDecodeCommand(app),
+      cli::addEncodeCommand(app),   cli::addTypesCommand(app),     cli::addCompletionCommand(app)};
 
   // --version anywhere on the line answers before anything else is checked
   // (`pitwall run --version` has no script to ask for).

@@ -31,6 +31,7 @@ Command addLeagueCommand(CLI::App& app);     // `league DIR|FILES…` (docs/leag
 Command addTryCommand(CLI::App& app);        // `try FILE`: a driver alone in the simulator
 Command addStandingsCommand(CLI::App& app);  // `standings` (docs/league.md "Standings")
 Command addReplayCommand(CLI::App& app);
+Command addCompareCommand(CLI::App& app);  // `compare A B …`: laps side by side (docs/racing.md)
 Command addTrackCommand(CLI::App& app);  // `track show`, `list`, `print`, `verify`
 Command addDecodeCommand(CLI::App& app);
 Command addEncodeCommand(CLI::App& app);

@@ -16,10 +16,10 @@
 #include "engine/cli/commands.hpp"
 #include "engine/cli/fail.hpp"
 #include "engine/cli/options.hpp"
+#include "engine/cli/record_source.hpp"
 #include "engine/cli/session.hpp"
 #include "engine/core/log.hpp"
 #include "engine/core/printable.hpp"
-#include "engine/record/capture.hpp"
 #include "engine/record/record_player.hpp"
 #include "engine/record/record_reader.hpp"
 
@@ -27,8 +27,6 @@ namespace pitwall::cli {
 
 namespace {
 
-constexpr std::size_t kBadLinesShown = 20;  // then a count: a binary file is not 10⁶ lines
-static_assert(kBadLinesShown <= kBadLinesKept, "the summary keeps the lines shown");
 constexpr auto kProgressEvery = std::chrono::milliseconds(100);  // the view's replay object
 
 double micro(double seconds) {
@@ -50,7 +48,7 @@ void printSummary(const RecordPlayer& player, const view::Feed& feed, bool json)
                 "IN", "OUT", "MALFORMED", "DROPS");
   for (int number : player.recordedCars()) {
     const AnkiCar* car = player.car(number);
-    const view::CarTracker* tracker = feed.tracker(car->identity().number);
+    const laps::CarTracker* tracker = feed.tracker(car->identity().number);
     static const std::vector<double> kNone;
     const std::vector<double>& laps = tracker ? tracker->lapTimes() : kNone;
     const CarState& s = car->state();
@@ -116,75 +114,11 @@ int replay(const ReplayOptions& options) {
       return fail("replay", *problem);
     }
   }
-  std::error_code ec;
-  if (std::filesystem::is_directory(file, ec)) {
-    return fail("replay", file + " is a folder; give a --record file");
-  }
-  if (std::filesystem::exists(file, ec) && !std::filesystem::is_regular_file(file, ec)) {
-    return fail("replay", file +
-                              " is not a file (a pipe or a device); a replay reads its record "
-                              "twice, from a file: save it to a file first");
-  }
-  std::ifstream file_in(file, std::ios::binary);
-  if (!file_in) {
-    return fail("replay", "cannot read " + file + ": " + std::strerror(errno));
-  }
-  // A capture without times (docs/cli.md "Captures without times") is read whole and given
-  // times; a record is played from its file.
-  std::istream* source = &file_in;
-  std::istringstream captured;
-  std::optional<BadLines> captureBad;
-  if (RecordKind kind = recordKind(file_in); kind != RecordKind::Timed) {
-    auto timed = timeCapture(file_in, kind, CaptureTiming{options.interval});
-    if (!timed) {
-      return fail("replay", file + ": " + timed.error());
-    }
-    log::info("replay", file +
-                            (kind == RecordKind::IndexedJson
-                                 ? "'s \"t\" counts its frames (0, 1, 2, …), not seconds: "
-                                 : " is a capture without times: ") +
-                            timed->how);
-    captured.str(std::move(timed->record));
-    captureBad = std::move(timed->bad);
-    source = &captured;
-  } else if (options.interval) {
-    return fail("replay",
-                "--interval states the time between the frames of a capture without times, and " +
-                    file + " has its times (\"t\"): leave it out");
-  }
-  std::istream& in = *source;
-  // One pass to count and check; the frames are read again as they are played (RecordPlayer):
-  // neither pass keeps more than a line, a frame and the first bad lines.
-  RecordSummary record = scanRecord(in);
-  if (in.bad()) {
-    return fail("replay", "cannot read " + file + ": " + std::strerror(errno));
-  }
-  if (captureBad) record.bad = std::move(*captureBad);  // the capture's lines, not ours
-  const auto& bad = record.bad;
-  for (std::size_t i = 0; i < bad.first.size() && i < kBadLinesShown; ++i)
-    std::cerr << file << ":" << bad.first[i].line << ": " << bad.first[i].why << "\n";
-  if (bad.count > kBadLinesShown)
-    std::cerr << file << ": " << bad.count - kBadLinesShown << " more bad lines\n";
-  if (record.frames == 0) {
-    return fail("replay",
-                file +
-                    (bad.count == 0 ? " is empty"
-                                    : " has no line that is a frame (" + std::to_string(bad.count) +
-                                          " bad lines)") +
-                    "; a record is what `pitwall run --record FILE` writes",
-                1);
-  }
-  if (bad.count > 0)
-    log::warn("replay", std::to_string(bad.count) + " bad line" + (bad.count == 1 ? "" : "s") +
-                            " of " + file + " left out; replaying the " +
-                            std::to_string(record.frames) + " frames that are whole");
-  in.clear();
-  in.seekg(0);
-  if (!in) {
-    return fail("replay", "cannot read " + file +
-                              " from its start again (a replay reads a record twice): give a "
-                              "file, not a pipe");
-  }
+  auto opened = openRecord("replay", file, options.interval);
+  if (auto* status = std::get_if<int>(&opened)) return *status;
+  RecordSource& source = *std::get<std::unique_ptr<RecordSource>>(opened);
+  std::istream& in = *source.in;
+  const RecordSummary& record = source.summary;
 
   // The track drawn: --track, else the record's own layout, else the default oval. A summary
   // and a script follow the cars on --track or the record's layout too, when there is one: the

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "engine/core/printable.hpp"
+#include "engine/core/svg_chart.hpp"
 
 namespace pitwall::league {
 
@@ -25,76 +26,34 @@ std::string seconds(const nlohmann::json& v) {
   return buf;
 }
 
-// The colours of a heat's lines (Okabe–Ito: told apart by colour-blind readers too).
-constexpr const char* kColours[] = {"#0072B2", "#D55E00", "#009E73", "#CC79A7",
-                                    "#E69F00", "#56B4E9", "#F0E442", "#000000"};
-
 // A heat's lap times, one line per driver: lap number across, seconds up.
 std::string chart(nlohmann::json& heat) {
-  const double width = 520, height = 220, left = 52, right = 120, top = 12, bottom = 30;
-  double lo = INFINITY, hi = -INFINITY;
+  svg::Chart c;
+  c.cssClass = "laps";
+  c.ariaLabel = "lap times";
+  c.xLabel = "lap";
+  c.yUnit = " s";
+  c.empty = "no lap was timed";
   std::size_t laps = 0;
   for (auto& r : heat["results"]) {
+    svg::Series s;
+    s.cssClass = "driver";
+    const auto& driver = r["driver"];
+    s.label = driver.is_string()
+                  ? driver.get<std::string>()
+                  : driver.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
     const auto& times = r["lapTimes"];
-    if (!times.is_array()) continue;
-    laps = std::max(laps, times.size());
-    for (const auto& t : times)
-      if (t.is_number()) {
-        lo = std::min(lo, t.get<double>());
-        hi = std::max(hi, t.get<double>());
-      }
-  }
-  std::ostringstream svg;
-  svg << "<svg class=\"laps\" viewBox=\"0 0 " << width << ' ' << height << "\" width=\"" << width
-      << "\" height=\"" << height << "\" role=\"img\" aria-label=\"lap "
-      << "times\">";
-  if (laps == 0 || !std::isfinite(lo)) {
-    svg << "<text x=\"" << left << "\" y=\"" << height / 2 << "\">no lap was timed</text></svg>";
-    return svg.str();
-  }
-  if (hi - lo < 0.05) {
-    lo -= 0.05;
-    hi += 0.05;
-  }
-  const double plotW = width - left - right, plotH = height - top - bottom;
-  auto x = [&](std::size_t lap) {
-    return left + (laps == 1 ? plotW / 2 : plotW * static_cast<double>(lap) / (laps - 1));
-  };
-  auto y = [&](double t) { return top + plotH * (hi - t) / (hi - lo); };
-  svg << "<g class=\"axes\" stroke=\"#888\"><line x1=\"" << left << "\" y1=\"" << top << "\" x2=\""
-      << left << "\" y2=\"" << top + plotH << "\"/><line x1=\"" << left << "\" y1=\"" << top + plotH
-      << "\" x2=\"" << left + plotW << "\" y2=\"" << top + plotH << "\"/></g>";
-  char label[64];
-  for (double t : {lo, (lo + hi) / 2, hi}) {
-    std::snprintf(label, sizeof label, "%.2f s", t);
-    svg << "<text x=\"" << left - 4 << "\" y=\"" << y(t) + 4
-        << "\" text-anchor=\"end\" font-size=\"10\">" << label << "</text>";
-  }
-  for (std::size_t lap = 0; lap < laps; ++lap)
-    svg << "<text x=\"" << x(lap) << "\" y=\"" << top + plotH + 14
-        << "\" text-anchor=\"middle\" font-size=\"10\">" << lap + 1 << "</text>";
-  svg << "<text x=\"" << left + plotW / 2 << "\" y=\"" << height - 2
-      << "\" text-anchor=\"middle\" font-size=\"10\">lap</text>";
-  std::size_t line = 0;
-  for (auto& r : heat["results"]) {
-    const char* colour = kColours[line % std::size(kColours)];
-    const auto& times = r["lapTimes"];
-    std::ostringstream points;
-    std::size_t n = 0;
-    if (times.is_array())
+    if (times.is_array()) {
+      laps = std::max(laps, times.size());
       for (std::size_t i = 0; i < times.size(); ++i)
-        if (times[i].is_number()) {
-          points << (n++ ? " " : "") << x(i) << ',' << y(times[i].get<double>());
-        }
-    if (n > 0)
-      svg << "<polyline class=\"driver\" fill=\"none\" stroke-width=\"2\" stroke=\"" << colour
-          << "\" points=\"" << points.str() << "\"/>";
-    svg << "<text x=\"" << left + plotW + 8 << "\" y=\"" << top + 12 + 14.0 * line
-        << "\" font-size=\"11\" fill=\"" << colour << "\">" << text(r["driver"]) << "</text>";
-    ++line;
+        if (times[i].is_number())
+          s.points.emplace_back(static_cast<double>(i + 1), times[i].get<double>());
+    }
+    c.series.push_back(std::move(s));
   }
-  svg << "</svg>";
-  return svg.str();
+  for (std::size_t lap = 1; lap <= laps; ++lap)
+    c.xTicks.push_back({static_cast<double>(lap), std::to_string(lap)});
+  return svg::lineChart(c);
 }
 
 }  // namespace

@@ -29,7 +29,9 @@ double round3(double v) {
 constexpr double kStandAfter = 0.5;  // s without a speed report after a command of speed 0
 
 struct Feed::Car {
-  CarTracker tracker;
+  laps::CarTracker tracker;
+  laps::TraceBuilder traces;
+  std::deque<laps::LapTrace> laps;            // its last kLapsKept laps' traces
   std::deque<std::pair<double, int>> speeds;  // (time, mm/s)
   int commanded = -1;      // the last speed sent to the car (mm/s); -1: none seen (a replay)
   double reportedAt = -1;  // feed time of its last report of its speed
@@ -82,6 +84,7 @@ Feed::Car& Feed::car(AnkiCar& car) {
   if (!slot) {
     slot = std::make_unique<Car>();
     slot->tracker.setTrack(track_ ? &*track_ : nullptr);
+    slot->traces.setTrack(track_ ? &*track_ : nullptr);
   }
   lastAnki_ = &car;
   lastNumber_ = number;
@@ -96,9 +99,14 @@ void Feed::reset() {
   ++changes_;
 }
 
-const CarTracker* Feed::tracker(int number) const {
+const laps::CarTracker* Feed::tracker(int number) const {
   auto it = cars_.find(number);
   return it == cars_.end() ? nullptr : &it->second->tracker;
+}
+
+const std::deque<laps::LapTrace>* Feed::laps(int number) const {
+  auto it = cars_.find(number);
+  return it == cars_.end() ? nullptr : &it->second->laps;
 }
 
 void Feed::sent(AnkiCar& ankiCar, const anki::Message& m) {
@@ -119,6 +127,10 @@ void Feed::frame(AnkiCar& ankiCar, AnkiCar::Direction d, const anki::Message& m)
                          ? ankiCar.state().last_position_time
                          : this->now();
   c.tracker.update(m, ankiCar.state(), now);
+  if (auto lap = c.traces.update(c.tracker, m, ankiCar.state().reverse, now)) {
+    c.laps.push_back(std::move(*lap));
+    if (c.laps.size() > kLapsKept) c.laps.pop_front();
+  }
   if (std::holds_alternative<anki::PositionUpdate>(m) ||
       std::holds_alternative<anki::SpeedUpdate>(m)) {
     c.reportedAt = now;
@@ -149,7 +161,10 @@ void Feed::setTrack(std::optional<sim::Track> track, const std::string& source) 
   trackSource_ = track_ ? source : "none";
   ++trackVersion_;
   ++changes_;
-  for (auto& [number, c] : cars_) c->tracker.setTrack(track_ ? &*track_ : nullptr);
+  for (auto& [number, c] : cars_) {
+    c->tracker.setTrack(track_ ? &*track_ : nullptr);
+    c->traces.setTrack(track_ ? &*track_ : nullptr);
+  }
   if (track_)
     event("info", "track: " + track_->name() + " (" + std::to_string(track_->size()) + " pieces, " +
                       source + ")");
@@ -251,7 +266,7 @@ nlohmann::json Feed::carJson(const AnkiCar& ankiCar, std::size_t laps) const {
   };
   if (!c) return j;
   if (c->standing) j["speed"] = 0;
-  const CarTracker& t = c->tracker;
+  const laps::CarTracker& t = c->tracker;
   j["lap"] = t.laps();
   // the latest `laps` of them: a long session's list does not grow every update
   const auto& all = t.lapTimes();

@@ -15,8 +15,9 @@
 #include "engine/core/loop.hpp"
 #include "engine/drive/seats.hpp"
 #include "engine/fleet/fleet.hpp"
+#include "engine/laps/trace.hpp"
+#include "engine/laps/tracker.hpp"
 #include "engine/sim/track.hpp"
-#include "engine/view/tracker.hpp"
 
 namespace pitwall::view {
 
@@ -88,7 +89,11 @@ class Feed {
   void reset();
 
   // The tracker of car `number` (for replay summaries and tests); nullptr when unknown.
-  const CarTracker* tracker(int number) const;
+  const laps::CarTracker* tracker(int number) const;
+  // The traces of car `number`'s last laps (kLapsKept at most), oldest first: for `pitwall
+  // compare` and the view's lap comparison; nullptr when unknown. Empty with no track.
+  const std::deque<laps::LapTrace>* laps(int number) const;
+  static constexpr std::size_t kLapsKept = 200;
 
  private:
   struct Car;

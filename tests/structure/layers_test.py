@@ -23,8 +23,9 @@ FLOORS = {
     "engine/drive": 6,  # human seats and the devices that hold them: above the fleet
     "engine/view": 7,  # the view shows the seats and its /drive page holds them
     "engine/print": 6,  # printing pieces and reading them back: the sim's geometry, drawn
-    "engine/league": 6,
-    "engine/classroom": 6,  # the code page's desks, files and credentials: plain files, no cars  # a league's heats, points and report: plain data, no cars
+    "engine/laps": 6,  # laps as traces (tracker, trace, compare): the car model's frames, drawn
+    "engine/league": 6,  # a league's heats, points and report: plain data, no cars
+    "engine/classroom": 6,  # the code page's desks, files and credentials: plain files, no cars
     "engine/standings": 7,  # every race's and league's results kept (SQLite): a league's points
     "bindings": 8,
     "engine/cli": 9,

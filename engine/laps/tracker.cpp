@@ -1,10 +1,10 @@
-#include "engine/view/tracker.hpp"
+#include "engine/laps/tracker.hpp"
 
 #include <algorithm>
 
 #include "engine/sim/code_layout.hpp"
 
-namespace pitwall::view {
+namespace pitwall::laps {
 
 // Where along a piece a location code lies (docs/tracks.md "The code"): the centre of its
 // section, as a fraction of the piece in its own forward direction; location ids name the same
@@ -165,4 +165,4 @@ void CarTracker::transition(bool reverse, double now) {
   if (reverse) sinceLine_.reset();
 }
 
-}  // namespace pitwall::view
+}  // namespace pitwall::laps

@@ -13,7 +13,7 @@
 #include "engine/sim/track.hpp"
 #include "engine/vehicles/anki_car.hpp"
 
-namespace pitwall::view {
+namespace pitwall::laps {
 
 class CarTracker {
  public:
@@ -34,6 +34,8 @@ class CarTracker {
   int laps() const { return static_cast<int>(lapTimes_.size()); }
   const std::vector<double>& lapTimes() const { return lapTimes_; }
   std::optional<double> bestLap() const { return best_; }
+  // When the car last crossed the line (none: not yet): the start of the lap under way.
+  std::optional<double> lastCrossing() const { return lastCrossing_; }
 
  private:
   void crossFinish(double now);
@@ -63,4 +65,4 @@ class CarTracker {
   std::optional<double> best_;
 };
 
-}  // namespace pitwall::view
+}  // namespace pitwall::laps

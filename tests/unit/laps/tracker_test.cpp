@@ -1,7 +1,7 @@
-// The view's lap counter and localization (engine/view/tracker.cpp) under what real cars send
+// The view's lap counter and localization (engine/laps/tracker.cpp) under what real cars send
 // (../shared/realdata): a transition (0x29) at every piece boundary, and position updates
 // (0x27) that thin out with speed — on a curve at race speed usually none at all.
-#include "engine/view/tracker.hpp"
+#include "engine/laps/tracker.hpp"
 
 #include <doctest/doctest.h>
 
@@ -16,8 +16,8 @@ namespace {
 // Drives `laps` laps of `track` from its first piece, a position update on each piece kept with
 // chance `keep(piece index, lap)`, a transition at every boundary; time advances 1 s a piece.
 template <class Keep>
-view::CarTracker drive(const sim::Track& track, const sim::Track* map, int laps, Keep keep) {
-  view::CarTracker tracker;
+laps::CarTracker drive(const sim::Track& track, const sim::Track* map, int laps, Keep keep) {
+  laps::CarTracker tracker;
   tracker.setTrack(map);
   CarState state;
   double now = 0;
@@ -102,7 +102,7 @@ TEST_CASE(
     "tracker: between updates the car moves on by its speed along its lane, never past the "
     "piece's end") {
   const sim::Track track = sim::namedLayout("oval").value();
-  view::CarTracker tracker;
+  laps::CarTracker tracker;
   tracker.setTrack(&track);
   CarState state;
   CHECK(tracker.fractionAt(5, 1000, 0, false) == 0);  // not localized: nothing to move on
@@ -139,7 +139,7 @@ TEST_CASE(
   CarState state;
   // off the grid (34) at speed: no report on 34, the line at t = 1, the first report on the
   // piece after the next one (two transitions back), then reports only on the start piece
-  view::CarTracker tracker;
+  laps::CarTracker tracker;
   tracker.setTrack(&track);
   tracker.update(anki::TransitionUpdate{}, state, 1.0);  // 34 → 33: the line
   tracker.update(anki::TransitionUpdate{}, state, 1.2);  // 33 → straight
@@ -159,7 +159,7 @@ TEST_CASE(
   CHECK(tracker.lapTimes()[0] == doctest::Approx(now - 1.0));
 
   // a car whose first report shows it has not reached the line yet: nothing is crossed
-  view::CarTracker before;
+  laps::CarTracker before;
   before.setTrack(&track);
   before.update(anki::TransitionUpdate{}, state, 1.0);
   p.piece_id = anki::kFinishBefore;
