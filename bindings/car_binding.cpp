@@ -214,6 +214,7 @@ const lua::Field kFields[] = {
     {"model", [](lua_State* L, int c) { pushString(L, modelName(identityAt(L, c).model_id)); }},
     {"modelId", [](lua_State* L, int c) { lua_pushinteger(L, identityAt(L, c).model_id); }},
     {"identifier", [](lua_State* L, int c) { lua_pushinteger(L, identityAt(L, c).identifier); }},
+    {"ghost", [](lua_State* L, int c) { lua_pushboolean(L, identityAt(L, c).ghost); }},
     {"address", [](lua_State* L, int c) { pushString(L, proxyAt(L, c).car->link().address()); }},
     {"connected", [](lua_State* L, int c) { lua_pushboolean(L, stateAt(L, c).connected); }},
     {"onTrack", [](lua_State* L, int c) { lua_pushboolean(L, stateAt(L, c).on_track); }},

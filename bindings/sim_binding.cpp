@@ -10,17 +10,24 @@
 #include "bindings/pitwall_module.hpp"
 #include "bindings/script_host.hpp"
 #include "bindings/track_table.hpp"
+#include "engine/core/log.hpp"
 #include "engine/core/printable.hpp"
+#include "engine/laps/ghost.hpp"
 #include "engine/protocol/anki/advertisement.hpp"
 #include "engine/protocol/anki/limits.hpp"
 #include "engine/sim/grid.hpp"
 #include "engine/transport/sim_link.hpp"
+#include "engine/view/record_laps.hpp"
 
 namespace pitwall {
 
 using lua::LuaError;
 
 namespace {
+
+// The largest record sim.addGhost reads: it is played on the loop, at about N MB/s
+// (docs/performance.md "Ghosts").
+constexpr std::uintmax_t kMaxGhostRecordBytes = 16ull * 1024 * 1024;
 
 SimSession& session(lua_State* L) {
   return *ScriptHost::from(L).sim();
@@ -95,6 +102,21 @@ void checkOnRoad(double offset_mm) {
                    std::to_string(static_cast<int>(kOffsetMax)) + " mm)");
 }
 
+// A simulated car made by the world joins the run over a SimLink, and is pushed.
+int join(lua_State* L, const sim::CarSpec& spec) {
+  ScriptHost& host = ScriptHost::from(L);
+  sim::SimCar& simCar = session(L).world->addCar(spec);
+  auto link = std::make_unique<SimLink>(host.loop(), simCar);
+  SimLink& toCar = *link;
+  AnkiCar& car = host.fleet().add(
+      std::move(link),
+      CarIdentity{0, spec.name, spec.model_id, simCar.identifier(), static_cast<bool>(spec.ghost)});
+  toCar.connect();  // now that the fleet listens: the car joins the run (pitwall.onCar) here
+  host.cars().bind(car);
+  host.cars().push(L, car);
+  return 1;
+}
+
 // sim._addCar{name=, model=, piece=, distance=, lane= | offset=, battery=, firmware=}
 int addCar(lua_State* L) {
   ScriptHost& host = ScriptHost::from(L);
@@ -144,15 +166,69 @@ int addCar(lua_State* L) {
   if (std::find(taken.begin(), taken.end(), spec.name) != taken.end())
     throw LuaError("a car named '" + spec.name + "' is already in the run");
 
-  sim::SimCar& simCar = s.world->addCar(spec);
-  auto link = std::make_unique<SimLink>(host.loop(), simCar);
-  SimLink& toCar = *link;
-  AnkiCar& car = host.fleet().add(std::move(link),
-                                  CarIdentity{0, spec.name, spec.model_id, simCar.identifier()});
-  toCar.connect();  // now that the fleet listens: the car joins the run (pitwall.onCar) here
-  host.cars().bind(car);
-  host.cars().push(L, car);
-  return 1;
+  return join(L, spec);
+}
+
+// sim._addGhost{record=, car=, lap=, name=}: the ghost of a recorded lap (docs/simulator.md
+// "Ghosts"). The record is read and played here, on the loop: it may be at most
+// kMaxGhostRecordBytes (docs/performance.md "Ghosts").
+int addGhost(lua_State* L) {
+  ScriptHost& host = ScriptHost::from(L);
+  SimSession& s = *host.sim();
+  static constexpr std::array<const char*, 4> kOptions = {"record", "car", "lap", "name"};
+  lua::Options read(L, 1, "sim.addGhost", kOptions, "record=, car=, lap=, name=");
+  auto record = read.string("record", "record (a --record file)");
+  if (!record) throw LuaError("sim.addGhost needs record=, the --record file that holds the lap");
+  view::LapAsk ask;
+  if (read.value("car")) {
+    if (lua_type(L, -1) == LUA_TNUMBER && lua_isinteger(L, -1))
+      ask.car = std::to_string(lua_tointeger(L, -1));
+    else if (lua_type(L, -1) == LUA_TSTRING)
+      ask.car = lua_tostring(L, -1);
+    else
+      throw LuaError("sim.addGhost: car= must be the recorded car's number or name, not a " +
+                     std::string(luaL_typename(L, -1)));
+    lua_pop(L, 1);
+  }
+  if (read.value("lap")) {
+    const bool best =
+        lua_type(L, -1) == LUA_TSTRING && std::string_view(lua_tostring(L, -1)) == "best";
+    if (lua_type(L, -1) == LUA_TSTRING && !best)
+      throw LuaError("sim.addGhost: lap= must be a lap's number or \"best\", not '" +
+                     printable(lua_tostring(L, -1), 40) + "'");
+    lua_pop(L, 1);
+    if (!best)
+      ask.lap =
+          static_cast<int>(*read.integer("lap", 1, 1000000, {}, "a lap's number, or \"best\""));
+  }
+  auto laps = view::readRecordLaps(*record, std::nullopt, kMaxGhostRecordBytes);
+  if (!laps) throw LuaError("sim.addGhost: " + laps.error());
+  const sim::Track& track = s.world->track();
+  if (laps->layout != sim::layoutText(track))
+    throw LuaError("sim.addGhost: " + printable(*record, 200) + " was driven on " +
+                   printable(laps->layout, 80) + ", and this run's track is " +
+                   printable(sim::layoutText(track), 80) + ": a ghost drives the track it was on");
+  auto picked = view::pickLap(*laps, ask);
+  if (!picked) throw LuaError("sim.addGhost: " + picked.error());
+  sim::CarSpec spec;
+  spec.piece_index = track.finishIndex();
+  auto ghost = std::make_shared<sim::GhostLap>(laps::ghostLap(*picked->trace));
+  spec.offset_mm = ghost->lanes.empty() ? 0 : ghost->lanes.front().offset;
+  checkOnRoad(spec.offset_mm);
+  spec.ghost = std::move(ghost);
+  std::vector<std::string> taken;
+  for (AnkiCar* c : host.fleet().cars()) taken.push_back(c->identity().name);
+  spec.name = read.string("name").value_or("");
+  if (spec.name.empty()) {
+    spec.name = "ghost";
+    for (int n = 2; std::find(taken.begin(), taken.end(), spec.name) != taken.end(); ++n)
+      spec.name = "ghost" + std::to_string(n);
+  } else if (std::find(taken.begin(), taken.end(), spec.name) != taken.end()) {
+    throw LuaError("a car named '" + spec.name + "' is already in the run");
+  }
+  log::info("sim", spec.name + " drives " + picked->label + " again (" +
+                       std::to_string(picked->trace->time) + " s)");
+  return join(L, spec);
 }
 
 int truth(lua_State* L) {
@@ -246,17 +322,13 @@ int sensor(lua_State* L) {
 
 void openSimModule(ScriptHost& host) {
   lua_State* L = host.state();
-  static const luaL_Reg functions[] = {{"track", lua::guarded<track>},
-                                       {"setTrack", lua::guarded<setTrack>},
-                                       {"layouts", lua::guarded<layouts>},
-                                       {"_addCar", lua::guarded<addCar>},
-                                       {"truth", lua::guarded<truth>},
-                                       {"lift", lua::guarded<lift>},
-                                       {"reboot", lua::guarded<reboot>},
-                                       {"place", lua::guarded<place>},
-                                       {"noise", lua::guarded<noise>},
-                                       {"sensor", lua::guarded<sensor>},
-                                       {nullptr, nullptr}};
+  static const luaL_Reg functions[] = {
+      {"track", lua::guarded<track>},        {"setTrack", lua::guarded<setTrack>},
+      {"layouts", lua::guarded<layouts>},    {"_addCar", lua::guarded<addCar>},
+      {"_addGhost", lua::guarded<addGhost>}, {"truth", lua::guarded<truth>},
+      {"lift", lua::guarded<lift>},          {"reboot", lua::guarded<reboot>},
+      {"place", lua::guarded<place>},        {"noise", lua::guarded<noise>},
+      {"sensor", lua::guarded<sensor>},      {nullptr, nullptr}};
   lua_getglobal(L, "pitwall");
   luaL_newlib(L, functions);
   openScriptUnderTest(L);

@@ -441,6 +441,7 @@ function expect.truthy(v, what) end
 ---@field extraBytes table<string, {frames: integer, last: string}> frames longer than their layout, by message name (a fresh table)
 ---@field firmware integer? firmware version from the version answer
 ---@field frames integer frames in + out
+---@field ghost boolean the simulator's ghost of a recorded lap (sim.addGhost)
 ---@field identifier integer the car's 32-bit identifier from its advertisement
 ---@field laneChanging boolean a lane change is under way
 ---@field lastPing number? round-trip time of the last answered ping, s
@@ -718,6 +719,13 @@ function Alphabot:stop() end
 ---@field battery? integer 3000..4300 mV
 ---@field firmware? integer firmware version, e.g. 0x266e (the older layouts) or 0x2b70 (the default)
 
+---What sim.addGhost{…} takes.
+---@class pitwall.sim.GhostSpec
+---@field record string a --record file
+---@field car? integer|string the recorded car's number or name (default: the record's first car)
+---@field lap? integer|"best" the lap (default: the car's best)
+---@field name? string default: ghost (ghost2, … when taken)
+
 ---@class pitwall.sim.Piece
 ---@field id integer road piece id
 ---@field type string
@@ -785,6 +793,11 @@ pitwall.sim = {}
 ---@param spec? pitwall.sim.CarSpec
 ---@return pitwall.Car
 function pitwall.sim.addCar(spec) end
+
+---The ghost of a recorded lap (docs/simulator.md "Ghosts"): a car that drives the lap again, lap after lap, while a set-speed above 0 holds, touching no one; inside a task it waits until it is connected.
+---@param spec pitwall.sim.GhostSpec
+---@return pitwall.Car
+function pitwall.sim.addGhost(spec) end
 
 ---The names of the built-in layouts.
 ---@return string[]

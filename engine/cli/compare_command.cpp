@@ -15,11 +15,10 @@
 #include "engine/cli/fail.hpp"
 #include "engine/cli/options.hpp"
 #include "engine/cli/record_source.hpp"
-#include "engine/cli/session.hpp"
 #include "engine/core/printable.hpp"
 #include "engine/laps/compare_report.hpp"
-#include "engine/record/record_player.hpp"
 #include "engine/record/results.hpp"
+#include "engine/view/record_laps.hpp"
 
 namespace pitwall::cli {
 
@@ -33,62 +32,10 @@ struct CompareOptions {
   double step = 10;                  // --step mm
 };
 
-// One lap asked for: the record, the car (its recorded number or name; empty: the first), the
-// lap (its number; 0: the best).
-struct Ask {
-  std::string spec, file, car;
-  int lap = 0;
-};
-
-// FILE[:CAR[:LAP]]: the longest prefix that is a file is the record (its name may hold ':').
-std::optional<Ask> parseAsk(const std::string& spec, std::string& why) {
-  std::error_code ec;
-  std::vector<std::string> parts;
-  std::string file = spec;
-  for (int tail = 0; tail <= 2; ++tail) {
-    if (std::filesystem::exists(file, ec)) {
-      Ask a{spec, file, "", 0};
-      if (parts.size() >= 1) a.car = parts.back();
-      if (parts.size() == 2) {
-        const std::string& lap = parts.front();
-        if (lap != "best") {
-          char* end = nullptr;
-          errno = 0;
-          const long n = std::strtol(lap.c_str(), &end, 10);
-          if (lap.empty() || *end || errno || n < 1 || n > 1000000) {
-            why =
-                spec + ": the lap must be a number from 1 or `best`, not '" + printable(lap) + "'";
-            return std::nullopt;
-          }
-          a.lap = static_cast<int>(n);
-        }
-      }
-      return a;
-    }
-    const auto colon = file.rfind(':');
-    if (colon == std::string::npos) break;
-    parts.push_back(file.substr(colon + 1));
-    file.resize(colon);
-  }
-  why = "cannot read " + spec + ": no such file (give FILE, FILE:CAR or FILE:CAR:LAP)";
-  return std::nullopt;
-}
-
-struct RecordedCar {
-  int number = 0;
-  std::string name;
-  std::vector<laps::LapTrace> laps;
-};
-
-struct Played {
-  sim::Track track;
-  std::string layout;  // its text: laps compared must share it
-  std::vector<RecordedCar> cars;
-};
-
-// The record played through the car model and the feed's trackers in virtual time: every car's
-// laps as traces. The exit status after a sentence when it cannot be.
-std::variant<Played, int> play(const std::string& file, const std::optional<std::string>& track) {
+// The record played for its laps (view::playLaps); the exit status after a sentence when it
+// cannot be.
+std::variant<view::RecordLaps, int> play(const std::string& file,
+                                         const std::optional<std::string>& track) {
   auto opened = openRecord("compare", file, std::nullopt);
   if (auto* status = std::get_if<int>(&opened)) return *status;
   RecordSource& source = *std::get<std::unique_ptr<RecordSource>>(opened);
@@ -99,77 +46,7 @@ std::variant<Played, int> play(const std::string& file, const std::optional<std:
   auto layout =
       track ? sim::loadLayout(*track) : sim::parseLayout(source.summary.layout, "recorded");
   if (!layout) return fail("compare", (track ? "" : file + "'s layout: ") + layout.error());
-  Played played;
-  played.track = *layout;
-  played.layout = sim::layoutText(played.track);
-  auto session = Session::openReplay(ClockKind::Virtual);
-  view::Feed& feed = session->startFeed("compare");
-  feed.setTrack(played.track, "layout");
-  RecordPlayer player(session->loop(), session->fleet(), *source.in, source.summary);
-  player.onEnd = [&session] { session->loop().stop(); };
-  player.play();
-  session->loop().run();
-  if (session->interrupted()) return 130;
-  for (int number : player.recordedCars()) {
-    const AnkiCar* car = player.car(number);
-    RecordedCar rc{number, car->identity().name, {}};
-    if (const auto* kept = feed.laps(car->identity().number))
-      for (const auto& lap : *kept)
-        if (lap.clean) rc.laps.push_back(lap);
-    played.cars.push_back(std::move(rc));
-  }
-  return played;
-}
-
-std::string lapsList(const RecordedCar& car) {
-  std::string out;
-  for (const auto& l : car.laps) out += (out.empty() ? "" : ", ") + std::to_string(l.lap);
-  return out;
-}
-
-// The lap asked for, or a sentence saying what the record has instead.
-const laps::LapTrace* pick(const Ask& ask, const Played& played, std::string& label,
-                           std::string& why) {
-  const RecordedCar* car = nullptr;
-  if (ask.car.empty()) {
-    if (!played.cars.empty()) car = &played.cars.front();
-  } else {
-    for (const auto& c : played.cars)
-      if (std::to_string(c.number) == ask.car || c.name == ask.car) car = &c;
-  }
-  std::string cars;
-  for (const auto& c : played.cars)
-    cars += (cars.empty() ? "" : ", ") + std::to_string(c.number) + " (" + printable(c.name) + ")";
-  if (!car) {
-    why = ask.file + " has no car '" + printable(ask.car) + "': its cars are " + cars;
-    return nullptr;
-  }
-  const std::string who =
-      ask.file + " car " + std::to_string(car->number) + " (" + printable(car->name) + ")";
-  if (car->laps.empty()) {
-    why = who +
-          " drove no whole lap the tracker could follow from line to line (forward, on the "
-          "track's map)" +
-          (played.cars.size() > 1 ? "; the record's cars are " + cars : "");
-    return nullptr;
-  }
-  const laps::LapTrace* lap = nullptr;
-  if (ask.lap == 0) {
-    for (const auto& l : car->laps)
-      if (!lap || l.time < lap->time) lap = &l;
-  } else {
-    for (const auto& l : car->laps)
-      if (l.lap == ask.lap) lap = &l;
-    if (!lap) {
-      why = who + " has no lap " + std::to_string(ask.lap) + " to compare: its whole laps are " +
-            lapsList(*car) + "; ask for one of them, or `best`";
-      return nullptr;
-    }
-  }
-  label = std::filesystem::path(ask.file).filename().string() + " car " +
-          std::to_string(car->number) + " (" + printable(car->name) + ") lap " +
-          std::to_string(lap->lap);
-  return lap;
+  return view::playLaps(*source.in, source.summary, *layout, file);
 }
 
 int compare(const CompareOptions& options) {
@@ -181,32 +58,30 @@ int compare(const CompareOptions& options) {
                                  ": the charts are written as .svg or .html (a page with the "
                                  "table); give a name ending in one of them");
   }
-  std::vector<Ask> asks;
+  std::vector<std::pair<std::string, view::LapAsk>> asks;
   for (const auto& spec : options.laps) {
-    std::string why;
-    auto ask = parseAsk(spec, why);
-    if (!ask) return fail("compare", why);
+    auto ask = view::splitLapSpec(spec);
+    if (!ask) return fail("compare", ask.error());
     asks.push_back(std::move(*ask));
   }
-  std::map<std::string, Played> records;  // each file played once
-  for (const auto& a : asks) {
-    if (records.count(a.file)) continue;
-    auto played = play(a.file, options.track);
+  std::map<std::string, view::RecordLaps> records;  // each file played once
+  for (const auto& [file, ask] : asks) {
+    if (records.count(file)) continue;
+    auto played = play(file, options.track);
     if (auto* status = std::get_if<int>(&played)) return *status;
-    records.emplace(a.file, std::move(std::get<Played>(played)));
+    records.emplace(file, std::move(std::get<view::RecordLaps>(played)));
   }
   laps::Report report;
-  const Played& first = records.at(asks.front().file);
-  for (const auto& a : asks) {
-    const Played& p = records.at(a.file);
-    if (p.layout != first.layout)
-      return fail("compare", a.file + " was driven on another track than " + asks.front().file +
-                                 " (" + printable(p.layout, 80) + " against " +
+  const view::RecordLaps& first = records.at(asks.front().first);
+  for (const auto& [file, ask] : asks) {
+    const view::RecordLaps& r = records.at(file);
+    if (r.layout != first.layout)
+      return fail("compare", file + " was driven on another track than " + first.file + " (" +
+                                 printable(r.layout, 80) + " against " +
                                  printable(first.layout, 80) + "): laps are compared on one track");
-    std::string label, why;
-    const laps::LapTrace* lap = pick(a, p, label, why);
-    if (!lap) return fail("compare", why, 1);
-    report.laps.push_back({label, lap});
+    auto picked = view::pickLap(r, ask);
+    if (!picked) return fail("compare", picked.error(), 1);
+    report.laps.push_back({picked->label, picked->trace});
   }
   laps::LapMap map(first.track);
   report.track = first.track.name() == "recorded" ? "the recorded track" : first.track.name();

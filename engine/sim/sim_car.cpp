@@ -165,7 +165,7 @@ void Car::receive(std::span<const std::uint8_t> frame) {
             if (target_ > 0) env_.wake();
           },
           [&](const anki::ChangeLane& m) {
-            if (!driving() || !finite(m.offset_mm)) return;
+            if (!driving() || !finite(m.offset_mm) || spec_.ghost) return;
             ++lane_recv_id_;
             lane_speed_asked_ = m.h_speed_mm_s;
             lane_speed_ = m.h_speed_mm_s > 0 ? m.h_speed_mm_s : kDefaultLaneSpeed;
@@ -177,16 +177,16 @@ void Car::receive(std::span<const std::uint8_t> frame) {
             env_.wake();
           },
           [&](const anki::CancelLaneChange&) {
-            if (!driving()) return;
+            if (!driving() || spec_.ghost) return;
             lane_active_ = false;
             lane_vel_ = 0;
           },
           [&](const anki::SetOffset& m) {
-            if (!driving() || !finite(m.offset_mm)) return;
+            if (!driving() || !finite(m.offset_mm) || spec_.ghost) return;
             bias_ = m.offset_mm - offset_ * dir_;
           },
           [&](const anki::Turn& m) {
-            if (!driving() || m.type == anki::TurnType::None) return;
+            if (!driving() || m.type == anki::TurnType::None || spec_.ghost) return;
             // Left/right turns and turns at the next intersection need an intersection piece.
             if (m.trigger != anki::TurnTrigger::Immediate ||
                 (m.type != anki::TurnType::UTurn && m.type != anki::TurnType::UTurnJump))
@@ -220,7 +220,41 @@ void Car::refuse(std::span<const std::uint8_t> frame, const std::string& why) co
 
 // ---- physics ----
 
+// A ghost drives its recorded lap again (CarSpec::ghost): its clock runs while a set-speed above
+// 0 holds, and each tick it moves to where the lap had it at that time, along its recorded lane.
+// From the actual position, so nothing drifts over many laps.
+void Car::planGhost(double dt) {
+  const GhostLap& g = *spec_.ghost;
+  planned_lane_ = planned_centre_ = 0;
+  if (target_ <= 0 || !on_track_ || g.time <= 0) {
+    speed_ = 0;
+    return;
+  }
+  ghost_clock_ += dt;
+  const double laps = std::floor(ghost_clock_ / g.time);
+  const double want = laps * env_.lap_mm + g.distanceAt(ghost_clock_ - laps * g.time);
+  const double have = (laps_ - ghost_laps0_) * env_.lap_mm + lapPosition();
+  const double advance = std::max(0.0, want - have);
+  offset_ = g.offsetAt(lapPosition(), spec_.offset_mm);
+  // the lane's length for that much of the centre line, piece by piece
+  double left = advance, lane = 0, u = u_;
+  std::size_t piece = piece_;
+  while (left > 0) {
+    const PieceInfo& p = env_.pieces[piece];
+    const double rest = (1 - u) * p.centre_mm;
+    const double step = std::min(left, rest);
+    lane += step * p.piece.length(offset_) / p.centre_mm;
+    left -= step;
+    u = 0;
+    piece = (piece + 1) % env_.pieces.size();
+  }
+  planned_centre_ = advance;
+  planned_lane_ = lane;
+  speed_ = dt > 0 ? lane / dt : 0;
+}
+
 void Car::plan(double dt) {
+  if (spec_.ghost) return planGhost(dt);
   if (delocalized_ && !sliding()) {
     speed_ = std::max(0.0, speed_ - kCoastDecel * dt);
   } else if (speed_ < target_) {
@@ -282,7 +316,7 @@ void Car::commit() {
       sendStatus();
     }
   }
-  checkDelocalization();
+  if (!spec_.ghost) checkDelocalization();
 }
 
 void Car::move(double lane_mm) {
@@ -372,6 +406,7 @@ void Car::delocalize() {
 }
 
 bool Car::active() const {
+  if (spec_.ghost) return target_ > 0 && on_track_;
   return speed_ > 0 || (target_ > 0 && on_track_);  // (on the track and delocalized: sliding)
 }
 
@@ -438,6 +473,7 @@ Truth Car::truth() const {
   t.slides = slides_;
   t.speed_commands = speed_commands_;
   t.stop_commands = stop_commands_;
+  t.ghost = static_cast<bool>(spec_.ghost);
   return t;
 }
 

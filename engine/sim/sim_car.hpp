@@ -75,8 +75,8 @@ class Car final : public SimCar {
   void holdAt(double centre_mm, double speed);
   void collided(bool rear);  // counts the contact and sends a collision frame
 
-  bool active() const;                      // needs ticks (moving, or about to)
-  bool solid() const { return on_track_; }  // other cars bump into it
+  bool active() const;                                      // needs ticks (moving, or about to)
+  bool solid() const { return on_track_ && !spec_.ghost; }  // other cars bump into it
   int direction() const { return dir_; }
   double trackOffset() const { return offset_; }
   double speed() const { return speed_; }
@@ -86,6 +86,7 @@ class Car final : public SimCar {
  private:
   const PieceInfo& here() const { return env_.pieces[piece_]; }
   int rowAt(const PieceInfo& p) const;  // the code row under the car
+  void planGhost(double dt);
   void move(double lane_mm);
   void crossBoundary();
   void checkDelocalization();
@@ -131,6 +132,8 @@ class Car final : public SimCar {
   bool on_track_ = true, delocalized_ = false, sdk_ = false, low_battery_ = false;
   double battery_mv_ = 0;
   int laps_ = 0, collisions_ = 0, slides_ = 0;
+  double ghost_clock_ = 0;   // a ghost: seconds of its lap driven (CarSpec::ghost)
+  int ghost_laps0_ = 0;      // laps_ when it set off
   double find_left_mm_ = 0;  // sliding: mm to drive until it reads the track again
   TimePoint boot_until_{};   // rebooting: not connectable before this
   std::shared_ptr<const int> life_ = std::make_shared<const int>(0);

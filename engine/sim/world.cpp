@@ -254,6 +254,24 @@ Loop& World::loop() {
   return state_->env.loop;
 }
 
+double GhostLap::distanceAt(double t) const {
+  if (points.empty()) return 0;
+  auto it = std::lower_bound(points.begin(), points.end(), t,
+                             [](const Point& p, double v) { return p.t < v; });
+  if (it == points.begin()) return points.front().distance;
+  if (it == points.end()) return points.back().distance;
+  const Point& a = *(it - 1);
+  const Point& b = *it;
+  return b.t <= a.t ? b.distance : a.distance + (b.distance - a.distance) * (t - a.t) / (b.t - a.t);
+}
+
+double GhostLap::offsetAt(double distance, double otherwise) const {
+  if (lanes.empty()) return otherwise;
+  auto it = std::upper_bound(lanes.begin(), lanes.end(), distance,
+                             [](double d, const Lane& l) { return d < l.distance; });
+  return it == lanes.begin() ? lanes.front().offset : (it - 1)->offset;
+}
+
 SimCar& World::addCar(CarSpec spec) {
   State& s = *state_;
   if (spec.piece_index >= s.track.size())

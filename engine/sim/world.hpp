@@ -18,6 +18,25 @@
 
 namespace pitwall::sim {
 
+// A recorded lap that a ghost car drives again (sim.addGhost, docs/simulator.md "Ghosts"): where
+// the car was along the track's centre line from the finish line, and its lane, at each time of
+// the lap. Made from a record's lap (engine/laps); the simulator only reads it.
+struct GhostLap {
+  struct Point {
+    double t = 0;         // s since the lap began at the line
+    double distance = 0;  // mm along the centre line from the line
+  };
+  std::vector<Point> points;  // t and distance never decreasing, from (0, 0) to (time, length)
+  struct Lane {
+    double distance = 0, offset = 0;  // mm from the line; mm right of the centre
+  };
+  std::vector<Lane> lanes;  // where the car said its lane; none: the spec's offset all lap
+  double time = 0;          // the lap's time, s
+  double length = 0;        // the lap's centre-line length, mm (the track's)
+  double distanceAt(double t) const;  // linear between the points
+  double offsetAt(double distance, double otherwise) const;
+};
+
 struct CarSpec {
   std::string name;                                // user name in the advertisement
   std::uint8_t model_id = 8;                       // Groundshock
@@ -27,6 +46,10 @@ struct CarSpec {
   double offset_mm = 0;                            // lateral offset from road centre, mm (+ right)
   std::uint16_t version = anki::kFirmwareDefault;  // docs/simulator.md "Firmware families"
   std::uint16_t battery_mv = 4100;
+  // Set: a ghost. It starts at the finish line and, while a set-speed above 0 holds, drives this
+  // lap again and again exactly as recorded; it touches no car, slides off no curve, and takes
+  // no lane change or turn.
+  std::shared_ptr<const GhostLap> ghost;
 };
 
 struct Noise {
@@ -54,6 +77,7 @@ struct Truth {
   int slides = 0;          // times thrown off a curve and slid on, still on the road
   int speed_commands = 0;  // set-speed frames received in SDK mode
   int stop_commands = 0;   // those of them that asked for 0 mm/s
+  bool ghost = false;      // a ghost car (CarSpec::ghost)
 };
 
 class SimCar {

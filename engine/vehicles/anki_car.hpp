@@ -24,6 +24,7 @@ struct CarIdentity {
   std::string name;  // user name from the advertisement, or "car<n>"
   std::uint8_t model_id = 0;
   std::uint32_t identifier = 0;
+  bool ghost = false;  // the simulator's ghost of a recorded lap (sim.addGhost): it races no one
 };
 
 // Frames of one message that came longer than its layout (anki-overdrive.md **Decision**): read by

@@ -36,6 +36,8 @@ struct Feed::Car {
   int commanded = -1;      // the last speed sent to the car (mm/s); -1: none seen (a replay)
   double reportedAt = -1;  // feed time of its last report of its speed
   bool standing = false;   // as settle() last found it
+  bool ghost = false;      // the simulator's ghost of a recorded lap
+  std::string name;
 };
 
 Feed::Feed(Loop& loop, Fleet& fleet, std::string source)
@@ -85,6 +87,8 @@ Feed::Car& Feed::car(AnkiCar& car) {
     slot = std::make_unique<Car>();
     slot->tracker.setTrack(track_ ? &*track_ : nullptr);
     slot->traces.setTrack(track_ ? &*track_ : nullptr);
+    slot->ghost = car.identity().ghost;
+    slot->name = car.identity().name;
   }
   lastAnki_ = &car;
   lastNumber_ = number;
@@ -94,6 +98,8 @@ Feed::Car& Feed::car(AnkiCar& car) {
 
 void Feed::reset() {
   cars_.clear();
+  ghost_.reset();
+  best_.reset();
   lastAnki_ = nullptr;
   lastCar_ = nullptr;
   ++changes_;
@@ -128,6 +134,13 @@ void Feed::frame(AnkiCar& ankiCar, AnkiCar::Direction d, const anki::Message& m)
                          : this->now();
   c.tracker.update(m, ankiCar.state(), now);
   if (auto lap = c.traces.update(c.tracker, m, ankiCar.state().reverse, now)) {
+    if (lap->clean) {  // the reference of the live deltas: a ghost's lap, else the best lap
+      const std::string label = c.name + " lap " + std::to_string(lap->lap);
+      if (c.ghost)
+        ghost_ = Reference{*lap, "the ghost (" + label + ")"};
+      else if (!best_ || lap->time < best_->lap.time)
+        best_ = Reference{*lap, "the best lap (" + label + ")"};
+    }
     c.laps.push_back(std::move(*lap));
     if (c.laps.size() > kLapsKept) c.laps.pop_front();
   }
@@ -236,6 +249,7 @@ nlohmann::json Feed::carJson(const AnkiCar& ankiCar, std::size_t laps) const {
   nlohmann::json j = {
       {"number", number},
       {"name", ankiCar.identity().name},
+      {"ghost", ankiCar.identity().ghost},
       {"color", kColours[(number - 1) % std::size(kColours)]},
       {"connected", s.connected},
       {"onTrack", s.on_track},
@@ -292,6 +306,15 @@ nlohmann::json Feed::carJson(const AnkiCar& ankiCar, std::size_t laps) const {
     j["heading"] = round3(p.heading);
     j["positionTime"] = round3(t.positionTime());
     j["at"] = round3(at);
+    // the live delta to the reference lap, at the distance the car has come this lap
+    const Reference* ref = ghost_ ? &*ghost_ : best_ ? &*best_ : nullptr;
+    const laps::LapTrace* lap = c->traces.current();
+    if (ref && lap && !c->ghost) {
+      if (auto d = c->traces.distanceNow(t, at, s.speed_mm_s, s.offset_mm, s.reverse)) {
+        j["delta"] = round3((at - lap->start) - ref->lap.timeAt(*d));
+        j["deltaTo"] = ref->label;
+      }
+    }
   }
   return j;
 }

@@ -124,6 +124,11 @@ class Feed {
   std::deque<Event> events_;
   std::uint64_t nextEvent_ = 0;
   std::map<int, std::unique_ptr<Car>> cars_;
+  struct Reference {
+    laps::LapTrace lap;
+    std::string label;
+  };
+  std::optional<Reference> ghost_, best_;  // the ghost's last lap; the session's best lap
   const AnkiCar* lastAnki_ = nullptr;  // the car of the last car() and its Car: one lookup fewer
   int lastNumber_ = 0;
   Car* lastCar_ = nullptr;

@@ -233,8 +233,7 @@ end
 local sim = pitwall.sim
 if sim then
   --- Adds a simulated car; inside a task it waits until the car is connected.
-  function sim.addCar(spec)
-    local car = sim._addCar(spec)
+  local function connected(car)
     if coroutine.isyieldable() then
       if not pitwall.waitUntil(function() return car.connected end, 5) then
         raise("simulated car " .. tostring(car) .. " did not connect within 5 s")
@@ -242,6 +241,9 @@ if sim then
     end
     return car
   end
+  function sim.addCar(spec) return connected(sim._addCar(spec)) end
+  --- The ghost of a recorded lap (docs/simulator.md "Ghosts"); waits as addCar does.
+  function sim.addGhost(spec) return connected(sim._addGhost(spec)) end
   --- Runs the world for `seconds` of engine time (inside a task).
   sim.run = pitwall.sleep
   --- Runs until cond() holds; false if `timeout` seconds passed first.

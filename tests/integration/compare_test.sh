@@ -77,7 +77,7 @@ check "the page: a table and three charts" "1 3" \
 # what cannot be compared: a sentence, and the status
 $PITWALL compare even-real.jsonl slow-real.jsonl:1:99 > /dev/null 2> nolap.err
 check "a lap the record lacks: status 1" 1 $?
-contains "a lap the record lacks: the sentence" "slow-real.jsonl car 1 (groundshock) has no lap 99 to compare: its whole laps are 1, 2," "$(cat nolap.err)"
+contains "a lap the record lacks: the sentence" "slow-real.jsonl car 1 (groundshock) has no lap 99: its whole laps are 1, 2," "$(cat nolap.err)"
 $PITWALL compare even-real.jsonl slow-real.jsonl:2 > /dev/null 2> standing.err
 check "a car that drove no lap: status 1" 1 $?
 contains "a car that drove no lap: the sentence" "car 2 (skull) drove no whole lap" "$(cat standing.err)"

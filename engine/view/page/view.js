@@ -12,6 +12,10 @@
 //                                   (no position, delocalized, off the road), `disconnected`
 //                                   when the car is not connected
 //   #leaderboard tbody tr           one per car (race.rows when a race runs, else the cars)
+//   #leaderboard td.delta           the live delta to the reference lap (the ghost's, else the
+//                                   session's best): "+0.123" behind, "-0.045" ahead; its
+//                                   title names the lap; `data-delta` the number
+//   g.car-marker.ghost              a ghost (sim.addGhost, --ghost): drawn translucent
 //   #leaderboard td.link            the car's link: "down", else its RSSI and drops ("ok" when
 //                                   nothing to tell); `data-drops`, and the whole story in
 //                                   its title (connections, last drop, failed writes, stalls)
@@ -290,6 +294,7 @@ function frame(ts) {
     m.g.classList.toggle("waiting", waiting(car));
     m.g.classList.toggle("disconnected", car.connected === false);
     m.g.classList.toggle("unseen", m.x == null);
+    m.g.classList.toggle("ghost", !!car.ghost);
     if (m.x != null) {
       m.g.setAttribute("transform", `translate(${m.x.toFixed(1)},${(-m.y).toFixed(1)})`);
       m.body.setAttribute("transform", `rotate(${(-m.heading).toFixed(1)})`);
@@ -380,7 +385,7 @@ function renderBoard() {
   while (tbody.rows.length > rows.length) tbody.deleteRow(-1);
   while (tbody.rows.length < rows.length) {
     const tr = tbody.insertRow();
-    for (let i = 0; i < 10; i++) tr.insertCell();
+    for (let i = 0; i < 11; i++) tr.insertCell();
   }
   rows.forEach((r, i) => {
     const tr = tbody.rows[i];
@@ -408,7 +413,21 @@ function renderBoard() {
     });
     tr.cells[5].classList.toggle("best", r.bestLap != null && r.bestLap === best);
     renderLink(tr.cells[9], car);
+    renderDelta(tr.cells[10], car);
+    tr.classList.toggle("ghost", !!car.ghost);
   });
+}
+
+// The Δ cell: the live delta to the reference lap (docs/view.md "Ghosts and deltas").
+function renderDelta(td, car) {
+  td.className = "num delta";
+  const d = car.delta;
+  const text = car.ghost ? "ghost" : d == null ? "–" : (d >= 0 ? "+" : "") + d.toFixed(3);
+  if (td.textContent !== text) td.textContent = text;
+  td.classList.toggle("behind", d != null && d > 0);
+  td.classList.toggle("ahead", d != null && d < 0);
+  td.title = d == null ? "" : `against ${car.deltaTo}`;
+  if (d == null) delete td.dataset.delta; else td.dataset.delta = d;
 }
 
 // The Link cell: what a racer needs at a glance (down; RSSI; how often it dropped), and the rest

@@ -115,6 +115,7 @@ Commands check their arguments: out of range raises an error naming the range, a
       model = { "string", "model name (Groundshock); unknown ids read model-<n>" },
       modelId = { "integer", "model id" },
       identifier = { "integer", "the car's 32-bit identifier from its advertisement" },
+      ghost = { "boolean", "the simulator's ghost of a recorded lap (sim.addGhost)" },
       address = { "string", "sim:…, ble:ADDR or mqtt:CAR-ID" },
       connected = { "boolean", "link up" },
       onTrack = { "boolean", "from status reports and position updates" },

@@ -14,6 +14,13 @@ return {
 ---@field battery? integer 3000..4300 mV
 ---@field firmware? integer firmware version, e.g. 0x266e (the older layouts) or 0x2b70 (the default)
 
+---What sim.addGhost{…} takes.
+---@class pitwall.sim.GhostSpec
+---@field record string a --record file
+---@field car? integer|string the recorded car's number or name (default: the record's first car)
+---@field lap? integer|"best" the lap (default: the car's best)
+---@field name? string default: ghost (ghost2, … when taken)
+
 ---@class pitwall.sim.Piece
 ---@field id integer road piece id
 ---@field type string
@@ -85,6 +92,9 @@ See docs/testing.md and docs/simulator.md.]],
     functions = {
       addCar = [[Adds a simulated car and returns it; inside a task it waits until it is connected.
 @param spec? pitwall.sim.CarSpec
+@return pitwall.Car]],
+      addGhost = [[The ghost of a recorded lap (docs/simulator.md "Ghosts"): a car that drives the lap again, lap after lap, while a set-speed above 0 holds, touching no one; inside a task it waits until it is connected.
+@param spec pitwall.sim.GhostSpec
 @return pitwall.Car]],
       track = [[The track.
 @return pitwall.sim.Track]],

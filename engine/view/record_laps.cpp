@@ -1,0 +1,150 @@
+#include "engine/view/record_laps.hpp"
+
+#include <cerrno>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include "engine/core/log.hpp"
+#include "engine/core/printable.hpp"
+#include "engine/record/record_player.hpp"
+#include "engine/view/feed.hpp"
+
+namespace pitwall::view {
+
+RecordLaps playLaps(std::istream& in, const RecordSummary& summary, const sim::Track& track,
+                    std::string file) {
+  // the cars' greetings ("connected") are the record's, not news for whoever asked
+  struct Quiet {
+    log::Level was = log::level();
+    Quiet() {
+      if (was < log::Level::Warn) log::setLevel(log::Level::Warn);
+    }
+    ~Quiet() { log::setLevel(was); }
+  } quiet;
+  RecordLaps out;
+  out.file = std::move(file);
+  out.track = track;
+  out.layout = sim::layoutText(track);
+  Loop loop(ClockKind::Virtual);
+  Fleet fleet(loop);
+  Feed feed(loop, fleet, "record");
+  feed.setTrack(track, "layout");
+  {
+    RecordPlayer player(loop, fleet, in, summary);
+    player.onEnd = [&loop] { loop.stop(); };
+    player.play();
+    loop.run();
+    for (int number : player.recordedCars()) {
+      const AnkiCar* car = player.car(number);
+      RecordedCarLaps c{number, car->identity().name, {}};
+      if (const auto* kept = feed.laps(car->identity().number))
+        for (const auto& lap : *kept)
+          if (lap.clean) c.laps.push_back(lap);
+      out.cars.push_back(std::move(c));
+    }
+  }
+  return out;
+}
+
+Result<std::pair<std::string, LapAsk>, std::string> splitLapSpec(const std::string& spec) {
+  std::error_code ec;
+  std::vector<std::string> parts;  // the tail, last first
+  std::string file = spec;
+  for (int tail = 0; tail <= 2; ++tail) {
+    if (!file.empty() && std::filesystem::exists(file, ec)) {
+      LapAsk ask;
+      if (!parts.empty()) ask.car = parts.back();
+      if (parts.size() == 2 && parts.front() != "best") {
+        const std::string& lap = parts.front();
+        char* end = nullptr;
+        errno = 0;
+        const long n = std::strtol(lap.c_str(), &end, 10);
+        if (lap.empty() || *end || errno || n < 1 || n > 1000000)
+          return Unexpected{spec + ": the lap must be a number from 1 or `best`, not '" +
+                            printable(lap, 40) + "'"};
+        ask.lap = static_cast<int>(n);
+      }
+      return std::pair{file, ask};
+    }
+    const auto colon = file.rfind(':');
+    if (colon == std::string::npos) break;
+    parts.push_back(file.substr(colon + 1));
+    file.resize(colon);
+  }
+  return Unexpected{"cannot read " + printable(spec, 200) +
+                    ": no such file (give FILE, FILE:CAR or FILE:CAR:LAP)"};
+}
+
+Result<PickedLap, std::string> pickLap(const RecordLaps& record, const LapAsk& ask) {
+  const RecordedCarLaps* car = nullptr;
+  if (ask.car.empty()) {
+    if (!record.cars.empty()) car = &record.cars.front();
+  } else {
+    for (const auto& c : record.cars)
+      if (std::to_string(c.number) == ask.car || c.name == ask.car) car = &c;
+  }
+  std::string cars;
+  for (const auto& c : record.cars)
+    cars += (cars.empty() ? "" : ", ") + std::to_string(c.number) + " (" + printable(c.name) + ")";
+  if (!car)
+    return Unexpected{record.file + " has no car '" + printable(ask.car, 40) + "': its cars are " +
+                      cars};
+  const std::string who =
+      record.file + " car " + std::to_string(car->number) + " (" + printable(car->name) + ")";
+  if (car->laps.empty())
+    return Unexpected{who +
+                      " drove no whole lap the tracker could follow from line to line (forward, "
+                      "on the track's map)" +
+                      (record.cars.size() > 1 ? "; the record's cars are " + cars : "")};
+  const laps::LapTrace* lap = nullptr;
+  if (ask.lap == 0) {
+    for (const auto& l : car->laps)
+      if (!lap || l.time < lap->time) lap = &l;
+  } else {
+    for (const auto& l : car->laps)
+      if (l.lap == ask.lap) lap = &l;
+    if (!lap) {
+      std::string list;
+      for (const auto& l : car->laps) list += (list.empty() ? "" : ", ") + std::to_string(l.lap);
+      return Unexpected{who + " has no lap " + std::to_string(ask.lap) + ": its whole laps are " +
+                        list + "; ask for one of them, or `best`"};
+    }
+  }
+  return PickedLap{lap, car,
+                   std::filesystem::path(record.file).filename().string() + " car " +
+                       std::to_string(car->number) + " (" + printable(car->name) + ") lap " +
+                       std::to_string(lap->lap)};
+}
+
+Result<RecordLaps, std::string> readRecordLaps(const std::string& path,
+                                               const std::optional<std::string>& track,
+                                               std::uintmax_t maxBytes) {
+  std::error_code ec;
+  const std::string shown = printable(path, 200);
+  if (!std::filesystem::is_regular_file(path, ec))
+    return Unexpected{"cannot read " + shown + ": " +
+                      (std::filesystem::exists(path, ec) ? "not a file" : "no such file")};
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec || size > maxBytes)
+    return Unexpected{shown + " is " + std::to_string(size / (1024 * 1024)) +
+                      " MB, more than the " + std::to_string(maxBytes >> 20) +
+                      " MB a ghost's record may be; cut it to the laps you want (a record is "
+                      "one JSON line a frame: keep the lines of the lap)"};
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Unexpected{"cannot read " + shown};
+  RecordSummary summary = scanRecord(in);
+  if (summary.frames == 0)
+    return Unexpected{shown + " has no frame; a record is what `pitwall run --record FILE` writes"};
+  if (!track && summary.layout.empty())
+    return Unexpected{shown +
+                      " keeps no track layout (a record of real cars): laps are placed on the "
+                      "track they drove; give it with --track LAYOUT"};
+  auto layout = track ? sim::loadLayout(*track) : sim::parseLayout(summary.layout, "recorded");
+  if (!layout) return Unexpected{(track ? "" : shown + "'s layout: ") + layout.error()};
+  in.clear();
+  in.seekg(0);
+  return playLaps(in, summary, *layout, path);
+}
+
+}  // namespace pitwall::view

@@ -1,0 +1,48 @@
+# The simulator's ghost (docs/simulator.md "Ghosts"): sim.addGhost drives a record's lap again,
+# lap after lap, in the recorded time within a tick (5 ms), in the lane it was driven in,
+# touching no car; it is marked as a ghost in Lua and in the view's state; what cannot be a
+# ghost is a sentence.
+source "$(dirname "$0")/lib.sh"
+cd "$TMP" || exit 2
+
+$PITWALL run "$SRC/tests/integration/compare_drive.lua" --fast --record even.jsonl -q || fail "the lap's record"
+best=$($PITWALL compare even.jsonl even.jsonl --json | python3 -c 'import json,sys; print(json.load(sys.stdin)["laps"][0]["time"])')
+echo "the recorded best lap: $best s"
+
+cp "$SRC/tests/integration/ghost_drive.lua" ghost.lua
+$PITWALL run ghost.lua --fast --record ghost.jsonl > out.txt 2> err.txt
+check "the run with a ghost: exit status" 0 $?
+contains "the ghost is one in Lua, the car is not" "ghost:	ghost	true	false" "$(cat out.txt)"
+contains "the lap it drives is said" "ghost drives even.jsonl car 1 (groundshock) lap" "$(cat err.txt)"
+contains "no lane change, no collision" "ghost offset:	-68.0	collisions:	0" "$(cat out.txt)"
+# its laps, counted from its own frames by the replay: the recorded lap's time within a tick
+$PITWALL replay ghost.jsonl --json > laps.json
+python3 - laps.json "$best" <<'PY' && echo "ok: every ghost lap in the recorded time within 5 ms" || fail "the ghost's lap times"
+import json, sys
+rows = [json.loads(l) for l in open(sys.argv[1])]
+best = float(sys.argv[2])
+ghost = next(r for r in rows if r["name"] == "ghost")
+times = ghost["lapTimes"]
+print("ghost laps:", times, "recorded:", best)
+assert len(times) >= 4, times
+assert all(abs(t - best) <= 0.005 for t in times), times
+PY
+
+# what cannot be a ghost
+try() {  # try NAME LUA EXPECTED
+  printf 'local sim = require "pitwall.sim"\n%s\npitwall.stop()\n' "$2" > bad.lua
+  $PITWALL run bad.lua --fast > /dev/null 2> bad.err
+  check "$1: exit status" 1 $?
+  contains "$1: the sentence" "$3" "$(cat bad.err)"
+}
+try "no record" 'sim.addGhost{}' "sim.addGhost needs record=, the --record file that holds the lap"
+try "a missing file" 'sim.addGhost{record="nope.jsonl"}' "sim.addGhost: cannot read nope.jsonl: no such file"
+try "a lap the record lacks" 'sim.addGhost{record="even.jsonl", lap=99}' "has no lap 99: its whole laps are"
+try "a car that drove no lap" 'sim.addGhost{record="even.jsonl", car=2}' "car 2 (skull) drove no whole lap"
+try "a lap that is no number" 'sim.addGhost{record="even.jsonl", lap="fast"}' "sim.addGhost: lap= must be a lap's number or \"best\", not 'fast'"
+$PITWALL run "$SRC/tests/integration/compare_drive.lua" --fast --track kidney --record kidney.jsonl -q
+try "another track" 'sim.addGhost{record="kidney.jsonl"}' "a ghost drives the track it was on"
+head -c 17000000 /dev/zero | tr '\0' ' ' > huge.jsonl
+try "a record too large" 'sim.addGhost{record="huge.jsonl"}' "MB, more than the 16 MB a ghost's record may be"
+
+exit $((FAILURES > 0))

@@ -1,0 +1,49 @@
+// The ghost on the race view (docs/view.md "Ghosts and deltas"): the ghost of a recorded lap is
+// drawn translucent and moves; car 1's live delta to it is shown on the leaderboard, named, and
+// grows while car 1 is slower than the lap.
+//
+//   node ghost_check.mjs VIEW-URL SHOT.png [--timeout SECONDS] [--chromium PATH]
+//
+// One PASS/FAIL line per check; exit status 1 when a check failed, 2 on bad arguments.
+import { check, fail, finish, launch, parseArgs, pass, passWhen, settings } from "./check_lib.mjs";
+
+const { opts, positional: [viewUrl, png] } = parseArgs("ghost_check",
+  "VIEW-URL SHOT.png [--timeout SECONDS] [--chromium PATH]", {},
+  [2, "give the view's URL and the screenshot's path"]);
+
+const browser = await launch({ chromium: opts.chromium,
+  viewport: { width: 1600, height: 1000, deviceScaleFactor: 1 } });
+try {
+  const page = await browser.newPage();
+  await page.goto(viewUrl, { waitUntil: "load", timeout: settings.timeoutMs });
+  const ghost = "#track g.car-marker.ghost";
+  await passWhen(page, "the ghost is drawn on the track",
+    (sel) => { const g = document.querySelector(sel); return g && g.dataset.x != null && !g.classList.contains("unseen"); }, ghost);
+  const opacity = await page.$eval(ghost, (g) => Number(getComputedStyle(g).opacity));
+  check("translucent", opacity > 0 && opacity < 0.7, `opacity ${opacity}`);
+  const normal = await page.$$eval("#track g.car-marker:not(.ghost)", (gs) => gs.length);
+  check("the other cars are not ghosts", normal === 4, `${normal} cars`);
+  const at = await page.$eval(ghost, (g) => [Number(g.dataset.x), Number(g.dataset.y)]);
+  await passWhen(page, "the ghost moves", ([sel, x, y]) => {
+    const g = document.querySelector(sel);
+    return Math.hypot(Number(g.dataset.x) - x, Number(g.dataset.y) - y) > 200;
+  }, [ghost, ...at]);
+  const row = '#leaderboard tbody tr[data-number="1"] td.delta';
+  await passWhen(page, "car 1's delta to the ghost is shown",
+    (sel) => { const c = document.querySelector(sel); return c && c.dataset.delta != null && /^[+-]\d+\.\d{3}$/.test(c.textContent); }, row);
+  // the session's best lap until the ghost has driven a whole lap of its own, then the ghost's
+  await passWhen(page, "the delta is to the ghost's lap once it drove one, and says so",
+    (sel) => /^against the ghost \(ghost lap \d+\)$/.test(document.querySelector(sel).title), row);
+  const first = await page.$eval(row, (c) => Number(c.dataset.delta));
+  await passWhen(page, "car 1, slower than the lap, falls behind it: its delta grows",
+    ([sel, d]) => { const c = document.querySelector(sel); return Number(c.dataset.delta) > d + 0.3 && c.classList.contains("behind"); }, [row, first]);
+  const ghostRow = await page.$eval("#leaderboard tbody tr.ghost td.delta", (c) => c.textContent);
+  check("the ghost's own row says ghost", ghostRow === "ghost", ghostRow);
+  await page.screenshot({ path: png, fullPage: true });
+  pass("screenshot written", png);
+} catch (e) {
+  fail("ghost check ran", e.stack || String(e));
+} finally {
+  await browser.close().catch(() => {});
+}
+finish("ghost check");
