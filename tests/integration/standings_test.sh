@@ -108,23 +108,34 @@ contains "--track: another track has no races" "no races yet on this track" \
 # A league killed in the middle keeps every race it finished: more heats (six rounds), killed once
 # the database has three of them; what is kept is the same as those heats of a whole run
 league --db "$TMP/whole.db" --races 6 --results "$TMP/whole.json" >/dev/null 2>&1
-$PITWALL league "$TMP/class" --laps 2 --qualifying-laps 1 --seed 5 --cars 3 --db "$TMP/killed.db" \
-  --races 6 >/dev/null 2>&1 &
-pid=$!  # (pitwall's own: the kill is for it, not for a shell around it)
-python3 - "$TMP/killed.db" "$pid" <<'PY'
-import os, signal, sqlite3, sys, time
-path, pid = sys.argv[1], int(sys.argv[2])
+# The poller starts the league itself, so that it looks from the league's first moment: started
+# after it, on a loaded machine it once first looked when the league had already finished (clean-
+# clone run 63), and killed nothing.
+python3 - "$TMP/killed.db" "$PITWALL" "$TMP/class" <<'PY' || fail "killed: the league was still running when three heats were kept"
+import signal, sqlite3, subprocess, sys, time
+path, pitwall, folder = sys.argv[1:4]
+league = subprocess.Popen([pitwall, "league", folder, "--laps", "2", "--qualifying-laps", "1",
+                           "--seed", "5", "--cars", "3", "--db", path, "--races", "6"],
+                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+n = 0
 for _ in range(20000):  # at most 100 s
+    if league.poll() is not None:
+        break
     try:
-        n = sqlite3.connect(path).execute("SELECT COUNT(*) FROM races WHERE kind = 'heat'").fetchone()[0]
+        db = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
+        n = db.execute("SELECT COUNT(*) FROM races WHERE kind = 'heat'").fetchone()[0]
+        db.close()
     except sqlite3.Error:
         n = 0
     if n >= 3:
         break
     time.sleep(0.005)
-os.kill(pid, signal.SIGKILL)
+running = league.poll() is None
+league.send_signal(signal.SIGKILL) if running else None
+league.wait()
+print(("ok: " if running else "FAIL: ") + f"killed: the league was killed with {n} heats kept")
+sys.exit(0 if running else 1)
 PY
-wait "$pid" 2>/dev/null
 kept=$(heats_in "$TMP/killed.db")
 k=$(echo "$kept" | awk '{ print $1 }' | sort -un | wc -l)
 [ "$k" -ge 3 ] && echo "ok: killed: $k heats were kept" || fail "killed: $k heats kept: $kept"
