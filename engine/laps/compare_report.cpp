@@ -87,6 +87,18 @@ std::vector<svg::Chart> charts(const Report& r) {
   return {speed, delta, lane};
 }
 
+// The table's rows: each section's times (its name, "FROM-TO" in mm), then the lap's.
+template <class Row>
+void eachRow(const Report& r, const char* dash, Row row) {
+  const Comparison& cmp = r.comparison;
+  for (std::size_t s = 0; s < r.sections.size() && s < cmp.sectionTimes.size(); ++s)
+    row(r.sections[s].name, fixed(r.sections[s].from, 0) + dash + fixed(r.sections[s].to, 0),
+        cmp.sectionTimes[s]);
+  std::vector<double> totals;
+  for (const auto& l : r.laps) totals.push_back(l.trace->time);
+  row("lap", "", totals);
+}
+
 const char* const kTitles[] = {"Speed", "Time delta to the first lap (rising: losing time)",
                                "Lane (mm right of the centre)"};
 
@@ -129,12 +141,7 @@ std::string reportText(const Report& r) {
     }
     out << "\n";
   };
-  for (std::size_t s = 0; s < r.sections.size() && s < cmp.sectionTimes.size(); ++s)
-    row(r.sections[s].name, fixed(r.sections[s].from, 0) + "-" + fixed(r.sections[s].to, 0),
-        cmp.sectionTimes[s]);
-  std::vector<double> totals;
-  for (const auto& l : r.laps) totals.push_back(l.trace->time);
-  row("lap", "", totals);
+  eachRow(r, "-", row);
   return out.str();
 }
 
@@ -218,13 +225,7 @@ std::string reportHtml(const Report& r) {
     }
     h << "</tr>";
   };
-  const Comparison& cmp = r.comparison;
-  for (std::size_t s = 0; s < r.sections.size() && s < cmp.sectionTimes.size(); ++s)
-    row(r.sections[s].name, fixed(r.sections[s].from, 0) + "–" + fixed(r.sections[s].to, 0),
-        cmp.sectionTimes[s]);
-  std::vector<double> totals;
-  for (const auto& l : r.laps) totals.push_back(l.trace->time);
-  row("lap", "", totals);
+  eachRow(r, "–", row);
   h << "</table>";
   for (std::size_t i = 0; i < cs.size(); ++i)
     h << "<h2>" << kTitles[i] << "</h2>" << svg::lineChart(cs[i]);

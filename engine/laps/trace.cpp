@@ -5,6 +5,8 @@
 #include <limits>
 #include <variant>
 
+#include "engine/core/interpolate.hpp"
+
 namespace pitwall::laps {
 
 namespace {
@@ -37,27 +39,15 @@ bool LapTrace::everyPieceReported() const {
 }
 
 double LapTrace::timeAt(double distance) const {
-  if (points.empty()) return kNaN;
-  auto it = std::lower_bound(points.begin(), points.end(), distance,
-                             [](const TracePoint& p, double d) { return p.distance < d; });
-  if (it == points.begin()) return points.front().t;
-  if (it == points.end()) return points.back().t;
-  const TracePoint& a = *(it - 1);
-  const TracePoint& b = *it;
-  if (b.distance <= a.distance) return b.t;
-  return a.t + (b.t - a.t) * (distance - a.distance) / (b.distance - a.distance);
+  return interpolate(
+      points, distance, [](const TracePoint& p) { return p.distance; },
+      [](const TracePoint& p) { return p.t; });
 }
 
 double LapTrace::distanceAt(double t) const {
-  if (points.empty()) return kNaN;
-  auto it = std::lower_bound(points.begin(), points.end(), t,
-                             [](const TracePoint& p, double v) { return p.t < v; });
-  if (it == points.begin()) return points.front().distance;
-  if (it == points.end()) return points.back().distance;
-  const TracePoint& a = *(it - 1);
-  const TracePoint& b = *it;
-  if (b.t <= a.t) return b.distance;
-  return a.distance + (b.distance - a.distance) * (t - a.t) / (b.t - a.t);
+  return interpolate(
+      points, t, [](const TracePoint& p) { return p.t; },
+      [](const TracePoint& p) { return p.distance; });
 }
 
 double LapTrace::enteredAt(std::size_t k, const LapMap& map) const {

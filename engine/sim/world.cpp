@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "engine/core/interpolate.hpp"
 #include "engine/sim/code_layout.hpp"
 #include "engine/sim/sim_car.hpp"
 
@@ -256,13 +257,8 @@ Loop& World::loop() {
 
 double GhostLap::distanceAt(double t) const {
   if (points.empty()) return 0;
-  auto it = std::lower_bound(points.begin(), points.end(), t,
-                             [](const Point& p, double v) { return p.t < v; });
-  if (it == points.begin()) return points.front().distance;
-  if (it == points.end()) return points.back().distance;
-  const Point& a = *(it - 1);
-  const Point& b = *it;
-  return b.t <= a.t ? b.distance : a.distance + (b.distance - a.distance) * (t - a.t) / (b.t - a.t);
+  return interpolate(
+      points, t, [](const Point& p) { return p.t; }, [](const Point& p) { return p.distance; });
 }
 
 double GhostLap::offsetAt(double distance, double otherwise) const {
