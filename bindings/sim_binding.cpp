@@ -25,9 +25,9 @@ using lua::LuaError;
 
 namespace {
 
-// The largest record sim.addGhost reads: it is played on the loop, at about N MB/s
-// (docs/performance.md "Ghosts").
-constexpr std::uintmax_t kMaxGhostRecordBytes = 16ull * 1024 * 1024;
+// The largest record sim.addGhost reads. It is played in the call, on the loop and within the
+// script's budget: 512 KiB took 20-35 ms of CPU here (docs/performance.md "Ghosts").
+constexpr std::uintmax_t kMaxGhostRecordBytes = 512 * 1024;
 
 SimSession& session(lua_State* L) {
   return *ScriptHost::from(L).sim();

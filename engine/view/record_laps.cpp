@@ -127,10 +127,10 @@ Result<RecordLaps, std::string> readRecordLaps(const std::string& path,
                       (std::filesystem::exists(path, ec) ? "not a file" : "no such file")};
   const auto size = std::filesystem::file_size(path, ec);
   if (ec || size > maxBytes)
-    return Unexpected{shown + " is " + std::to_string(size / (1024 * 1024)) +
-                      " MB, more than the " + std::to_string(maxBytes >> 20) +
-                      " MB a ghost's record may be; cut it to the laps you want (a record is "
-                      "one JSON line a frame: keep the lines of the lap)"};
+    return Unexpected{shown + " is " + std::to_string((size + 1023) / 1024) +
+                      " KB, more than the " + std::to_string(maxBytes / 1024) +
+                      " KB a ghost's record may be (it is read within the script's budget): "
+                      "record the lap on its own, e.g. a time trial of that driver with --record"};
   std::ifstream in(path, std::ios::binary);
   if (!in) return Unexpected{"cannot read " + shown};
   RecordSummary summary = scanRecord(in);

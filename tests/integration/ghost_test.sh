@@ -42,7 +42,7 @@ try "a car that drove no lap" 'sim.addGhost{record="even.jsonl", car=2}' "car 2 
 try "a lap that is no number" 'sim.addGhost{record="even.jsonl", lap="fast"}' "sim.addGhost: lap= must be a lap's number or \"best\", not 'fast'"
 $PITWALL run "$SRC/tests/integration/compare_drive.lua" --fast --track kidney --record kidney.jsonl -q
 try "another track" 'sim.addGhost{record="kidney.jsonl"}' "a ghost drives the track it was on"
-head -c 17000000 /dev/zero | tr '\0' ' ' > huge.jsonl
-try "a record too large" 'sim.addGhost{record="huge.jsonl"}' "MB, more than the 16 MB a ghost's record may be"
+head -c 600000 /dev/zero | tr '\0' ' ' > huge.jsonl
+try "a record too large" 'sim.addGhost{record="huge.jsonl"}' "huge.jsonl is 586 KB, more than the 512 KB a ghost's record may be"
 
 exit $((FAILURES > 0))
