@@ -210,6 +210,11 @@ int addGhost(lua_State* L) {
                    printable(sim::layoutText(track), 80) + ": a ghost drives the track it was on");
   auto picked = view::pickLap(*laps, ask);
   if (!picked) throw LuaError("sim.addGhost: " + picked.error());
+  if (!(picked->trace->time * sim::GhostLap::kMaxSpeed >= picked->trace->length))
+    throw LuaError("sim.addGhost: " + picked->label + " took " + lua::show(picked->trace->time) +
+                   " s for " + lua::show(picked->trace->length) + " mm, faster than any car (" +
+                   std::to_string(static_cast<int>(sim::GhostLap::kMaxSpeed)) +
+                   " mm/s): the record's times are wrong; pick another lap");
   sim::CarSpec spec;
   spec.piece_index = track.finishIndex();
   auto ghost = std::make_shared<sim::GhostLap>(laps::ghostLap(*picked->trace));

@@ -40,12 +40,13 @@ std::variant<view::RecordLaps, int> play(const std::string& file,
   if (auto* status = std::get_if<int>(&opened)) return *status;
   RecordSource& source = *std::get<std::unique_ptr<RecordSource>>(opened);
   if (!track && source.summary.layout.empty())
-    return fail("compare", file +
+    return fail("compare", printable(file, 200) +
                                " keeps no track layout (a record of real cars): laps are placed "
                                "on the track they drove; give it with --track LAYOUT");
   auto layout =
       track ? sim::loadLayout(*track) : sim::parseLayout(source.summary.layout, "recorded");
-  if (!layout) return fail("compare", (track ? "" : file + "'s layout: ") + layout.error());
+  if (!layout)
+    return fail("compare", (track ? "" : printable(file, 200) + "'s layout: ") + layout.error());
   return view::playLaps(*source.in, source.summary, *layout, file);
 }
 
@@ -76,9 +77,10 @@ int compare(const CompareOptions& options) {
   for (const auto& [file, ask] : asks) {
     const view::RecordLaps& r = records.at(file);
     if (r.layout != first.layout)
-      return fail("compare", file + " was driven on another track than " + first.file + " (" +
-                                 printable(r.layout, 80) + " against " +
-                                 printable(first.layout, 80) + "): laps are compared on one track");
+      return fail("compare", printable(file, 200) + " was driven on another track than " +
+                                 printable(first.file, 200) + " (" + printable(r.layout, 80) +
+                                 " against " + printable(first.layout, 80) +
+                                 "): laps are compared on one track");
     auto picked = view::pickLap(r, ask);
     if (!picked) return fail("compare", picked.error(), 1);
     report.laps.push_back({picked->label, picked->trace});
@@ -90,7 +92,9 @@ int compare(const CompareOptions& options) {
   for (const auto& l : report.laps) traces.push_back(l.trace);
   report.comparison = laps::compare(traces, map, report.sections, options.step);
   if (options.json)
-    std::cout << laps::reportJson(report).dump() << "\n";
+    std::cout << laps::reportJson(report).dump(-1, ' ', false,
+                                               nlohmann::json::error_handler_t::replace)
+              << "\n";
   else
     std::cout << laps::reportText(report);
   std::cout.flush();

@@ -1,6 +1,6 @@
 #pragma once
-// A lap's trace as the simulator's ghost drives it (sim.addGhost, `pitwall run --ghost`;
-// docs/simulator.md "Ghosts"): its distance against time, and the lane it reported.
+// A lap's trace as the simulator's ghost drives it (sim.addGhost; docs/simulator.md "Ghosts"):
+// its distance against time, and the lane it reported (on the road: clamped to ±70 mm).
 #include "engine/laps/trace.hpp"
 #include "engine/sim/world.hpp"
 

@@ -102,6 +102,10 @@ std::optional<LapTrace> TraceBuilder::update(const CarTracker& tracker,
       LapTrace& lap = *current_;
       lap.time = *crossing - lap.start;
       add({lap.time, lap.length, kNaN, kNaN});
+      // whole: every piece was seen, by its transition or a position update (a lap the tracker
+      // jumped across, after a misread, is no lap to race or compare)
+      for (std::size_t k = 0; k < lap.pieceEntered.size(); ++k)
+        if (!std::isfinite(lap.pieceEntered[k]) && !lap.pieceReported[k]) lap.clean = false;
       finished = std::move(lap);
     }
     crossing_ = crossing;

@@ -37,12 +37,14 @@ struct TracePoint {
 };
 
 struct LapTrace {
-  int lap = 0;                     // its number, from 1, as the tracker counts laps
-  double start = 0;                // engine seconds at the line
-  double time = 0;                 // the lap's time, s
-  double length = 0;               // centre-line length of a lap, mm
-  bool clean = true;               // driven forward all the way (no U-turn, never lost off the map)
-  std::vector<TracePoint> points;  // distance never decreasing, from (0, 0) to (time, length)
+  int lap = 0;        // its number, from 1, as the tracker counts laps
+  double start = 0;   // engine seconds at the line
+  double time = 0;    // the lap's time, s
+  double length = 0;  // centre-line length of a lap, mm
+  // driven forward all the way (no U-turn, never lost off the map), every piece seen (its
+  // transition or a position update from it)
+  bool clean = true;
+  std::vector<TracePoint> points;    // distance never decreasing, from (0, 0) to (time, length)
   std::vector<double> pieceEntered;  // by k: s since the line the car entered piece k; NaN: unseen
   std::vector<bool> pieceReported;   // by k: a position update came from the piece
 

@@ -234,7 +234,7 @@ void Car::planGhost(double dt) {
   const double laps = std::floor(ghost_clock_ / g.time);
   const double want = laps * env_.lap_mm + g.distanceAt(ghost_clock_ - laps * g.time);
   const double have = (laps_ - ghost_laps0_) * env_.lap_mm + lapPosition();
-  const double advance = std::max(0.0, want - have);
+  const double advance = std::clamp(want - have, 0.0, GhostLap::kMaxSpeed * dt);
   offset_ = g.offsetAt(lapPosition(), spec_.offset_mm);
   // the lane's length for that much of the centre line, piece by piece
   double left = advance, lane = 0, u = u_;

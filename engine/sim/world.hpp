@@ -33,7 +33,10 @@ struct GhostLap {
   std::vector<Lane> lanes;  // where the car said its lane; none: the spec's offset all lap
   double time = 0;          // the lap's time, s
   double length = 0;        // the lap's centre-line length, mm (the track's)
-  double distanceAt(double t) const;  // linear between the points
+  // Faster than this on average is no lap a car drove (a record's times are any numbers): a
+  // ghost never goes faster, nor takes such a lap (sim.addGhost refuses it).
+  static constexpr double kMaxSpeed = 5000;  // mm/s
+  double distanceAt(double t) const;         // linear between the points
   double offsetAt(double distance, double otherwise) const;
 };
 

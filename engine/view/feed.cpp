@@ -172,6 +172,8 @@ void Feed::settle() {
 void Feed::setTrack(std::optional<sim::Track> track, const std::string& source) {
   track_ = std::move(track);
   trackSource_ = track_ ? source : "none";
+  ghost_.reset();  // laps of another track are no reference
+  best_.reset();
   ++trackVersion_;
   ++changes_;
   for (auto& [number, c] : cars_) {

@@ -80,18 +80,26 @@ Result<PickedLap, std::string> pickLap(const RecordLaps& record, const LapAsk& a
   const RecordedCarLaps* car = nullptr;
   if (ask.car.empty()) {
     if (!record.cars.empty()) car = &record.cars.front();
-  } else {
+  } else {  // its number, else its name (which must then be one car's)
     for (const auto& c : record.cars)
-      if (std::to_string(c.number) == ask.car || c.name == ask.car) car = &c;
+      if (std::to_string(c.number) == ask.car) car = &c;
+    int named = 0;
+    for (const auto& c : record.cars)
+      if (!car && c.name == ask.car) ++named;
+    for (const auto& c : record.cars)
+      if (!car && named == 1 && c.name == ask.car) car = &c;
+    if (named > 1)
+      return Unexpected{printable(record.file, 200) + " has " + std::to_string(named) +
+                        " cars named '" + printable(ask.car, 40) + "': ask for one by its number"};
   }
   std::string cars;
   for (const auto& c : record.cars)
     cars += (cars.empty() ? "" : ", ") + std::to_string(c.number) + " (" + printable(c.name) + ")";
   if (!car)
-    return Unexpected{record.file + " has no car '" + printable(ask.car, 40) + "': its cars are " +
-                      cars};
-  const std::string who =
-      record.file + " car " + std::to_string(car->number) + " (" + printable(car->name) + ")";
+    return Unexpected{printable(record.file, 200) + " has no car '" + printable(ask.car, 40) +
+                      "': its cars are " + cars};
+  const std::string who = printable(record.file, 200) + " car " + std::to_string(car->number) +
+                          " (" + printable(car->name) + ")";
   if (car->laps.empty())
     return Unexpected{who +
                       " drove no whole lap the tracker could follow from line to line (forward, "
@@ -112,9 +120,9 @@ Result<PickedLap, std::string> pickLap(const RecordLaps& record, const LapAsk& a
     }
   }
   return PickedLap{lap, car,
-                   std::filesystem::path(record.file).filename().string() + " car " +
-                       std::to_string(car->number) + " (" + printable(car->name) + ") lap " +
-                       std::to_string(lap->lap)};
+                   printable(std::filesystem::path(record.file).filename().string(), 200) +
+                       " car " + std::to_string(car->number) + " (" + printable(car->name) +
+                       ") lap " + std::to_string(lap->lap)};
 }
 
 Result<RecordLaps, std::string> readRecordLaps(const std::string& path,
@@ -126,7 +134,8 @@ Result<RecordLaps, std::string> readRecordLaps(const std::string& path,
     return Unexpected{"cannot read " + shown + ": " +
                       (std::filesystem::exists(path, ec) ? "not a file" : "no such file")};
   const auto size = std::filesystem::file_size(path, ec);
-  if (ec || size > maxBytes)
+  if (ec) return Unexpected{"cannot read " + shown + ": " + ec.message()};
+  if (size > maxBytes)
     return Unexpected{shown + " is " + std::to_string((size + 1023) / 1024) +
                       " KB, more than the " + std::to_string(maxBytes / 1024) +
                       " KB a ghost's record may be (it is read within the script's budget): "
@@ -138,8 +147,8 @@ Result<RecordLaps, std::string> readRecordLaps(const std::string& path,
     return Unexpected{shown + " has no frame; a record is what `pitwall run --record FILE` writes"};
   if (!track && summary.layout.empty())
     return Unexpected{shown +
-                      " keeps no track layout (a record of real cars): laps are placed on the "
-                      "track they drove; give it with --track LAYOUT"};
+                      " keeps no track layout (a record of real cars): a ghost drives a lap "
+                      "recorded in the simulator, whose records keep their track"};
   auto layout = track ? sim::loadLayout(*track) : sim::parseLayout(summary.layout, "recorded");
   if (!layout) return Unexpected{(track ? "" : shown + "'s layout: ") + layout.error()};
   in.clear();

@@ -1,5 +1,5 @@
 #pragma once
-// The laps of a record as traces (`pitwall compare`, `sim.addGhost`, `--ghost`; docs/racing.md
+// The laps of a record as traces (`pitwall compare`, `sim.addGhost`; docs/racing.md
 // "Comparing laps"): the record played through the codec, the car model and the view's feed in
 // virtual time, on a loop and fleet of its own, as `pitwall replay` plays it, so a lap here is a
 // lap the replay summary and the view count. And the one lap someone asked for by

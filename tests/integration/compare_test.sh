@@ -74,6 +74,13 @@ contains "three laps: C" "C  even-ideal.jsonl car 1 (groundshock) lap 1" "$(cat 
 check "the page: a table and three charts" "1 3" \
   "$(grep -o '<table class="sections"' cmp.html | wc -l) $(grep -oE '<svg class="(speed|delta|lane)"' cmp.html | wc -l)"
 
+# a file name that is not UTF-8: the JSON still is
+cp even-real.jsonl "$(printf 'caf\xe9.jsonl')"
+$PITWALL compare "$(printf 'caf\xe9.jsonl')" slow-real.jsonl --json > latin.json 2> latin.err
+check "a Latin-1 file name: exit status" 0 $?
+python3 -c 'import json,sys; json.load(open(sys.argv[1], encoding="utf-8"))' latin.json &&
+  echo "ok: a Latin-1 file name: the JSON is UTF-8" || fail "a Latin-1 file name: the JSON is not UTF-8"
+
 # what cannot be compared: a sentence, and the status
 $PITWALL compare even-real.jsonl slow-real.jsonl:1:99 > /dev/null 2> nolap.err
 check "a lap the record lacks: status 1" 1 $?

@@ -15,7 +15,7 @@
 //   #leaderboard td.delta           the live delta to the reference lap (the ghost's, else the
 //                                   session's best): "+0.123" behind, "-0.045" ahead; its
 //                                   title names the lap; `data-delta` the number
-//   g.car-marker.ghost              a ghost (sim.addGhost, --ghost): drawn translucent
+//   g.car-marker.ghost              a ghost (sim.addGhost): drawn translucent
 //   #leaderboard td.link            the car's link: "down", else its RSSI and drops ("ok" when
 //                                   nothing to tell); `data-drops`, and the whole story in
 //                                   its title (connections, last drop, failed writes, stalls)

@@ -9,6 +9,7 @@
 #include <functional>
 
 #include "engine/laps/compare_report.hpp"
+#include "engine/laps/ghost.hpp"
 
 using namespace pitwall;
 
@@ -122,4 +123,22 @@ TEST_CASE("compare: a trace's time at a distance and distance at a time are inve
   }
   CHECK(lap.timeAt(-5) == 0);
   CHECK(lap.timeAt(map.lap + 100) == doctest::Approx(lap.time));
+}
+
+TEST_CASE("ghost lap: the lanes a record says are taken on the road") {
+  laps::LapTrace t;
+  t.time = 4;
+  t.length = 4000;
+  t.points = {{0, 0, NAN, NAN},
+              {1, 1000, 600, -700},
+              {2, 2000, 600, 1e38f},
+              {3, 3000, 600, 23},
+              {4, 4000, NAN, NAN}};
+  const sim::GhostLap g = laps::ghostLap(t);
+  REQUIRE(g.lanes.size() == 3);
+  CHECK(g.lanes[0].offset == -70);
+  CHECK(g.lanes[1].offset == 70);
+  CHECK(g.lanes[2].offset == 23);
+  CHECK(g.points.size() == 5);
+  CHECK(g.distanceAt(2.5) == doctest::Approx(2500));
 }

@@ -104,3 +104,19 @@ TEST_CASE("sim ghost: laps in the recorded time within a tick, touching no one")
   r.run(0.2);
   CHECK(r.ghost->truth().lap_distance_mm > stoppedAt);
 }
+
+TEST_CASE("sim ghost: a lap faster than any car is driven at the top speed, not in a blink") {
+  // a record's times are any numbers: a lap of a millisecond would be a million pieces a tick
+  Rig r;
+  const auto lap = lapOf(r.world.track(), 4e6, 4e6);  // ≈ 1 ms for the lap
+  CarSpec spec{.name = "ghost", .piece_index = r.world.track().finishIndex(), .offset_mm = -23};
+  spec.ghost = lap;
+  r.ghost = &r.connect(r.world.addCar(spec));
+  r.send(*r.ghost, anki::SetSpeed{300, 100});
+  r.run(1);
+  const auto t = r.ghost->truth();
+  const double lapMm = lap->length;
+  const double driven = t.laps * lapMm + t.lap_distance_mm;
+  CHECK(driven <= GhostLap::kMaxSpeed * 1.0 + 1);
+  CHECK(driven >= GhostLap::kMaxSpeed * 0.9);
+}
