@@ -110,6 +110,12 @@ const laps::CarTracker* Feed::tracker(int number) const {
   return it == cars_.end() ? nullptr : &it->second->tracker;
 }
 
+std::vector<std::pair<int, std::string>> Feed::tracedCars() const {
+  std::vector<std::pair<int, std::string>> out;
+  for (const auto& [number, c] : cars_) out.emplace_back(number, c->name);
+  return out;
+}
+
 const std::deque<laps::LapTrace>* Feed::laps(int number) const {
   auto it = cars_.find(number);
   return it == cars_.end() ? nullptr : &it->second->laps;

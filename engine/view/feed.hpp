@@ -94,6 +94,8 @@ class Feed {
   // compare` and the view's lap comparison; nullptr when unknown. Empty with no track.
   const std::deque<laps::LapTrace>* laps(int number) const;
   static constexpr std::size_t kLapsKept = 200;
+  // Every car the feed follows: its number and name, by number.
+  std::vector<std::pair<int, std::string>> tracedCars() const;
 
  private:
   struct Car;

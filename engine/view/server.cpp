@@ -19,6 +19,7 @@
 #include "engine/view/assets.hpp"
 #include "engine/view/code_api.hpp"
 #include "engine/view/host_check.hpp"
+#include "engine/view/lap_compare.hpp"
 #include "engine/view/page_messages.hpp"
 
 namespace pitwall::view {
@@ -380,6 +381,20 @@ struct Server::Impl::Http : std::enable_shared_from_this<Http> {
     if (req.method() != http::verb::get && req.method() != http::verb::head)
       return text(req, http::status::method_not_allowed, "text/plain",
                   "only GET: the view is read-only\n");
+    // a lap comparison (docs/view.md "Comparing two laps"): read-only, as /api/state
+    if (target == "/api/laps")
+      return text(
+          req, http::status::ok, "application/json",
+          lapList(server->feed).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
+    if (target.starts_with("/api/laps/compare?")) {
+      auto compared = compareLaps(server->feed, std::string_view(target).substr(18));
+      if (!compared)
+        return text(req, http::status::bad_request, "application/json",
+                    nlohmann::json{{"error", compared.error()}}.dump(
+                        -1, ' ', false, nlohmann::json::error_handler_t::replace));
+      return text(req, http::status::ok, "application/json",
+                  compared->dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
+    }
     if (target == "/api/state" || target.starts_with("/api/state?")) {
       server->feed.settle();
       return text(

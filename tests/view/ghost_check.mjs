@@ -41,6 +41,30 @@ try {
   check("the ghost's own row says ghost", ghostRow === "ghost", ghostRow);
   await page.screenshot({ path: png, fullPage: true });
   pass("screenshot written", png);
+
+  // two laps compared by distance (docs/view.md "Comparing two laps"): car 1's and the ghost's
+  await page.click("#compare-open");
+  await passWhen(page, "the dialog lists car 1's and the ghost's whole laps",
+    () => { const o = [...document.querySelectorAll("#lap-a option")].map((o) => o.value);
+            return o.some((v) => v.startsWith("1:")) && o.some((v) => v.startsWith("5:")); });
+  await page.evaluate(() => {
+    const pick = (sel, car) => { const s = document.querySelector(sel);
+      s.value = [...s.options].find((o) => o.value.startsWith(car + ":")).value; };
+    pick("#lap-a", 5); pick("#lap-b", 1);
+  });
+  await page.click("#lap-compare-go");
+  await passWhen(page, "the comparison is drawn: the section table and the three charts",
+    () => document.querySelectorAll("#lap-compare-result table.sections tr").length === 7 &&
+      ["speed", "delta", "lane"].every((c) => document.querySelector(`#lap-compare-result svg.${c} polyline.lap`)));
+  const how = await page.$eval("#lap-compare-how", (p) => p.textContent);
+  check("it says how the laps were aligned", /^(aligned by distance|per piece): /.test(how), how);
+  const lost = await page.$$eval("#lap-compare-result table.sections tr", (rows) =>
+    rows.slice(1).map((r) => Number(r.cells[3].querySelector("span").textContent)));
+  check("car 1 (600 mm/s) lost time to the ghost (800 mm/s) in every section and the lap",
+    lost.length === 6 && lost.every((d) => d > 0), lost.join(" "));
+  const shot = png.replace(/(\.png)?$/i, "-compare.png");
+  await page.screenshot({ path: shot, fullPage: true });
+  pass("screenshot written", shot);
 } catch (e) {
   fail("ghost check ran", e.stack || String(e));
 } finally {

@@ -16,6 +16,11 @@
 //                                   session's best): "+0.123" behind, "-0.045" ahead; its
 //                                   title names the lap; `data-delta` the number
 //   g.car-marker.ghost              a ghost (sim.addGhost): drawn translucent
+//   #compare-open, #lap-compare     "Compare laps…" and its dialog: #lap-a, #lap-b (options
+//                                   "CAR:LAP"), #lap-compare-go; the answer in
+//                                   #lap-compare-result (table.sections and svg.compare) and
+//                                   #lap-compare-how. Two clicks on the lap-time chart pick A
+//                                   and B and open it
 //   #leaderboard td.link            the car's link: "down", else its RSSI and drops ("ok" when
 //                                   nothing to tell); `data-drops`, and the whole story in
 //                                   its title (connections, last drop, failed writes, stalls)
@@ -593,6 +598,8 @@ function renderCharts() {
   if (key !== view.lapKey || !view.lapChart) {
     view.lapChart?.destroy();
     view.lapChart = makeChart($("#lap-chart"), cars, "lap", "seconds", (v) => `lap ${v}`);
+    const chart = view.lapChart;
+    chart?.over.addEventListener("click", () => pickFromChart(chart, cars));
     view.lapKey = key;
   }
   if (key !== view.speedKey || !view.speedChart) {
@@ -768,3 +775,83 @@ function connect() {
 drawTrack();
 connect();
 requestAnimationFrame(frame);
+
+// ---------------------------------------------------------------------------------------------
+// Comparing two laps (docs/view.md "Comparing two laps"): the feed's lap traces, compared by
+// distance by the engine (GET /api/laps/compare), drawn as `pitwall compare` draws them.
+
+const lapPicks = [];
+
+async function lapList() {
+  const r = await fetch("api/laps");
+  return r.ok ? (await r.json()).cars : [];
+}
+
+function fillLapSelects(cars) {
+  for (const id of ["#lap-a", "#lap-b"]) {
+    const sel = $(id);
+    const keep = sel.value;
+    sel.textContent = "";
+    for (const c of cars) {
+      for (const l of c.laps) {
+        if (!l.clean) continue;
+        const o = document.createElement("option");
+        o.value = `${c.number}:${l.lap}`;
+        o.textContent = `${c.name || "car " + c.number} lap ${l.lap} (${l.time.toFixed(3)} s)`;
+        sel.append(o);
+      }
+    }
+    if ([...sel.options].some((o) => o.value === keep)) sel.value = keep;
+  }
+}
+
+async function openCompare(a, b) {
+  fillLapSelects(await lapList());
+  if (a) $("#lap-a").value = a;
+  if (b) $("#lap-b").value = b;
+  const dlg = $("#lap-compare");
+  if (!dlg.open) dlg.showModal();
+  if (a && b) runCompare();
+}
+
+async function runCompare() {
+  const a = $("#lap-a").value, b = $("#lap-b").value;
+  const out = $("#lap-compare-result"), how = $("#lap-compare-how");
+  if (!a || !b) { how.textContent = "no whole lap yet to compare"; return; }
+  const r = await fetch(`api/laps/compare?a=${a}&b=${b}`);  // (CAR:LAP: digits and a colon)
+  const j = await r.json();
+  if (!r.ok) { how.textContent = j.error || "the comparison failed"; out.textContent = ""; return; }
+  how.textContent = j.how;
+  const row = (name, mm, t) => {
+    const d = t[1] - t[0];
+    return `<tr><td>${escapeHtml(name)}</td><td>${mm}</td><td>${t[0].toFixed(3)}</td>` +
+      `<td>${t[1].toFixed(3)} <span class="${d > 0 ? "lose" : "gain"}">${d >= 0 ? "+" : ""}${d.toFixed(3)}</span></td></tr>`;
+  };
+  const rows = j.sections.map((s) => row(s.name, `${Math.round(s.from)}–${Math.round(s.to)}`, s.times))
+    .join("") + row("lap", "", j.laps.map((l) => l.time));
+  const head = j.laps.map((l) => `<th>${escapeHtml(l.label)}</th>`).join("");
+  out.innerHTML = `<table class="sections"><tr><th>section</th><th>mm</th>${head}</tr>${rows}</table>` + j.svg;
+}
+
+// A click on the lap-time chart picks the lap of the line nearest the pointer at that lap.
+async function pickFromChart(u, cars) {
+  const i = u.cursor.idx;
+  if (i == null) return;
+  const y = u.posToVal(u.cursor.top, "y");
+  let best = null;
+  for (let k = 1; k < u.series.length; k++) {
+    const v = u.data[k][i];
+    if (v == null) continue;
+    if (!best || Math.abs(v - y) < Math.abs(best.v - y)) best = { k, v };
+  }
+  if (!best) return;
+  const car = cars[best.k - 1];
+  const listed = (await lapList()).find((c) => c.number === car.number);
+  const lap = listed && listed.laps.find((l) => Math.abs(l.time - best.v) < 0.002);
+  if (!lap) return;
+  lapPicks.push(`${car.number}:${lap.lap}`);
+  if (lapPicks.length === 2) openCompare(...lapPicks.splice(0, 2));
+}
+
+$("#compare-open").addEventListener("click", () => openCompare());
+$("#lap-compare-go").addEventListener("click", () => runCompare());
