@@ -12,7 +12,6 @@
 #include "bindings/track_table.hpp"
 #include "engine/core/log.hpp"
 #include "engine/core/printable.hpp"
-#include "engine/laps/ghost.hpp"
 #include "engine/protocol/anki/advertisement.hpp"
 #include "engine/protocol/anki/limits.hpp"
 #include "engine/sim/grid.hpp"
@@ -201,38 +200,17 @@ int addGhost(lua_State* L) {
       ask.lap =
           static_cast<int>(*read.integer("lap", 1, 1000000, {}, "a lap's number, or \"best\""));
   }
-  auto laps = view::readRecordLaps(*record, std::nullopt, kMaxGhostRecordBytes);
-  if (!laps) throw LuaError("sim.addGhost: " + laps.error());
-  const sim::Track& track = s.world->track();
-  if (laps->layout != sim::layoutText(track))
-    throw LuaError("sim.addGhost: " + printable(*record, 200) + " was driven on " +
-                   printable(laps->layout, 80) + ", and this run's track is " +
-                   printable(sim::layoutText(track), 80) + ": a ghost drives the track it was on");
-  auto picked = view::pickLap(*laps, ask);
-  if (!picked) throw LuaError("sim.addGhost: " + picked.error());
-  if (!(picked->trace->time * sim::GhostLap::kMaxSpeed >= picked->trace->length))
-    throw LuaError("sim.addGhost: " + picked->label + " took " + lua::show(picked->trace->time) +
-                   " s for " + lua::show(picked->trace->length) + " mm, faster than any car (" +
-                   std::to_string(static_cast<int>(sim::GhostLap::kMaxSpeed)) +
-                   " mm/s): the record's times are wrong; pick another lap");
-  sim::CarSpec spec;
-  spec.piece_index = track.finishIndex();
-  auto ghost = std::make_shared<sim::GhostLap>(laps::ghostLap(*picked->trace));
-  spec.offset_mm = ghost->lanes.empty() ? 0 : ghost->lanes.front().offset;
-  checkOnRoad(spec.offset_mm);
-  spec.ghost = std::move(ghost);
   std::vector<std::string> taken;
   for (AnkiCar* c : host.fleet().cars()) taken.push_back(c->identity().name);
-  spec.name = read.string("name").value_or("");
-  if (spec.name.empty()) {
-    spec.name = "ghost";
-    for (int n = 2; std::find(taken.begin(), taken.end(), spec.name) != taken.end(); ++n)
-      spec.name = "ghost" + std::to_string(n);
-  } else if (std::find(taken.begin(), taken.end(), spec.name) != taken.end()) {
-    throw LuaError("a car named '" + spec.name + "' is already in the run");
+  auto ghost = view::ghostSpec(*record, ask, s.world->track(), taken, kMaxGhostRecordBytes);
+  if (!ghost) throw LuaError("sim.addGhost: " + ghost.error());
+  sim::CarSpec& spec = ghost->spec;
+  if (auto name = read.string("name"); name && !name->empty()) {
+    if (std::find(taken.begin(), taken.end(), *name) != taken.end())
+      throw LuaError("a car named '" + *name + "' is already in the run");
+    spec.name = *name;
   }
-  log::info("sim", spec.name + " drives " + picked->label + " again (" +
-                       std::to_string(picked->trace->time) + " s)");
+  log::info("sim", spec.name + " drives " + ghost->what + " again");
   return join(L, spec);
 }
 

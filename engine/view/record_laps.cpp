@@ -1,12 +1,15 @@
 #include "engine/view/record_laps.hpp"
 
+#include <algorithm>
 #include <cerrno>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
 #include "engine/core/log.hpp"
 #include "engine/core/printable.hpp"
+#include "engine/laps/ghost.hpp"
 #include "engine/record/record_player.hpp"
 #include "engine/view/feed.hpp"
 
@@ -154,6 +157,37 @@ Result<RecordLaps, std::string> readRecordLaps(const std::string& path,
   in.clear();
   in.seekg(0);
   return playLaps(in, summary, *layout, path);
+}
+
+Result<Ghost, std::string> ghostSpec(const std::string& path, const LapAsk& ask,
+                                     const sim::Track& track, const std::vector<std::string>& taken,
+                                     std::uintmax_t maxBytes) {
+  auto laps = readRecordLaps(path, std::nullopt, maxBytes);
+  if (!laps) return Unexpected{laps.error()};
+  if (laps->layout != sim::layoutText(track))
+    return Unexpected{printable(path, 200) + " was driven on " + printable(laps->layout, 80) +
+                      ", and this run's track is " + printable(sim::layoutText(track), 80) +
+                      ": a ghost drives the track it was on"};
+  auto picked = pickLap(*laps, ask);
+  if (!picked) return Unexpected{picked.error()};
+  const laps::LapTrace& lap = *picked->trace;
+  char took[96];
+  std::snprintf(took, sizeof took, "%.3f s for %.0f mm", lap.time, lap.length);
+  if (!(lap.time * sim::GhostLap::kMaxSpeed >= lap.length))
+    return Unexpected{picked->label + " took " + took + ", faster than any car (" +
+                      std::to_string(static_cast<int>(sim::GhostLap::kMaxSpeed)) +
+                      " mm/s): the record's times are wrong; pick another lap"};
+  Ghost g;
+  g.spec.piece_index = track.finishIndex();
+  auto ghost = std::make_shared<sim::GhostLap>(laps::ghostLap(lap));
+  g.spec.offset_mm = ghost->lanes.empty() ? 0 : ghost->lanes.front().offset;  // on the road
+  g.spec.ghost = std::move(ghost);
+  g.spec.name = "ghost";
+  for (int n = 2; std::find(taken.begin(), taken.end(), g.spec.name) != taken.end(); ++n)
+    g.spec.name = "ghost" + std::to_string(n);
+  std::snprintf(took, sizeof took, ", %.3f s", lap.time);
+  g.what = picked->label + took;
+  return g;
 }
 
 }  // namespace pitwall::view

@@ -14,6 +14,7 @@
 #include "engine/laps/trace.hpp"
 #include "engine/record/record_reader.hpp"
 #include "engine/sim/track.hpp"
+#include "engine/sim/world.hpp"
 
 namespace pitwall::view {
 
@@ -56,5 +57,18 @@ Result<PickedLap, std::string> pickLap(const RecordLaps& record, const LapAsk& a
 Result<RecordLaps, std::string> readRecordLaps(const std::string& path,
                                                const std::optional<std::string>& track,
                                                std::uintmax_t maxBytes);
+
+// The simulator's ghost of the lap `ask` asks for in the record at `path` (sim.addGhost;
+// docs/simulator.md "Ghosts"), on `track`: a car spec standing at the finish line
+// in the lap's first lane, named "ghost" (or ghost2, … when `taken` has it), and what it drives
+// ("a.jsonl car 1 (skull) lap 3, 4.465 s"). A sentence when the record is over `maxBytes`, was
+// driven on another track, lacks the lap, or its lap is faster than any car.
+struct Ghost {
+  sim::CarSpec spec;
+  std::string what;
+};
+Result<Ghost, std::string> ghostSpec(const std::string& path, const LapAsk& ask,
+                                     const sim::Track& track, const std::vector<std::string>& taken,
+                                     std::uintmax_t maxBytes);
 
 }  // namespace pitwall::view
