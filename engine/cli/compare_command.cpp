@@ -2,10 +2,6 @@
 // aligned by distance along the track (docs/racing.md "Comparing laps"). Each record is played
 // through the codec, the car model and the view's tracker in virtual time, as `pitwall replay`
 // plays it, so a lap here is the lap the view and the replay summary count.
-#include <algorithm>
-#include <cerrno>
-#include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <map>
