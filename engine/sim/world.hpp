@@ -52,7 +52,7 @@ struct CarSpec {
   // Set: a ghost. It starts at the finish line and, while a set-speed above 0 holds, drives this
   // lap again and again exactly as recorded; it touches no car, slides off no curve, and takes
   // no lane change or turn.
-  std::shared_ptr<const GhostLap> ghost;
+  std::shared_ptr<const GhostLap> ghost = nullptr;
 };
 
 struct Noise {
