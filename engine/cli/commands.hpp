@@ -62,6 +62,9 @@ struct CarSource {
   int humans = 0;
   bool gamepads = false;
   bool keyboard = false;
+  // --ghost FILE[:CAR[:LAP]] | best[:NAME] (run): a ghost of that lap joins after the cars and
+  // drives from the race's green light (docs/racing.md "Racing a ghost"); empty: none
+  std::string ghost;
 };
 
 struct RunOptions : CarSource {

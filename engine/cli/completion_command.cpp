@@ -35,6 +35,7 @@ const std::map<std::string, Values>& valuesByName() {
       {"piece", {Kind::Layout, {}}},
       {"--results", {Kind::Files, {}}},
       {"--record", {Kind::Files, {}}},
+      {"--ghost", {Kind::Files, {}}},
       {"--history", {Kind::Files, {}}},
       {"--mqtt-password-file", {Kind::Files, {}}},
       {"--mqtt-ca", {Kind::Files, {}}},

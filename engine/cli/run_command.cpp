@@ -13,6 +13,7 @@
 #include "bindings/script_file.hpp"
 #include "engine/cli/commands.hpp"
 #include "engine/cli/fail.hpp"
+#include "engine/cli/ghost_option.hpp"
 #include "engine/cli/league_final.hpp"
 #include "engine/cli/options.hpp"
 #include "engine/cli/repl.hpp"
@@ -21,6 +22,7 @@
 #include "engine/core/data_dir.hpp"
 #include "engine/core/log.hpp"
 #include "engine/core/numbers.hpp"
+#include "engine/laps/trace_json.hpp"
 #include "engine/record/results.hpp"
 #include "engine/standings/keeper.hpp"
 #include "engine/standings/race_json.hpp"
@@ -34,6 +36,26 @@ namespace pitwall::cli {
 constexpr double kFastCap = 24 * 3600;
 
 namespace {
+// Personal bests (docs/racing.md "Personal bests"): each entry's best whole lap since the race
+// before it kept (`upTo`: car number → the time up to which its laps were looked at), as the
+// feed traced it, and the race's layout, which the best is of.
+void traceBestLaps(standings::Race& race, const view::Feed& feed, std::map<int, double>& upTo,
+                   double now) {
+  if (!feed.track()) return;  // (real cars with no layout: no lap is traced)
+  race.layout = sim::layoutText(*feed.track());
+  for (standings::Entry& e : race.entries) {
+    const auto* traces = feed.laps(e.number);
+    auto seen = upTo.find(e.number);
+    const double from = seen == upTo.end() ? -1e300 : seen->second;
+    upTo[e.number] = now;
+    if (!traces) continue;
+    const laps::LapTrace* best = nullptr;
+    for (const laps::LapTrace& lap : *traces)
+      if (lap.clean && lap.start + lap.time > from && (!best || lap.time < best->time)) best = &lap;
+    if (best) e.bestTrace = standings::Entry::Trace{best->time, laps::traceJson(*best).dump()};
+  }
+}
+
 // --driver CAR=FILE, each read and checked now (before any car is connected): the number, a file
 // that exists and compiles, one file per car.
 Result<std::map<int, std::string>, std::string> driverFiles(const std::vector<std::string>& given) {
@@ -162,6 +184,16 @@ int run(const RunOptions& given) {
     }
   }
   Loop& loop = session.loop();
+  if (!options.ghost.empty()) {  // (a record played, or the standings read: before any car)
+    const sim::Track* track = session.ghostTrack();
+    if (!track)
+      return fail("run",
+                  "--ghost with --ble needs --track LAYOUT: the layout the cars race on, which "
+                  "the ghost drives");
+    auto ghost = resolveGhost(options.ghost, *track, keeper ? &keeper->database() : nullptr);
+    if (!ghost) return fail("run", ghost.error());
+    session.setGhost(std::move(ghost->spec), ghost->what);
+  }
   // Everything that can refuse the start comes before the first car is connected, and the record
   // is opened (truncated) only once nothing can: a refused start leaves an old record as it was
   // and no car driven (docs/safety.md).
@@ -199,7 +231,11 @@ int run(const RunOptions& given) {
   host.seed = options.seed;
   host.classroom = session.classroom();
   host.results = options.results;
-  host.view = session.viewFeed();
+  host.view = session.viewFeed();  // (the view's: the script shows its race there)
+  // Personal bests (docs/racing.md): each car's laps traced, so that a race kept in the
+  // standings keeps each entry's best lap as a ghost can drive it again.
+  view::Feed* traced = keeper ? &session.startFeed(options.ble ? "ble" : "simulator") : nullptr;
+  std::map<int, double> tracedUpTo;  // car number → the time up to which its laps were kept
   host.seats = session.seats();
   host.driverFiles = files;
   host.driverLimits.memory = static_cast<std::size_t>(options.limits.driverMemory) << 20;
@@ -210,13 +246,15 @@ int run(const RunOptions& given) {
     host.leagueFinal =
         HostOptions::LeagueFinal{final->title, final->laps, final->league, final->drivers};
   if (keeper)
-    host.keepRace = [&keeper](const nlohmann::json& race) -> std::optional<std::string> {
+    host.keepRace = [&keeper, traced, &tracedUpTo,
+                     &loop](const nlohmann::json& race) -> std::optional<std::string> {
       auto parsed = standings::raceFromJson(race);
       if (!parsed) {  // (kept as it came, with why, in the unsaved file at the end)
         keeper->reject(race, parsed.error());
         return "the race's results are not a race: " + parsed.error() +
                " (kept as they came beside the database)";
       }
+      traceBestLaps(*parsed, *traced, tracedUpTo, loop.seconds());
       return keeper->add(std::move(*parsed));
     };
   try {
@@ -319,6 +357,10 @@ Command addRunCommand(CLI::App& app) {
   addRemoteCars(cmd, *run)->excludes(fastFlag);
   addView(cmd, run->view);
   addHumans(cmd, *run);
+  cmd->add_option("--ghost", run->ghost,
+                  "FILE[:CAR[:LAP]] | best[:NAME]: a ghost of that recorded lap, or of the "
+                  "fastest personal best the standings keep on this track (of NAME, a driver or "
+                  "car), drives from the green light (docs/racing.md \"Racing a ghost\")");
   auto* replFlag = cmd->add_flag("--repl", run->repl,
                                  "Open a Lua prompt beside the script, in the same Lua world");
   cmd->add_flag("--watch", run->watch,

@@ -428,13 +428,56 @@ int Session::connectLocalCars(const char* command) {
       loop_.run();
       return 2;
     }
+    if (!addGhost()) {
+      if (interrupted_) return 130;
+      return fail(command, "the ghost did not connect", 1);
+    }
     return 0;
   }
   if (!addGridCars(source_.cars)) {
     if (interrupted_) return 130;
     return fail(command, "not every simulated car connected", 1);
   }
+  if (!addGhost()) {
+    if (interrupted_) return 130;
+    return fail(command, "the ghost did not connect", 1);
+  }
   return 0;
+}
+
+const sim::Track* Session::ghostTrack() const {
+  if (sim_.world) return &sim_.world->track();
+  return design_ ? &*design_ : nullptr;
+}
+
+// A simulated car, the ghost's, joins the fleet as the grid's cars do; beside real cars it
+// drives a world of its own on their layout (it touches no one, so it needs no one else there).
+bool Session::addGhost() {
+  if (!ghost_) return true;
+  sim::World* world = sim_.world.get();
+  if (!world) {
+    ghostWorld_ = std::make_unique<sim::World>(loop_, *design_, sim_.seed);
+    world = ghostWorld_.get();
+  }
+  sim::CarSpec spec = std::move(*ghost_);
+  ghost_.reset();
+  spec.version = source_.firmware;
+  sim::SimCar& simCar = world->addCar(spec);
+  auto link = std::make_unique<SimLink>(loop_, simCar);
+  SimLink& toCar = *link;
+  bool joinedNow = false;
+  AnkiCar& car = fleet_.add(std::move(link),
+                            CarIdentity{0, spec.name, spec.model_id, simCar.identifier(), true});
+  Subscription joined = fleet_.carJoined.connect([&](AnkiCar& c) {
+    if (&c != &car) return;
+    joinedNow = true;
+    loop_.stop();
+  });
+  toCar.connect();
+  if (!joinedNow) loop_.runAtMost(std::chrono::seconds(5));
+  if (!joinedNow) return false;
+  log::info("pitwall", spec.name + " drives " + ghostWhat_ + " again, from the green light");
+  return true;
 }
 
 void Session::record(const std::string& path) {

@@ -74,6 +74,15 @@ class Session {
   void openRecord();  // throws std::runtime_error naming the file
   // Puts `count` cars on the starting grid and runs the loop until all are connected.
   bool addGridCars(int count);
+  // --ghost (docs/racing.md "Racing a ghost"): the track a ghost drives — the simulator's, or
+  // the layout --ble --track gives; nullptr with real cars and no layout.
+  const sim::Track* ghostTrack() const;
+  // The ghost joins after the grid (or the real cars), as a simulated car of its own world
+  // beside real cars; connectCars adds it.
+  void setGhost(sim::CarSpec spec, std::string what) {
+    ghost_ = std::move(spec);
+    ghostWhat_ = std::move(what);
+  }
   // Finds and connects the real cars (runs the loop until every car had a first attempt).
   std::optional<std::string> connectRealCars();
   void startHost(HostOptions options);
@@ -127,7 +136,11 @@ class Session {
     ~ResetLogTime() { log::setTimeSource(nullptr); }
   } resetLogTime_;
   SimSession sim_;
-  std::optional<sim::Track> design_;  // --ble --track: the layout the real cars are on
+  std::optional<sim::Track> design_;   // --ble --track: the layout the real cars are on
+  std::optional<sim::CarSpec> ghost_;  // --ghost: added after the other cars
+  std::string ghostWhat_;
+  std::unique_ptr<sim::World> ghostWorld_;  // the ghost's world beside real cars'
+  bool addGhost();
   Fleet fleet_;
   std::unique_ptr<Recorder> recorder_;
   Subscription recording_;      // the fleet's frames into recorder_ (--record)

@@ -73,6 +73,18 @@ constexpr std::array<const char*, kSchemaVersion> kMigrations = {
          lap INTEGER NOT NULL,
          time REAL NOT NULL,
          PRIMARY KEY(race, number, lap));)",
+    // 3: personal bests: each driver's best lap in each car on each layout, as a trace a ghost
+    // drives again (laps::traceJson)
+    R"(CREATE TABLE best_laps(
+         driver TEXT NOT NULL,
+         car TEXT NOT NULL,
+         layout TEXT NOT NULL,
+         track TEXT NOT NULL,
+         lap REAL NOT NULL,
+         trace TEXT NOT NULL,
+         event INTEGER REFERENCES events(id),
+         set_at TEXT NOT NULL,
+         PRIMARY KEY(driver, car, layout));)",
 };
 
 // A prepared statement, finalized when it goes.
@@ -328,7 +340,7 @@ Result<bool, std::string> Database::checkTables() {
   int rc;
   while ((rc = s.step()) == SQLITE_ROW) have.insert(s.text(0));
   if (rc != SQLITE_DONE) return Unexpected{sentence(rc, "reading it")};
-  for (const char* table : {"events", "races", "results", "laps"})
+  for (const char* table : {"events", "races", "results", "laps", "best_laps"})
     if (!have.count(table))
       return Unexpected{path_ + " has schema version " + std::to_string(kSchemaVersion) +
                         " but no table " + table +
@@ -434,9 +446,55 @@ Result<bool, std::string> Database::addRace(std::int64_t event, const Race& race
       if (int rc = l.step(); rc != SQLITE_DONE) return fail(rc);
     }
   }
+  // Each entry's traced best lap becomes its driver's personal best in that car on this layout
+  // when it beats the one kept (or none is).
+  Statement b(db_,
+              "INSERT INTO best_laps(driver, car, layout, track, lap, trace, event, set_at) "
+              "VALUES(?, ?, ?, ?, ?, ?, ?, strftime('%Y-%m-%dT%H:%M:%SZ', 'now')) "
+              "ON CONFLICT(driver, car, layout) DO UPDATE SET track = excluded.track, "
+              "lap = excluded.lap, trace = excluded.trace, event = excluded.event, "
+              "set_at = excluded.set_at WHERE excluded.lap < best_laps.lap");
+  if (int rc = b.prepared(); rc != SQLITE_OK) return fail(rc);
+  for (const Entry& x : race.entries) {
+    if (!x.bestTrace || race.layout.empty()) continue;
+    b.reset();
+    b.bind(1, x.driver);
+    b.bind(2, x.car);
+    b.bind(3, race.layout);
+    b.bind(4, race.track);
+    b.bind(5, x.bestTrace->time);
+    b.bind(6, x.bestTrace->json);
+    b.bind(7, event);
+    if (int rc = b.step(); rc != SQLITE_DONE) return fail(rc);
+  }
   if (int rc = sqlite3_exec(db_, "COMMIT", nullptr, nullptr, nullptr); rc != SQLITE_OK)
     return fail(rc);
   return true;
+}
+
+Result<std::optional<KeptLap>, std::string> Database::bestLap(const std::string& layout,
+                                                              const std::string& who) {
+  Statement s(db_,
+              "SELECT driver, car, track, lap, trace, set_at FROM best_laps "
+              "WHERE layout = ? AND (? = '' OR driver = ? OR car = ?) "
+              "ORDER BY lap, set_at LIMIT 1");
+  if (int rc = s.prepared(); rc != SQLITE_OK)
+    return Unexpected{sentence(rc, "reading the personal bests")};
+  s.bind(1, layout);
+  s.bind(2, who);
+  s.bind(3, who);
+  s.bind(4, who);
+  int rc = s.step();
+  if (rc == SQLITE_DONE) return std::optional<KeptLap>();
+  if (rc != SQLITE_ROW) return Unexpected{sentence(rc, "reading the personal bests")};
+  KeptLap k;
+  k.driver = s.text(0);
+  k.car = s.text(1);
+  k.track = s.text(2);
+  k.lap = s.real(3).value_or(0);
+  k.trace = s.text(4);
+  k.when = s.text(5);
+  return std::optional<KeptLap>(std::move(k));
 }
 
 Result<bool, std::string> Database::endEvent(std::int64_t event) {
@@ -540,7 +598,7 @@ Result<StoredLeague, std::string> Database::league(std::optional<std::int64_t> i
                            : path_ + " has no league that ended (pitwall league … --db " + path_ +
                                  " races one)"};
     if (rc != SQLITE_ROW) return Unexpected{sentence(rc, "reading a league")};
-    out.event = {s.integer64(0), "league", s.text(1), s.text(2), s.text(3), s.text(4), 0};
+    out.event = {s.integer64(0), "league", s.text(1), s.text(2), s.text(3), s.text(4), 0, {}};
     out.details = s.text(5);
   }
   std::map<std::string, std::size_t> index;

@@ -17,8 +17,8 @@ struct sqlite3;
 namespace pitwall::standings {
 
 // The schema this build writes. 1: events, races, results; 2: a result's reason and driver file,
-// and every lap's time.
-inline constexpr int kSchemaVersion = 2;
+// and every lap's time; 3: personal bests as traces (best_laps).
+inline constexpr int kSchemaVersion = 3;
 
 // The default database: $PITWALL_DB, else $XDG_DATA_HOME/pitwall/standings.db, else
 // $HOME/.local/share/pitwall/standings.db; empty when none of them is set. A write waits 10 s
@@ -38,6 +38,13 @@ struct Entry {
   int laps = 0;
   std::optional<double> bestLap, totalTime;
   std::vector<double> lapTimes;
+  // Its best whole lap as a trace (laps::traceJson), when the run traced it: its driver's
+  // personal best in this car on the race's layout when it beats the one kept.
+  struct Trace {
+    double time = 0;
+    std::string json;
+  };
+  std::optional<Trace> bestTrace;
 };
 
 // One race (a heat, a qualifying run, a final, a race of `pitwall run`).
@@ -47,6 +54,7 @@ struct Race {
   std::string track;
   int laps = 0;
   std::vector<Entry> entries;
+  std::string layout = {};  // the track's layout text (sim::layoutText): what personal bests are of
 };
 
 // An event: a league, a `pitwall run`, a final. details: JSON (a league's options).
@@ -74,6 +82,13 @@ struct TableRow {
 struct Best {
   std::string driver, track, car, when, event;
   double lap = 0;
+};
+
+// A personal best as kept: whose, in which car, on which track, and the lap (laps::traceJson).
+struct KeptLap {
+  std::string driver, car, track, when;
+  double lap = 0;
+  std::string trace;
 };
 
 // One race of a driver's history.
@@ -133,6 +148,10 @@ class Database {
 
   Result<std::vector<TableRow>, std::string> table(const Filter& filter);
   Result<std::vector<Best>, std::string> bests(const Filter& filter);
+  // The fastest personal best kept on `layout` — of the driver or car named `who`, or anyone's
+  // when it is empty; none when there is none.
+  Result<std::optional<KeptLap>, std::string> bestLap(const std::string& layout,
+                                                      const std::string& who);
   Result<std::vector<Past>, std::string> history(const std::string& driver);
   Result<std::vector<EventInfo>, std::string> events();
   // The league event `id`, or the last league that ended when none is given.

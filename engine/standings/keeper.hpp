@@ -38,6 +38,7 @@ class Keeper {
   std::optional<std::string> finish();
 
   const std::string& path() const { return db_->path(); }
+  Database& database() { return *db_; }  // to read from (a personal best for --ghost)
   std::optional<std::int64_t> event() const { return id_; }
   int written() const { return written_; }
 

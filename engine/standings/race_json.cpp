@@ -3,6 +3,8 @@
 #include <cmath>
 #include <set>
 
+#include "engine/laps/trace_json.hpp"
+
 namespace pitwall::standings {
 
 namespace {
@@ -72,11 +74,16 @@ nlohmann::json toJson(const Race& race) {
                        {"bestLap", orNull(e.bestLap)},
                        {"totalTime", orNull(e.totalTime)},
                        {"lapTimes", e.lapTimes}});
-  return {{"kind", race.kind},
-          {"number", race.number},
-          {"track", race.track},
-          {"laps", race.laps},
-          {"entries", entries}};
+  for (std::size_t k = 0; k < race.entries.size(); ++k)
+    if (const auto& t = race.entries[k].bestTrace)
+      entries[k]["bestTrace"] = nlohmann::json::parse(t->json, nullptr, false);
+  nlohmann::json j = {{"kind", race.kind},
+                      {"number", race.number},
+                      {"track", race.track},
+                      {"laps", race.laps},
+                      {"entries", entries}};
+  if (!race.layout.empty()) j["layout"] = race.layout;
+  return j;
 }
 
 Result<Race, std::string> raceFromJson(const nlohmann::json& j) {
@@ -94,6 +101,10 @@ Result<Race, std::string> raceFromJson(const nlohmann::json& j) {
   race.number = *number;
   race.track = *track;
   race.laps = *laps;
+  if (auto it = j.find("layout"); it != j.end() && !it->is_null()) {
+    if (!it->is_string()) return Unexpected{std::string("race.layout must be a layout's text")};
+    race.layout = it->get<std::string>();
+  }
   static const nlohmann::json kNone = nlohmann::json::array();
   const auto found = j.find("entries");
   const nlohmann::json& entries = found == j.end() || found->is_null() ? kNone : *found;
@@ -149,6 +160,11 @@ Result<Race, std::string> raceFromJson(const nlohmann::json& j) {
           return Unexpected{where + ".lapTimes must be a list of seconds, got " + shown(t)};
         e.lapTimes.push_back(t.get<double>());
       }
+    }
+    if (auto it = x.find("bestTrace"); it != x.end() && !it->is_null()) {
+      auto trace = laps::traceFromJson(*it);
+      if (!trace) return Unexpected{where + ".bestTrace: " + trace.error()};
+      e.bestTrace = Entry::Trace{trace->time, laps::traceJson(*trace).dump()};
     }
     if (!numbers.insert(e.number).second)
       return Unexpected{where + ".number " + std::to_string(e.number) +

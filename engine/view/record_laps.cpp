@@ -170,11 +170,15 @@ Result<Ghost, std::string> ghostSpec(const std::string& path, const LapAsk& ask,
                       ": a ghost drives the track it was on"};
   auto picked = pickLap(*laps, ask);
   if (!picked) return Unexpected{picked.error()};
-  const laps::LapTrace& lap = *picked->trace;
+  return ghostOf(*picked->trace, picked->label, track, taken);
+}
+
+Result<Ghost, std::string> ghostOf(const laps::LapTrace& lap, const std::string& label,
+                                   const sim::Track& track, const std::vector<std::string>& taken) {
   char took[96];
   std::snprintf(took, sizeof took, "%.3f s for %.0f mm", lap.time, lap.length);
   if (!(lap.time * sim::GhostLap::kMaxSpeed >= lap.length))
-    return Unexpected{picked->label + " took " + took + ", faster than any car (" +
+    return Unexpected{label + " took " + took + ", faster than any car (" +
                       std::to_string(static_cast<int>(sim::GhostLap::kMaxSpeed)) +
                       " mm/s): the record's times are wrong; pick another lap"};
   Ghost g;
@@ -186,7 +190,7 @@ Result<Ghost, std::string> ghostSpec(const std::string& path, const LapAsk& ask,
   for (int n = 2; std::find(taken.begin(), taken.end(), g.spec.name) != taken.end(); ++n)
     g.spec.name = "ghost" + std::to_string(n);
   std::snprintf(took, sizeof took, ", %.3f s", lap.time);
-  g.what = picked->label + took;
+  g.what = label + took;
   return g;
 }
 

@@ -70,5 +70,9 @@ struct Ghost {
 Result<Ghost, std::string> ghostSpec(const std::string& path, const LapAsk& ask,
                                      const sim::Track& track, const std::vector<std::string>& taken,
                                      std::uintmax_t maxBytes);
+// The same of a lap at hand (a personal best the standings keep), `label` naming it, on the
+// track it was driven on.
+Result<Ghost, std::string> ghostOf(const laps::LapTrace& lap, const std::string& label,
+                                   const sim::Track& track, const std::vector<std::string>& taken);
 
 }  // namespace pitwall::view

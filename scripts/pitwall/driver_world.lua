@@ -22,7 +22,9 @@ local function call(method, car, limit, pieceLimits, period, race, sameRace, sen
     -- cruiser) pays for no tracker of another car.
     local field = {}
     ctx = drivers.context(car, map, field, { period = period })
-    for _, c in ipairs(pitwall.cars()) do field[#field + 1] = c end
+    for _, c in ipairs(pitwall.cars()) do -- (a ghost is no one to pass or follow)
+      if not c.ghost then field[#field + 1] = c end
+    end
   end
   -- ctx.race: a race view the same as the last one is not sent again (drivers.lua's send)
   ctx.limit, ctx.pieceLimits = limit, pieceLimits

@@ -176,10 +176,19 @@ function race.new(options)
   if (mode == "qualifying" or mode == "practice") and not seconds and not options.laps then
     pitwall._raise("race." .. mode .. ": give minutes = M (or seconds, or laps)")
   end
-  local cars = options.cars or pitwall.cars()
+  -- A ghost (sim.addGhost, run --ghost) is no entry: it stands at the line until the green
+  -- light, then drives its lap again beside the race (docs/racing.md "Racing a ghost").
+  local cars, ghosts = options.cars, {}
+  if not cars then
+    cars = {}
+    for _, c in ipairs(pitwall.cars()) do
+      if c.ghost then ghosts[#ghosts + 1] = c else cars[#cars + 1] = c end
+    end
+  end
   if #cars == 0 then pitwall._raise("race: no cars") end
   return setmetatable({
-    mode = mode, options = options, cars = cars, seconds = seconds, laps = options.laps,
+    mode = mode, options = options, cars = cars, ghosts = ghosts, seconds = seconds,
+    laps = options.laps,
     period = options.period or 0.1, state = "new", entries = {}, order = {},
     finishers = 0, title = options.title or MODES[mode],
   }, Race)
@@ -744,6 +753,9 @@ function Race:_race()
       if e.started and not e.finished then drivers.call(e.driver, "finish", e.car, e.ctx) end
       if e.car.connected then pcall(e.car.stop, e.car) end
     end
+    for _, g in ipairs(self.ghosts or {}) do
+      if g.connected then pcall(g.stop, g) end
+    end
   end
   -- (car.speed is the last reported one: a stopped car reports nothing.) A version that took
   -- the session up here waits out what is left of the half second, no more.
@@ -818,6 +830,9 @@ function Race:_startSession()
     if self.mode ~= "practice" and o.lights ~= 0 then self:_lights() end
     self.state = "racing"
     self.green = pitwall.now()
+    for _, g in ipairs(self.ghosts or {}) do -- (any speed above 0: it drives its lap's pace)
+      if g.connected then pcall(g.setSpeed, g, 1000) end
+    end
     for _, e in ipairs(self.order) do
       e.releaseAt = self.green + (e.falseStart and self.penalty or 0)
     end

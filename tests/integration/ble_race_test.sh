@@ -31,6 +31,36 @@ for n in 1 2 3 4; do
     "E0:00:00:00:00:0$n connected=false target=0" "$summary"
 done
 
+# A ghost beside real cars (docs/racing.md "Racing a ghost"): --ble --track gives it the layout,
+# it drives a simulated world of its own beside the cars, from the green light, and laps in the
+# recorded lap's time (within 0.1 s: in real time a frame is stamped when the loop reads it, late on
+# a loaded machine; the virtual-time tests hold it to a tick); without --track it is refused before any car is connected
+$PITWALL run "$SRC/tests/integration/compare_drive.lua" --fast --no-db --record "$TMP/even.jsonl" -q
+best=$($PITWALL compare "$TMP/even.jsonl" "$TMP/even.jsonl" --json |
+  python3 -c 'import json,sys; print(json.load(sys.stdin)["laps"][0]["time"])')
+err=$($PITWALL run "$SRC/tests/integration/ghost_run.lua" --ble --scan-timeout 1 --no-db \
+  --ghost "$TMP/even.jsonl" 2>&1 >/dev/null); rc=$?
+check "ghost without --track: exit status" 2 "$rc"
+contains "ghost without --track: says why" "--ghost with --ble needs --track LAYOUT" "$err"
+start_fake --adapters 1 --cars 2
+out=$(GHOST_LAPS=4 $PITWALL run "$SRC/tests/integration/ghost_run.lua" --ble --scan-timeout 1 \
+  --track oval --no-db --ghost "$TMP/even.jsonl" --record "$TMP/ghost.jsonl" 2>"$TMP/ghost.err"); rc=$?
+check "ghost beside real cars: exit status" 0 "$rc"
+contains "ghost beside real cars: the ghost is no entry and waits for the green light" \
+  "entries:	2	ghost moved before green:	false" "$out"
+contains "ghost beside real cars: stopped at the end" "ghost speed after:	0" "$out"
+stop_fake
+$PITWALL replay "$TMP/ghost.jsonl" --track oval --json 2>/dev/null | python3 -c '
+import json, sys
+best = float(sys.argv[1])
+rows = [json.loads(l) for l in sys.stdin]
+ghost = next(r for r in rows if r["name"] == "ghost")
+times = ghost["lapTimes"]
+print("the ghost beside real cars lapped:", times)
+assert len(times) >= 2 and all(abs(t - best) <= 0.1 for t in times), times
+' "$best" && echo "ok: ghost beside real cars: every lap in the recorded time within 0.1 s" ||
+  fail "ghost beside real cars: its lap times"
+
 # Ctrl-C: the cars are stopped, then disconnected; exit status 130
 start_fake --adapters 1 --cars 2
 mkfifo "$TMP/run.fifo"

@@ -171,7 +171,7 @@ PRAGMA user_version = 1;
 db.commit()
 PY
 out=$($PITWALL standings --db "$TMP/old.db" --json)
-check "version 1: migrated to 2" 2 "$(python3 -c "import sqlite3; print(sqlite3.connect('$TMP/old.db').execute('PRAGMA user_version').fetchone()[0])")"
+check "version 1: migrated to 3" 3 "$(python3 -c "import sqlite3; print(sqlite3.connect('$TMP/old.db').execute('PRAGMA user_version').fetchone()[0])")"
 check "version 1: its rows are kept" "alice 25 1 1
 zoe 18 1 0" "$(table "$TMP/old.db")"
 contains "version 1: its personal best is kept" '"lap": 3.456' "$out"
@@ -351,7 +351,7 @@ import sqlite3; db = sqlite3.connect('$TMP/other.db'); db.execute('CREATE TABLE 
 refused "another program's database" "$TMP/other.db" "not pitwall's standings (its tables: photos)"
 cp "$TMP/a.db" "$TMP/newer.db"
 python3 -c "import sqlite3; db = sqlite3.connect('$TMP/newer.db'); db.execute('PRAGMA user_version = 99'); db.commit()"
-refused "a newer schema" "$TMP/newer.db" "has schema version 99, newer than this pitwall's 2"
+refused "a newer schema" "$TMP/newer.db" "has schema version 99, newer than this pitwall's 3"
 # read-only: a file the user may not write (root may write any file: the check runs as nobody)
 cp "$TMP/a.db" "$TMP/ro/a.db" 2>/dev/null || { mkdir -p "$TMP/ro" && cp "$TMP/a.db" "$TMP/ro/a.db"; }
 chmod 755 "$TMP" "$TMP/ro" "$TMP/class"; chmod 644 "$TMP"/class/*.lua; chmod 444 "$TMP/ro/a.db"

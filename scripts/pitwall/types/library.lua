@@ -632,7 +632,7 @@ function Human:waiting(car, ctx) end]],
 ---@field laps? integer laps of a race (race.laps), or of qualifying / practice
 ---@field minutes? number length of a timed race, qualifying or practice
 ---@field seconds? number the same in seconds
----@field cars? pitwall.Car[] default pitwall.cars()
+---@field cars? pitwall.Car[] default pitwall.cars() but the ghosts, which drive from the green light
 ---@field map? pitwall.track.Map a track map to race on
 ---@field scan? boolean|pitwall.track.ScanOptions drive a scan lap with the first car (unless a map is known)
 ---@field drivers? pitwall.race.DriverSpec|pitwall.race.DriverSpec[]|table<pitwall.Car|string, pitwall.race.DriverSpec>|fun(car: pitwall.Car, i: integer): pitwall.race.DriverSpec default "cruiser"

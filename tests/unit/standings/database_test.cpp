@@ -275,8 +275,89 @@ TEST_CASE("standings: a schema version below zero, or a table removed, is a sent
   REQUIRE_FALSE(negative);
   CHECK(negative.error().find("has schema version -2147483648, which no pitwall writes") !=
         std::string::npos);
-  sqlOn(t.path, "PRAGMA user_version = 2; DROP TABLE laps");
+  sqlOn(t.path, "PRAGMA user_version = 3; DROP TABLE laps");
   auto dropped = Database::open(t.path);
   REQUIRE_FALSE(dropped);
   CHECK(dropped.error().find("but no table laps") != std::string::npos);
+}
+
+namespace {
+Entry traced(int number, std::string driver, double best) {
+  Entry e = entry(number, std::move(driver), number, true, best);
+  e.bestTrace = Entry::Trace{best, "{\"time\":" + std::to_string(best) + "}"};
+  return e;
+}
+}  // namespace
+
+TEST_CASE("standings: personal bests — each driver's best lap in each car on each layout") {
+  TempDb t;
+  auto db = Database::open(t.path);
+  REQUIRE(db);
+  auto event = (*db)->beginEvent({"race", "night", "oval", "{}"});
+  REQUIRE(event);
+  auto race = [&](int number, std::string layout, std::vector<Entry> entries) {
+    Race r{"race", number, "oval", 3, std::move(entries)};
+    r.layout = std::move(layout);
+    REQUIRE((*db)->addRace(*event, r));
+  };
+  race(1, "start S L L S L L", {traced(1, "ann", 3.5), traced(2, "bob", 3.2)});
+  auto best = (*db)->bestLap("start S L L S L L", "");
+  REQUIRE(best);
+  REQUIRE(*best);
+  CHECK((*best)->driver == "bob");
+  CHECK((*best)->lap == doctest::Approx(3.2));
+  CHECK((*best)->trace.find("3.2") != std::string::npos);
+  // a slower lap keeps the best; a faster one replaces it; one driver's is found by name or car
+  race(2, "start S L L S L L", {traced(1, "ann", 3.6), traced(2, "bob", 3.1)});
+  CHECK((*(*db)->bestLap("start S L L S L L", "ann"))->lap == doctest::Approx(3.5));
+  CHECK((*(*db)->bestLap("start S L L S L L", "car1"))->driver == "ann");
+  CHECK((*(*db)->bestLap("start S L L S L L", ""))->lap == doctest::Approx(3.1));
+  race(3, "start S L L S L L", {traced(1, "ann", 3.0)});
+  CHECK((*(*db)->bestLap("start S L L S L L", ""))->driver == "ann");
+  // another layout has bests of its own; an entry without a trace, or a race without a layout,
+  // keeps none
+  race(4, "start S S L L S S L L", {traced(1, "ann", 5.0), entry(2, "bob", 2, true, 1.0)});
+  CHECK((*(*db)->bestLap("start S S L L S S L L", ""))->lap == doctest::Approx(5.0));
+  CHECK_FALSE(*(*db)->bestLap("start S S L L S S L L", "bob"));
+  race(5, "", {traced(1, "ann", 0.5)});
+  CHECK((*(*db)->bestLap("start S L L S L L", ""))->lap == doctest::Approx(3.0));
+  CHECK_FALSE(*(*db)->bestLap("start", ""));
+}
+
+TEST_CASE("standings: a database of schema 2 gains the personal bests, keeping its rows") {
+  TempDb t;
+  {
+    auto db = Database::open(t.path);
+    REQUIRE(db);
+    auto event = (*db)->beginEvent({"race", "night", "oval", "{}"});
+    REQUIRE((*db)->addRace(*event, {"race", 1, "oval", 3, {entry(1, "ann", 1, true, 3.0)}}));
+  }
+  sqlOn(t.path, "DROP TABLE best_laps; PRAGMA user_version = 2");
+  auto db = Database::open(t.path);
+  REQUIRE(db);
+  CHECK((*db)->versionFound() == 2);
+  CHECK((*db)->table({})->size() == 1);
+  auto best = (*db)->bestLap("start S L L S L L", "");
+  REQUIRE(best);
+  CHECK_FALSE(*best);
+}
+
+TEST_CASE(
+    "standings: a race's best-lap trace survives the unsaved file's JSON, and a bad one is "
+    "a sentence") {
+  Race r{"race", 1, "oval", 3, {entry(1, "ann", 1, true, 3.0)}};
+  r.layout = "start S L L S L L";
+  r.entries[0].bestTrace = Entry::Trace{
+      3.0, R"({"lap":2,"time":3,"length":100,"points":[[0,0,null,null],[3,100,400,0]]})"};
+  auto back = raceFromJson(toJson(r));
+  REQUIRE(back);
+  CHECK(back->layout == r.layout);
+  REQUIRE(back->entries[0].bestTrace);
+  CHECK(back->entries[0].bestTrace->time == doctest::Approx(3.0));
+  auto j = toJson(r);
+  j["entries"][0]["bestTrace"]["points"] = {{0, 0, nullptr, nullptr}, {3, -5, 0, 0}};
+  auto bad = raceFromJson(j);
+  REQUIRE_FALSE(bad);
+  CHECK(bad.error().find("race.entries[1].bestTrace: a kept lap's points go back") !=
+        std::string::npos);
 }

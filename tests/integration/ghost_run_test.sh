@@ -1,0 +1,94 @@
+# Racing a ghost (docs/racing.md "Racing a ghost", "Personal bests"): `pitwall run --ghost
+# FILE[:CAR[:LAP]]` puts a ghost of that lap beside the cars; the race library leaves it out of
+# the race, starts it at the green light and stops it at the end; it laps in the recorded time
+# within a tick (5 ms). Every race kept in the standings keeps each driver's best lap as a trace,
+# and `--ghost best[:NAME]` races it. What cannot be a ghost is a sentence, before any car moves
+# and before the record is touched.
+source "$(dirname "$0")/lib.sh"
+cd "$TMP" || exit 2
+export PITWALL_DB="$TMP/st.db"
+
+$PITWALL run "$SRC/tests/integration/compare_drive.lua" --fast --no-db --record even.jsonl -q ||
+  fail "the lap's record"
+best=$($PITWALL compare even.jsonl even.jsonl --json | python3 -c 'import json,sys; print(json.load(sys.stdin)["laps"][0]["time"])')
+echo "the recorded best lap: $best s"
+
+# ghost_laps RECORD TIME: every lap the ghost drove in RECORD, counted by the replay from its own
+# frames, took TIME within 5 ms
+ghost_laps() {
+  $PITWALL replay "$1" --json > laps.json 2> /dev/null
+  python3 - laps.json "$2" <<'PY'
+import json, sys
+rows = [json.loads(l) for l in open(sys.argv[1])]
+want = float(sys.argv[2])
+ghost = next(r for r in rows if r["name"] == "ghost")
+times = ghost["lapTimes"]
+print("ghost laps:", times, "want:", want)
+assert len(times) >= 3, times
+assert all(abs(t - want) <= 0.005 for t in times), times
+PY
+}
+
+cp "$SRC/tests/integration/ghost_run.lua" race.lua
+GHOST_LAPS=6 $PITWALL run race.lua --fast --cars 2 --ghost even.jsonl --record raced.jsonl --results res.json \
+  > out.txt 2> err.txt
+check "a race with --ghost: exit status" 0 $?
+contains "the lap it drives is said" "ghost drives even.jsonl car 1 (groundshock) lap" "$(cat err.txt)"
+contains "the ghost is no entry, stands until the green light and after the race" \
+  "entries:	2	ghost moved before green:	false" "$(cat out.txt)"
+contains "the ghost stands after the race" "ghost speed after:	0" "$(cat out.txt)"
+check "the results have the two cars only" "groundshock skull" \
+  "$(python3 -c 'import json; print(" ".join(sorted(e["car"] for e in json.load(open("res.json")))))' 2>&1)"
+ghost_laps raced.jsonl "$best" && echo "ok: every ghost lap in the recorded time within 5 ms" ||
+  fail "the ghost's lap times"
+
+# Personal bests: each entry's best whole lap, kept as a trace; none of the ghost
+python3 - "$PITWALL_DB" > bests.txt <<'PY'
+import json, sqlite3, sys
+db = sqlite3.connect(sys.argv[1])
+for driver, car, lap, trace in db.execute("SELECT driver, car, lap, trace FROM best_laps ORDER BY car"):
+    t = json.loads(trace)
+    assert abs(t["time"] - lap) < 1e-9 and t["points"][-1][0] == t["time"], (lap, t["time"])
+    print(driver, car, "%.3f" % lap, len(t["points"]) > 2)
+PY
+check "the standings keep both cars' best laps as traces" 2 "$(wc -l < bests.txt)"
+contains "groundshock's best lap is kept" "groundshock groundshock" "$(cat bests.txt)"
+pb=$(awk '$2 == "skull" { print $3 }' bests.txt)
+best_of=$(python3 -c 'import json; print(min(e["bestLap"] for e in json.load(open("res.json")) if e["car"] == "skull"))')
+python3 -c "import sys; sys.exit(abs($pb - $best_of) > 0.005)" && echo "ok: skull's kept best is its race's best lap ($pb, $best_of)" ||
+  fail "skull's kept best $pb is not its race's best lap $best_of"
+
+# --ghost best:skull races the kept lap again
+$PITWALL run race.lua --fast --cars 2 --ghost best:skull --record pb.jsonl > out2.txt 2> err2.txt
+check "--ghost best:skull: exit status" 0 $?
+contains "the personal best is named" "ghost drives skull's personal best in skull" "$(cat err2.txt)"
+ghost_laps pb.jsonl "$pb" && echo "ok: the personal best's ghost laps in its time within 5 ms" ||
+  fail "the personal best's ghost lap times"
+
+# What cannot be a ghost: a sentence, exit status 2, no car moved, an old record untouched
+echo '{"old": "record"}' > old.jsonl
+cp old.jsonl old.copy
+refused() {  # refused NAME EXPECTED ARGS…
+  local name=$1 want=$2
+  shift 2
+  $PITWALL run race.lua --fast --cars 2 --record old.jsonl "$@" > /dev/null 2> bad.err
+  check "$name: exit status" 2 $?
+  contains "$name: the sentence" "$want" "$(cat bad.err)"
+  cmp -s old.jsonl old.copy && echo "ok: $name: the old record is untouched" ||
+    fail "$name: the old record was touched"
+  if grep -q "connected" bad.err; then fail "$name: a car was connected"; fi
+}
+refused "a missing record" "--ghost cannot read nope.jsonl: no such file" --ghost nope.jsonl
+refused "a lap the record lacks" "has no lap 99" --ghost even.jsonl:1:99
+refused "another track" "a ghost drives the track it was on" --ghost even.jsonl --track kidney
+refused "no standings" "--ghost best races a personal best the standings keep, and this run keeps none" \
+  --ghost best --no-db
+refused "no one of that name" "keeps no personal best of nobody on this track" --ghost best:nobody
+refused "no best on this track" "keeps no personal best on this track (start" --ghost best --track kidney
+python3 -c "
+import sqlite3; db = sqlite3.connect('$PITWALL_DB')
+db.execute(\"UPDATE best_laps SET trace = '{\\\"lap\\\": 1, \\\"time\\\": 1, \\\"length\\\": 5, \\\"points\\\": [[0,0,null,null],[2,1,null,null]]}'\"); db.commit()"
+refused "a damaged best" "keeps skull's personal best in skull" --ghost best:skull
+contains "a damaged best: what is wrong" "damaged (a kept lap does not run from the line round to the line)" "$(cat bad.err)"
+
+exit $((FAILURES > 0))
