@@ -8,34 +8,42 @@
 
 namespace pitwall::cli {
 
-namespace {
-
-Result<view::Ghost, std::string> personalBest(const std::string& who, const sim::Track& track,
-                                              standings::Database* db) {
-  const std::string whose = who.empty() ? "" : " of " + printable(who, 80);
-  if (!db)
-    return Unexpected{std::string(
-        "--ghost best races a personal best the standings keep, and this run keeps none "
-        "(--no-db, or no $HOME): give --db FILE, or a record: --ghost FILE[:CAR[:LAP]]")};
-  const std::string layout = sim::layoutText(track);
-  auto kept = db->bestLap(layout, who);
+Result<std::optional<KeptBest>, std::string> keptBest(standings::Database& db,
+                                                      const sim::Track& track,
+                                                      const std::string& who) {
+  auto kept = db.bestLap(sim::layoutText(track), who);
   if (!kept) return Unexpected{kept.error()};
-  if (!*kept)
-    return Unexpected{db->path() + " keeps no personal best" + whose + " on this track (" +
-                      printable(layout, 80) +
-                      "): race it once with the standings on, or give a record: --ghost "
-                      "FILE[:CAR[:LAP]]"};
+  if (!*kept) return std::optional<KeptBest>();
   const standings::KeptLap& k = **kept;
   const std::string label =
       printable(k.driver, 80) + "'s personal best in " + printable(k.car, 80) + " (" + k.when + ")";
   auto trace = laps::traceFromJson(nlohmann::json::parse(k.trace, nullptr, false));
   if (!trace)
-    return Unexpected{db->path() + " keeps " + label + " damaged (" + trace.error() +
+    return Unexpected{db.path() + " keeps " + label + " damaged (" + trace.error() +
                       "): race the track again to keep a new one, or give a record"};
   if (std::abs(trace->length - laps::LapMap(track).lap) > 1)
-    return Unexpected{db->path() + " keeps " + label +
+    return Unexpected{db.path() + " keeps " + label +
                       " for a lap of another length than this track's: race the track again"};
-  return view::ghostOf(*trace, label, track, {});
+  return std::optional<KeptBest>(KeptBest{std::move(*trace), label});
+}
+
+namespace {
+
+Result<view::Ghost, std::string> personalBest(const std::string& who, const sim::Track& track,
+                                              standings::Database* db) {
+  if (!db)
+    return Unexpected{std::string(
+        "--ghost best races a personal best the standings keep, and this run keeps none "
+        "(--no-db, or no $HOME): give --db FILE, or a record: --ghost FILE[:CAR[:LAP]]")};
+  auto kept = keptBest(*db, track, who);
+  if (!kept) return Unexpected{kept.error()};
+  if (!*kept)
+    return Unexpected{db->path() + " keeps no personal best" +
+                      (who.empty() ? "" : " of " + printable(who, 80)) + " on this track (" +
+                      printable(sim::layoutText(track), 80) +
+                      "): race it once with the standings on, or give a record: --ghost "
+                      "FILE[:CAR[:LAP]]"};
+  return view::ghostOf((*kept)->lap, (*kept)->label, track, {});
 }
 
 }  // namespace

@@ -236,6 +236,14 @@ int run(const RunOptions& given) {
   // standings keeps each entry's best lap as a ghost can drive it again.
   view::Feed* traced = keeper ? &session.startFeed(options.ble ? "ble" : "simulator") : nullptr;
   std::map<int, double> tracedUpTo;  // car number → the time up to which its laps were kept
+  // ...and the track's personal best, the view's reference lap until the session beats it
+  if (traced && host.view && traced->track()) {
+    auto kept = keptBest(keeper->database(), *traced->track(), "");
+    if (!kept)
+      log::warn("pitwall", kept.error());
+    else if (*kept)
+      traced->setPersonalBest(std::move((*kept)->lap), (*kept)->label);
+  }
   host.seats = session.seats();
   host.driverFiles = files;
   host.driverLimits.memory = static_cast<std::size_t>(options.limits.driverMemory) << 20;

@@ -180,6 +180,9 @@ void Feed::setTrack(std::optional<sim::Track> track, const std::string& source) 
   trackSource_ = track_ ? source : "none";
   ghost_.reset();  // laps of another track are no reference
   best_.reset();
+  personal_.reset();
+  lapMap_.reset();
+  if (track_) lapMap_.emplace(*track_);
   ++trackVersion_;
   ++changes_;
   for (auto& [number, c] : cars_) {
@@ -315,7 +318,7 @@ nlohmann::json Feed::carJson(const AnkiCar& ankiCar, std::size_t laps) const {
     j["positionTime"] = round3(t.positionTime());
     j["at"] = round3(at);
     // the live delta to the reference lap, at the distance the car has come this lap
-    const Reference* ref = ghost_ ? &*ghost_ : best_ ? &*best_ : nullptr;
+    const Reference* ref = reference();
     const laps::LapTrace* lap = c->traces.current();
     if (ref && lap && !c->ghost) {
       if (auto d = c->traces.distanceNow(t, at, s.speed_mm_s, s.offset_mm, s.reverse)) {
@@ -325,6 +328,70 @@ nlohmann::json Feed::carJson(const AnkiCar& ankiCar, std::size_t laps) const {
     }
   }
   return j;
+}
+
+void Feed::setPersonalBest(laps::LapTrace lap, std::string label) {
+  personal_ = Reference{std::move(lap), std::move(label)};
+  ++changes_;
+}
+
+const Feed::Reference* Feed::reference() const {
+  if (ghost_) return &*ghost_;
+  if (best_ && personal_) return personal_->lap.time < best_->lap.time ? &*personal_ : &*best_;
+  return best_ ? &*best_ : personal_ ? &*personal_ : nullptr;
+}
+
+// The reference lap as a ghost the page draws: it starts at the line when the leading car (the
+// most laps; of two, the one that crossed first) last crossed it, and waits there when its lap
+// is done before the car's. None while a simulated ghost races (it is drawn already), before
+// the leader's first crossing, or with no reference or no track.
+nlohmann::json Feed::viewGhostJson() const {
+  const Reference* ref = reference();
+  if (!ref || !track_ || !lapMap_ || lapMap_->n == 0) return nullptr;
+  const Car* leader = nullptr;
+  int leaderNumber = 0;
+  for (const auto& [number, c] : cars_) {
+    if (c->ghost) return nullptr;
+    const laps::LapTrace* lap = c->traces.current();
+    if (!lap) continue;
+    const laps::LapTrace* best = leader ? leader->traces.current() : nullptr;
+    if (!leader || c->tracker.laps() > leader->tracker.laps() ||
+        (c->tracker.laps() == leader->tracker.laps() && lap->start < best->start)) {
+      leader = c.get();
+      leaderNumber = number;
+    }
+  }
+  if (!leader) return nullptr;
+  const laps::LapTrace& lap = ref->lap;
+  const double at = now();
+  const double t = std::clamp(at - leader->traces.current()->start, 0.0, lap.time);
+  const double d = std::clamp(lap.distanceAt(t), 0.0, lapMap_->lap);
+  std::size_t k = 0;
+  while (k + 1 < lapMap_->n && d >= lapMap_->start[k + 1]) ++k;
+  const double fraction = lapMap_->length[k] > 0
+                              ? std::clamp((d - lapMap_->start[k]) / lapMap_->length[k], 0.0, 1.0)
+                              : 0.0;
+  const double offset = lap.offsetOn(k, *lapMap_);
+  const std::size_t index = lapMap_->trackIndex(k);
+  // its speed along the lap here (the page moves it on between updates, as it moves the cars)
+  constexpr double kAround = 0.05;
+  const double speed = t >= lap.time
+                           ? 0.0
+                           : (lap.distanceAt(std::min(lap.time, t + kAround)) -
+                              lap.distanceAt(std::max(0.0, t - kAround))) /
+                                 (std::min(lap.time, t + kAround) - std::max(0.0, t - kAround));
+  Pose p = pointOnTrack(*track_, index, fraction, offset);
+  return {{"label", ref->label},
+          {"follows", leaderNumber},
+          {"t", round3(t)},
+          {"pieceIndex", index},
+          {"fraction", round3(fraction)},
+          {"offset", round3(offset)},
+          {"speed", round3(speed)},
+          {"x", round3(p.x)},
+          {"y", round3(p.y)},
+          {"heading", round3(p.heading)},
+          {"at", round3(at)}};
 }
 
 nlohmann::json Feed::carsJson(bool history) const {
@@ -380,6 +447,7 @@ nlohmann::json Feed::state() const {
           {"replay", replay_.is_null() ? nlohmann::json(nullptr) : replay_},
           {"cars", carsJson(true)},
           {"seats", seatsJson()},
+          {"viewGhost", viewGhostJson()},
           {"events", std::move(events)}};
 }
 
@@ -396,7 +464,8 @@ std::string Feed::updateText(std::uint64_t& cursor, std::uint64_t& trackSeen) co
         R"("cars":)" + carsJson(false).dump(-1, ' ', false, kReplace) + R"(,"race":)" + raceText_ +
         R"(,"replay":)" +
         (replay_.is_null() ? nlohmann::json(nullptr) : replay_).dump(-1, ' ', false, kReplace) +
-        R"(,"seats":)" + seatsJson().dump(-1, ' ', false, kReplace);
+        R"(,"seats":)" + seatsJson().dump(-1, ' ', false, kReplace) + R"(,"viewGhost":)" +
+        viewGhostJson().dump(-1, ' ', false, kReplace);
     sharedAt_ = changes_;
   }
   std::string text = R"({"type":"update","time":)" + nlohmann::json(round3(now())).dump() + "," +

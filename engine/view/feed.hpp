@@ -96,6 +96,13 @@ class Feed {
   static constexpr std::size_t kLapsKept = 200;
   // Every car the feed follows: its number and name, by number.
   std::vector<std::pair<int, std::string>> tracedCars() const;
+  // A personal best the standings keep for this track (docs/view.md "Ghosts and deltas"): the
+  // reference of the live deltas and the view's ghost until the session drives a faster lap. A
+  // new track forgets it.
+  void setPersonalBest(laps::LapTrace lap, std::string label);
+  // The view's ghost ("viewGhost" of the state; null: none): the reference lap driven from the
+  // leading car's last line crossing — drawn beside the cars when no simulated ghost races.
+  nlohmann::json viewGhostJson() const;
 
  private:
   struct Car;
@@ -130,8 +137,11 @@ class Feed {
     laps::LapTrace lap;
     std::string label;
   };
-  std::optional<Reference> ghost_, best_;  // the ghost's last lap; the session's best lap
-  const AnkiCar* lastAnki_ = nullptr;  // the car of the last car() and its Car: one lookup fewer
+  // the ghost's last lap; the session's best lap; the standings' personal best on this track
+  std::optional<Reference> ghost_, best_, personal_;
+  const Reference* reference() const;   // of the deltas: the ghost's lap, else the fastest
+  std::optional<laps::LapMap> lapMap_;  // of track_
+  const AnkiCar* lastAnki_ = nullptr;   // the car of the last car() and its Car: one lookup fewer
   int lastNumber_ = 0;
   Car* lastCar_ = nullptr;
   Subscription framesSub_, connectionSub_;  // the fleet's events, while the feed lives

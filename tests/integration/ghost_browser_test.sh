@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # The ghost in the race view, in headless Chromium (docs/view.md "Ghosts and deltas",
 # tests/view/ghost_check.mjs): a record's lap driven again by sim.addGhost beside car 1, drawn
-# translucent and moving, car 1's live delta to it on the leaderboard. Screenshot
-# ./view_test_artifacts/ghost.png.
+# translucent and moving, car 1's live delta to it on the leaderboard; then, with no simulated
+# ghost, the view's own ghost of the track's personal best from the standings
+# (tests/view/view_ghost_check.mjs). Screenshots ./view_test_artifacts/ghost*.png.
 source "$(dirname "$0")/lib.sh"
 source "$(dirname "$0")/browser_lib.sh"
 
-install_checks ghost_browser_check ghost_check.mjs
+install_checks ghost_browser_check ghost_check.mjs view_ghost_check.mjs
 artifacts 'ghost*.png'
 
 cd "$TMP" || exit 2
@@ -23,4 +24,25 @@ if await_view "$TMP/err"; then
   grep -q '^FAIL' "$TMP/check" && fail "a check in the browser failed"
 fi
 show_if_failed "pitwall's stderr" "$TMP/err"
+kill "$pid" 2>/dev/null
+wait "$pid" 2>/dev/null
+
+# The view's own ghost: a race kept in the standings leaves the track's personal best (car 1 at
+# the cruiser's pace); car 1 alone at 600 mm/s races against it
+export PITWALL_DB="$TMP/st.db"
+LAPS=2 "$PITWALL" run "$SRC/examples/time_trial.lua" --fast --cars 1 -q > /dev/null 2>&1 ||
+  fail "the race that keeps a personal best"
+"$PITWALL" run "$SRC/tests/view/pb_drive.lua" --cars 1 --view 127.0.0.1:0 > "$TMP/out2" 2> "$TMP/err2" &
+pid=$!
+if await_view "$TMP/err2"; then
+  timeout -k 5 120 node "$CHECK/view_ghost_check.mjs" "$url" "$ART/ghost-view.png" --timeout 40 \
+    --chromium "$CHROMIUM" > "$TMP/check2" 2>&1
+  status=$?
+  cat "$TMP/check2"
+  check "the view's ghost check: exit status" 0 "$status"
+  grep -q '^FAIL' "$TMP/check2" && fail "a check of the view's ghost in the browser failed"
+fi
+show_if_failed "pitwall's stderr" "$TMP/err2"
+kill "$pid" 2>/dev/null
+wait "$pid" 2>/dev/null
 exit $((FAILURES > 0))

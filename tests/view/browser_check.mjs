@@ -46,7 +46,7 @@ async function watchRaceStart(page, n, screenshot) {
       if (p === "lights" && o.lightsAt == null) o.lightsAt = now;
       if (p === "racing" && o.racingAt == null) o.racingAt = now;
       if (["scan", "grid", "lights"].includes(p) && document.querySelector("#track svg path.road")) {
-        const shown = [...document.querySelectorAll("#track g.car-marker")].filter((g) =>
+        const shown = [...document.querySelectorAll("#track g.car-marker:not([data-number=view-ghost])")].filter((g) =>
           g.dataset.x != null && !g.classList.contains("unseen") && !g.classList.contains("off-track"));
         const rows = [...document.querySelectorAll("#leaderboard tbody tr")];
         const warned = rows.filter((tr) => tr.classList.contains("off-track")).length;
@@ -145,8 +145,8 @@ try {
   const n = opts.cars;
   if (n != null) {
     if (await waitFor(page, `${n} car markers`,
-        (k) => document.querySelectorAll("#track g.car-marker").length === k, n)) {
-      const names = await page.$$eval("#track g.car-marker", (gs) =>
+        (k) => document.querySelectorAll("#track g.car-marker:not([data-number=view-ghost])").length === k, n)) {
+      const names = await page.$$eval("#track g.car-marker:not([data-number=view-ghost])", (gs) =>
         gs.map((g) => `${g.dataset.number}:${g.querySelector("text.car-name")?.textContent ?? ""}`));
       pass(`${n} car markers`, names.join(", "));
       const unnamed = names.filter((s) => s.split(":")[1].trim() === "");
@@ -158,10 +158,10 @@ try {
 
   // Movement: the first position seen of each marker, then until one moved by > 10 mm.
   await passWhen(page, "a marker is placed on the track",
-      () => [...document.querySelectorAll("#track g.car-marker")].some((g) => g.dataset.x != null && !g.classList.contains("off-track")));
+      () => [...document.querySelectorAll("#track g.car-marker:not([data-number=view-ghost])")].some((g) => g.dataset.x != null && !g.classList.contains("off-track")));
   await page.evaluate(() => { window.__start = {}; });
   if (await waitFor(page, "markers move (> 10 mm)", () => {
-    for (const g of document.querySelectorAll("#track g.car-marker")) {
+    for (const g of document.querySelectorAll("#track g.car-marker:not([data-number=view-ghost])")) {
       if (g.dataset.x == null) continue;
       const p = [Number(g.dataset.x), Number(g.dataset.y)];
       const s = (window.__start[g.dataset.number] ??= p);
@@ -169,7 +169,7 @@ try {
     }
     return false;
   })) {
-    const moved = await page.evaluate(() => [...document.querySelectorAll("#track g.car-marker")]
+    const moved = await page.evaluate(() => [...document.querySelectorAll("#track g.car-marker:not([data-number=view-ghost])")]
       .map((g) => { const s = window.__start[g.dataset.number]; return s ? `${g.dataset.number}: ${Math.round(Math.hypot(g.dataset.x - s[0], g.dataset.y - s[1]))} mm` : null; })
       .filter(Boolean).join(", "));
     pass("markers move (> 10 mm)", moved);
@@ -216,7 +216,7 @@ try {
           await passWhen(page, "live again after the engine restarted",
               () => document.querySelector("#connection")?.textContent === "live");
           if (opts.cars != null && await waitFor(page, "the cars back",
-              (k) => document.querySelectorAll("#track g.car-marker").length === k &&
+              (k) => document.querySelectorAll("#track g.car-marker:not([data-number=view-ghost])").length === k &&
                 document.querySelectorAll("#leaderboard tbody tr").length === k, opts.cars))
             pass("the cars back", `${opts.cars} markers and rows`);
         } finally {

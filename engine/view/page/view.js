@@ -13,9 +13,12 @@
 //                                   when the car is not connected
 //   #leaderboard tbody tr           one per car (race.rows when a race runs, else the cars)
 //   #leaderboard td.delta           the live delta to the reference lap (the ghost's, else the
-//                                   session's best): "+0.123" behind, "-0.045" ahead; its
+//                                   session's best or the track's personal best): "+0.123" behind, "-0.045" ahead; its
 //                                   title names the lap; `data-delta` the number
 //   g.car-marker.ghost              a ghost (sim.addGhost): drawn translucent
+//   g.car-marker[data-number="view-ghost"]  the view's ghost (state.viewGhost): the reference
+//                                   lap driven from the leader's last crossing; its title
+//                                   names the lap (`data-follows`: the leader's number)
 //   #compare-open, #lap-compare     "Compare laps…" and its dialog: #lap-a, #lap-b (options
 //                                   "CAR:LAP"), #lap-compare-go; the answer in
 //                                   #lap-compare-result (table.sections and svg.compare) and
@@ -271,12 +274,29 @@ function engineNow() {
   return view.time + ((performance.now() - view.receivedAt) / 1000) * rate;
 }
 
+// The view's ghost (docs/view.md "Ghosts and deltas") as a car the markers draw: the feed says
+// where it is and how fast it goes there, and the page moves it on between updates as it moves
+// the cars.
+function viewGhostCar() {
+  const g = view.viewGhost;
+  if (!g) return null;
+  return { number: "view-ghost", name: "ghost", color: "#888888", ghost: true, connected: true,
+    onTrack: true, x: g.x, y: g.y, heading: g.heading, pieceIndex: g.pieceIndex,
+    fraction: g.fraction, offset: g.offset, speed: g.speed, at: g.at, positionTime: g.at,
+    label: g.label, follows: g.follows };
+}
+
+function drawnCars() {
+  const ghost = viewGhostCar();
+  return ghost ? [...view.cars.values(), ghost] : [...view.cars.values()];
+}
+
 let lastFrame = performance.now();
 function frame(ts) {
   const dt = Math.min(0.1, Math.max(0, (ts - lastFrame) / 1000));
   lastFrame = ts;
   const now = engineNow();
-  for (const car of view.cars.values()) {
+  for (const car of drawnCars()) {
     if (!carLayer) break;
     const m = markerFor(car);
     const target = targetOf(car, now);
@@ -344,13 +364,26 @@ function placeLabels() {
 }
 
 function syncMarkers() {
+  const ghost = viewGhostCar();
   for (const [num, m] of view.markers) {
-    if (!view.cars.has(num)) { m.g.remove(); view.markers.delete(num); }
+    if (!view.cars.has(num) && !(ghost && num === ghost.number)) {
+      m.g.remove(); view.markers.delete(num);
+    }
   }
   for (const car of view.cars.values()) {
     const m = markerFor(car);
     m.g.style.setProperty("--car", car.color || "#888");
     m.g.querySelector("text.car-name").textContent = car.name || `car ${car.number}`;
+  }
+  if (ghost) {
+    const m = markerFor(ghost);
+    m.g.style.setProperty("--car", ghost.color);
+    m.g.querySelector("text.car-number").textContent = "";
+    m.g.querySelector("text.car-name").textContent = "ghost";
+    m.g.dataset.follows = ghost.follows;
+    let title = m.g.querySelector("title");
+    if (!title) title = svgEl("title", {}, m.g);
+    if (title.textContent !== ghost.label) title.textContent = ghost.label;
   }
   const why = (c) => (c.connected === false ? "disconnected" : c.delocalized ? "delocalized"
     : c.onTrack === false ? "off the track" : c.x == null && !waiting(c) ? "no position yet" : "");
@@ -667,6 +700,7 @@ function onState(s) {
   view.cars = new Map((s.cars || []).map((c) => [c.number, c]));
   view.race = s.race || null;
   view.replay = s.replay || null;
+  view.viewGhost = s.viewGhost || null;
   showDriveLink(s.seats);
   view.source = s.source || "";
   view.time = s.time || 0;
@@ -703,6 +737,7 @@ function onUpdate(u) {
   }
   if (u.race !== undefined) view.race = u.race;
   if (u.replay !== undefined) view.replay = u.replay;
+  if (u.viewGhost !== undefined) view.viewGhost = u.viewGhost;
   if (u.seats !== undefined) showDriveLink(u.seats);
   syncMarkers();
   renderRace();

@@ -242,3 +242,56 @@ TEST_CASE(
   r.feed->settle();
   CHECK(r.feed->state()["cars"][0]["speed"].get<int>() > 400);
 }
+
+TEST_CASE("view feed: the view's ghost drives the personal best from the leader's crossing") {
+  Race r;
+  AnkiCar& car = r.driving(700, 2000);
+  const laps::LapMap map(r.world.track());
+  // a personal best at 1000 mm/s all the way round, in the inside lane
+  laps::LapTrace best;
+  best.lap = 1;
+  best.time = map.lap / 1000;
+  best.length = map.lap;
+  best.points = {{0, 0, 1000, -68}, {best.time, map.lap, 1000, -68}};
+  r.feed->setPersonalBest(best, "ann's personal best in skull");
+  CHECK(r.feed->state()["viewGhost"].is_null());  // no crossing yet: nothing to start from
+  double t0 = -1;
+  for (int step = 0; step < 400 && t0 < 0; ++step) {
+    r.run(0.05);
+    auto g = r.feed->state()["viewGhost"];
+    if (!g.is_null()) t0 = r.loop.seconds() - g["t"].get<double>();
+  }
+  REQUIRE(t0 >= 0);
+  auto lastCrossing = r.feed->tracker(car.identity().number)->lastCrossing();
+  REQUIRE(lastCrossing);
+  CHECK(t0 == doctest::Approx(*lastCrossing).epsilon(0.001));
+  // 1 s into the lap it is 1000 mm along it, where the geometry puts that point of the lap
+  r.run(1.0 - (r.loop.seconds() - t0));
+  auto s = r.feed->state();
+  auto g = s["viewGhost"];
+  REQUIRE_FALSE(g.is_null());
+  CHECK(g["follows"] == car.identity().number);
+  CHECK(g["label"] == "ann's personal best in skull");
+  const double d = g["t"].get<double>() * 1000;
+  std::size_t k = 0;
+  while (k + 1 < map.n && d >= map.start[k + 1]) ++k;
+  CHECK(g["pieceIndex"] == map.trackIndex(k));
+  CHECK(g["fraction"].get<double>() ==
+        doctest::Approx((d - map.start[k]) / map.length[k]).epsilon(0.01));
+  CHECK(g["offset"] == -68);
+  CHECK(g["speed"].get<double>() == doctest::Approx(1000).epsilon(0.01));
+  auto pose = view::pointOnTrack(r.world.track(), g["pieceIndex"], g["fraction"], -68);
+  CHECK(g["x"].get<double>() == doctest::Approx(pose.x).epsilon(0.01));
+  // car 1 at 700 mm/s is behind it, against it by name
+  CHECK(s["cars"][0]["deltaTo"] == "ann's personal best in skull");
+  CHECK(s["cars"][0]["delta"].get<double>() > 0.2);
+  // its lap done before the car's, it waits at the line
+  r.run(best.time);
+  g = r.feed->state()["viewGhost"];
+  REQUIRE(r.feed->tracker(car.identity().number)->lastCrossing() == lastCrossing);  // (5.7 s a lap)
+  CHECK(g["t"].get<double>() == doctest::Approx(best.time).epsilon(0.001));
+  CHECK(g["speed"] == 0);
+  // a new track forgets it
+  r.feed->setTrack(r.world.track(), "layout");
+  CHECK(r.feed->state()["viewGhost"].is_null());
+}
