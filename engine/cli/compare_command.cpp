@@ -10,6 +10,7 @@
 
 #include "engine/cli/fail.hpp"
 #include "engine/cli/options.hpp"
+#include "engine/cli/print_module.hpp"
 #include "engine/cli/record_source.hpp"
 #include "engine/core/printable.hpp"
 #include "engine/laps/compare_report.hpp"
@@ -50,10 +51,10 @@ int compare(const CompareOptions& options) {
   if (options.laps.size() < 2) return fail("compare", "give two laps or more: A.jsonl B.jsonl …");
   if (!options.out.empty()) {
     const auto ext = std::filesystem::path(options.out).extension().string();
-    if (ext != ".svg" && ext != ".html")
+    if (ext != ".svg" && ext != ".html" && ext != ".png")
       return fail("compare", "--out " + options.out +
-                                 ": the charts are written as .svg or .html (a page with the "
-                                 "table); give a name ending in one of them");
+                                 ": the charts are written as .svg, .png or .html (a page with "
+                                 "the table); give a name ending in one of them");
   }
   std::vector<std::pair<std::string, view::LapAsk>> asks;
   for (const auto& spec : options.laps) {
@@ -95,9 +96,13 @@ int compare(const CompareOptions& options) {
     std::cout << laps::reportText(report);
   std::cout.flush();
   if (!options.out.empty()) {
-    const bool svg = std::filesystem::path(options.out).extension() == ".svg";
+    const auto ext = std::filesystem::path(options.out).extension();
+    if (ext == ".png")  // (drawn by the print module's librsvg: loaded for this only)
+      return runPrintModule(
+          "compare", print::PngRequest{"compare", laps::reportSvg(report), options.out, 2.0});
     auto written = results::writeText(
-        options.out, svg ? laps::reportSvg(report) : laps::reportHtml(report), "the comparison");
+        options.out, ext == ".svg" ? laps::reportSvg(report) : laps::reportHtml(report),
+        "the comparison");
     if (!written) return fail("compare", written.error(), 1);
   }
   return 0;
@@ -118,7 +123,8 @@ Command addCompareCommand(CLI::App& app) {
                   "reference")
       ->required();
   cmd->add_option("--out", options->out,
-                  "Also write the charts: FILE.svg, or FILE.html (a page with the table)");
+                  "Also write the charts: FILE.svg, FILE.png, or FILE.html (a page with the "
+                  "table)");
   cmd->add_flag("--json", options->json, "The comparison as one JSON object instead of the table");
   cmd->add_option("--track", options->track,
                   "The layout the cars drove, a name or a file (default: the record's own)");

@@ -58,7 +58,7 @@ void* entry(const char* command, const char* symbol) {
     why = path.string() + " has no " + symbol;
   }
   const bool fromEnv = std::getenv("PITWALL_PRINT_MODULE") && *std::getenv("PITWALL_PRINT_MODULE");
-  std::cerr << "pitwall track " << command << ": the print module cannot be loaded ("
+  std::cerr << "pitwall " << command << ": the print module cannot be loaded ("
             << (why.empty() ? "looked for " + tried : why) << "); "
             << (fromEnv ? "set $PITWALL_PRINT_MODULE to the pitwall_print.so of this build, or "
                           "unset it"
@@ -82,6 +82,10 @@ int runPrintModule(const char* command, const print::PrintRequest& request) {
 
 int runPrintModule(const char* command, const print::VerifyRequest& request) {
   return run(command, "pitwall_verify_piece", request);
+}
+
+int runPrintModule(const char* command, const print::PngRequest& request) {
+  return run(command, "pitwall_svg_png", request);
 }
 
 }  // namespace pitwall::cli

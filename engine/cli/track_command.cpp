@@ -103,11 +103,11 @@ int trackList() {
 }
 
 int trackPrint(const TrackPrintOptions& options) {
-  return runPrintModule("print", options);
+  return runPrintModule("track print", options);
 }
 
 int trackVerify(const TrackVerifyOptions& options) {
-  return runPrintModule("verify", options);
+  return runPrintModule("track verify", options);
 }
 
 Command addTrackCommand(CLI::App& app) {

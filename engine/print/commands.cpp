@@ -164,4 +164,8 @@ __attribute__((visibility("default"))) int pitwall_verify_piece(
     const pitwall::print::VerifyRequest* request) {
   return pitwall::print::verifyPiece(*request);
 }
+__attribute__((visibility("default"))) int pitwall_svg_png(
+    const pitwall::print::PngRequest* request) {
+  return pitwall::print::svgToPng(*request);
+}
 }

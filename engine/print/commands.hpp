@@ -1,5 +1,6 @@
 #pragma once
-// `pitwall track print` and `pitwall track verify` as the print module runs them (docs/cli.md):
+// `pitwall track print`, `pitwall track verify` and `compare --out FILE.png` as the print module
+// runs them (docs/cli.md):
 // what the command line asks, and the runs, which write to stdout/stderr and return the exit
 // status. The module (pitwall_print.so) holds cairo and librsvg, which cost about 10 MB of memory
 // once loaded; the command line loads it only for these two commands (engine/cli/print_module.cpp),
@@ -37,11 +38,21 @@ struct VerifyRequest {
 };
 int verifyPiece(const VerifyRequest& request);
 
+// An SVG this program drew (`pitwall compare --out FILE.png`: docs/racing.md "Comparing laps")
+// as a PNG at `scale` × its size, on white; 0 written, 1 (a sentence on stderr) not.
+struct PngRequest {
+  std::string command;  // for sentences: "compare"
+  std::string svg;
+  std::string out;
+  double scale = 2;
+};
+int svgToPng(const PngRequest& request);
+
 // The requests' layout, checked before a loaded module is used: a module from another build of
 // pitwall, with other requests, is refused, never called. A version counted by hand (raise it
 // when a field changes) and the structs' sizes.
-inline constexpr unsigned long kRequestAbi =
-    2'000'000'000UL + sizeof(PrintRequest) * 10'000 + sizeof(VerifyRequest);
+inline constexpr unsigned long kRequestAbi = 3'000'000'000UL + sizeof(PrintRequest) * 1'000'000 +
+                                             sizeof(VerifyRequest) * 1'000 + sizeof(PngRequest);
 
 }  // namespace pitwall::print
 
@@ -50,4 +61,5 @@ extern "C" {
 unsigned long pitwall_print_abi();  // kRequestAbi of the build that made the module
 int pitwall_print_pieces(const pitwall::print::PrintRequest* request);
 int pitwall_verify_piece(const pitwall::print::VerifyRequest* request);
+int pitwall_svg_png(const pitwall::print::PngRequest* request);
 }

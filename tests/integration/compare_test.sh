@@ -68,6 +68,54 @@ assert [c.get("class") for c in charts] == ["speed", "delta", "lane"], charts
 for c in charts:
     assert len([p for p in c.iter(ns + "polyline") if p.get("class") == "lap"]) >= 2, c.get("class")
 PY
+# the same charts as a PNG (the print module's librsvg): twice the SVG's size, drawn, not blank
+$PITWALL compare even-real.jsonl:1:best slow-real.jsonl:groundshock:2 --out cmp.png > /dev/null
+check "the PNG: exit status" 0 $?
+python3 - cmp.png cmp.svg <<'PY' && echo "ok: the PNG: the SVG's charts at twice their size" || fail "the PNG"
+import struct, sys, zlib, xml.etree.ElementTree as ET
+data = open(sys.argv[1], "rb").read()
+assert data[:8] == b"\x89PNG\r\n\x1a\n", "not a PNG"
+pos, idat, size = 8, b"", None
+while pos < len(data):
+    n, kind = struct.unpack(">I4s", data[pos:pos + 8])
+    body = data[pos + 8:pos + 8 + n]
+    if kind == b"IHDR": size = struct.unpack(">II", body[:8])
+    if kind == b"IDAT": idat += body
+    pos += 12 + n
+root = ET.parse(sys.argv[2]).getroot()
+want = (round(2 * float(root.get("width"))), round(2 * float(root.get("height"))))
+print("PNG", size, "SVG x2", want)
+assert abs(size[0] - want[0]) <= 1 and abs(size[1] - want[1]) <= 1, (size, want)
+# the pixels, unfiltered (8-bit RGB or RGBA, as cairo writes them)
+ihdr = data[16:29]
+channels = {2: 3, 6: 4}[ihdr[9]]
+w, h = size
+raw, stride, rows, prev = zlib.decompress(idat), w * channels, [], bytearray(w * channels)
+for y in range(h):
+    f, line = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
+    for i in range(stride):
+        a = line[i - channels] if i >= channels else 0
+        b, c = prev[i], prev[i - channels] if i >= channels else 0
+        if f == 1: line[i] = (line[i] + a) & 255
+        elif f == 2: line[i] = (line[i] + b) & 255
+        elif f == 3: line[i] = (line[i] + (a + b) // 2) & 255
+        elif f == 4:
+            p = a + b - c
+            pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+            line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+    rows.append(line)
+    prev = line
+px = [(r[i], r[i + 1], r[i + 2]) for r in rows[::4] for i in range(0, stride, channels * 4)]
+ink = sum(1 for p in px if min(p) < 200)
+orange = sum(1 for r, g, b in px if r > 150 and b < 100)
+blue = sum(1 for r, g, b in px if b > 150 and r < 100)
+print("pixels sampled:", len(px), "inked:", ink, "orange:", orange, "blue:", blue)
+assert len(px) // 100 < ink < len(px) // 2, "blank, or all ink"
+assert orange > 0 and blue > 0, "the two laps' lines are not drawn"
+PY
+$PITWALL compare even-real.jsonl slow-real.jsonl --out no/such/cmp.png > /dev/null 2> png.err
+check "a PNG it cannot write: status 1" 1 $?
+contains "a PNG it cannot write: the sentence" "pitwall compare: cannot write no/such/cmp.png" "$(cat png.err)"
 $PITWALL compare even-ideal.jsonl slow-ideal.jsonl even-ideal.jsonl:1:1 --out cmp.html > three.txt
 check "three laps: exit status" 0 $?
 contains "three laps: C" "C  even-ideal.jsonl car 1 (groundshock) lap 1" "$(cat three.txt)"
@@ -102,7 +150,7 @@ check "a missing file: status 2" 2 $?
 contains "a missing file: the sentence" "cannot read missing.jsonl: no such file" "$(cat missing.err)"
 $PITWALL compare even-real.jsonl slow-real.jsonl --out cmp.pdf > /dev/null 2> ext.err
 check "an --out it cannot write: status 2" 2 $?
-contains "an --out it cannot write: the sentence" "written as .svg or .html" "$(cat ext.err)"
+contains "an --out it cannot write: the sentence" "written as .svg, .png or .html" "$(cat ext.err)"
 # a record that keeps no layout (real cars'): the track must be given
 sed '1s/"layout":"[^"]*",//' even-real.jsonl > nolayout.jsonl
 $PITWALL compare nolayout.jsonl slow-real.jsonl > /dev/null 2> nolayout.err
