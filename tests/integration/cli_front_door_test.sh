@@ -33,7 +33,7 @@ contains "a PITWALL_DATA without data is named, not passed over" "data: not foun
 out=$($PITWALL); rc=$?
 check "bare pitwall exit status" 0 "$rc"
 for c in run repl bridge view scan emulate-car sim-robot test replay track decode encode types completion; do
-  if echo "$out" | grep -qE "^  $c +[A-Z]"; then echo "ok: bare pitwall lists $c"; else fail "bare pitwall does not list $c: $out"; fi
+  if grep -qE "^  $c +[A-Z]" <<< "$out"; then echo "ok: bare pitwall lists $c"; else fail "bare pitwall does not list $c: $out"; fi
 done
 
 # mistyped: the nearest, status 2, one line

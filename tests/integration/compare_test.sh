@@ -49,7 +49,7 @@ for sensor in real ideal; do
   check "compare ($sensor): nothing on stderr" "" "$(cat cmp-$sensor.err)"
   out=$(judge cmp-$sensor.json $sensor)
   echo "$out"
-  if echo "$out" | grep -q '^FAIL'; then FAILURES=$((FAILURES + 1)); fi
+  if grep -q '^FAIL' <<< "$out"; then FAILURES=$((FAILURES + 1)); fi
 done
 
 # the table and the charts

@@ -26,7 +26,7 @@ cars_stopped() {
   for c in "${CARS[@]}"; do
     if [ -n "${2:-}" ]; then
       local deadline=$((SECONDS + 10))
-      until tail -n +"$2" "$ALL" | grep -qE "^Anki/Car/$c/S/Speed/Desired .*\"value\":800}"; do
+      until tail -n +"$2" "$ALL" | grep -E "^Anki/Car/$c/S/Speed/Desired .*\"value\":800}" > /dev/null; do
         [ $SECONDS -ge $deadline ] && { fail "$1: $c never got the script's 800 mm/s"; break; }
         sleep 0.02
       done

@@ -18,7 +18,7 @@ contains "the cap is stated at the start" "--fast: until the script ends, at mos
 # with its winner and results; before issue 14 it was cut silently at 3600 s.
 out=$(LAPS=1000 $PITWALL run "$SRC/examples/grand_prix.lua" --fast 2>"$TMP/err"); rc=$?
 check "1000 laps: exit status" 0 "$rc"
-printf '%s\n' "$out" | grep -qE '^Winner: [a-z]+ \([a-z]+\), 1000 laps in [0-9]+ min [0-9.]+ s$' &&
+grep -qE '^Winner: [a-z]+ \([a-z]+\), 1000 laps in [0-9]+ min [0-9.]+ s$' <<< "$out" &&
   echo "ok: 1000 laps: the winner" || fail "1000 laps: no winner in [$(printf '%s' "$out" | tail -3)]"
 contains "1000 laps: the results" "Grand prix, 1000 laps   results" "$out"
 

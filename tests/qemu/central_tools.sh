@@ -22,7 +22,7 @@ bt_since() {
   tail -n +$((BT_MARK + 1)) "$BT_LOG" | sed -e 's/\x1b\[[0-9;]*m//g' -e 's/\r//g' \
     -e 's/\x01\|\x02//g'
 }
-bt_matches() { bt_since | grep -q -E -- "$BT_EXPECT"; }
+bt_matches() { bt_since | grep -E -- "$BT_EXPECT" > /dev/null; }
 # expect SECONDS REGEX WHAT: waits until the output since the last command matches.
 expect() {
   BT_EXPECT=$2
@@ -32,7 +32,7 @@ expect() {
 bt_info() {
   bt "info $1"
   sleep 0.2
-  bt_since | grep -q ManufacturerData
+  bt_since | grep ManufacturerData > /dev/null
 }
 
 central_tools() {
@@ -52,9 +52,9 @@ central_tools() {
   until_ok 5 bt_info "$car" || fail "bluetoothctl shows no manufacturer data for $car: $(bt_since)"
   local info
   info=$(bt_since)
-  echo "$info" | grep -q "$service" || fail "the advertisement has no Anki service UUID: $info"
-  echo "$info" | grep -q -i "Key: 0xefbe" || fail "no manufacturer data 0xefbe: $info"
-  echo "$info" | grep -q "00 08" || fail "the manufacturer data does not say model 8: $info"
+  grep -q "$service" <<< "$info" || fail "the advertisement has no Anki service UUID: $info"
+  grep -q -i "Key: 0xefbe" <<< "$info" || fail "no manufacturer data 0xefbe: $info"
+  grep -q "00 08" <<< "$info" || fail "the manufacturer data does not say model 8: $info"
   say "tools: service $service, manufacturer data 0xefbe (model 8): $(echo "$info" |
     grep -E 'Name:' | head -n1 | xargs)"
   bt "scan off"
