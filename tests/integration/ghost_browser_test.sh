@@ -13,36 +13,32 @@ artifacts 'ghost*.png'
 cd "$TMP" || exit 2
 "$PITWALL" run "$SRC/tests/integration/compare_drive.lua" --fast --record even.jsonl -q ||
   fail "the lap's record"
-"$PITWALL" run "$SRC/tests/view/ghost_race.lua" --view 127.0.0.1:0 > "$TMP/out" 2> "$TMP/err" &
-pid=$!
-if await_view "$TMP/err"; then
-  timeout -k 5 120 node "$CHECK/ghost_check.mjs" "$url" "$ART/ghost.png" --timeout 40 \
-    --chromium "$CHROMIUM" > "$TMP/check" 2>&1
-  status=$?
-  cat "$TMP/check"
-  check "the ghost check: exit status" 0 "$status"
-  grep -q '^FAIL' "$TMP/check" && fail "a check in the browser failed"
-fi
-show_if_failed "pitwall's stderr" "$TMP/err"
-kill "$pid" 2>/dev/null
-wait "$pid" 2>/dev/null
+# browse NAME CHECK SHOT RUN-OPTIONS…: a run with the view, and CHECK's browser checks of it
+browse() {
+  local name=$1 checker=$2 shot=$3
+  shift 3
+  "$PITWALL" run "$@" --view 127.0.0.1:0 > "$TMP/out" 2> "$TMP/err" &
+  local pid=$!
+  if await_view "$TMP/err"; then
+    timeout -k 5 120 node "$CHECK/$checker" "$url" "$ART/$shot" --timeout 40 \
+      --chromium "$CHROMIUM" > "$TMP/check" 2>&1
+    local status=$?
+    cat "$TMP/check"
+    check "$name: exit status" 0 "$status"
+    grep -q '^FAIL' "$TMP/check" && fail "$name: a check in the browser failed"
+  fi
+  show_if_failed "pitwall's stderr" "$TMP/err"
+  kill "$pid" 2>/dev/null
+  wait "$pid" 2>/dev/null
+}
+
+browse "the ghost check" ghost_check.mjs ghost.png "$SRC/tests/view/ghost_race.lua"
 
 # The view's own ghost: a race kept in the standings leaves the track's personal best (car 1 at
 # the cruiser's pace); car 1 alone at 600 mm/s races against it
 export PITWALL_DB="$TMP/st.db"
 LAPS=2 "$PITWALL" run "$SRC/examples/time_trial.lua" --fast --cars 1 -q > /dev/null 2>&1 ||
   fail "the race that keeps a personal best"
-"$PITWALL" run "$SRC/tests/view/pb_drive.lua" --cars 1 --view 127.0.0.1:0 > "$TMP/out2" 2> "$TMP/err2" &
-pid=$!
-if await_view "$TMP/err2"; then
-  timeout -k 5 120 node "$CHECK/view_ghost_check.mjs" "$url" "$ART/ghost-view.png" --timeout 40 \
-    --chromium "$CHROMIUM" > "$TMP/check2" 2>&1
-  status=$?
-  cat "$TMP/check2"
-  check "the view's ghost check: exit status" 0 "$status"
-  grep -q '^FAIL' "$TMP/check2" && fail "a check of the view's ghost in the browser failed"
-fi
-show_if_failed "pitwall's stderr" "$TMP/err2"
-kill "$pid" 2>/dev/null
-wait "$pid" 2>/dev/null
+browse "the view's ghost check" view_ghost_check.mjs ghost-view.png "$SRC/tests/view/pb_drive.lua" \
+  --cars 1
 exit $((FAILURES > 0))

@@ -3,6 +3,7 @@
 # touching no car; it is marked as a ghost in Lua and in the view's state; what cannot be a
 # ghost is a sentence.
 source "$(dirname "$0")/lib.sh"
+source "$(dirname "$0")/ghost_lib.sh"
 cd "$TMP" || exit 2
 
 $PITWALL run "$SRC/tests/integration/compare_drive.lua" --fast --record even.jsonl -q || fail "the lap's record"
@@ -16,17 +17,7 @@ contains "the ghost is one in Lua, the car is not" "ghost:	ghost	true	false" "$(
 contains "the lap it drives is said" "ghost drives even.jsonl car 1 (groundshock) lap" "$(cat err.txt)"
 contains "no lane change, no collision" "ghost offset:	-68.0	collisions:	0" "$(cat out.txt)"
 # its laps, counted from its own frames by the replay: the recorded lap's time within a tick
-$PITWALL replay ghost.jsonl --json > laps.json
-python3 - laps.json "$best" <<'PY' && echo "ok: every ghost lap in the recorded time within 5 ms" || fail "the ghost's lap times"
-import json, sys
-rows = [json.loads(l) for l in open(sys.argv[1])]
-best = float(sys.argv[2])
-ghost = next(r for r in rows if r["name"] == "ghost")
-times = ghost["lapTimes"]
-print("ghost laps:", times, "recorded:", best)
-assert len(times) >= 4, times
-assert all(abs(t - best) <= 0.005 for t in times), times
-PY
+ghost_laps ghost.jsonl "$best" 4 0.005
 
 # what cannot be a ghost
 try() {  # try NAME LUA EXPECTED
