@@ -25,7 +25,10 @@ local function driverFor(car, i)
   return drivers.load(pick[1]).new(pick[2])
 end
 
-local cars = pitwall.cars()
+local cars = {} -- (a ghost, from --ghost, races beside them: the race leaves it out)
+for _, car in ipairs(pitwall.cars()) do
+  if not car.ghost then cars[#cars + 1] = car end
+end
 print(string.format("Grand prix: %d cars, %d laps", #cars, LAPS))
 local gp = race.laps {
   laps = LAPS,

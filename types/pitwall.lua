@@ -107,7 +107,7 @@ function pitwall.copy(t) end
 ---@return pitwall.Timer
 function pitwall.every(period, fn) end
 
----Keeps a race's results in the run's standings database (--db; docs/league.md "Standings"): {kind, number, track, laps, entries = {{number, driver, car, file?, position, finished, status, reason?, laps, bestLap, totalTime, lapTimes}}}. The race library calls it when a race ends.
+---Keeps a race's results in the run's standings database (--db; docs/league.md "Standings"): {kind, number, track, laps, green?, entries = {{number, driver, car, file?, position, finished, status, reason?, laps, bestLap, totalTime, lapTimes}}} (green: the engine time of the green light, from which each entry's best lap is kept as a personal best). The race library calls it when a race ends.
 ---@param race table
 ---@return boolean kept false when the run keeps no standings, or when they were held or saved beside the database
 ---@return string? why not now

@@ -36,22 +36,30 @@ namespace pitwall::cli {
 constexpr double kFastCap = 24 * 3600;
 
 namespace {
-// Personal bests (docs/racing.md "Personal bests"): each entry's best whole lap since the race
-// before it kept (`upTo`: car number → the time up to which its laps were looked at), as the
-// feed traced it, and the race's layout, which the best is of.
-void traceBestLaps(standings::Race& race, const view::Feed& feed, std::map<int, double>& upTo,
+// Personal bests (docs/racing.md "Personal bests"): each entry's best whole lap of this race —
+// begun at its green light or after, ended by `now` — as the feed traced it, and the race's
+// layout, which the best is of. An entry whose number is not the feed's car of that name gets
+// none (a script's own results may number their entries otherwise); a race without its green
+// light's time, none.
+void traceBestLaps(standings::Race& race, const nlohmann::json& given, const view::Feed& feed,
                    double now) {
-  if (!feed.track()) return;  // (real cars with no layout: no lap is traced)
+  race.layout.clear();  // (what a script sent is no trace of ours)
+  for (standings::Entry& e : race.entries) e.bestTrace.reset();
+  auto green = given.find("green");
+  if (!feed.track() || green == given.end() || !green->is_number()) return;
+  const double from = green->get<double>();
   race.layout = sim::layoutText(*feed.track());
+  const auto cars = feed.tracedCars();
   for (standings::Entry& e : race.entries) {
+    const auto car =
+        std::find_if(cars.begin(), cars.end(), [&](const auto& c) { return c.first == e.number; });
     const auto* traces = feed.laps(e.number);
-    auto seen = upTo.find(e.number);
-    const double from = seen == upTo.end() ? -1e300 : seen->second;
-    upTo[e.number] = now;
-    if (!traces) continue;
+    if (car == cars.end() || car->second != e.car || !traces) continue;
     const laps::LapTrace* best = nullptr;
     for (const laps::LapTrace& lap : *traces)
-      if (lap.clean && lap.start + lap.time > from && (!best || lap.time < best->time)) best = &lap;
+      if (lap.clean && lap.start >= from - 1e-6 && lap.start + lap.time <= now + 1e-6 &&
+          (!best || lap.time < best->time))
+        best = &lap;
     if (best) e.bestTrace = standings::Entry::Trace{best->time, laps::traceJson(*best).dump()};
   }
 }
@@ -184,6 +192,11 @@ int run(const RunOptions& given) {
     }
   }
   Loop& loop = session.loop();
+  if (!options.ghost.empty() && !options.ble && options.humans > options.cars)
+    return fail("run", "--humans " + std::to_string(options.humans) + " with --ghost: car " +
+                           std::to_string(options.cars + 1) +
+                           " is the ghost, which no one drives; give at most --humans " +
+                           std::to_string(options.cars) + " (the --cars)");
   if (!options.ghost.empty()) {  // (a record played, or the standings read: before any car)
     const sim::Track* track = session.ghostTrack();
     if (!track)
@@ -235,7 +248,6 @@ int run(const RunOptions& given) {
   // Personal bests (docs/racing.md): each car's laps traced, so that a race kept in the
   // standings keeps each entry's best lap as a ghost can drive it again.
   view::Feed* traced = keeper ? &session.startFeed(options.ble ? "ble" : "simulator") : nullptr;
-  std::map<int, double> tracedUpTo;  // car number → the time up to which its laps were kept
   // ...and the track's personal best, the view's reference lap until the session beats it
   if (traced && host.view && traced->track()) {
     auto kept = keptBest(keeper->database(), *traced->track(), "");
@@ -254,7 +266,7 @@ int run(const RunOptions& given) {
     host.leagueFinal =
         HostOptions::LeagueFinal{final->title, final->laps, final->league, final->drivers};
   if (keeper)
-    host.keepRace = [&keeper, traced, &tracedUpTo,
+    host.keepRace = [&keeper, traced,
                      &loop](const nlohmann::json& race) -> std::optional<std::string> {
       auto parsed = standings::raceFromJson(race);
       if (!parsed) {  // (kept as it came, with why, in the unsaved file at the end)
@@ -262,7 +274,7 @@ int run(const RunOptions& given) {
         return "the race's results are not a race: " + parsed.error() +
                " (kept as they came beside the database)";
       }
-      traceBestLaps(*parsed, *traced, tracedUpTo, loop.seconds());
+      traceBestLaps(*parsed, race, *traced, loop.seconds());
       return keeper->add(std::move(*parsed));
     };
   try {

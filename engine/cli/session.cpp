@@ -109,6 +109,7 @@ std::unique_ptr<Session> Session::open(const CarSource& source, bool fast, const
     try {
       session = std::make_unique<Session>(std::move(central));
       session->design_ = std::move(design);
+      session->sim_.seed = source.seed;  // (a --ghost's world beside the real cars)
     } catch (const ble::BleError& e) {
       fail(command, e.what());
       return nullptr;
@@ -681,6 +682,7 @@ int Session::openClassroom(const std::string& folder, const char* command) {
 Result<std::map<int, std::string>, std::string> Session::addDesks() {
   std::map<int, std::string> files;
   for (AnkiCar* car : fleet_.cars()) {
+    if (car->identity().ghost) continue;  // (no one codes a ghost's driver)
     const int n = car->identity().number;
     if (auto ok = classroom_->addDesk(n, car->identity().name); !ok) return Unexpected{ok.error()};
     files[n] = classroom_->driverFile(n).string();

@@ -5,6 +5,7 @@
 #include <librsvg/rsvg.h>
 
 #include <cmath>
+#include <filesystem>
 #include <iostream>
 #include <string>
 
@@ -53,10 +54,17 @@ int svgToPng(const PngRequest& request) {
     cairo_surface_destroy(surface);
     return 1;
   }
-  const cairo_status_t written = cairo_surface_write_to_png(surface, request.out.c_str());
+  // Written beside it and renamed over it: a write that fails leaves no half a picture
+  const std::string part = request.out + ".part";
+  const cairo_status_t written = cairo_surface_write_to_png(surface, part.c_str());
   cairo_surface_destroy(surface);
-  if (written != CAIRO_STATUS_SUCCESS) {
-    std::cerr << who << "cannot write " << request.out << " (" << cairo_status_to_string(written)
+  std::error_code ec;
+  if (written == CAIRO_STATUS_SUCCESS) std::filesystem::rename(part, request.out, ec);
+  if (written != CAIRO_STATUS_SUCCESS || ec) {
+    std::filesystem::remove(part, ec);
+    std::cerr << who << "cannot write " << request.out << " ("
+              << (written != CAIRO_STATUS_SUCCESS ? cairo_status_to_string(written)
+                                                  : "it cannot take the picture's place")
               << "): give a file in a folder that exists and takes files\n";
     return 1;
   }

@@ -448,12 +448,16 @@ Result<bool, std::string> Database::addRace(std::int64_t event, const Race& race
   }
   // Each entry's traced best lap becomes its driver's personal best in that car on this layout
   // when it beats the one kept (or none is).
-  Statement b(db_,
-              "INSERT INTO best_laps(driver, car, layout, track, lap, trace, event, set_at) "
-              "VALUES(?, ?, ?, ?, ?, ?, ?, strftime('%Y-%m-%dT%H:%M:%SZ', 'now')) "
-              "ON CONFLICT(driver, car, layout) DO UPDATE SET track = excluded.track, "
-              "lap = excluded.lap, trace = excluded.trace, event = excluded.event, "
-              "set_at = excluded.set_at WHERE excluded.lap < best_laps.lap");
+  Statement b(
+      db_,
+      "INSERT INTO best_laps(driver, car, layout, track, lap, trace, event, set_at) "
+      "VALUES(?, ?, ?, ?, ?, ?, ?, strftime('%Y-%m-%dT%H:%M:%SZ', 'now')) "
+      "ON CONFLICT(driver, car, layout) DO UPDATE SET track = excluded.track, "
+      "lap = excluded.lap, trace = excluded.trace, event = excluded.event, "
+      "set_at = excluded.set_at WHERE excluded.lap < best_laps.lap "
+      // (a kept lap that is not whole — edited, damaged — gives way to any new one)
+      "OR NOT json_valid(best_laps.trace) "
+      "OR coalesce(abs(json_extract(best_laps.trace, '$.time') - best_laps.lap) > 0.001, 1)");
   if (int rc = b.prepared(); rc != SQLITE_OK) return fail(rc);
   for (const Entry& x : race.entries) {
     if (!x.bestTrace || race.layout.empty()) continue;
@@ -472,29 +476,33 @@ Result<bool, std::string> Database::addRace(std::int64_t event, const Race& race
   return true;
 }
 
-Result<std::optional<KeptLap>, std::string> Database::bestLap(const std::string& layout,
-                                                              const std::string& who) {
+Result<std::vector<KeptLap>, std::string> Database::bestLaps(const std::string& layout,
+                                                             const std::string& who, int most) {
   Statement s(db_,
               "SELECT driver, car, track, lap, trace, set_at FROM best_laps "
               "WHERE layout = ? AND (? = '' OR driver = ? OR car = ?) "
-              "ORDER BY lap, set_at LIMIT 1");
+              "ORDER BY lap, set_at LIMIT ?");
   if (int rc = s.prepared(); rc != SQLITE_OK)
     return Unexpected{sentence(rc, "reading the personal bests")};
   s.bind(1, layout);
   s.bind(2, who);
   s.bind(3, who);
   s.bind(4, who);
-  int rc = s.step();
-  if (rc == SQLITE_DONE) return std::optional<KeptLap>();
-  if (rc != SQLITE_ROW) return Unexpected{sentence(rc, "reading the personal bests")};
-  KeptLap k;
-  k.driver = s.text(0);
-  k.car = s.text(1);
-  k.track = s.text(2);
-  k.lap = s.real(3).value_or(0);
-  k.trace = s.text(4);
-  k.when = s.text(5);
-  return std::optional<KeptLap>(std::move(k));
+  s.bind(5, most);
+  std::vector<KeptLap> out;
+  int rc;
+  while ((rc = s.step()) == SQLITE_ROW) {
+    KeptLap k;
+    k.driver = s.text(0);
+    k.car = s.text(1);
+    k.track = s.text(2);
+    k.lap = s.real(3).value_or(0);
+    k.trace = s.text(4);
+    k.when = s.text(5);
+    out.push_back(std::move(k));
+  }
+  if (rc != SQLITE_DONE) return Unexpected{sentence(rc, "reading the personal bests")};
+  return out;
 }
 
 Result<bool, std::string> Database::endEvent(std::int64_t event) {

@@ -148,10 +148,10 @@ class Database {
 
   Result<std::vector<TableRow>, std::string> table(const Filter& filter);
   Result<std::vector<Best>, std::string> bests(const Filter& filter);
-  // The fastest personal best kept on `layout` — of the driver or car named `who`, or anyone's
-  // when it is empty; none when there is none.
-  Result<std::optional<KeptLap>, std::string> bestLap(const std::string& layout,
-                                                      const std::string& who);
+  // The fastest personal bests kept on `layout` (at most `most`, fastest first) — of the driver
+  // or car named `who`, or anyone's when it is empty.
+  Result<std::vector<KeptLap>, std::string> bestLaps(const std::string& layout,
+                                                     const std::string& who, int most = 20);
   Result<std::vector<Past>, std::string> history(const std::string& driver);
   Result<std::vector<EventInfo>, std::string> events();
   // The league event `id`, or the last league that ended when none is given.

@@ -164,7 +164,7 @@ Result<Race, std::string> raceFromJson(const nlohmann::json& j) {
     if (auto it = x.find("bestTrace"); it != x.end() && !it->is_null()) {
       auto trace = laps::traceFromJson(*it);
       if (!trace) return Unexpected{where + ".bestTrace: " + trace.error()};
-      e.bestTrace = Entry::Trace{trace->time, laps::traceJson(*trace).dump()};
+      e.bestTrace = Entry::Trace{trace->time, it->dump()};  // (as it came: it reads back the same)
     }
     if (!numbers.insert(e.number).second)
       return Unexpected{where + ".number " + std::to_string(e.number) +

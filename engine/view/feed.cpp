@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "engine/core/log.hpp"
+#include "engine/protocol/anki/limits.hpp"
 #include "engine/view/geometry.hpp"
 
 namespace pitwall::view {
@@ -345,12 +346,10 @@ const Feed::Reference* Feed::reference() const {
 // most laps; of two, the one that crossed first) last crossed it, and waits there when its lap
 // is done before the car's. None while a simulated ghost races (it is drawn already), before
 // the leader's first crossing, or with no reference or no track.
-nlohmann::json Feed::viewGhostJson() const {
-  const Reference* ref = reference();
-  if (!ref || !track_ || !lapMap_ || lapMap_->n == 0) return nullptr;
+const Feed::Car* Feed::ghostLeader(int& number) const {
+  if (!reference() || !track_ || !lapMap_ || lapMap_->n == 0) return nullptr;
   const Car* leader = nullptr;
-  int leaderNumber = 0;
-  for (const auto& [number, c] : cars_) {
+  for (const auto& [n, c] : cars_) {
     if (c->ghost) return nullptr;
     const laps::LapTrace* lap = c->traces.current();
     if (!lap) continue;
@@ -358,11 +357,29 @@ nlohmann::json Feed::viewGhostJson() const {
     if (!leader || c->tracker.laps() > leader->tracker.laps() ||
         (c->tracker.laps() == leader->tracker.laps() && lap->start < best->start)) {
       leader = c.get();
-      leaderNumber = number;
+      number = n;
     }
   }
+  return leader;
+}
+
+std::uint64_t Feed::changes() const {
+  // The view's ghost drives with the clock, not with the cars' frames: while it drives, a new
+  // count every 50 ms, so that browsers get its place even when no car moves
+  int number = 0;
+  const Car* leader = ghostLeader(number);
+  if (!leader) return changes_;
+  const double t = now() - leader->traces.current()->start;
+  if (t < 0 || t > reference()->lap.time) return changes_;
+  return changes_ + 1 + static_cast<std::uint64_t>(now() * 20);
+}
+
+nlohmann::json Feed::viewGhostJson() const {
+  int leaderNumber = 0;
+  const Car* leader = ghostLeader(leaderNumber);
   if (!leader) return nullptr;
-  const laps::LapTrace& lap = ref->lap;
+  const laps::LapTrace& lap = reference()->lap;
+  const Reference* ref = reference();
   const double at = now();
   const double t = std::clamp(at - leader->traces.current()->start, 0.0, lap.time);
   const double d = std::clamp(lap.distanceAt(t), 0.0, lapMap_->lap);
@@ -371,7 +388,8 @@ nlohmann::json Feed::viewGhostJson() const {
   const double fraction = lapMap_->length[k] > 0
                               ? std::clamp((d - lapMap_->start[k]) / lapMap_->length[k], 0.0, 1.0)
                               : 0.0;
-  const double offset = lap.offsetOn(k, *lapMap_);
+  const double offset =  // (on the road: a kept lap's offsets are any numbers)
+      std::clamp(lap.offsetOn(k, *lapMap_), anki::limits::kOffsetMin, anki::limits::kOffsetMax);
   const std::size_t index = lapMap_->trackIndex(k);
   // its speed along the lap here (the page moves it on between updates, as it moves the cars)
   constexpr double kAround = 0.05;
@@ -464,12 +482,13 @@ std::string Feed::updateText(std::uint64_t& cursor, std::uint64_t& trackSeen) co
         R"("cars":)" + carsJson(false).dump(-1, ' ', false, kReplace) + R"(,"race":)" + raceText_ +
         R"(,"replay":)" +
         (replay_.is_null() ? nlohmann::json(nullptr) : replay_).dump(-1, ' ', false, kReplace) +
-        R"(,"seats":)" + seatsJson().dump(-1, ' ', false, kReplace) + R"(,"viewGhost":)" +
-        viewGhostJson().dump(-1, ' ', false, kReplace);
+        R"(,"seats":)" + seatsJson().dump(-1, ' ', false, kReplace);
     sharedAt_ = changes_;
   }
+  // (the view's ghost moves with the clock, not with the cars' frames: made for every update)
   std::string text = R"({"type":"update","time":)" + nlohmann::json(round3(now())).dump() + "," +
-                     shared_ + R"(,"events":)" + eventsJson(cursor).dump(-1, ' ', false, kReplace);
+                     shared_ + R"(,"viewGhost":)" + viewGhostJson().dump(-1, ' ', false, kReplace) +
+                     R"(,"events":)" + eventsJson(cursor).dump(-1, ' ', false, kReplace);
   cursor = nextEvent_;
   if (trackSeen != trackVersion_) {
     text += R"(,"track":)" + (track_ ? trackJson(*track_, trackSource_) : nlohmann::json(nullptr))

@@ -65,8 +65,9 @@ class Feed {
   // each browser's own.
   std::string updateText(std::uint64_t& cursor, std::uint64_t& trackSeen) const;
   // Counts every change of what an update carries but the time: a frame that moved a car, the
-  // race, the replay, an event, the track. Equal counts: nothing to send.
-  std::uint64_t changes() const { return changes_; }
+  // race, the replay, an event, the track; and, while the view's ghost drives, every 50 ms of
+  // the clock. Equal counts: nothing to send.
+  std::uint64_t changes() const;
   std::uint64_t eventCursor() const { return nextEvent_; }
   std::uint64_t trackVersion() const { return trackVersion_; }
 
@@ -139,7 +140,9 @@ class Feed {
   };
   // the ghost's last lap; the session's best lap; the standings' personal best on this track
   std::optional<Reference> ghost_, best_, personal_;
-  const Reference* reference() const;   // of the deltas: the ghost's lap, else the fastest
+  const Reference* reference() const;  // of the deltas: the ghost's lap, else the fastest
+  // The car the view's ghost follows (its number in `number`); nullptr: no view's ghost now.
+  const Car* ghostLeader(int& number) const;
   std::optional<laps::LapMap> lapMap_;  // of track_
   const AnkiCar* lastAnki_ = nullptr;   // the car of the last car() and its Car: one lookup fewer
   int lastNumber_ = 0;

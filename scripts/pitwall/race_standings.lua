@@ -43,7 +43,8 @@ function Standings:_keep()
   local ok, kept, why = pcall(pitwall.keepResults, {
     kind = self.cut and "stopped" or pitwall.final and "final" or KINDS[self.mode] or "race",
     number = 1,
-    laps = self.laps or 0, entries = entries, track = track })
+    laps = self.laps or 0, entries = entries, track = track,
+    green = self.green }) -- (a personal best is a lap driven from the green light on)
   if not ok then
     pitwall.log("error", "race: the results were not kept in the standings: " .. tostring(kept))
   elseif why then -- (held, or kept beside the database: the run's end says what became of it)

@@ -48,6 +48,26 @@ check "--ghost best:skull: exit status" 0 $?
 contains "the personal best is named" "ghost drives skull's personal best in skull" "$(cat err2.txt)"
 ghost_laps pb.jsonl "$pb" 3 0.005
 
+# What an adversary plants is no personal best: a lap driven before the race's green light, a
+# trace and layout a script made up, an entry whose number is another car's
+PITWALL_DB="$TMP/cheat.db" $PITWALL run "$SRC/tests/integration/ghost_pb_cheat.lua" --fast --cars 1 \
+  > cheat.txt 2> cheat.err
+check "the planted bests: exit status" 0 $?
+kept=$(python3 -c "import sqlite3; print('\n'.join('%s %s %.3f' % r for r in sqlite3.connect('$TMP/cheat.db').execute('SELECT driver, car, lap FROM best_laps ORDER BY car')))")
+echo "kept: $kept"
+within() {  # within LINES-A LINES-B: the same drivers and cars, each lap within 5 ms
+  python3 -c "
+import sys
+a = sorted(l.split() for l in sys.argv[1].splitlines())
+b = sorted(l.split() for l in sys.argv[2].splitlines())
+assert a, 'no race best to compare'
+assert [x[:2] for x in a] == [x[:2] for x in b], (a, b)
+assert all(abs(float(x[2]) - float(y[2])) <= 0.005 for x, y in zip(a, b)), (a, b)" "$1" "$2"
+}
+within "$(sed -n 's/^race best: //p' cheat.txt)" "$kept" &&
+  echo "ok: only the race's laps are kept: not the faster one before the green, not a script's" ||
+  fail "the kept bests are not the race's laps: $kept"
+
 # What cannot be a ghost: a sentence, exit status 2, no car moved, an old record untouched
 echo '{"old": "record"}' > old.jsonl
 cp old.jsonl old.copy
@@ -64,6 +84,8 @@ refused() {  # refused NAME EXPECTED ARGS…
 refused "a missing record" "--ghost cannot read nope.jsonl: no such file" --ghost nope.jsonl
 refused "a lap the record lacks" "has no lap 99" --ghost even.jsonl:1:99
 refused "another track" "a ghost drives the track it was on" --ghost even.jsonl --track kidney
+refused "a seat on the ghost" "--humans 3 with --ghost: car 3 is the ghost, which no one drives" \
+  --ghost even.jsonl --humans 3
 refused "no standings" "--ghost best races a personal best the standings keep, and this run keeps none" \
   --ghost best --no-db
 refused "no one of that name" "keeps no personal best of nobody on this track" --ghost best:nobody
