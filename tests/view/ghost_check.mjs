@@ -60,8 +60,15 @@ try {
   check("it says how the laps were aligned", /^(aligned by distance|per piece): /.test(how), how);
   const lost = await page.$$eval("#lap-compare-result table.sections tr", (rows) =>
     rows.slice(1).map((r) => Number(r.cells[3].querySelector("span").textContent)));
-  check("car 1 (600 mm/s) lost time to the ghost (800 mm/s) in every section and the lap",
-    lost.length === 6 && lost.every((d) => d > 0), lost.join(" "));
+  // (per piece, in real time: a transition read late moves time between two neighbouring
+  // sections — docs/racing.md "Comparing laps" — so one short section may show a gain; the lap
+  // and the sections' sum may not)
+  const sections = lost.slice(0, -1), lap = lost[lost.length - 1];
+  const sum = sections.reduce((a, d) => a + d, 0);
+  check("car 1 (600 mm/s) lost time to the ghost (800 mm/s): the lap, the sections' sum, and all "
+    + "sections but one at most",
+    lost.length === 6 && lap > 0.5 && Math.abs(sum - lap) < 0.02 &&
+      sections.filter((d) => d > 0).length >= sections.length - 1, lost.join(" "));
   const shot = png.replace(/(\.png)?$/i, "-compare.png");
   await page.screenshot({ path: shot, fullPage: true });
   pass("screenshot written", shot);
