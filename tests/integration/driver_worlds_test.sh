@@ -109,6 +109,7 @@ adversary loop "$D/loop.lua" "loop.lua:2: still running after 50 ms: interrupted
 adversary grow "$D/grow.lua" "driver memory limit of 16 MB reached"
 adversary errors "$D/errors.lua" "errors.lua:2: this driver is broken"
 adversary exit "$D/exit.lua" "it called os.exit(3): a driver cannot end the run"
+adversary stop "$D/stop.lua" "it called pitwall.stop: a driver cannot end the race"
 adversary require_other "$D/require_other.lua" "module 'good' not found"
 adversary read_file "$D/read_file.lua" "io.open is not available to scripts: a driver reads and writes no file"
 adversary broken_save - "its file does not load:" "$TMP/save_race.lua" "$D/broken_save.lua" \

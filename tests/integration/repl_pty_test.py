@@ -3,6 +3,7 @@
 # readline editing the line. Every wait is an expect with a timeout; nothing sleeps.
 #
 # usage: repl_pty_test.py PITWALL   (exit 0: passed, 1: failed, 77: python3-pexpect missing)
+import json
 import os
 import re
 import sys
@@ -86,6 +87,26 @@ def fail(message):
         if child.isalive():
             child.terminate(force=True)
     sys.exit(1)
+
+
+def last_frames(record):
+    """The last frame sent to each car in a --record file: {car: (name, speed)}."""
+    last = {}
+    with open(record, encoding="utf-8") as f:
+        for line in f:
+            r = json.loads(line)
+            if r.get("dir") == "tx":
+                last[r["car"]] = (r["msg"]["name"], r["msg"].get("speed_mm_s"))
+    return last
+
+
+def expect_stopped(what, record, cars):
+    """docs/safety.md: the REPL's way out is the stop path, the last frame to every car its stop."""
+    last = last_frames(record)
+    want = {car: ("set-speed", 0) for car in range(1, cars + 1)}
+    if last != want:
+        fail(f"{what}: the last frame to each car should be its stop {want}, got {last}")
+    print(f"ok: {what}: the last frame to every car is its stop")
 
 
 def main():
@@ -349,8 +370,9 @@ def main():
                 "function speedUp(s) car:setSpeed(s) return car.targetSpeed end\n"
                 "function scriptSeesHelp() return help end\n"
                 "pitwall.persist.version = 1\n")
+    record = os.path.join(scratch, "watch.jsonl")
     repl = Session(scratch, history, "run --repl --watch",
-                   ("run", script, "--repl", "--watch", "--cars", "1"))
+                   ("run", script, "--repl", "--watch", "--cars", "1", "--record", record))
     repl.expect("the prompt comes up beside the script", PROMPT)
     repl.line("=type(laps) .. ' ' .. type(speedUp)")
     repl.expect("the script's globals are at hand", value('"number function"'))
@@ -378,6 +400,25 @@ def main():
     repl.expect("the old version's globals are gone", value("nil"))
     repl.line(":quit")
     repl.finish("run --repl :quit")
+    expect_stopped("run --repl :quit", record, 1)
+
+    # Ctrl-D with a car driving and a timer commanding it every 20 ms: the stop path too.
+    record = os.path.join(scratch, "ctrl-d.jsonl")
+    nagging = os.path.join(scratch, "nagging.lua")
+    with open(nagging, "w", encoding="utf-8") as f:
+        f.write("pitwall.every(0.02, function()\n"
+                "  for _, c in ipairs(pitwall.cars()) do c:setSpeed(900) end\n"
+                "end)\n")
+    repl = Session(scratch, history, "run --repl Ctrl-D",
+                   ("run", nagging, "--repl", "--cars", "2", "--record", record))
+    repl.expect("the prompt comes up beside the script", PROMPT)
+    repl.line("pitwall.waitUntil(function() return pitwall.cars()[2].speed > 0 end, 5)")
+    repl.expect("the prompt is back", PROMPT)
+    repl.line("=pitwall.cars()[2].speed > 0")
+    repl.expect("the cars drive", value("true"))
+    repl.child.sendcontrol("d")
+    repl.finish("run --repl Ctrl-D")
+    expect_stopped("run --repl Ctrl-D", record, 2)
 
 
 main()

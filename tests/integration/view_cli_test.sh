@@ -120,6 +120,33 @@ PY
 contains "/ws: updates flow at no more than 30 a second" "ok" "$rate"
 echo "  ($rate)"
 
+# A body over 64 KiB (announced): 413 with a sentence, and the view serves on (docs/view.md's limits).
+big=$(timeout 30 python3 - "$URL" <<'PY'
+import socket, sys, urllib.parse, urllib.request
+u = urllib.parse.urlparse(sys.argv[1])
+s = socket.create_connection((u.hostname, u.port), timeout=10)
+# the length announced, no byte of the body sent: the server answers on the header, and with
+# nothing left unread its close is no reset that could drop the answer
+s.sendall(b"POST /api/state HTTP/1.1\r\nHost: %s\r\nContent-Length: %d\r\n\r\n"
+          % (u.netloc.encode(), 70 * 1024))
+answer = b""
+while True:
+    try:
+        chunk = s.recv(4096)
+    except OSError:
+        break
+    if not chunk:
+        break
+    answer += chunk
+status = answer.split(b"\r\n", 1)[0].decode()
+said = b"the view takes no body over 64 KiB" in answer
+again = urllib.request.urlopen(sys.argv[1] + "api/state", timeout=10).status
+print(status, "| said" if said else "| not said", "| then", again)
+PY
+)
+check "a body over 64 KiB: 413 with a sentence, and the view goes on" \
+  "HTTP/1.1 413 Payload Too Large | said | then 200" "$big"
+
 # 2. A port in use: refused with the port named and what to do; nothing started.
 "$PITWALL" run "$SRC/examples/grand_prix.lua" --view "127.0.0.1:$port" --record "$TMP/busy.jsonl" \
   >"$TMP/busy.out" 2>"$TMP/busy.err"
