@@ -679,6 +679,7 @@ function Human:waiting(car, ctx) end]],
 ---@field falseStart boolean
 ---@field gap? number s how long ago the leader was where this car is (a finisher: behind the winner's finish)
 ---@field lapsBehind? integer
+---@field reason? string why the car's driver world failed (a DNF at once: docs/drivers.md); empty otherwise
 
 ---The director's record of a car (session:entry).
 ---@class pitwall.race.Entry
