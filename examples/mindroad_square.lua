@@ -1,6 +1,6 @@
 -- Drives a MindRoad robot car (docs/robots.md) around a square — straight 2 s, turn right 1 s,
 -- four times per square — and carries on through a dropped connection: while contact is lost
--- the square waits, and after onContact it redoes the side it was on.
+-- the square waits, and after onContact it finishes the side it was on with the time left.
 --
 --   build/pitwall sim-robot mindroad --listen 127.0.0.1:4000 &      # or a real robot
 --   build/pitwall run examples/mindroad_square.lua

@@ -83,7 +83,7 @@ class MqttClient {
   // connected.
   bool publish(std::string_view topic, std::string_view payload, int qos = 0, bool retain = false);
   // While a Batch lives, what is published leaves in as few TCP segments as the kernel can make
-  // (TCP_CORK): a car's position update is 9 publications. Nests; harmless when not connected.
+  // (TCP_CORK): a car's position update is 10 publications. Nests; harmless when not connected.
   class Batch {
    public:
     explicit Batch(MqttClient& client);
@@ -107,7 +107,7 @@ class MqttClient {
 
   State state() const { return state_; }
   const MqttOptions& options() const { return options_; }
-  // Why the last attempt failed, a phrase ("Connection refused", "no answer within 5 s"); empty
+  // Why the last attempt failed, a phrase ("Connection refused", "no answer within 10 s"); empty
   // before any failure and once connected.
   const std::string& lastFailure() const { return failure_; }
 
