@@ -10,9 +10,10 @@
 // id of its own (0–127, not one of Anki's) and its geometry as keys after commas:
 //   S:60,len=300     a straight of 300 mm
 //   L:61,r=400,deg=45  a curve of centre radius 400 mm turning 45°
-// A layout must contain exactly one `start`, must close (end where it began, heading the same
-// way), its pieces must not overlap and each must carry a code (docs/tracks.md "Rules");
-// otherwise parsing fails with a sentence naming the piece and saying why.
+// A layout holds at most one `start` (none: laps are counted from its first piece), must close
+// (end where it began, heading the same way), its pieces must not overlap and each must carry a
+// code (docs/tracks.md "Rules"); otherwise parsing fails with a sentence naming the piece and
+// saying why.
 #include <cstdint>
 #include <string>
 #include <string_view>
