@@ -9,24 +9,25 @@
 //
 // BM_MqttBridgeThroughput/<cars>/<window>/<broker_nodelay>: position updates injected on A round
 //   robin over the cars, as fast as B takes them: at most <window> updates' worth of messages
-//   (window × 9) published and not yet received on B (the broker's queue for a client holds
+//   (window × 10) published and not yet received on B (the broker's queue for a client holds
 //   1000 messages; beyond that it drops them);
-//   B is a plain client subscribed to Anki/Car/+/E/# (QoS 0) and Anki/Car/+/S/# (QoS 1), as
-//   RemoteCars subscribes. One position update = 9 publications (E/frame, 6 events, 2 retained
-//   status at QoS 1). Time: first injection → last message on B. items_per_second = vehicle
-//   messages received on B; counters upd_per_s (position updates/s), pub_per_s (the bridge's
+//   B is a plain client subscribed to Anki/Car/+/E/# (QoS 0) and Anki/Car/+/S/# (QoS 1), a
+//   superset of what RemoteCars subscribes to. One position update = 10 publications (E/frame,
+//   6 events, the controller's E/Messages/…POSITION_UPDATE, 2 retained status at QoS 1).
+//   Time: first injection → last message on B. items_per_second = vehicle messages received on
+//   B; counters upd_per_s (position updates/s), pub_per_s (the bridge's
 //   publications/s), lost (messages expected on B and never seen; lost_frame, lost_status by
 //   kind), a_us (thread CPU µs per update spent on host A's side: AnkiCar::receive → bridge →
 //   publish), cpu_us (this thread's CPU µs per update, A and B), broker_us (mosquitto's CPU µs
 //   per update, from /proc).
 // BM_MqttRemoteThroughput/<cars>/<window>/<broker_nodelay>: the same with B = RemoteCars, which
-//   takes 3 messages per update (E/frame and the 2 status; not the other events), so the window
-//   is window × 3 messages: items are the frames that reach B's AnkiCars (AnkiCar::receive),
-//   counted by B's Fleet::frames.
+//   takes 4 messages per update (E/frame, E/Messages and the 2 status; not the other events), so
+//   the window is window × 4 messages: items are the frames that reach B's AnkiCars
+//   (AnkiCar::receive), counted by B's Fleet::frames.
 // BM_MqttFrameToLua/<samples>/<broker_nodelay>: one sample at a time (tests/bench/latency.hpp):
 //   t0, inject a position update on A's car, t1 when B's Lua onPosition handler calls
 //   mark(ev.location). Path `eng`:
-//   AnkiCar::receive → MqttBridge (9 publications, E/frame first) → broker → RemoteCars →
+//   AnkiCar::receive → MqttBridge (10 publications, E/frame first) → broker → RemoteCars →
 //   AnkiCar::receive → Lua. Path `raw`, taking turns with it: a bare libmosquitto round trip
 //   through the same broker, one QoS-0 message of the same size as E/frame between two other
 //   MqttClients. Counters in µs: <path>50, <path>99 (nearest rank), <path>Avg, <path>Min,
@@ -71,7 +72,8 @@ using bench::kLocationByte;
 using bench::positionFrame;
 using Clock = std::chrono::steady_clock;
 
-constexpr int kPublicationsPerUpdate = 9;  // E/frame + 6 events + 2 status (mqtt_topics.cpp)
+// E/frame + 6 events + E/Messages/…POSITION_UPDATE + 2 status (engine/mqtt/topics.cpp)
+constexpr int kPublicationsPerUpdate = 10;
 
 // A car of host A: connected from the start, with a BLE-like address of its own so that every
 // car gets its own topic id (BenchLink's "bench" would give them all one).
@@ -382,7 +384,8 @@ void BM_MqttRemoteThroughput(benchmark::State& state) {
     MqttClient& b = *rig.clientB;
     Fleet fleetB(rig.loop);
     RemoteCars remote(rig.loop, fleetB, b);
-    Pump p(rig, state.range(1), 3);  // RemoteCars takes E/frame and the status, not the events
+    // RemoteCars takes E/frame, E/Messages and the 2 status, not the other events
+    Pump p(rig, state.range(1), 4);
     b.subscribe("bench/sync", 1);
     auto inner = b.onMessage;
     b.onMessage = [&](std::string_view topic, std::string_view payload, bool retained) {
