@@ -9,7 +9,7 @@ local race = require "pitwall.race"
 
 local room = pitwall.classroom
 if not room.active then
-  pitwall._raise("classroom/race.lua is the code page's race: run it with --code FOLDER "
+  error("classroom/race.lua is the code page's race: run it with --code FOLDER "
     .. "--view 0.0.0.0:8080 (docs/classroom.md)")
 end
 

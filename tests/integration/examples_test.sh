@@ -41,4 +41,10 @@ check "docs/tutorial.md's listings are the scripts" "5 listings" "$out"
 
 out=$(LAPS=2 $PITWALL run "$SRC/examples/lap_times.lua" --fast --cars 4 2>/dev/null)
 check "lap_times prints 2 laps for each of 4 cars" 8 "$(echo "$out" | grep -c ' lap [0-9]')"
+
+# The classroom's race, run without --code: a sentence saying how to run it, exit status 1.
+err=$($PITWALL run "$SRC/examples/classroom/race.lua" --fast 2>&1 >/dev/null); rc=$?
+check "classroom/race.lua without --code: exit status" 1 "$rc"
+contains "classroom/race.lua without --code: says how to run it" \
+  "classroom/race.lua is the code page's race: run it with --code FOLDER" "$err"
 finish
