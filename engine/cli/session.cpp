@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -463,20 +464,7 @@ bool Session::addGhost() {
   sim::CarSpec spec = std::move(*ghost_);
   ghost_.reset();
   spec.version = source_.firmware;
-  sim::SimCar& simCar = world->addCar(spec);
-  auto link = std::make_unique<SimLink>(loop_, simCar);
-  SimLink& toCar = *link;
-  bool joinedNow = false;
-  AnkiCar& car = fleet_.add(std::move(link),
-                            CarIdentity{0, spec.name, spec.model_id, simCar.identifier(), true});
-  Subscription joined = fleet_.carJoined.connect([&](AnkiCar& c) {
-    if (&c != &car) return;
-    joinedNow = true;
-    loop_.stop();
-  });
-  toCar.connect();
-  if (!joinedNow) loop_.runAtMost(std::chrono::seconds(5));
-  if (!joinedNow) return false;
+  if (!awaitJoined({&joinSimCar(*world, spec, true)})) return false;
   log::info("pitwall", spec.name + " drives " + ghostWhat_ + " again, from the green light");
   return true;
 }
@@ -571,23 +559,39 @@ void Session::flushRecordPeriodically() {
 
 bool Session::addGridCars(int count) {
   std::vector<std::string> names;
+  std::vector<const AnkiCar*> cars;
   for (int i = 0; i < count; ++i) {
     sim::CarSpec spec = sim::gridSpec(sim_.world->track(), i);
     spec.name = anki::uniqueCarName(spec.model_id, names);
     spec.version = source_.firmware;
     names.push_back(spec.name);
-    sim::SimCar& simCar = sim_.world->addCar(spec);
-    auto link = std::make_unique<SimLink>(loop_, simCar);
-    SimLink& toCar = *link;
-    fleet_.add(std::move(link), CarIdentity{0, spec.name, spec.model_id, simCar.identifier()});
-    toCar.connect();  // now that the fleet listens
+    cars.push_back(&joinSimCar(*sim_.world, spec, false));
   }
-  if (count == 0) return true;
+  return awaitJoined(cars);
+}
+
+// A simulated car joins the fleet over a SimLink, which connects once the fleet listens.
+AnkiCar& Session::joinSimCar(sim::World& world, const sim::CarSpec& spec, bool ghost) {
+  sim::SimCar& simCar = world.addCar(spec);
+  auto link = std::make_unique<SimLink>(loop_, simCar);
+  SimLink& toCar = *link;
+  AnkiCar& car = fleet_.add(std::move(link),
+                            CarIdentity{0, spec.name, spec.model_id, simCar.identifier(), ghost});
+  toCar.connect();
+  return car;
+}
+
+// Runs the loop until each of `cars` is connected, for 5 s at most.
+bool Session::awaitJoined(const std::vector<const AnkiCar*>& cars) {
+  auto all = [&] {
+    return std::ranges::all_of(cars, [](const AnkiCar* c) { return c->state().connected; });
+  };
+  if (all()) return true;
   Subscription joined = fleet_.carJoined.connect([&](AnkiCar&) {
-    if (fleet_.connectedCount() == static_cast<std::size_t>(count)) loop_.stop();
+    if (all()) loop_.stop();
   });
   loop_.runAtMost(std::chrono::seconds(5));
-  return fleet_.connectedCount() == static_cast<std::size_t>(count);
+  return all();
 }
 
 std::optional<std::string> Session::connectRealCars() {

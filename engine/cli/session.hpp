@@ -141,6 +141,8 @@ class Session {
   std::string ghostWhat_;
   std::unique_ptr<sim::World> ghostWorld_;  // the ghost's world beside real cars'
   bool addGhost();
+  AnkiCar& joinSimCar(sim::World& world, const sim::CarSpec& spec, bool ghost);
+  bool awaitJoined(const std::vector<const AnkiCar*>& cars);
   Fleet fleet_;
   std::unique_ptr<Recorder> recorder_;
   Subscription recording_;      // the fleet's frames into recorder_ (--record)
