@@ -13,6 +13,7 @@
 #include "engine/cli/fail.hpp"
 #include "engine/cli/league_heat.hpp"
 #include "engine/cli/options.hpp"
+#include "engine/sim/track.hpp"
 
 namespace pitwall::cli {
 
@@ -61,6 +62,8 @@ int tryDriver(const TryOptions& o) {
   std::error_code ec;
   if (!fs::is_regular_file(o.file, ec))
     return fail("try", o.file + ": no such file (give a driver file, such as alice.lua)", 2);
+  // a usage error as for `league`: said before anything runs
+  if (auto track = sim::loadLayout(o.track); !track) return fail("try", track.error());
   HeatSpec spec;
   spec.files = {fs::absolute(o.file, ec).lexically_normal().string()};
   spec.qualifying = true;  // alone, its laps counted, its best kept

@@ -1,7 +1,8 @@
 # pitwall try FILE (docs/cli.md): a driver file alone in the simulator, virtual time, real sensor
 # model — its laps, its best and its speed along the lap, as text or one JSON object whose trace
 # follows the car (distance within a lap growing, speed within the car's range); a driver that
-# fails is out with the engine's sentence (exit 1), as is one that never finishes; a file that is not there is a usage error.
+# fails is out with the engine's sentence (exit 1), as is one that never finishes; a file that is
+# not there, or a layout that does not load, is a usage error (exit 2).
 source "$(dirname "$0")/lib.sh"
 D="$SRC/tests/integration/drivers"
 
@@ -46,4 +47,8 @@ contains "it says so" "out after 0 laps: it did not finish its laps (DNF)" "$out
 out=$("$PITWALL" try "$TMP/missing.lua" 2>&1); rc=$?
 check "a file that is not there: exit status" 2 "$rc"
 contains "names it" "$TMP/missing.lua: no such file" "$out"
+
+out=$("$PITWALL" try "$D/good.lua" --track nosuch 2>&1); rc=$?
+check "a layout that does not load: exit status" 2 "$rc"
+contains "says what to give" "layout 'nosuch' is neither a named layout" "$out"
 finish
